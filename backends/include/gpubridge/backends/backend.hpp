@@ -1,0 +1,70 @@
+#pragma once
+// The one interface every device sits behind: the simulator (default, sigrok-`demo` style) and
+// real boards reached through USB-SPI bridges. The daemon, the CLI's `render` and the tests only
+// talk to this interface.
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "gpubridge/common/result.hpp"
+#include "gpubridge/protocol/frame.hpp"
+#include "gpubridge/protocol/registers.hpp"
+
+namespace gpubridge::backends {
+
+// One scanned-out frame (one per FB_DISPLAY swap), in the device's pixel format.
+struct ScanoutFrame {
+  std::uint32_t number = 0;  // full 32-bit frame counter (STATUS.FRAME_COUNT is its low 16 bits)
+  unsigned width = 0, height = 0;
+  protocol::PixelFormat format = protocol::PixelFormat::RGBA8888;
+  std::vector<std::uint8_t> pixels;  // width * height * bpp, rows top to bottom
+  std::uint32_t crc = 0;             // FRAME_CRC of these bytes
+  std::chrono::steady_clock::time_point swap_time{};
+};
+using ScanoutCallback = std::function<void(std::shared_ptr<const ScanoutFrame>)>;
+
+struct DeviceInfo {
+  std::string backend;  // "sim" or "board"
+  std::string board;    // profile name ("" for the plain simulator)
+  std::string bridge;   // bridge chip ("" for the simulator)
+  unsigned max_width = protocol::kMaxFramebufferDim;
+  unsigned max_height = protocol::kMaxFramebufferDim;
+  std::uint64_t vram_bytes = 0;
+  std::uint64_t id = 0;    // ID register
+  std::uint64_t caps = 0;  // CAPS register
+};
+
+// Error codes of backend results (Error::code).
+enum BackendError : int {
+  kDeviceGone = 100,      // unplugged / NO_DEVICE: caller may fall back to the simulator
+  kDeviceTimeout = 101,   // bridge or flow-control timeout; device state unknown
+  kDeviceProtocol = 102,  // bad response (not configured, stuck MISO, link CRC failure after retries)
+  kBadRequest = 103,      // caller error (address out of range, read frame in a write batch, ...)
+};
+
+class Backend {
+ public:
+  virtual ~Backend() = default;
+
+  virtual DeviceInfo info() const = 0;
+
+  // Register writes exactly as 9-byte wire frames (read bit must be 0). Executed in order.
+  virtual Result<void> write_frames(protocol::FrameView frames) = 0;
+  // Reads a register over the device's read path (immediate; see docs/protocol.md).
+  virtual Result<std::uint64_t> read_register(std::uint8_t index) = 0;
+  // Bulk memory access through MEM_ADDR/MEM_DATA (or an equivalent fast path with the same effect).
+  virtual Result<void> upload(std::uint32_t address, std::span<const std::uint8_t> bytes) = 0;
+  virtual Result<std::vector<std::uint8_t>> readback(std::uint32_t address, std::uint32_t length) = 0;
+  // Returns once every earlier command has executed.
+  virtual Result<void> flush() = 0;
+  // Soft reset (RESET register): registers, FIFO and flags to reset values; memory kept.
+  virtual Result<void> reset() = 0;
+  // Called for every scanned-out frame, on the thread that caused the swap.
+  virtual void set_scanout_callback(ScanoutCallback cb) = 0;
+};
+
+}  // namespace gpubridge::backends

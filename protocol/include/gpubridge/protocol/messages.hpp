@@ -1,0 +1,176 @@
+#pragma once
+// The gpubridge socket protocol v1 (docs/protocol.md, "Socket protocol"): typed messages, their
+// encoder, and an incremental parser that never does I/O. Every message is
+//   header (12 bytes, little-endian): magic 'G' 'B' | version u8 (=1) | type u8 | length u32 | request id u32
+//   payload (length bytes, at most the negotiated maximum, never more than kMaxPayload).
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <string_view>
+#include <variant>
+#include <vector>
+
+#include "gpubridge/protocol/frame.hpp"
+#include "gpubridge/protocol/registers.hpp"
+
+namespace gpubridge::protocol {
+
+inline constexpr std::uint8_t kMagic0 = 'G';
+inline constexpr std::uint8_t kMagic1 = 'B';
+inline constexpr std::uint8_t kSocketVersion = 1;
+inline constexpr std::size_t kHeaderBytes = 12;
+inline constexpr std::uint32_t kMaxPayload = 16u << 20;        // hard ceiling (16 MiB)
+inline constexpr std::uint32_t kMaxReadbackChunk = 64u << 10;  // READBACK_DATA payload data ≤ 64 KiB
+inline constexpr std::size_t kMaxNameBytes = 64;
+inline constexpr std::size_t kMaxTokenBytes = 128;
+
+enum class MsgType : std::uint8_t {
+  Hello = 0x01,         // c→s  u16 version, u8 name_len, name, u8 token_len, token
+  Welcome = 0x02,       // s→c  u16 version, u32 max_payload, u32 session_id, JSON device description
+  Error = 0x03,         // s→c  u16 code, u32 ref (request id it answers, 0 = none), UTF-8 text
+  Ping = 0x04,          // c→s  ≤ 64 opaque bytes
+  Pong = 0x05,          // s→c  the same bytes
+  Bye = 0x06,           // both: empty; the server answers Bye and closes
+  WriteFrames = 0x10,   // c→s  N × 9-byte device write frames, N ≥ 1 (lease required)
+  ReadReg = 0x11,       // c→s  u8 index
+  RegValue = 0x12,      // s→c  u8 index, u64 value
+  Upload = 0x13,        // c→s  u32 address, ≥ 1 data bytes (lease required)
+  UploadAck = 0x14,     // s→c  u32 address, u32 length applied
+  Readback = 0x15,      // c→s  u32 address, u32 length (1 .. 64 MiB) (lease required)
+  ReadbackData = 0x16,  // s→c  u32 address, u8 last (0/1), data (≤ 64 KiB)
+  Fence = 0x20,         // c→s  u64 id
+  FenceDone = 0x21,     // s→c  u64 id: every earlier command of this client has executed
+  StatusReq = 0x22,     // c→s  empty
+  StatusReply = 0x23,   // s→c  JSON
+  Subscribe = 0x30,     // c→s  u8 format (FrameFormat), u16 max_fps (0 = every frame)
+  Unsubscribe = 0x31,   // c→s  empty
+  FrameMsg = 0x32,      // s→c  u32 number, u16 width, u16 height, u8 format, u8 0, u32 crc, u64 swap_ns, pixels
+  LeaseAcquire = 0x40,  // c→s  u8 mode (LeaseMode)
+  LeaseGranted = 0x41,  // s→c  u32 session_id
+  LeaseRelease = 0x42,  // c→s  empty
+  LeaseReleased = 0x43, // s→c  empty
+  DeviceEvent = 0x50,   // s→c  JSON {"event": "...", ...}
+};
+std::string_view to_string(MsgType t);
+bool is_known_type(std::uint8_t t);
+
+// Stable error codes carried by Error messages (never renumbered).
+enum class ErrorCode : std::uint16_t {
+  BadMagic = 1,
+  BadVersion = 2,
+  UnknownType = 3,
+  TooLarge = 4,
+  Malformed = 5,
+  AuthFailed = 6,
+  NotHandshaken = 7,
+  Busy = 8,
+  NoLease = 9,
+  DeviceError = 10,
+  DeviceGone = 11,
+  Timeout = 12,
+  ServerFull = 13,
+  Range = 14,
+  ShuttingDown = 15,
+  Internal = 16,
+  BadFrame = 17,
+};
+std::string_view to_string(ErrorCode c);
+
+enum class FrameFormat : std::uint8_t { Native = 0, RGBA8888 = 1, RGB565 = 2, RGBA2222 = 3 };
+enum class LeaseMode : std::uint8_t { Wait = 0, FailIfBusy = 1 };
+
+struct Header {
+  std::uint8_t version = kSocketVersion;
+  MsgType type = MsgType::Ping;
+  std::uint32_t length = 0;
+  std::uint32_t request_id = 0;
+};
+
+// Typed payloads. Byte spans point into the parser's buffer and are valid until the next
+// call to MessageParser::next(); copy what you keep.
+struct Hello { std::uint16_t version = kSocketVersion; std::string name; std::string token; };
+struct Welcome { std::uint16_t version = kSocketVersion; std::uint32_t max_payload = kMaxPayload; std::uint32_t session_id = 0; std::string json; };
+struct ErrorMsg { ErrorCode code = ErrorCode::Internal; std::uint32_t ref = 0; std::string text; };
+struct Ping { std::vector<std::uint8_t> data; };
+struct Pong { std::vector<std::uint8_t> data; };
+struct Bye {};
+struct WriteFrames { FrameView frames; };
+struct ReadReg { std::uint8_t index = 0; };
+struct RegValue { std::uint8_t index = 0; std::uint64_t value = 0; };
+struct Upload { std::uint32_t address = 0; std::span<const std::uint8_t> data; };
+struct UploadAck { std::uint32_t address = 0; std::uint32_t length = 0; };
+struct Readback { std::uint32_t address = 0; std::uint32_t length = 0; };
+struct ReadbackData { std::uint32_t address = 0; bool last = false; std::span<const std::uint8_t> data; };
+struct FenceMsg { std::uint64_t id = 0; };
+struct FenceDone { std::uint64_t id = 0; };
+struct StatusReq {};
+struct StatusReply { std::string json; };
+struct Subscribe { FrameFormat format = FrameFormat::Native; std::uint16_t max_fps = 0; };
+struct Unsubscribe {};
+struct FrameData {
+  std::uint32_t number = 0;
+  std::uint16_t width = 0, height = 0;
+  PixelFormat format = PixelFormat::RGBA8888;
+  std::uint32_t crc = 0;
+  std::uint64_t swap_ns = 0;
+  std::span<const std::uint8_t> pixels;  // width * height * bpp(format)
+};
+struct LeaseAcquire { LeaseMode mode = LeaseMode::Wait; };
+struct LeaseGranted { std::uint32_t session_id = 0; };
+struct LeaseRelease {};
+struct LeaseReleased {};
+struct DeviceEvent { std::string json; };
+
+using Payload = std::variant<Hello, Welcome, ErrorMsg, Ping, Pong, Bye, WriteFrames, ReadReg, RegValue, Upload,
+                             UploadAck, Readback, ReadbackData, FenceMsg, FenceDone, StatusReq, StatusReply, Subscribe,
+                             Unsubscribe, FrameData, LeaseAcquire, LeaseGranted, LeaseRelease, LeaseReleased,
+                             DeviceEvent>;
+
+struct Message {
+  std::uint32_t request_id = 0;
+  Payload payload;
+};
+
+MsgType type_of(const Payload& p);
+
+// Appends the complete wire form (header + payload) of m to out.
+void encode(const Message& m, std::vector<std::uint8_t>& out);
+std::vector<std::uint8_t> encode(const Message& m);
+// Writes only the 12-byte header for a payload of `length` bytes (zero-copy senders).
+void encode_header(MsgType type, std::uint32_t length, std::uint32_t request_id, std::uint8_t* out12);
+
+// Decodes one payload whose header has already been validated.
+struct DecodeError {
+  ErrorCode code;
+  std::string message;  // what is wrong and where ("WRITE_FRAMES payload of 10 bytes is not a multiple of 9")
+};
+
+// Incremental parser: feed bytes as they arrive, then call next() until it returns NeedMore.
+// After an Error the parser is poisoned (the stream cannot be resynchronised) and keeps
+// returning the same error. The length field is checked against max_payload before any
+// allocation; the parser's buffer never exceeds max_payload + kHeaderBytes plus one feed() call.
+class MessageParser {
+ public:
+  enum class Status { Ok, NeedMore, Error };
+
+  explicit MessageParser(std::uint32_t max_payload = kMaxPayload);
+  void set_max_payload(std::uint32_t max_payload);
+  void feed(std::span<const std::uint8_t> bytes);
+  Status next(Message& out);
+  const DecodeError& error() const { return error_; }
+  // Bytes buffered but not yet returned as messages (for trickle/idle accounting).
+  std::size_t buffered() const { return buf_.size() - pos_; }
+  // Total stream offset of the first byte of the message being parsed (for error messages).
+  std::uint64_t stream_offset() const { return consumed_ + pos_; }
+
+ private:
+  std::vector<std::uint8_t> buf_;
+  std::size_t pos_ = 0;
+  std::uint64_t consumed_ = 0;
+  std::uint32_t max_payload_;
+  bool failed_ = false;
+  DecodeError error_{ErrorCode::Internal, {}};
+};
+
+}  // namespace gpubridge::protocol

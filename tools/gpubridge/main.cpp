@@ -1,0 +1,51 @@
+// gpubridge: the command-line tool (render, compare, traces, daemon client, board bring-up).
+#include <algorithm>
+#include <cstdio>
+#include <iostream>
+
+#include "command.hpp"
+#include "gpubridge/common/log.hpp"
+#include "gpubridge/version.hpp"
+
+namespace gpubridge::cli {
+std::vector<CommandSpec>& command_registry() {
+  static std::vector<CommandSpec> registry;
+  return registry;
+}
+}  // namespace gpubridge::cli
+
+int main(int argc, char** argv) {
+  using namespace gpubridge::cli;
+  CLI::App app{"gpubridge: drive spigpu FPGA GPUs and the gpubridge simulator"};
+  app.set_version_flag("--version", std::string("gpubridge ") + gpubridge::kVersion);
+  app.require_subcommand(1);
+  GlobalOptions global;
+  app.add_flag("--json", global.json, "machine-readable JSON output")->configurable();
+  app.add_option("--log-level", global.log_level, "trace|debug|info|warn|error|off")->capture_default_str();
+
+  auto& registry = command_registry();
+  std::sort(registry.begin(), registry.end(), [](const auto& a, const auto& b) { return a.order < b.order; });
+  std::vector<std::pair<CLI::App*, Runner>> runners;
+  for (auto& spec : registry) spec.setup(app, global, runners);
+  // Global options may also follow the subcommand (`gpubridge regs --json`).
+  for (auto* sub : app.get_subcommands([](CLI::App*) { return true; })) sub->fallthrough();
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 2;
+  }
+  gpubridge::init_logging(global.log_level);
+  for (auto& [sub, run] : runners) {
+    if (sub->parsed()) {
+      try {
+        return run();
+      } catch (const std::exception& e) {
+        std::fprintf(stderr, "gpubridge %s: %s\n", sub->get_name().c_str(), e.what());
+        return 1;
+      }
+    }
+  }
+  std::fprintf(stderr, "gpubridge: no command given; see gpubridge --help\n");
+  return 2;
+}
