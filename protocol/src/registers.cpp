@@ -108,7 +108,8 @@ constexpr Field kLinkCheck[] = {F("CRC", 0, 32, K::Unsigned, "host's CRC-32 of a
 constexpr Field kLinkStatus[] = {
     F("GROUPS_BAD", 48, 16, K::Unsigned, "LINK_CHECKs that failed, modulo 2^16"),
     F("GROUPS_OK", 32, 16, K::Unsigned, "LINK_CHECKs that matched, modulo 2^16"),
-    F("FRAMES", 0, 32, K::Unsigned, "complete frames received since the last LINK_CHECK or LINK_CTRL write"),
+    F("DISCARDING", 24, 1, K::Flag, "strict mode: a check failed; queued writes are dropped until LINK_CTRL is written"),
+    F("FRAMES", 0, 24, K::Unsigned, "complete frames received since the last LINK_CHECK or LINK_CTRL write"),
 };
 constexpr Field kHostTag[] = {F("TAG", 0, 64, K::Unsigned, "any value; 0 after reset (detects board resets)")};
 constexpr Field kReset[] = {F("MAGIC", 0, 40, K::Unsigned, "must be 0x5245534554 (\"RESET\")")};
