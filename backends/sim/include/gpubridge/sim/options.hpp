@@ -1,0 +1,69 @@
+#pragma once
+// Run-time options of the simulator: the device it models (memory size, limits, FIFO) and the
+// accuracy knobs. Knobs are simulator options, never part of the wire protocol; the defaults are
+// the exact hardware behaviour of docs/protocol.md.
+#include <cstdint>
+#include <span>
+#include <string>
+#include <string_view>
+
+#include "gpubridge/common/result.hpp"
+#include "gpubridge/protocol/registers.hpp"
+
+namespace gpubridge::sim {
+
+struct AccuracyKnobs {
+  unsigned recip_bits = 10;    // reciprocal table index bits b (section 10.1), 1..16
+  unsigned nr_steps = 1;       // Newton-Raphson steps k, 0..4
+  unsigned subpixel_bits = 4;  // honoured vertex subpixel bits, 0..4 (fewer: X/Y truncated toward -inf)
+  unsigned z_bits = 24;        // honoured depth bits, 1..24 (fewer: Z truncated before test and store)
+  bool fast = false;           // floating-point attribute evaluation (not bit-exact)
+
+  // True when every knob has its hardware value (the simulator is then the golden model).
+  bool exact() const {
+    return recip_bits == 10 && nr_steps == 1 && subpixel_bits == 4 && z_bits == 24 && !fast;
+  }
+  friend bool operator==(const AccuracyKnobs&, const AccuracyKnobs&) = default;
+};
+
+// Applies one "KNOB=VALUE" setting ("recip_bits=8", "fast=1"). Errors name the knob, the value
+// and the accepted range.
+Result<void> apply_knob(AccuracyKnobs& knobs, std::string_view setting);
+// Parses a list of settings starting from the defaults.
+Result<AccuracyKnobs> parse_knobs(std::span<const std::string> settings);
+// "recip_bits=10 nr_steps=1 subpixel_bits=4 z_bits=24 fast=0"
+std::string to_string(const AccuracyKnobs& knobs);
+
+// CAPS.FEATURES bits (docs/protocol.md, CAPS).
+enum Feature : std::uint8_t {
+  FEATURE_BILINEAR = 1u << 0,
+  FEATURE_BLEND = 1u << 1,
+  FEATURE_DITHER = 1u << 2,
+  FEATURE_STRICT_LINK = 1u << 3,
+  FEATURE_RGB565 = 1u << 4,
+  FEATURE_RGBA2222 = 1u << 5,
+};
+inline constexpr std::uint8_t kAllFeatures = 0x3F;
+
+inline constexpr std::uint64_t kMaxVramBytes = 1ull << 32;  // addresses are 32-bit
+inline constexpr unsigned kMaxThreads = 64;
+
+struct DeviceOptions {
+  std::uint64_t vram_bytes = 8u << 20;  // multiple of 1024, 64 KiB .. 4 GiB
+  unsigned max_width = protocol::kMaxFramebufferDim;   // CAPS.MAX_WIDTH, 1..1024
+  unsigned max_height = protocol::kMaxFramebufferDim;  // CAPS.MAX_HEIGHT, 1..1024
+  unsigned fifo_depth = 512;                           // CAPS.FIFO_DEPTH, 64..1023
+  std::uint16_t variant = 0;                           // ID.VARIANT (0 = simulator)
+  std::uint8_t features = kAllFeatures;                // CAPS.FEATURES
+  // 0 = untimed: queued writes execute as soon as they are released (the default).
+  // N > 0: each received frame lets at most N FIFO entries execute (a device slower than the
+  // link, for flow-control tests); Device::drain() executes the rest.
+  unsigned fifo_drain_per_frame = 0;
+  unsigned threads = 1;  // rasteriser worker threads (1 = no pool), 1..kMaxThreads
+  AccuracyKnobs accuracy;
+
+  // Empty when valid, otherwise what is wrong and the accepted range.
+  Result<void> validate() const;
+};
+
+}  // namespace gpubridge::sim
