@@ -1,0 +1,72 @@
+#pragma once
+// The host triangle pipeline: what the seeds' host CPUs do before the GPU sees a triangle.
+//
+//   window-homogeneous triangle (X, Y, Z, W, colour, u, v)
+//     → near-plane clip (Z >= 0), 0..2 triangles, Foenix style; far plane (Z <= W) optional
+//     → W >= min_w clip (only matters for matrices that are not perspective()/orthographic())
+//     → guard-band clip when a vertex lies outside the band (2D lines as homogeneous planes)
+//     → texture-precision subdivision (textured triangles only, see below)
+//     → perspective divide → snap/convert (convert_triangle) → back-face / zero-area cull
+//
+// Texture-precision subdivision: the device's texel-coordinate error is bounded (≤ 1/256 texel
+// for 1024-texel textures) only when, within a triangle, max W / min W ≤ 64 and the U and V
+// extents are ≤ 4 texture sizes. The pipeline splits every EDGE that violates the bound for its
+// two endpoints at its homogeneous midpoint (which halves the edge's U/V extent and pulls its W
+// ratio towards 1). Because a triangle's vertex pairs are exactly its edges, a triangle whose
+// edges all pass meets the bound; and because the decision and the midpoint depend only on the
+// edge's two endpoints, neighbouring triangles split a shared edge identically (no T-junctions).
+// Depth is limited (max_subdivision_depth); triangles still over the bound at the limit are
+// emitted anyway and counted in PipelineStats::precision_exceeded.
+#include <cstddef>
+#include <vector>
+
+#include "gpubridge/common/result.hpp"
+#include "gpubridge/geometry/clip.hpp"
+#include "gpubridge/geometry/convert.hpp"
+
+namespace gpubridge::geometry {
+
+enum class CullMode { None, Back, Front };
+// Which on-screen winding is the front face, as seen on the display (y down).
+enum class FrontFace { CounterClockwise, Clockwise };
+
+struct PipelineOptions {
+  CullMode cull = CullMode::None;
+  FrontFace front_face = FrontFace::CounterClockwise;
+  bool clip_far = true;            // also clip Z <= W (depth 1)
+  double min_w = 1e-6;             // W below this is clipped away (protects 1/W)
+  GuardBand guard_band{};
+  bool textured = false;           // enables S/T (TEXCOORD) and precision subdivision
+  TexAddressing tex{};
+  bool subdivide = true;           // texture-precision subdivision (textured only)
+  double max_w_ratio = 64.0;       // bound on max W / min W per triangle
+  double max_uv_extent = 4.0;      // bound on the U and V extent per triangle (texture sizes)
+  unsigned max_subdivision_depth = 6;  // at most 4^depth triangles per clipped triangle
+};
+
+struct PipelineStats {
+  std::size_t input = 0;               // triangles given to the pipeline
+  std::size_t clipped_away = 0;        // entirely outside the near/far/guard planes
+  std::size_t clipped = 0;             // triangles that needed clipping and kept some area
+  std::size_t subdivided = 0;          // triangles split for texture precision
+  std::size_t precision_exceeded = 0;  // emitted although over the precision bound (depth limit)
+  std::size_t culled = 0;              // back/front-facing or zero area after snapping
+  std::size_t emitted = 0;             // device triangles produced
+};
+
+// Signed area ×2 of the snapped triangle in 12.4 units, y down: negative = counter-clockwise
+// on screen.
+std::int64_t signed_area2(const DeviceTriangle& t);
+
+// Runs one window-homogeneous triangle through the pipeline, appending device triangles.
+// Errors: non-finite input (NaN/Inf in any position, colour or texture coordinate), or a texture
+// coordinate range that S/T cannot hold even after subdivision.
+Result<void> process_triangle(const Triangle& tri, const PipelineOptions& opt, std::vector<DeviceTriangle>& out,
+                              PipelineStats* stats = nullptr);
+
+// Window-homogeneous vertex from a screen-space vertex: (x·w, y·w, z·w, w).
+Vertex from_screen(const ScreenVertex& v);
+// Perspective divide (W must be > 0).
+ScreenVertex to_screen(const Vertex& v);
+
+}  // namespace gpubridge::geometry

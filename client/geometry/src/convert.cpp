@@ -1,0 +1,102 @@
+#include "gpubridge/geometry/convert.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+
+namespace gpubridge::geometry {
+namespace {
+
+Error not_finite(std::string_view what, double v) {
+  return make_error(fmt::format("{}: {} is not allowed (values must be finite numbers)", what,
+                                std::isnan(v) ? "NaN" : (v > 0 ? "+Inf" : "-Inf")));
+}
+
+}  // namespace
+
+Result<std::int16_t> snap_12_4(double x, std::string_view what) {
+  if (!std::isfinite(x)) return not_finite(what, x);
+  const double s = std::floor(16.0 * x + 0.5);
+  if (s < -32768.0 || s > 32767.0)
+    return make_error(fmt::format("{}: {} px is outside the 12.4 register range [-2048, 2047.9375]", what, x));
+  return static_cast<std::int16_t>(s);
+}
+
+Result<std::uint32_t> depth_to_z24(double z) {
+  if (!std::isfinite(z)) return not_finite("z", z);
+  if (z < -1e-9) return make_error(fmt::format("z: {} is below 0 (depth must be in [0, 1])", z));
+  const double s = std::floor(std::clamp(z, 0.0, 1.0) * 16777215.0 + 0.5);
+  return static_cast<std::uint32_t>(std::min(s, 16777215.0));
+}
+
+Result<std::uint8_t> unit_to_u8(double c, std::string_view what) {
+  if (!std::isfinite(c)) return not_finite(what, c);
+  return static_cast<std::uint8_t>(std::clamp(std::round(c * 255.0), 0.0, 255.0));
+}
+
+Result<std::uint32_t> color_to_rgba8(Vec4 c) {
+  const double ch[4] = {c.x, c.y, c.z, c.w};
+  static constexpr std::string_view names[4] = {"r", "g", "b", "a"};
+  std::uint32_t out = 0;
+  for (int i = 0; i < 4; ++i) {
+    auto v = unit_to_u8(ch[i], names[i]);
+    if (!v) return v.error();
+    out = (out << 8) | *v;
+  }
+  return out;
+}
+
+double texture_offset(double min_coord, protocol::Wrap wrap) {
+  switch (wrap) {
+    case protocol::Wrap::Repeat: return std::floor(min_coord);
+    case protocol::Wrap::Mirror: return 2.0 * std::floor(min_coord / 2.0);
+    default: return 0.0;
+  }
+}
+
+Result<DeviceTriangle> convert_triangle(const std::array<ScreenVertex, 3>& tri, const TexAddressing& tex) {
+  DeviceTriangle out;
+  static constexpr std::string_view vnames[3] = {"vertex 0", "vertex 1", "vertex 2"};
+  double qmax = 0;
+  std::array<double, 3> q{};
+  for (int i = 0; i < 3; ++i) {
+    const auto& v = tri[i];
+    for (double a : {v.w, v.uv.x, v.uv.y})
+      if (!std::isfinite(a)) return not_finite(fmt::format("{}: w/u/v", vnames[i]), a);
+    if (!(v.w > 0)) return make_error(fmt::format("{}: w = {} must be > 0 (clip against the near plane first)", vnames[i], v.w));
+    auto x = snap_12_4(v.x, fmt::format("{}: x", vnames[i]));
+    if (!x) return x.error();
+    auto y = snap_12_4(v.y, fmt::format("{}: y", vnames[i]));
+    if (!y) return y.error();
+    auto z = depth_to_z24(v.z);
+    if (!z) return make_error(fmt::format("{}: {}", vnames[i], z.error().message));
+    auto c = color_to_rgba8(v.color);
+    if (!c) return make_error(fmt::format("{}: {}", vnames[i], c.error().message));
+    out[i].x = *x;
+    out[i].y = *y;
+    out[i].z = *z;
+    out[i].rgba = *c;
+    q[i] = 1.0 / v.w;
+    if (!std::isfinite(q[i])) return make_error(fmt::format("{}: w = {} is too small (1/w overflows)", vnames[i], v.w));
+    qmax = std::max(qmax, q[i]);
+  }
+  const double u_off = texture_offset(std::min({tri[0].uv.x, tri[1].uv.x, tri[2].uv.x}), tex.wrap_s);
+  const double v_off = texture_offset(std::min({tri[0].uv.y, tri[1].uv.y, tri[2].uv.y}), tex.wrap_t);
+  for (int i = 0; i < 3; ++i) {
+    const double qn = std::round(q[i] / qmax * 4294967295.0);  // q[i] <= qmax: at most 2^32 - 1
+    out[i].q = static_cast<std::uint32_t>(qn);
+    const double du = tri[i].uv.x - u_off, dv = tri[i].uv.y - v_off;
+    if (!(std::fabs(du) < kMaxTexOffset) || !(std::fabs(dv) < kMaxTexOffset))
+      return make_error(fmt::format(
+          "{}: texture coordinate ({}, {}) is {} or more texture sizes from the triangle's offset ({}, {}); "
+          "S/T (signed 8.24) cannot hold it — subdivide the triangle or use REPEAT/MIRROR wrapping",
+          vnames[i], tri[i].uv.x, tri[i].uv.y, kMaxTexOffset, u_off, v_off));
+    // |du| < 128 and qn < 2^32: |du · qn / 256| < 2^31, so the rounded value fits in int32.
+    out[i].s = static_cast<std::int32_t>(std::clamp(std::round(du * qn / 256.0), -2147483648.0, 2147483647.0));
+    out[i].t = static_cast<std::int32_t>(std::clamp(std::round(dv * qn / 256.0), -2147483648.0, 2147483647.0));
+  }
+  return out;
+}
+
+}  // namespace gpubridge::geometry

@@ -1,0 +1,172 @@
+#include "gpubridge/geometry/pipeline.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+
+namespace gpubridge::geometry {
+namespace {
+
+bool finite(const Vertex& v) {
+  for (double a : {v.pos.x, v.pos.y, v.pos.z, v.pos.w, v.color.x, v.color.y, v.color.z, v.color.w, v.uv.x, v.uv.y})
+    if (!std::isfinite(a)) return false;
+  return true;
+}
+
+// Whether edge a-b needs splitting for texture precision. Depends only on the two endpoints
+// (and symmetrically on them), so both triangles sharing the edge decide the same.
+bool edge_over_bound(const Vertex& a, const Vertex& b, const PipelineOptions& opt) {
+  const double wmin = std::min(a.pos.w, b.pos.w), wmax = std::max(a.pos.w, b.pos.w);
+  if (wmax > opt.max_w_ratio * wmin) return true;
+  return std::fabs(a.uv.x - b.uv.x) > opt.max_uv_extent || std::fabs(a.uv.y - b.uv.y) > opt.max_uv_extent;
+}
+
+// Homogeneous midpoint, computed as a symmetric function of the endpoints.
+Vertex midpoint(const Vertex& a, const Vertex& b) {
+  return Vertex{(a.pos + b.pos) * 0.5, (a.color + b.color) * 0.5, (a.uv + b.uv) * 0.5};
+}
+
+class Emitter {
+ public:
+  Emitter(const PipelineOptions& opt, std::vector<DeviceTriangle>& out, PipelineStats& st)
+      : opt_(opt), out_(out), st_(st) {}
+
+  Result<void> subdivide(const Triangle& t, unsigned depth) {
+    if (!opt_.textured || !opt_.subdivide) return emit(t);
+    const bool split[3] = {edge_over_bound(t[0], t[1], opt_), edge_over_bound(t[1], t[2], opt_),
+                           edge_over_bound(t[2], t[0], opt_)};
+    const int n = split[0] + split[1] + split[2];
+    if (n == 0) return emit(t);
+    if (depth >= opt_.max_subdivision_depth) {
+      ++st_.precision_exceeded;
+      return emit(t);
+    }
+    ++st_.subdivided;
+    // Rotate so the first split edge is edge 0 (t0-t1); keeps the winding.
+    int r = split[0] ? 0 : split[1] ? 1 : 2;
+    const Vertex& a = t[r];
+    const Vertex& b = t[(r + 1) % 3];
+    const Vertex& c = t[(r + 2) % 3];
+    const bool sbc = split[(r + 1) % 3], sca = split[(r + 2) % 3];
+    const Vertex mab = midpoint(a, b);
+    std::array<Triangle, 4> parts;
+    int count = 0;
+    if (sbc && sca) {
+      const Vertex mbc = midpoint(b, c), mca = midpoint(c, a);
+      parts = {Triangle{a, mab, mca}, Triangle{mab, b, mbc}, Triangle{mca, mbc, c}, Triangle{mab, mbc, mca}};
+      count = 4;
+    } else if (sbc) {
+      const Vertex mbc = midpoint(b, c);
+      parts[0] = {a, mab, c};
+      parts[1] = {mab, b, mbc};
+      parts[2] = {mab, mbc, c};
+      count = 3;
+    } else if (sca) {
+      const Vertex mca = midpoint(c, a);
+      parts[0] = {a, mab, mca};
+      parts[1] = {mab, b, c};
+      parts[2] = {mab, c, mca};
+      count = 3;
+    } else {
+      parts[0] = {a, mab, c};
+      parts[1] = {mab, b, c};
+      count = 2;
+    }
+    for (int i = 0; i < count; ++i)
+      if (auto r2 = subdivide(parts[i], depth + 1); !r2) return r2;
+    return {};
+  }
+
+ private:
+  Result<void> emit(const Triangle& t) {
+    const std::array<ScreenVertex, 3> s{to_screen(t[0]), to_screen(t[1]), to_screen(t[2])};
+    auto dev = convert_triangle(s, opt_.tex);
+    if (!dev) return dev.error();
+    const std::int64_t area = signed_area2(*dev);
+    if (area == 0) {
+      ++st_.culled;
+      return {};
+    }
+    if (opt_.cull != CullMode::None) {
+      const bool ccw = area < 0;
+      const bool front = (opt_.front_face == FrontFace::CounterClockwise) == ccw;
+      if ((opt_.cull == CullMode::Back && !front) || (opt_.cull == CullMode::Front && front)) {
+        ++st_.culled;
+        return {};
+      }
+    }
+    out_.push_back(*dev);
+    ++st_.emitted;
+    return {};
+  }
+
+  const PipelineOptions& opt_;
+  std::vector<DeviceTriangle>& out_;
+  PipelineStats& st_;
+};
+
+}  // namespace
+
+std::int64_t signed_area2(const DeviceTriangle& t) {
+  const std::int64_t x0 = t[0].x, y0 = t[0].y, x1 = t[1].x, y1 = t[1].y, x2 = t[2].x, y2 = t[2].y;
+  return (x1 - x0) * (y2 - y0) - (x2 - x0) * (y1 - y0);
+}
+
+Vertex from_screen(const ScreenVertex& v) {
+  return Vertex{Vec4{v.x * v.w, v.y * v.w, v.z * v.w, v.w}, v.color, v.uv};
+}
+
+ScreenVertex to_screen(const Vertex& v) {
+  const double inv = 1.0 / v.pos.w;
+  return ScreenVertex{v.pos.x * inv, v.pos.y * inv, v.pos.z * inv, v.pos.w, v.color, v.uv};
+}
+
+Result<void> process_triangle(const Triangle& tri, const PipelineOptions& opt, std::vector<DeviceTriangle>& out,
+                              PipelineStats* stats) {
+  PipelineStats local;
+  PipelineStats& st = stats ? *stats : local;
+  ++st.input;
+  for (int i = 0; i < 3; ++i)
+    if (!finite(tri[i]))
+      return make_error(fmt::format("vertex {}: NaN or Inf in position, colour or texture coordinate "
+                                    "(every value must be a finite number)", i));
+
+  // Planes in the order the seeds' pipeline applies them: the near plane first (Foenix), then
+  // the ones that only matter for unusual input.
+  Polygon poly = polygon_from(tri);
+  bool clipped = false;
+  auto clip = [&](Vec4 plane, double offset = 0.0) {
+    const std::size_t before = poly.count;
+    Polygon next = clip_polygon(poly, plane, offset);
+    bool changed = next.count != before;
+    for (std::size_t i = 0; !changed && i < next.count; ++i) changed = !(next.v[i] == poly.v[i]);
+    clipped |= changed;
+    poly = next;
+  };
+  clip(kNearPlane);
+  if (opt.clip_far && poly.count) clip(kFarPlane);
+  if (poly.count) clip(Vec4{0, 0, 0, 1}, -opt.min_w);  // W - min_w >= 0
+  if (poly.count) {
+    bool inside = true;
+    for (std::size_t i = 0; i < poly.count && inside; ++i) {
+      const double x = poly.v[i].pos.x / poly.v[i].pos.w, y = poly.v[i].pos.y / poly.v[i].pos.w;
+      inside = x >= opt.guard_band.min && x <= opt.guard_band.max && y >= opt.guard_band.min && y <= opt.guard_band.max;
+    }
+    if (!inside)
+      for (const Vec4& plane : guard_band_planes(opt.guard_band))
+        if (poly.count) clip(plane);
+  }
+  if (poly.count == 0) {
+    ++st.clipped_away;
+    return {};
+  }
+  if (clipped) ++st.clipped;
+
+  Emitter emitter(opt, out, st);
+  for (std::size_t i = 1; i + 1 < poly.count; ++i)
+    if (auto r = emitter.subdivide(Triangle{poly.v[0], poly.v[i], poly.v[i + 1]}, 0); !r) return r;
+  return {};
+}
+
+}  // namespace gpubridge::geometry
