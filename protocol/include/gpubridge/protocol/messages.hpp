@@ -5,6 +5,7 @@
 //   payload (length bytes, at most the negotiated maximum, never more than kMaxPayload).
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -88,7 +89,7 @@ struct Header {
 };
 
 // Typed payloads. Byte spans point into the parser's buffer and are valid until the next
-// call to MessageParser::next(); copy what you keep.
+// call to MessageParser::next() or feed(); copy what you keep.
 struct Hello { std::uint16_t version = kSocketVersion; std::string name; std::string token; };
 struct Welcome { std::uint16_t version = kSocketVersion; std::uint32_t max_payload = kMaxPayload; std::uint32_t session_id = 0; std::string json; };
 struct ErrorMsg { ErrorCode code = ErrorCode::Internal; std::uint32_t ref = 0; std::string text; };
@@ -145,6 +146,19 @@ struct DecodeError {
   ErrorCode code;
   std::string message;  // what is wrong and where ("WRITE_FRAMES payload of 10 bytes is not a multiple of 9")
 };
+
+// Empty when `text` is a valid UTF-8 JSON object nested at most kMaxJsonDepth deep; otherwise
+// what is wrong. Used for every JSON payload and for trace metadata.
+inline constexpr unsigned kMaxJsonDepth = 64;
+std::string json_object_problem(std::string_view text);
+
+// The two halves of parsing, usable on their own (the binary trace reader uses them).
+// decode_header checks magic, version, type and length (against max_payload) in that order.
+std::optional<DecodeError> decode_header(std::span<const std::uint8_t, kHeaderBytes> bytes, std::uint32_t max_payload,
+                                         Header& out);
+// Decodes a payload whose header passed decode_header. Spans in `out` point into `payload`.
+// Messages name the field and its payload byte offset; the caller adds the stream position.
+std::optional<DecodeError> decode_payload(const Header& h, std::span<const std::uint8_t> payload, Message& out);
 
 // Incremental parser: feed bytes as they arrive, then call next() until it returns NeedMore.
 // After an Error the parser is poisoned (the stream cannot be resynchronised) and keeps
