@@ -17,7 +17,11 @@ Error not_finite(std::string_view what, double v) {
 
 Result<std::int16_t> snap_12_4(double x, std::string_view what) {
   if (!std::isfinite(x)) return not_finite(what, x);
-  const double s = std::floor(16.0 * x + 0.5);
+  // floor(16x + 0.5) evaluated exactly: 16x is exact (power of two), and so is its fractional
+  // part, whereas adding 0.5 first could round values just below a tie up to it.
+  const double sixteen_x = 16.0 * x;
+  const double whole = std::floor(sixteen_x);
+  const double s = whole + (sixteen_x - whole >= 0.5 ? 1.0 : 0.0);
   if (s < -32768.0 || s > 32767.0)
     return make_error(fmt::format("{}: {} px is outside the 12.4 register range [-2048, 2047.9375]", what, x));
   return static_cast<std::int16_t>(s);
@@ -26,6 +30,8 @@ Result<std::int16_t> snap_12_4(double x, std::string_view what) {
 Result<std::uint32_t> depth_to_z24(double z) {
   if (!std::isfinite(z)) return not_finite("z", z);
   if (z < -1e-9) return make_error(fmt::format("z: {} is below 0 (depth must be in [0, 1])", z));
+  // z·16777215 is not exact in double; the product's error (≤ 2^-29) only matters within that
+  // distance of a tie, where either neighbour is within the documented ±0.5 LSB bound.
   const double s = std::floor(std::clamp(z, 0.0, 1.0) * 16777215.0 + 0.5);
   return static_cast<std::uint32_t>(std::min(s, 16777215.0));
 }

@@ -80,7 +80,9 @@ class Emitter {
 
  private:
   Result<void> emit(const Triangle& t) {
-    const std::array<ScreenVertex, 3> s{to_screen(t[0]), to_screen(t[1]), to_screen(t[2])};
+    std::array<ScreenVertex, 3> s{to_screen(t[0]), to_screen(t[1]), to_screen(t[2])};
+    if (!opt_.textured)
+      for (auto& v : s) v.uv = {};  // S/T are not sent: their range must not limit untextured draws
     auto dev = convert_triangle(s, opt_.tex);
     if (!dev) return dev.error();
     const std::int64_t area = signed_area2(*dev);

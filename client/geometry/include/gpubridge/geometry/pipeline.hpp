@@ -8,14 +8,16 @@
 //     → texture-precision subdivision (textured triangles only, see below)
 //     → perspective divide → snap/convert (convert_triangle) → back-face / zero-area cull
 //
-// Texture-precision subdivision: the device's texel-coordinate error is bounded (≤ 1/256 texel
-// for 1024-texel textures) only when, within a triangle, max W / min W ≤ 64 and the U and V
-// extents are ≤ 4 texture sizes. The pipeline splits every EDGE that violates the bound for its
-// two endpoints at its homogeneous midpoint (which halves the edge's U/V extent and pulls its W
-// ratio towards 1). Because a triangle's vertex pairs are exactly its edges, a triangle whose
-// edges all pass meets the bound; and because the decision and the midpoint depend only on the
-// edge's two endpoints, neighbouring triangles split a shared edge identically (no T-junctions).
-// Depth is limited (max_subdivision_depth); triangles still over the bound at the limit are
+// Texture-precision subdivision: the device's texel-coordinate error is ≤ 1/256 texel for
+// 1024-texel textures (docs/protocol.md section 15) when, within a triangle, max W / min W ≤ 32
+// and |u − u_off|, |v − v_off| ≤ 4 texture sizes. The pipeline splits every EDGE whose two
+// endpoints violate the bound (W ratio > max_w_ratio, or U or V differing by more than
+// max_uv_extent = 3, which keeps |u − floor(min u)| < 4) at its homogeneous midpoint; that
+// halves the edge's U/V extent and pulls its W ratio towards 1. A triangle's vertex pairs are
+// exactly its edges, so a triangle whose edges all pass meets the bound; and because the
+// decision and the midpoint depend only on the edge's two endpoints, neighbouring triangles split
+// a shared edge identically (no T-junctions). Depth is limited (max_subdivision_depth); triangles
+// still over the bound at the limit are
 // emitted anyway and counted in PipelineStats::precision_exceeded.
 #include <cstddef>
 #include <vector>
@@ -39,8 +41,8 @@ struct PipelineOptions {
   bool textured = false;           // enables S/T (TEXCOORD) and precision subdivision
   TexAddressing tex{};
   bool subdivide = true;           // texture-precision subdivision (textured only)
-  double max_w_ratio = 64.0;       // bound on max W / min W per triangle
-  double max_uv_extent = 4.0;      // bound on the U and V extent per triangle (texture sizes)
+  double max_w_ratio = 32.0;       // bound on max W / min W per triangle (docs section 15)
+  double max_uv_extent = 3.0;      // bound on max−min of U and of V: keeps |u − u_off| < 4
   unsigned max_subdivision_depth = 6;  // at most 4^depth triangles per clipped triangle
 };
 
