@@ -103,6 +103,12 @@ std::string hex(std::uint64_t v) {
   return buf;
 }
 
+std::string raw_index(std::uint8_t index) {
+  char buf[8];
+  std::snprintf(buf, sizeof buf, "0x%02X", index);
+  return buf;
+}
+
 // Value of one field from its text; `shown` is "FIELD=value" for messages.
 std::optional<std::string> parse_field_value(const Field& f, std::string_view v, const std::string& shown,
                                              std::uint64_t& bits) {
@@ -199,8 +205,8 @@ std::optional<LineError> parse_named(const RegisterDesc& r, std::span<const Toke
     const auto check = check_write(r.index, *n);
     if (check.errors != 0)
       return LineError{v.column, "value " + hex(*n) + " is not valid for " + name + " (" + check.problem +
-                                     "); set fields by name, or use the raw form 0x" +
-                                     hex(r.index).substr(2) + " " + hex(*n) + " to send it anyway"};
+                                     "); set fields by name, or use the raw form " + raw_index(r.index) + " " + hex(*n) +
+                                     " to send it anyway"};
     out.data = *n;
     return std::nullopt;
   }

@@ -45,7 +45,8 @@ Result<Frame> parse_register_line(std::string_view line);
 // Whitespace-separated hex bytes ("0a 1B ff", optional 0x prefixes) as used by hex asset files.
 Result<std::vector<std::uint8_t>> parse_hex_bytes(std::string_view text);
 
-// Exact decimal form of a fixed-point field value: raw / 2^frac_bits ("-3.5", "0.0625").
+// Exact decimal form of a fixed-point field value: raw / 2^frac_bits ("-3.5", "0.0625");
+// frac_bits ≤ 32 (the widest fraction in the register table).
 std::string format_fixed(std::int64_t raw, unsigned frac_bits);
 
 }  // namespace gpubridge::protocol
