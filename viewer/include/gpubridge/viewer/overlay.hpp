@@ -1,0 +1,40 @@
+#pragma once
+// What the overlay and the window title say. Pure functions of the viewer's state so that the
+// wording is tested without a window.
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "gpubridge/viewer/frame_source.hpp"
+#include "gpubridge/viewer/layout.hpp"
+
+namespace gpubridge::viewer {
+
+struct ShownFrame {  // the frame on screen (metadata only)
+  std::uint32_t number = 0;
+  unsigned width = 0, height = 0;
+  protocol::PixelFormat format = protocol::PixelFormat::RGBA8888;
+  bool crc_ok = true;
+};
+
+struct ViewState {
+  SourceStatus status;
+  std::optional<ShownFrame> frame;
+  double fps_received = 0, fps_drawn = 0;
+  std::optional<double> latency_ms;  // swap -> on screen, when known
+  std::uint64_t dropped = 0, rejected = 0;
+  std::string last_rejection;
+  ScaleMode scale = ScaleMode::Fit;
+  bool flipped = false, paused = false;
+  std::string notice;  // last user-facing event ("saved gpubridge-000042.png")
+};
+
+// "waiting for gpubridged at unix:/run/... (connection refused)" and similar; empty while streaming.
+std::string status_line(const SourceStatus& s);
+std::vector<std::string> overlay_lines(const ViewState& v);
+std::vector<std::string> help_lines();
+// "gpubridge-view - unix:/run/x.sock - sim/ulx3s - 640x480 RGBA8888 [paused]"
+std::string window_title(const ViewState& v);
+
+}  // namespace gpubridge::viewer

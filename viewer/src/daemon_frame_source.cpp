@@ -1,0 +1,130 @@
+#include "gpubridge/viewer/daemon_frame_source.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include "gpubridge/client/address.hpp"
+#include "gpubridge/client/client.hpp"
+#include "gpubridge/common/log.hpp"
+
+namespace gpubridge::viewer {
+namespace {
+
+using namespace std::chrono_literals;
+constexpr auto kConnectTimeout = 2000ms;
+constexpr auto kHandshakeTimeout = 5000ms;
+constexpr auto kRetryDelay = 500ms;
+constexpr auto kPollInterval = 200ms;  // how often the reader checks for stop
+
+Frame to_viewer_frame(client::ReceivedFrame&& f) {
+  Frame out;
+  out.number = f.number;
+  out.width = f.width;
+  out.height = f.height;
+  out.format = f.format;
+  out.crc = f.crc;
+  out.swap_ns = f.swap_ns;
+  out.pixels = std::move(f.pixels);
+  return out;
+}
+
+bool is_auth_failure(const Error& e) { return client::is_protocol_error(e, protocol::ErrorCode::AuthFailed); }
+
+}  // namespace
+
+std::pair<std::string, std::string> backend_and_board(const std::string& device_json) {
+  const auto j = nlohmann::json::parse(device_json, nullptr, false);
+  if (j.is_discarded() || !j.is_object()) return {"?", ""};
+  const auto text = [&](const char* key) {
+    const auto it = j.find(key);
+    return it != j.end() && it->is_string() ? it->get<std::string>() : std::string();
+  };
+  return {text("backend"), text("board")};
+}
+
+DaemonFrameSource::DaemonFrameSource(DaemonSourceConfig config) : config_(std::move(config)) {
+  auto parsed = client::parse_address(config_.address);
+  display_address_ = parsed ? parsed->to_string() : config_.address;
+}
+
+void DaemonFrameSource::run(std::stop_token stop) {
+  auto log = logger("viewer");
+  SourceStatus status;
+  status.address = display_address_;
+  status.state = SourceStatus::State::Connecting;
+  publish_status(status);
+  const auto fail = [&](std::string message) {
+    status.state = SourceStatus::State::Failed;
+    status.message = std::move(message);
+    publish_status(status);
+  };
+  if (auto parsed = client::parse_address(config_.address); !parsed) {
+    fail(parsed.error().message);
+    return;
+  }
+
+  bool ever_connected = false;
+  while (!stop.stop_requested()) {
+    auto connection = client::Client::connect(config_.address, kConnectTimeout);
+    if (!connection) {
+      if (!ever_connected && !config_.wait_at_start) {
+        fail(connection.error().message + "; is gpubridged running? (--wait keeps trying)");
+        return;
+      }
+      if (status.state != SourceStatus::State::Waiting || status.message != connection.error().message) {
+        status.state = SourceStatus::State::Waiting;
+        status.message = connection.error().message;
+        publish_status(status);
+      }
+      if (!sleep_for(stop, kRetryDelay)) return;
+      continue;
+    }
+    client::Client& c = *connection;
+    auto session = c.handshake("gpubridge-view", config_.token, kHandshakeTimeout);
+    if (!session) {
+      if (is_auth_failure(session.error())) {
+        fail("token refused: " + session.error().message + " (pass the daemon's token with --token)");
+        return;
+      }
+      status.state = SourceStatus::State::Waiting;
+      status.message = session.error().message;
+      publish_status(status);
+      if (!sleep_for(stop, kRetryDelay)) return;
+      continue;
+    }
+    std::tie(status.backend, status.board) = backend_and_board(session->device_json);
+    const auto max_fps = static_cast<std::uint16_t>(std::min(config_.max_fps, 65535u));
+    if (auto sub = c.subscribe(protocol::FrameFormat::Native, max_fps, kHandshakeTimeout); !sub) {
+      status.state = SourceStatus::State::Waiting;
+      status.message = "subscribe failed: " + sub.error().message;
+      publish_status(status);
+      if (!sleep_for(stop, kRetryDelay)) return;
+      continue;
+    }
+    ever_connected = true;
+    status.state = SourceStatus::State::Streaming;
+    status.message.clear();
+    publish_status(status);
+    log->info("subscribed to {} (max {} fps)", display_address_, max_fps);
+
+    while (!stop.stop_requested()) {
+      auto frame = c.next_frame(kPollInterval);
+      if (frame) {
+        publish_frame(to_viewer_frame(std::move(*frame)));
+        continue;
+      }
+      if (frame.error().code == client::kTimeoutError) continue;
+      log->info("connection to {} lost: {}", display_address_, frame.error().message);
+      status.state = SourceStatus::State::Waiting;
+      status.message = frame.error().message;
+      publish_status(status);
+      break;
+    }
+    if (stop.stop_requested()) {
+      c.close();
+      return;
+    }
+    if (!sleep_for(stop, kRetryDelay)) return;
+  }
+}
+
+}  // namespace gpubridge::viewer

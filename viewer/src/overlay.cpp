@@ -1,0 +1,77 @@
+#include "gpubridge/viewer/overlay.hpp"
+
+#include <fmt/format.h>
+
+namespace gpubridge::viewer {
+namespace {
+
+std::string device_name(const SourceStatus& s) {
+  if (s.backend.empty()) return "?";
+  return s.board.empty() ? s.backend : s.backend + "/" + s.board;
+}
+
+}  // namespace
+
+std::string status_line(const SourceStatus& s) {
+  using State = SourceStatus::State;
+  const std::string why = s.message.empty() ? "" : " (" + s.message + ")";
+  switch (s.state) {
+    case State::Connecting: return "connecting to gpubridged at " + s.address + "...";
+    case State::Streaming: return {};
+    case State::Waiting: return "waiting for gpubridged at " + s.address + why;
+    case State::Failed: return "cannot show frames from " + s.address + why;
+    case State::Finished: return "frame source at " + s.address + " finished";
+  }
+  return {};
+}
+
+std::vector<std::string> overlay_lines(const ViewState& v) {
+  std::vector<std::string> lines;
+  lines.push_back(fmt::format("{}  {}", v.status.address, device_name(v.status)));
+  if (auto s = status_line(v.status); !s.empty()) lines.push_back(std::move(s));
+  if (v.frame) {
+    lines.push_back(fmt::format("frame {}  {}x{} {}{}", v.frame->number, v.frame->width, v.frame->height,
+                                protocol::to_string(v.frame->format), v.frame->crc_ok ? "" : "  CRC MISMATCH"));
+  } else {
+    lines.push_back("no frame yet");
+  }
+  lines.push_back(fmt::format("fps received {:.1f}  drawn {:.1f}  dropped {}", v.fps_received, v.fps_drawn,
+                              v.dropped));
+  lines.push_back(v.latency_ms ? fmt::format("latency swap->display {:.1f} ms", *v.latency_ms)
+                               : std::string("latency swap->display n/a"));
+  std::string mode = "scale " + to_string(v.scale);
+  if (v.flipped) mode += "  flipped";
+  if (v.paused) mode += "  PAUSED";
+  lines.push_back(std::move(mode));
+  if (v.rejected) lines.push_back(fmt::format("{} frames refused: {}", v.rejected, v.last_rejection));
+  if (!v.notice.empty()) lines.push_back(v.notice);
+  lines.push_back("? help");
+  return lines;
+}
+
+std::vector<std::string> help_lines() {
+  return {
+      "gpubridge-view keys",
+      "  S      save the frame's pixels as PNG",
+      "  F      flip vertically",
+      "  I      integer scaling on/off",
+      "  1 2 3  zoom 1:1 2:1 3:1 (again: fit)",
+      "  P      pause / resume",
+      "  O      overlay on/off",
+      "  ?      this help",
+      "  Q Esc  quit",
+  };
+}
+
+std::string window_title(const ViewState& v) {
+  std::string title = "gpubridge-view - " + v.status.address + " - " + device_name(v.status);
+  if (v.frame) {
+    title += fmt::format(" - {}x{} {}", v.frame->width, v.frame->height, protocol::to_string(v.frame->format));
+  }
+  if (v.status.state == SourceStatus::State::Waiting) title += " [waiting]";
+  if (v.status.state == SourceStatus::State::Failed) title += " [failed]";
+  if (v.paused) title += " [paused]";
+  return title;
+}
+
+}  // namespace gpubridge::viewer
