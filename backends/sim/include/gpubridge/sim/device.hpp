@@ -75,6 +75,9 @@ class Device final : public backends::SpiTarget {
   std::uint64_t read(std::uint8_t index);
   // Executes every released FIFO entry (no-op in untimed mode, where nothing waits).
   void drain();
+  // Executes at most n released FIFO entries (time passing without frames on the link, e.g. while
+  // a bridge waits for the BUSY pin). Returns how many executed.
+  unsigned step(unsigned n);
 
   // Video memory (vram_bytes). Direct access is the simulator's fast path for uploads and
   // readback; it has the same effect as MEM_ADDR/MEM_DATA writes of the same bytes.

@@ -59,6 +59,9 @@ struct DeviceOptions {
   // N > 0: each received frame lets at most N FIFO entries execute (a device slower than the
   // link, for flow-control tests); Device::drain() executes the rest.
   unsigned fifo_drain_per_frame = 0;
+  // With fifo_drain_per_frame > 0: the drain happens after every fifo_drain_interval-th received
+  // frame (1..1024), so N = 1, interval = 4 models a device four times slower than the link.
+  unsigned fifo_drain_interval = 1;
   unsigned threads = 1;  // rasteriser worker threads (1 = no pool), 1..kMaxThreads
   AccuracyKnobs accuracy;
 

@@ -1,0 +1,49 @@
+#pragma once
+// The timing model (docs/protocol.md section 19): predicted board time for a piece of work
+// (usually one scanned-out frame), from the device's counters and a board profile, plus the SPI
+// time of the frames that carried it. Not part of the device contract; the simulator never
+// sleeps or stalls because of it.
+#include <string>
+
+#include "gpubridge/common/result.hpp"
+#include "gpubridge/sim/device.hpp"
+
+namespace gpubridge::sim {
+
+struct BoardTiming {
+  std::string name = "ecp5-50mhz";
+  double clock_mhz = 50.0;              // core clock
+  double cycles_per_command = 1.0;      // every executed FIFO entry (register decode)
+  double cycles_per_triangle = 24.0;    // setup: D, edges, bias, attribute planes
+  double cycles_per_scanned_pixel = 0.25;  // coverage test (4 pixels per clock)
+  double cycles_per_pixel = 1.0;        // depth test/write + colour store, per passed pixel
+  double cycles_per_textured_pixel = 2.0;  // extra: reciprocal + fetch + combine
+  double cycles_per_blended_pixel = 1.0;   // extra: destination read + blend
+  double clear_bytes_per_cycle = 8.0;
+  double memory_bytes_per_cycle = 4.0;  // external memory bandwidth (SDRAM 16 bit, DDR)
+  double spi_clock_mhz = 40.0;
+  double cs_gap_us = 1.0;               // chip-select high time between bursts
+  unsigned frames_per_burst = 32;       // flow-control group size
+};
+
+struct TimingEstimate {
+  double pipeline_cycles = 0;  // setup + rasterisation + pixel stages + clears
+  double memory_cycles = 0;    // bytes moved / memory_bytes_per_cycle
+  double board_cycles = 0;     // max(pipeline, memory): the stages overlap memory traffic
+  double board_ms = 0;
+  double spi_ms = 0;           // link time of the frames received
+  double frame_ms = 0;         // max(board, spi): the slower side sets the frame time
+  double fps = 0;
+  std::uint64_t memory_bytes = 0;
+};
+
+// Counters of `work` (e.g. the difference of two DeviceStats snapshots) under profile `board`;
+// bytes per pixel of the colour buffer and texels decide the memory traffic.
+TimingEstimate estimate_timing(const DeviceStats& work, const BoardTiming& board, unsigned colour_bpp,
+                               unsigned texel_bpp, bool bilinear);
+// a − b, field by field.
+DeviceStats stats_difference(const DeviceStats& a, const DeviceStats& b);
+// "clock_mhz=25 spi_clock_mhz=10 ..." settings applied to a profile (errors name the key).
+Result<void> apply_timing_setting(BoardTiming& board, std::string_view setting);
+
+}  // namespace gpubridge::sim

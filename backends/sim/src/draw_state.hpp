@@ -1,0 +1,50 @@
+#pragma once
+// The render state a triangle executes with, decoded once from TRI_MODE, TEX_*, FB_*, SCISSOR when
+// one of them changes (not per triangle). Also the accuracy knobs that shape the arithmetic.
+#include <cstdint>
+
+#include "gpubridge/protocol/registers.hpp"
+#include "gpubridge/sim/options.hpp"
+
+namespace gpubridge::sim {
+
+struct ClipRect {
+  int x0 = 0, y0 = 0, x1 = 0, y1 = 0;  // [x0, x1) x [y0, y1); empty when x1 <= x0 or y1 <= y0
+  bool empty() const { return x1 <= x0 || y1 <= y0; }
+};
+
+struct TextureState {
+  std::uint32_t base = 0;
+  unsigned wl = 3, hl = 3;  // log2 width / height
+  protocol::PixelFormat format = protocol::PixelFormat::RGBA8888;
+  bool bilinear = false;
+  protocol::Wrap wrap_s = protocol::Wrap::Repeat, wrap_t = protocol::Wrap::Repeat;
+  bool in_vram = false;  // the whole texture lies inside video memory (unchecked fetches)
+};
+
+struct DrawState {
+  // TRI_MODE
+  bool gouraud = false, textured = false, z_test = false, z_write = false, dither = false, decal = false;
+  protocol::DepthFunc z_func = protocol::DepthFunc::Never;
+  protocol::BlendMode blend = protocol::BlendMode::Off;
+  std::uint8_t keep_mask = 0;  // bit 0 R, 1 G, 2 B, 3 A: 1 = channel keeps its stored bits
+  // FB_*
+  protocol::PixelFormat fb_format = protocol::PixelFormat::RGBA8888;
+  unsigned fb_width = 640, fb_height = 480, bpp = 4;
+  std::uint32_t fb_draw = 0, fb_z = 0;
+  bool color_in_vram = false, z_in_vram = false;  // whole buffers inside memory
+  ClipRect clip;  // scissor ∩ framebuffer
+  TextureState tex;
+  // Derived decisions (per draw specialisation).
+  bool writes_nothing = false;   // Z_FUNC NEVER with the test on, or nothing writable
+  bool reads_color = false;      // blend or a partial write mask needs the destination
+  bool simple_color = false;     // RGBA8888, no blend, no mask: store the 4 bytes directly
+};
+
+// Register indices into the device's register file.
+struct RegisterValues {
+  std::uint64_t tri_mode, tex_base, tex_fmt, scissor, fb_draw, fb_z, fb_format;
+};
+DrawState decode_draw_state(const RegisterValues& regs, std::uint64_t vram_bytes);
+
+}  // namespace gpubridge::sim

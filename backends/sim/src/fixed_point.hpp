@@ -1,0 +1,49 @@
+#pragma once
+// Exact integer helpers shared by the stages: floor division, 128-bit intermediates, big-endian
+// memory words. Everything here is exact; no floating point.
+#include <cstdint>
+
+namespace gpubridge::sim {
+
+using i128 = __int128;
+
+// floor(a / b) and the matching non-negative remainder, for b > 0.
+struct DivMod {
+  std::int64_t q, r;
+};
+inline DivMod floor_divmod(std::int64_t a, std::int64_t b) {
+  std::int64_t q = a / b, r = a % b;
+  if (r < 0) { r += b; --q; }
+  return {q, r};
+}
+inline DivMod floor_divmod128(i128 a, std::int64_t b) {
+  // Fast path: most values fit in 64 bits (colours, Z, small triangles).
+  if (a >= INT64_MIN && a <= INT64_MAX) return floor_divmod(static_cast<std::int64_t>(a), b);
+  i128 q = a / b, r = a % b;
+  if (r < 0) { r += b; --q; }
+  return {static_cast<std::int64_t>(q), static_cast<std::int64_t>(r)};
+}
+inline std::int64_t floor_div(std::int64_t a, std::int64_t b) { return floor_divmod(a, b).q; }
+inline std::int64_t ceil_div(std::int64_t a, std::int64_t b) { return -floor_div(-a, b); }
+
+inline std::uint32_t load_be32(const std::uint8_t* p) {
+  return (std::uint32_t{p[0]} << 24) | (std::uint32_t{p[1]} << 16) | (std::uint32_t{p[2]} << 8) | p[3];
+}
+inline void store_be32(std::uint8_t* p, std::uint32_t v) {
+  p[0] = static_cast<std::uint8_t>(v >> 24);
+  p[1] = static_cast<std::uint8_t>(v >> 16);
+  p[2] = static_cast<std::uint8_t>(v >> 8);
+  p[3] = static_cast<std::uint8_t>(v);
+}
+inline std::uint64_t load_be64(const std::uint8_t* p) {
+  return (std::uint64_t{load_be32(p)} << 32) | load_be32(p + 4);
+}
+inline void store_be64(std::uint8_t* p, std::uint64_t v) {
+  store_be32(p, static_cast<std::uint32_t>(v >> 32));
+  store_be32(p + 4, static_cast<std::uint32_t>(v));
+}
+
+// div255 of docs/protocol.md section 10.5: round(x / 255) for 0 <= x <= 65025.
+constexpr unsigned div255(unsigned x) { return (x + 128 + ((x + 128) >> 8)) >> 8; }
+
+}  // namespace gpubridge::sim

@@ -1,0 +1,278 @@
+#include "rasterizer.hpp"
+
+#include <algorithm>
+#include <array>
+#include <utility>
+
+#include "pixel.hpp"
+#include "texture.hpp"
+
+namespace gpubridge::sim {
+namespace {
+
+using protocol::Rgba8;
+
+struct Steppers {
+  std::int64_t q[kAttrCount], r[kAttrCount];
+};
+
+// Rows this long or longer find their covered span by division instead of testing every pixel.
+constexpr int kSpanSolveWidth = 16;
+// Jumps along a span shorter than this are stepped instead of divided.
+constexpr std::int64_t kStepJump = 24;
+
+template <bool kGouraud, bool kTextured, bool kDepth, bool kSimple>
+class Kernel {
+ public:
+  static constexpr unsigned kPlanes = (kGouraud ? 0x0Fu : 0u) | (kDepth ? 1u << kZ : 0u) | (kTextured ? 0xE0u : 0u);
+
+  Kernel(const Triangle& t, const DrawState& st, RasterContext& ctx)
+      : t_(t), st_(st), ctx_(ctx), tex_(st.tex, ctx.mem) {
+    width_ = st.fb_width;
+    color_ = ctx.mem.data() + st.fb_draw;
+    zbuf_ = ctx.mem.data() + st.fb_z;
+    zmask_ = ctx.z_bits >= 24 ? 0xFFFFFFu : 0xFFFFFFu & ~((1u << (24 - ctx.z_bits)) - 1);
+    const std::uint8_t stored = st.fb_format == protocol::PixelFormat::RGB565 ? 0x7 : 0xF;
+    skip_colour_ = (st.keep_mask & stored) == stored;
+    if (kGouraud) {
+      flat_ = {};
+    } else if (st.gouraud) {  // Gouraud requested but every vertex has the same colour
+      flat_ = {t.v[0].c[0], t.v[0].c[1], t.v[0].c[2], t.v[0].c[3]};
+    } else {
+      flat_ = {t.flat[0], t.flat[1], t.flat[2], t.flat[3]};
+    }
+    if (kTextured && t.plane[kQ].constant && t.plane[kQ].q != 0) {
+      q_const_ = true;  // affine: the reciprocal is the same at every pixel
+      const_rc_ = ctx.recip(static_cast<std::uint32_t>(t.plane[kQ].q));
+    }
+  }
+
+  void run(int ya, int yz) {
+    const std::int64_t k = ya - t_.y0;
+    std::int64_t e[3];
+    for (int i = 0; i < 3; ++i) e[i] = t_.edge[i].e + k * t_.edge[i].ey;
+    Steppers row;
+    for (unsigned i = 0; i < kAttrCount; ++i) {
+      if (!((kPlanes >> i) & 1)) continue;
+      row.q[i] = t_.plane[i].q;
+      row.r[i] = t_.plane[i].r;
+      if (k > 0) Plane::advance(row.q[i], row.r[i], t_.plane[i].qy, t_.plane[i].ry, k, t_.den);
+    }
+    const int w = t_.x1 - t_.x0;
+    for (int y = ya; y < yz; ++y) {
+      if (w >= kSpanSolveWidth) {
+        std::int64_t kl = 0, kr = w - 1;
+        for (int i = 0; i < 3; ++i) {
+          const std::int64_t ex = t_.edge[i].ex;
+          if (ex > 0) kl = std::max(kl, ceil_div(-e[i], ex));
+          else if (ex < 0) kr = std::min(kr, floor_div(e[i], -ex));
+          else if (e[i] < 0) kr = -1;
+        }
+        if (kl <= kr) {
+          Steppers s = row;
+          jump_x(s, kl);
+          for (std::int64_t kx = kl; kx <= kr; ++kx) {
+            pixel(t_.x0 + static_cast<int>(kx), y, s);
+            step_x(s);
+          }
+          ctx_.counters.scanned += static_cast<std::uint64_t>(kr - kl + 1);
+          ctx_.counters.covered += static_cast<std::uint64_t>(kr - kl + 1);
+        }
+      } else {
+        Steppers s = row;
+        std::int64_t e0 = e[0], e1 = e[1], e2 = e[2];
+        const std::int64_t x0 = t_.edge[0].ex, x1 = t_.edge[1].ex, x2 = t_.edge[2].ex;
+        for (int kx = 0; kx < w; ++kx) {
+          if ((e0 | e1 | e2) >= 0) {
+            ++ctx_.counters.covered;
+            pixel(t_.x0 + kx, y, s);
+          }
+          e0 += x0;
+          e1 += x1;
+          e2 += x2;
+          step_x(s);
+        }
+        ctx_.counters.scanned += static_cast<std::uint64_t>(w);
+      }
+      for (int i = 0; i < 3; ++i) e[i] += t_.edge[i].ey;
+      step_y(row);
+    }
+  }
+
+ private:
+  void step_x(Steppers& s) const {
+    for (unsigned i = 0; i < kAttrCount; ++i) {
+      if (!((kPlanes >> i) & 1)) continue;
+      s.q[i] += t_.plane[i].qx;
+      s.r[i] += t_.plane[i].rx;
+      const bool carry = s.r[i] >= t_.den;
+      s.r[i] -= carry ? t_.den : 0;
+      s.q[i] += carry;
+    }
+  }
+  void step_y(Steppers& s) const {
+    for (unsigned i = 0; i < kAttrCount; ++i) {
+      if (!((kPlanes >> i) & 1)) continue;
+      s.q[i] += t_.plane[i].qy;
+      s.r[i] += t_.plane[i].ry;
+      const bool carry = s.r[i] >= t_.den;
+      s.r[i] -= carry ? t_.den : 0;
+      s.q[i] += carry;
+    }
+  }
+  void jump_x(Steppers& s, std::int64_t k) const {
+    if (k <= 0) return;
+    if (k < kStepJump) {
+      for (std::int64_t j = 0; j < k; ++j) step_x(s);
+      return;
+    }
+    for (unsigned i = 0; i < kAttrCount; ++i)
+      if ((kPlanes >> i) & 1) Plane::advance(s.q[i], s.r[i], t_.plane[i].qx, t_.plane[i].rx, k, t_.den);
+  }
+
+  void pixel(int x, int y, const Steppers& s) {
+    const std::size_t pix = static_cast<std::size_t>(y) * width_ + static_cast<std::size_t>(x);
+    if constexpr (kDepth) {
+      const std::uint32_t z = static_cast<std::uint32_t>(s.q[kZ]) & zmask_;
+      std::uint8_t* zp = zbuf_ + pix * 4;
+      std::uint8_t tmp[4];
+      const bool direct = st_.z_in_vram;
+      if (!direct) {
+        if (!ctx_.mem.read(std::uint64_t{st_.fb_z} + pix * 4, tmp, 4)) ctx_.errors |= protocol::ERR_MEM_RANGE;
+        zp = tmp;
+      }
+      if (st_.z_test && !depth_passes(st_.z_func, z, load_be32(zp) & 0xFFFFFFu)) return;
+      if (st_.z_write) {
+        store_be32(zp, z);
+        if (!direct && !ctx_.mem.write(std::uint64_t{st_.fb_z} + pix * 4, tmp, 4)) ctx_.errors |= protocol::ERR_MEM_RANGE;
+      }
+    }
+    ++ctx_.counters.passed;
+    if (skip_colour_) return;
+    Rgba8 c = flat_;
+    if constexpr (kGouraud) {
+      c = {static_cast<std::uint8_t>(s.q[kR]), static_cast<std::uint8_t>(s.q[kG]), static_cast<std::uint8_t>(s.q[kB]),
+           static_cast<std::uint8_t>(s.q[kA])};
+    }
+    if constexpr (kTextured) {
+      ++ctx_.counters.textured;
+      TexelCoords tc;
+      const std::uint32_t q = static_cast<std::uint32_t>(s.q[kQ]);
+      if (q != 0) {
+        const Reciprocal rc = q_const_ ? const_rc_ : ctx_.recip(q);
+        tc = texel_coords(static_cast<std::int32_t>(s.q[kS]), static_cast<std::int32_t>(s.q[kT]), rc, st_.tex.wl,
+                          st_.tex.hl);
+      }
+      c = combine(tex_.sample(tc, ctx_.errors), c, st_.decal);
+    }
+    if constexpr (kSimple) {
+      if (st_.color_in_vram) {
+        std::uint8_t* p = color_ + pix * 4;
+        p[0] = c.r;
+        p[1] = c.g;
+        p[2] = c.b;
+        p[3] = c.a;
+        return;
+      }
+    }
+    write_colour(pix, x, y, c);
+  }
+
+  void write_colour(std::size_t pix, int x, int y, Rgba8 c) {
+    const unsigned bpp = st_.bpp;
+    const std::uint64_t at = std::uint64_t{st_.fb_draw} + pix * bpp;
+    std::uint8_t tmp[4] = {0, 0, 0, 0};
+    std::uint8_t* p = color_ + pix * bpp;
+    if (!st_.color_in_vram) {
+      if (!ctx_.mem.read(at, tmp, bpp)) ctx_.errors |= protocol::ERR_MEM_RANGE;
+      p = tmp;
+    }
+    if (st_.blend != protocol::BlendMode::Off) {
+      ++ctx_.counters.blended;
+      c = blend(st_.blend, c, protocol::load_pixel(st_.fb_format, p));
+    }
+    store_colour(st_.fb_format, p, c, st_.dither, st_.keep_mask, x, y);
+    if (!st_.color_in_vram && !ctx_.mem.write(at, tmp, bpp)) ctx_.errors |= protocol::ERR_MEM_RANGE;
+  }
+
+  const Triangle& t_;
+  const DrawState& st_;
+  RasterContext& ctx_;
+  TextureUnit tex_;
+  std::size_t width_ = 0;
+  std::uint8_t* color_ = nullptr;
+  std::uint8_t* zbuf_ = nullptr;
+  std::uint32_t zmask_ = 0xFFFFFF;
+  bool skip_colour_ = false;
+  Rgba8 flat_;
+  bool q_const_ = false;
+  Reciprocal const_rc_;
+};
+
+template <bool G, bool T, bool Z, bool S>
+void run_kernel(const Triangle& t, const DrawState& st, RasterContext& ctx, int ya, int yz) {
+  Kernel<G, T, Z, S>(t, st, ctx).run(ya, yz);
+}
+
+using KernelFn = void (*)(const Triangle&, const DrawState&, RasterContext&, int, int);
+
+// Specialisation table over the boolean axes (DuckStation-style, no JIT).
+template <unsigned... I>
+constexpr auto make_table(std::integer_sequence<unsigned, I...>) {
+  return std::array<KernelFn, sizeof...(I)>{&run_kernel<(I & 1) != 0, (I & 2) != 0, (I & 4) != 0, (I & 8) != 0>...};
+}
+constexpr auto kKernels = make_table(std::make_integer_sequence<unsigned, 16>{});
+
+}  // namespace
+
+void rasterize_rows(const Triangle& t, const DrawState& st, RasterContext& ctx, int row_begin, int row_end) {
+  const int ya = std::max(row_begin, t.y0), yz = std::min(row_end, t.y1);
+  if (ya >= yz) return;
+  bool colours_differ = false;
+  for (unsigned ch = 0; ch < 4; ++ch) colours_differ |= !t.plane[kR + ch].constant;
+  const bool gouraud = st.gouraud && colours_differ;  // Gouraud only when colours differ
+  const bool depth = st.z_test || st.z_write;
+  const unsigned key = (gouraud ? 1u : 0u) | (st.textured ? 2u : 0u) | (depth ? 4u : 0u) | (st.simple_color ? 8u : 0u);
+  kKernels[key](t, st, ctx, ya, yz);
+}
+
+void observe_triangle(const Triangle& t, const DrawState& st, const PixelObserver& observer) {
+  const Vertex* v = t.v;
+  auto raw_edge = [](const Vertex& a, const Vertex& b, std::int64_t sx, std::int64_t sy) {
+    return (std::int64_t{b.x} - a.x) * (sy - a.y) - (std::int64_t{b.y} - a.y) * (sx - a.x);
+  };
+  auto bias = [](const Vertex& a, const Vertex& b) -> std::int64_t {
+    return (a.y == b.y && b.x > a.x) || b.y < a.y ? 0 : -1;
+  };
+  const std::int64_t bias0 = bias(v[1], v[2]), bias1 = bias(v[2], v[0]), bias2 = bias(v[0], v[1]);
+  const long double D = static_cast<long double>(t.den / 2);
+  for (int y = t.y0; y < t.y1; ++y) {
+    for (int x = t.x0; x < t.x1; ++x) {
+      const std::int64_t sx = 16 * std::int64_t{x} + 8, sy = 16 * std::int64_t{y} + 8;
+      const std::int64_t b0 = raw_edge(v[1], v[2], sx, sy), b1 = raw_edge(v[2], v[0], sx, sy),
+                         b2 = raw_edge(v[0], v[1], sx, sy);
+      if (b0 + bias0 < 0 || b1 + bias1 < 0 || b2 + bias2 < 0) continue;
+      auto n = [&](std::int64_t a0, std::int64_t a1, std::int64_t a2) {
+        return i128{a0} * b0 + i128{a1} * b1 + i128{a2} * b2;
+      };
+      CoveredPixel p;
+      p.x = x;
+      p.y = y;
+      p.triangle = t.index;
+      p.z = static_cast<double>(static_cast<long double>(n(v[0].z, v[1].z, v[2].z)) / D);
+      double* ch[4] = {&p.r, &p.g, &p.b, &p.a};
+      for (unsigned c = 0; c < 4; ++c)
+        *ch[c] = st.gouraud ? static_cast<double>(static_cast<long double>(n(v[0].c[c], v[1].c[c], v[2].c[c])) / D)
+                            : t.flat[c];
+      const i128 nq = n(v[0].q, v[1].q, v[2].q);
+      if (nq != 0) {
+        // u = S / Q with S = s / 2^24 and Q = q / 2^32: the ratio of the interpolants times 2^8.
+        p.u = static_cast<double>(static_cast<long double>(n(v[0].s, v[1].s, v[2].s)) * 256 / static_cast<long double>(nq));
+        p.v = static_cast<double>(static_cast<long double>(n(v[0].t, v[1].t, v[2].t)) * 256 / static_cast<long double>(nq));
+      }
+      observer(p);
+    }
+  }
+}
+
+}  // namespace gpubridge::sim

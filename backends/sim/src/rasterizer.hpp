@@ -1,0 +1,43 @@
+#pragma once
+// The rasteriser (docs/protocol.md sections 8-11 per pixel): walks the covered pixels of a set-up
+// triangle row by row, steps the exact attribute planes, and runs the texture unit and the pixel
+// pipeline. Per draw it picks a routine specialised on the render state (Gouraud, textured, depth,
+// plain RGBA8888 store) so disabled features cost nothing. Rows can be restricted to a band so
+// several workers can share a triangle with identical results.
+#include <cstdint>
+
+#include "draw_state.hpp"
+#include "gpubridge/sim/device.hpp"
+#include "reciprocal.hpp"
+#include "setup.hpp"
+#include "video_memory.hpp"
+
+namespace gpubridge::sim {
+
+struct RasterCounters {
+  std::uint64_t scanned = 0, covered = 0, passed = 0, textured = 0, blended = 0;
+  void add(const RasterCounters& o) {
+    scanned += o.scanned;
+    covered += o.covered;
+    passed += o.passed;
+    textured += o.textured;
+    blended += o.blended;
+  }
+};
+
+struct RasterContext {
+  VideoMemory& mem;
+  const ReciprocalUnit& recip;
+  unsigned z_bits = 24;
+  std::uint16_t errors = 0;  // ERR_MEM_RANGE from out-of-memory accesses
+  RasterCounters counters;
+};
+
+// Draws the rows [row_begin, row_end) of t (clipped to its bounding box) with state st.
+void rasterize_rows(const Triangle& t, const DrawState& st, RasterContext& ctx, int row_begin, int row_end);
+
+// The slow, obviously exact path for --dump-attributes: reports every covered pixel's attribute
+// values as N / D (section 9) in double.
+void observe_triangle(const Triangle& t, const DrawState& st, const PixelObserver& observer);
+
+}  // namespace gpubridge::sim

@@ -1,0 +1,98 @@
+#include "renderer.hpp"
+
+#include <algorithm>
+
+namespace gpubridge::sim {
+namespace {
+
+bool overlaps(std::uint64_t a, std::uint64_t alen, std::uint64_t b, std::uint64_t blen) {
+  return a < b + blen && b < a + alen;
+}
+
+}  // namespace
+
+Renderer::Renderer(VideoMemory& mem, const AccuracyKnobs& knobs, unsigned threads)
+    : mem_(mem), knobs_(knobs), recip_(knobs.recip_bits, knobs.nr_steps), pool_(threads) {
+  if (pool_.workers() > 1) batch_.reserve(kMaxBatch);
+}
+
+// Bands can only be drawn independently when no buffer the draw reads overlaps one it writes in
+// another band: colour, depth and texture ranges must not alias.
+bool Renderer::can_batch(const DrawState& st) const {
+  const std::uint64_t pixels = std::uint64_t{st.fb_width} * st.fb_height;
+  const std::uint64_t clen = pixels * st.bpp, zlen = pixels * 4;
+  const bool depth = st.z_test || st.z_write;
+  if (depth && overlaps(st.fb_draw, clen, st.fb_z, zlen)) return false;
+  if (st.textured) {
+    const std::uint64_t tlen = (std::uint64_t{1} << (st.tex.wl + st.tex.hl)) * protocol::bytes_per_pixel(st.tex.format);
+    if (overlaps(st.tex.base, tlen, st.fb_draw, clen)) return false;
+    if (depth && overlaps(st.tex.base, tlen, st.fb_z, zlen)) return false;
+  }
+  return true;
+}
+
+void Renderer::draw(const Vertex& a, const Vertex& b, const Vertex& c, const std::shared_ptr<const DrawState>& state,
+                    std::uint64_t index) {
+  const DrawState& st = *state;
+  if (st.clip.empty()) return;
+  const bool observing = static_cast<bool>(observer_);
+  // No work when nothing is written (unless someone watches the attributes).
+  if (st.writes_nothing && !observing) return;
+  const bool batching = pool_.workers() > 1 && !observing && can_batch(st);
+  if (batching && batch_state_ != state) flush();
+  if (!batching) flush();
+  Triangle& t = batching ? batch_.emplace_back() : scratch_;
+  if (!setup_triangle(a, b, c, st, knobs_.subpixel_bits, observing, t)) {
+    if (batching) batch_.pop_back();
+    return;
+  }
+  t.index = index;
+  ++rasterised_;
+  if (observing) observe_triangle(t, st, observer_);
+  if (!batching) {
+    if (st.writes_nothing) return;
+    RasterContext ctx{mem_, recip_, knobs_.z_bits, 0, {}};
+    rasterize_rows(t, st, ctx, t.y0, t.y1);
+    errors_ |= ctx.errors;
+    counters_.add(ctx.counters);
+    return;
+  }
+  batch_state_ = state;
+  if (batch_.size() >= kMaxBatch) flush();
+}
+
+void Renderer::flush() {
+  if (batch_.empty()) {
+    batch_state_.reset();
+    return;
+  }
+  const DrawState& st = *batch_state_;
+  const unsigned n = pool_.workers();
+  std::vector<RasterContext> ctx;
+  ctx.reserve(n);
+  for (unsigned w = 0; w < n; ++w) ctx.push_back(RasterContext{mem_, recip_, knobs_.z_bits, 0, {}});
+  pool_.run([&](unsigned w) {
+    RasterContext& c = ctx[w];
+    for (const Triangle& t : batch_) {
+      // First band of this worker at or after the triangle's first row.
+      int band = t.y0 / kBandRows;
+      band += static_cast<int>((w + n - static_cast<unsigned>(band) % n) % n);
+      for (; band * kBandRows < t.y1; band += static_cast<int>(n))
+        rasterize_rows(t, st, c, band * kBandRows, (band + 1) * kBandRows);
+    }
+  });
+  for (const auto& c : ctx) {
+    errors_ |= c.errors;
+    counters_.add(c.counters);
+  }
+  batch_.clear();
+  batch_state_.reset();
+}
+
+std::uint16_t Renderer::take_errors() {
+  const std::uint16_t e = errors_;
+  errors_ = 0;
+  return e;
+}
+
+}  // namespace gpubridge::sim

@@ -1,0 +1,59 @@
+#pragma once
+// Runs kicked triangles through setup and the rasteriser. With one thread every triangle is drawn
+// at once. With N threads triangles are batched while the render state stays the same; a batch is
+// drawn by N workers that each walk all triangles in submission order and draw only the rows of
+// their own 16-row bands (band i → worker i % N), so the bytes are identical for any N.
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "band_pool.hpp"
+#include "draw_state.hpp"
+#include "gpubridge/sim/device.hpp"
+#include "rasterizer.hpp"
+#include "reciprocal.hpp"
+#include "setup.hpp"
+#include "video_memory.hpp"
+
+namespace gpubridge::sim {
+
+class Renderer {
+ public:
+  Renderer(VideoMemory& mem, const AccuracyKnobs& knobs, unsigned threads);
+
+  void set_observer(PixelObserver observer) { observer_ = std::move(observer); }
+  // Draws (or queues) one triangle. A state object different from the batch's flushes the batch.
+  void draw(const Vertex& a, const Vertex& b, const Vertex& c, const std::shared_ptr<const DrawState>& state,
+            std::uint64_t index);
+  // Completes every queued triangle. Call before anything reads or writes video memory.
+  void flush();
+
+  // ERR_* flags raised by drawing since the last call.
+  std::uint16_t take_errors();
+  std::uint64_t triangles_rasterised() const { return rasterised_; }
+  const RasterCounters& counters() const { return counters_; }
+  void reset_counters() {
+    counters_ = {};
+    rasterised_ = 0;
+  }
+
+  static constexpr int kBandRows = 16;
+  static constexpr std::size_t kMaxBatch = 4096;
+
+ private:
+  bool can_batch(const DrawState& st) const;
+
+  VideoMemory& mem_;
+  AccuracyKnobs knobs_;
+  ReciprocalUnit recip_;
+  BandPool pool_;
+  PixelObserver observer_;
+  std::vector<Triangle> batch_;
+  std::shared_ptr<const DrawState> batch_state_;
+  Triangle scratch_;
+  std::uint16_t errors_ = 0;
+  std::uint64_t rasterised_ = 0;
+  RasterCounters counters_;
+};
+
+}  // namespace gpubridge::sim

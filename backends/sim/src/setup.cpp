@@ -1,0 +1,106 @@
+#include "setup.hpp"
+
+#include <algorithm>
+#include <utility>
+
+namespace gpubridge::sim {
+namespace {
+
+// Top-left rule (section 8.3): bias 0 for top or left edges, −1 otherwise.
+std::int64_t edge_bias(const Vertex& a, const Vertex& b) {
+  const bool top = a.y == b.y && b.x > a.x;
+  const bool left = b.y < a.y;
+  return top || left ? 0 : -1;
+}
+
+// Raw edge function a → b at sample point (sx, sy) and its per-pixel steps.
+Edge make_edge(const Vertex& a, const Vertex& b, std::int64_t sx, std::int64_t sy) {
+  Edge e;
+  const std::int64_t dx = std::int64_t{b.x} - a.x, dy = std::int64_t{b.y} - a.y;
+  e.e = dx * (sy - a.y) - dy * (sx - a.x);
+  e.ex = -16 * dy;
+  e.ey = 16 * dx;
+  return e;
+}
+
+void setup_plane(Plane& p, std::int64_t a0, std::int64_t a1, std::int64_t a2, const Edge& b1, const Edge& b2,
+                 std::int64_t D, std::int64_t den) {
+  const std::int64_t d1 = a1 - a0, d2 = a2 - a0;
+  if (d1 == 0 && d2 == 0) {
+    p = Plane{};
+    p.q = a0;
+    return;
+  }
+  p.constant = false;
+  const i128 m0 = 2 * (i128{d1} * b1.e + i128{d2} * b2.e) + D;
+  const DivMod o = floor_divmod128(m0, den);
+  p.q = a0 + o.q;
+  p.r = o.r;
+  const DivMod sx = floor_divmod(2 * (d1 * b1.ex + d2 * b2.ex), den);
+  const DivMod sy = floor_divmod(2 * (d1 * b1.ey + d2 * b2.ey), den);
+  p.qx = sx.q;
+  p.rx = sx.r;
+  p.qy = sy.q;
+  p.ry = sy.r;
+}
+
+}  // namespace
+
+bool setup_triangle(const Vertex& va, const Vertex& vb, const Vertex& vc, const DrawState& state,
+                    unsigned subpixel_bits, bool all_attributes, Triangle& t) {
+  t.v[0] = va;
+  t.v[1] = vb;
+  t.v[2] = vc;
+  if (subpixel_bits < 4) {
+    const std::int32_t keep = ~((std::int32_t{1} << (4 - subpixel_bits)) - 1);
+    for (auto& v : t.v) {
+      v.x &= keep;
+      v.y &= keep;
+    }
+  }
+  std::copy(std::begin(va.c), std::end(va.c), t.flat);
+  const std::int64_t X0 = t.v[0].x, Y0 = t.v[0].y;
+  std::int64_t D = (t.v[1].x - X0) * (t.v[2].y - Y0) - (t.v[2].x - X0) * (t.v[1].y - Y0);
+  if (D == 0) return false;
+  if (D < 0) {
+    std::swap(t.v[1], t.v[2]);
+    D = -D;
+  }
+  const auto [mnx, mxx] = std::minmax({t.v[0].x, t.v[1].x, t.v[2].x});
+  const auto [mny, mxy] = std::minmax({t.v[0].y, t.v[1].y, t.v[2].y});
+  // Pixels whose sample point 16x + 8 lies inside the vertices' extent.
+  t.x0 = std::max<std::int64_t>(state.clip.x0, ceil_div(std::int64_t{mnx} - 8, 16));
+  t.x1 = std::min<std::int64_t>(state.clip.x1, floor_div(std::int64_t{mxx} - 8, 16) + 1);
+  t.y0 = std::max<std::int64_t>(state.clip.y0, ceil_div(std::int64_t{mny} - 8, 16));
+  t.y1 = std::min<std::int64_t>(state.clip.y1, floor_div(std::int64_t{mxy} - 8, 16) + 1);
+  if (t.x0 >= t.x1 || t.y0 >= t.y1) return false;
+
+  t.den = 2 * D;
+  const std::int64_t sx = 16 * std::int64_t{t.x0} + 8, sy = 16 * std::int64_t{t.y0} + 8;
+  const Edge e12 = make_edge(t.v[1], t.v[2], sx, sy);
+  const Edge e20 = make_edge(t.v[2], t.v[0], sx, sy);
+  const Edge e01 = make_edge(t.v[0], t.v[1], sx, sy);
+  t.edge[0] = e12;
+  t.edge[0].e += edge_bias(t.v[1], t.v[2]);
+  t.edge[1] = e20;
+  t.edge[1].e += edge_bias(t.v[2], t.v[0]);
+  t.edge[2] = e01;
+  t.edge[2].e += edge_bias(t.v[0], t.v[1]);
+
+  const Vertex* v = t.v;
+  const bool colour = all_attributes || state.gouraud;
+  const bool depth = all_attributes || state.z_test || state.z_write;
+  const bool tex = all_attributes || state.textured;
+  for (unsigned i = 0; i < kAttrCount; ++i) t.plane[i] = Plane{};
+  if (colour)
+    for (unsigned ch = 0; ch < 4; ++ch) setup_plane(t.plane[kR + ch], v[0].c[ch], v[1].c[ch], v[2].c[ch], e20, e01, D, t.den);
+  if (depth) setup_plane(t.plane[kZ], v[0].z, v[1].z, v[2].z, e20, e01, D, t.den);
+  if (tex) {
+    setup_plane(t.plane[kS], v[0].s, v[1].s, v[2].s, e20, e01, D, t.den);
+    setup_plane(t.plane[kT], v[0].t, v[1].t, v[2].t, e20, e01, D, t.den);
+    setup_plane(t.plane[kQ], v[0].q, v[1].q, v[2].q, e20, e01, D, t.den);
+  }
+  return true;
+}
+
+}  // namespace gpubridge::sim

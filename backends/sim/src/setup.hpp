@@ -1,0 +1,66 @@
+#pragma once
+// Triangle setup (docs/protocol.md sections 8-9): area D, edge functions with top-left biases, the
+// clipped bounding box, and each interpolated attribute as an exact plane stepper.
+//
+// An attribute's value at a pixel is a0 + floor(M / (2D)) with M = 2·(Δ1·b1 + Δ2·b2) + D linear in
+// (x, y) (Δi = ai − a0, bi the barycentric edge values). A Plane keeps (q, r) = floor-divmod of M by
+// den = 2D and steps it with additions only: q += qx; r += rx; if (r >= den) { r -= den; ++q; }.
+// That yields exactly floor((2N + D) / (2D)) of section 9 at every pixel, with no division per
+// pixel and no drift.
+#include <cstdint>
+
+#include "draw_state.hpp"
+#include "fixed_point.hpp"
+
+namespace gpubridge::sim {
+
+struct Vertex {
+  std::int32_t x = 0, y = 0;  // 1/16 pixel (s12.4 sign-extended)
+  std::uint32_t z = 0;        // 24 bits
+  std::uint8_t c[4] = {0, 0, 0, 0};  // R, G, B, A
+  std::uint32_t q = 0;        // u0.32
+  std::int32_t s = 0, t = 0;  // s8.24
+};
+
+// Attribute order inside a triangle.
+enum Attr : unsigned { kR = 0, kG, kB, kA, kZ, kS, kT, kQ, kAttrCount };
+
+struct Plane {
+  std::int64_t q = 0, r = 0;    // value and remainder at the bounding-box origin
+  std::int64_t qx = 0, rx = 0;  // step for x + 1 (rx in [0, den))
+  std::int64_t qy = 0, ry = 0;  // step for y + 1
+  bool constant = true;         // every vertex equal: value is q everywhere, no stepping
+
+  // (q, r) advanced by k steps of (qs, rs) (k >= 0), exact.
+  static void advance(std::int64_t& q, std::int64_t& r, std::int64_t qs, std::int64_t rs, std::int64_t k,
+                      std::int64_t den) {
+    const i128 rr = i128{r} + i128{rs} * k;
+    const DivMod d = floor_divmod128(rr, den);
+    q += qs * k + d.q;
+    r = d.r;
+  }
+};
+
+struct Edge {
+  std::int64_t e = 0;   // E + bias at the bounding-box origin's sample point
+  std::int64_t ex = 0;  // change per pixel in x (= −16·(Yb − Ya))
+  std::int64_t ey = 0;  // change per pixel in y (= 16·(Xb − Xa))
+};
+
+struct Triangle {
+  Vertex v[3];          // after the exchange of section 8.1 (D > 0)
+  std::int64_t den = 0; // 2D
+  Edge edge[3];         // E12, E20, E01 (so edge[i] is the barycentric weight of vertex i)
+  int x0 = 0, y0 = 0, x1 = 0, y1 = 0;  // clipped bounding box, inclusive-exclusive
+  Plane plane[kAttrCount];
+  std::uint8_t flat[4] = {0, 0, 0, 0};  // flat colour (first vertex as listed)
+  std::uint64_t index = 0;              // kicked-triangle number
+};
+
+// Returns false when the triangle draws nothing (D = 0 or an empty clipped box). Planes are set up
+// only for the attributes the state needs (colour when Gouraud, S/T/Q when textured, Z when the
+// depth test or depth write is on). subpixel_bits < 4 truncates vertex coordinates first.
+bool setup_triangle(const Vertex& a, const Vertex& b, const Vertex& c, const DrawState& state,
+                    unsigned subpixel_bits, bool all_attributes, Triangle& out);
+
+}  // namespace gpubridge::sim

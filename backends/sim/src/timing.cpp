@@ -1,0 +1,96 @@
+#include "gpubridge/sim/timing.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <string>
+
+namespace gpubridge::sim {
+
+TimingEstimate estimate_timing(const DeviceStats& w, const BoardTiming& b, unsigned colour_bpp, unsigned texel_bpp,
+                               bool bilinear) {
+  TimingEstimate e;
+  e.pipeline_cycles = double(w.queued_executed) * b.cycles_per_command +
+                      double(w.triangles_rasterised) * b.cycles_per_triangle +
+                      double(w.pixels_scanned) * b.cycles_per_scanned_pixel +
+                      double(w.pixels_depth_passed) * b.cycles_per_pixel +
+                      double(w.pixels_textured) * b.cycles_per_textured_pixel +
+                      double(w.pixels_blended) * b.cycles_per_blended_pixel +
+                      double(w.clear_bytes) / b.clear_bytes_per_cycle;
+  // Memory: depth read + write (4 + 4) for every covered pixel (an upper bound: not every draw
+  // tests or writes Z), colour write, destination read when blending, texels fetched, clears,
+  // uploads (8 bytes per MEM_DATA).
+  const std::uint64_t texels = w.pixels_textured * (bilinear ? 4u : 1u);
+  e.memory_bytes = w.pixels_covered * 8 + w.pixels_depth_passed * colour_bpp + w.pixels_blended * colour_bpp +
+                   texels * texel_bpp + w.clear_bytes + w.mem_data_writes * 8;
+  e.memory_cycles = double(e.memory_bytes) / b.memory_bytes_per_cycle;
+  e.board_cycles = std::max(e.pipeline_cycles, e.memory_cycles);
+  e.board_ms = e.board_cycles / (b.clock_mhz * 1e3);
+  const double bursts = std::ceil(double(w.frames_received) / std::max(1u, b.frames_per_burst));
+  e.spi_ms = double(w.frames_received) * 72.0 / (b.spi_clock_mhz * 1e3) + bursts * b.cs_gap_us / 1e3;
+  e.frame_ms = std::max(e.board_ms, e.spi_ms);
+  e.fps = e.frame_ms > 0 ? 1000.0 / e.frame_ms : 0;
+  return e;
+}
+
+DeviceStats stats_difference(const DeviceStats& a, const DeviceStats& b) {
+  DeviceStats d;
+  d.frames_received = a.frames_received - b.frames_received;
+  d.frames_aborted = a.frames_aborted - b.frames_aborted;
+  d.queued_executed = a.queued_executed - b.queued_executed;
+  d.triangles_kicked = a.triangles_kicked - b.triangles_kicked;
+  d.triangles_rasterised = a.triangles_rasterised - b.triangles_rasterised;
+  d.pixels_scanned = a.pixels_scanned - b.pixels_scanned;
+  d.pixels_covered = a.pixels_covered - b.pixels_covered;
+  d.pixels_depth_passed = a.pixels_depth_passed - b.pixels_depth_passed;
+  d.pixels_textured = a.pixels_textured - b.pixels_textured;
+  d.pixels_blended = a.pixels_blended - b.pixels_blended;
+  d.clear_bytes = a.clear_bytes - b.clear_bytes;
+  d.mem_data_writes = a.mem_data_writes - b.mem_data_writes;
+  d.swaps = a.swaps - b.swaps;
+  return d;
+}
+
+Result<void> apply_timing_setting(BoardTiming& b, std::string_view setting) {
+  struct Key {
+    std::string_view name;
+    double BoardTiming::*field;
+  };
+  static constexpr Key kKeys[] = {
+      {"clock_mhz", &BoardTiming::clock_mhz},
+      {"cycles_per_command", &BoardTiming::cycles_per_command},
+      {"cycles_per_triangle", &BoardTiming::cycles_per_triangle},
+      {"cycles_per_scanned_pixel", &BoardTiming::cycles_per_scanned_pixel},
+      {"cycles_per_pixel", &BoardTiming::cycles_per_pixel},
+      {"cycles_per_textured_pixel", &BoardTiming::cycles_per_textured_pixel},
+      {"cycles_per_blended_pixel", &BoardTiming::cycles_per_blended_pixel},
+      {"clear_bytes_per_cycle", &BoardTiming::clear_bytes_per_cycle},
+      {"memory_bytes_per_cycle", &BoardTiming::memory_bytes_per_cycle},
+      {"spi_clock_mhz", &BoardTiming::spi_clock_mhz},
+      {"cs_gap_us", &BoardTiming::cs_gap_us},
+  };
+  const auto eq = setting.find('=');
+  if (eq == std::string_view::npos) return make_error("timing setting '" + std::string(setting) + "' is not KEY=VALUE");
+  const std::string_view name = setting.substr(0, eq);
+  const std::string text(setting.substr(eq + 1));
+  char* end = nullptr;
+  const double v = std::strtod(text.c_str(), &end);
+  const bool ok = !text.empty() && end == text.c_str() + text.size() && std::isfinite(v) && v >= 0 && v <= 1e9;
+  if (name == "frames_per_burst") {
+    if (!ok || v < 1 || v != std::floor(v)) return make_error("timing frames_per_burst=" + text + ": expected an integer >= 1");
+    b.frames_per_burst = static_cast<unsigned>(v);
+    return {};
+  }
+  for (const auto& k : kKeys) {
+    if (k.name != name) continue;
+    const bool positive_needed = name != "cs_gap_us" && name.substr(0, 7) != "cycles_";
+    if (!ok || (positive_needed && v <= 0))
+      return make_error("timing " + std::string(name) + "=" + text + ": expected a finite number" +
+                        (positive_needed ? " > 0" : " >= 0"));
+    b.*k.field = v;
+    return {};
+  }
+  return make_error("unknown timing key '" + std::string(name) + "'");
+}
+
+}  // namespace gpubridge::sim
