@@ -1,0 +1,88 @@
+#pragma once
+// backends::Backend for a real (or emulated) FPGA board reached through a SpiBridge: burst writes
+// under one chip select, FIFO flow control, strict link integrity with go-back-N resend,
+// STATUS/ID/memory reads, upload/readback through MEM_ADDR/MEM_DATA and scanout frames.
+#include <cstdint>
+#include <memory>
+#include <mutex>
+
+#include "gpubridge/backends/backend.hpp"
+#include "gpubridge/usb/board_profile.hpp"
+#include "gpubridge/usb/spi_bridge.hpp"
+
+namespace gpubridge::usb {
+
+struct BoardOptions {
+  unsigned max_link_retries = 8;   // resends of one batch before giving up with kDeviceProtocol
+  unsigned max_status_polls = 20000;  // bounded polling of STATUS (flow control, flush, swap)
+  std::uint64_t host_tag = 0;      // written to HOST_TAG at attach (0 = derived from the clock)
+};
+
+// Link counters for tests, benchmarks and `gpubridge bringup`.
+struct LinkStats {
+  std::uint64_t frames_sent = 0, payload_frames = 0, groups_sent = 0, groups_resent = 0, batches = 0;
+  std::uint64_t status_polls = 0, recoveries = 0;
+};
+
+class BoardBackend final : public backends::Backend {
+ public:
+  // `lower` keeps whatever sits below the bridge alive (libusb handle, chip model chain); it is
+  // destroyed after the bridge. Attaching checks ID and CAPS, writes HOST_TAG and enables strict
+  // link mode when the profile and the design both support it.
+  static Result<std::unique_ptr<BoardBackend>> attach(BoardProfile profile, std::shared_ptr<void> lower,
+                                                      std::unique_ptr<SpiBridge> bridge, BoardOptions opts = {});
+  ~BoardBackend() override;
+
+  backends::DeviceInfo info() const override;
+  Result<void> write_frames(protocol::FrameView frames) override;
+  Result<std::uint64_t> read_register(std::uint8_t index) override;
+  Result<void> upload(std::uint32_t address, std::span<const std::uint8_t> bytes) override;
+  Result<std::vector<std::uint8_t>> readback(std::uint32_t address, std::uint32_t length) override;
+  Result<void> flush() override;
+  Result<void> reset() override;
+  void set_scanout_callback(backends::ScanoutCallback cb) override;
+
+  SpiBridge& bridge() { return *bridge_; }
+  const BoardProfile& profile() const { return profile_; }
+  const LinkStats& link_stats() const { return stats_; }
+  bool strict_link() const { return strict_; }
+
+ private:
+  BoardBackend(BoardProfile profile, std::shared_ptr<void> lower, std::unique_ptr<SpiBridge> bridge, BoardOptions opts);
+  Result<void> attach_locked();
+  Result<void> send_frames(std::span<const protocol::Frame> frames);  // writes, link + flow control
+  Result<std::vector<std::uint64_t>> read_frames(std::span<const std::uint8_t> indices);
+  Result<std::vector<std::uint8_t>> exchange(std::span<const SpiWindow> windows,
+                                             std::span<const protocol::Frame> sent_in_order);
+  Result<void> on_fault(const Error& e);
+  Result<void> restart_link();
+  Result<std::uint64_t> read_link_status_stable();
+  Result<void> check_host_tag();
+  Result<std::uint64_t> poll_status(std::uint64_t mask, std::uint64_t want, const char* waiting_for);
+  Result<unsigned> fifo_credits();
+  Result<void> emit_scanout();
+  Result<std::vector<std::uint8_t>> readback_locked(std::uint32_t address, std::uint32_t length);
+  void note_sent(const protocol::Frame& f);
+  void track(const protocol::Frame& f);
+  Error gone_error() const;
+
+  BoardProfile profile_;
+  std::shared_ptr<void> lower_;          // destroyed after bridge_ (declared first)
+  std::unique_ptr<SpiBridge> bridge_;
+  BoardOptions opts_;
+  mutable std::mutex mu_;
+  backends::ScanoutCallback scanout_cb_;
+  std::uint64_t id_ = 0, caps_ = 0;
+  unsigned fifo_depth_ = 0;
+  std::uint32_t vram_bytes_ = 0;
+  bool strict_ = false, gone_ = false;
+  std::uint32_t host_crc_ = 0;   // CRC-32 of frames sent since the last LINK_CHECK/LINK_CTRL
+  std::uint16_t groups_ok_ = 0;  // LINK_STATUS.GROUPS_OK after the last accounted batch
+  std::uint64_t tag_ = 0;
+  std::uint64_t fb_format_ = 0, fb_display_ = 0;
+  std::uint32_t frame_number_ = 0;
+  LinkStats stats_;
+  std::vector<std::shared_ptr<const backends::ScanoutFrame>> pending_frames_;  // emitted after unlocking
+};
+
+}  // namespace gpubridge::usb

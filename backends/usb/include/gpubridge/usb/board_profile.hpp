@@ -1,0 +1,62 @@
+#pragma once
+// Board profiles are data (configs/boards/*.json): which bridge chip, how it is wired, how fast
+// the SPI link may run and what the FPGA design offers. Cable descriptions (configs/cables/*.json)
+// list the bridge chips `gpubridge probe` looks for.
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "gpubridge/common/result.hpp"
+#include "gpubridge/usb/ftdi_mpsse.hpp"
+
+namespace gpubridge::usb {
+
+enum class BridgeChip : std::uint8_t { FT232H, FT2232H, FT4232H, CH341A, MCP2210, CP2130 };
+std::string_view to_string(BridgeChip c);
+std::optional<BridgeChip> parse_bridge_chip(std::string_view s);  // "ft232h", "ch341a", ...
+
+enum class ScanoutMode : std::uint8_t { Readback, CrcOnly, Off };
+
+struct BoardProfile {
+  std::string name, description, fpga;
+  std::filesystem::path file;
+  // Bridge wiring.
+  BridgeChip chip = BridgeChip::FT232H;
+  std::uint16_t vid = 0, pid = 0;
+  int interface = 0;          // FTDI channel A=0 / B=1; 0 for single-interface chips
+  std::string serial;         // optional: select this adapter when several are attached
+  std::string port_path;      // optional: select by USB port path
+  std::uint32_t spi_clock_hz = 0;
+  std::uint8_t cs_pin = 3;    // bridge GPIO used as chip select (FTDI ADBUS n, CH341A D0, MCP2210 GPn, CP2130 CSn)
+  bool busy_pin = false;      // FPGA BUSY output wired to the bridge (FTDI GPIOL1)
+  ReadEdge read_edge = ReadEdge::Rising;
+  std::uint8_t latency_ms = 1;
+  // FPGA design.
+  std::uint32_t vram_kib = 0;
+  unsigned max_width = 0, max_height = 0, fifo_depth = 0;
+  bool strict_link = true;
+  ScanoutMode scanout = ScanoutMode::Readback;
+};
+
+struct CableInfo {
+  std::string name, chip, description, api;
+  std::uint16_t vid = 0, pid = 0;
+  std::uint32_t max_spi_hz = 0;
+  std::vector<std::string> interfaces;
+  std::filesystem::path file;
+};
+
+// GPUBRIDGE_CONFIG_DIR from the environment, else the source tree's configs/ (compile time).
+std::filesystem::path default_config_dir();
+
+// Errors name the file and the key ("configs/boards/x.json: bridge.spi_clock_hz: ...").
+Result<BoardProfile> load_board_profile(const std::filesystem::path& file);
+Result<BoardProfile> parse_board_profile(std::string_view json_text, const std::string& file_for_errors);
+Result<std::vector<BoardProfile>> load_board_profiles(const std::filesystem::path& config_dir);
+// Finds a profile by name in config_dir/boards, or loads `name_or_path` if it is a .json file.
+Result<BoardProfile> find_board_profile(const std::filesystem::path& config_dir, const std::string& name_or_path);
+Result<std::vector<CableInfo>> load_cables(const std::filesystem::path& config_dir);
+
+}  // namespace gpubridge::usb
