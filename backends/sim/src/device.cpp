@@ -84,6 +84,7 @@ struct Device::State {
   std::uint16_t groups_ok = 0, groups_bad = 0;
   // Memory access.
   std::uint64_t prefetch = 0;
+  bool prefetch_beyond = false;
   bool mem_ready = false;
   // Primitive assembly.
   Vertex stored[2];
@@ -308,7 +309,9 @@ struct Device::State {
   void load_prefetch() {
     renderer.flush();
     std::uint8_t b[8];
-    if (!mem.read(mem_addr(), b, 8)) errors |= ERR_MEM_RANGE;
+    // Bytes beyond VRAM read as 0; the error is raised when a MEM_DATA read returns them, so
+    // writing the last word of memory does not flag the look-ahead.
+    prefetch_beyond = !mem.read(mem_addr(), b, 8);
     prefetch = load_be64(b);
     mem_ready = true;
   }
@@ -455,6 +458,7 @@ struct Device::State {
       case Reg::ID: return id;
       case Reg::MEM_DATA: {
         const std::uint64_t v = prefetch;
+        if (prefetch_beyond) errors |= ERR_MEM_RANGE;
         set_mem_addr(mem_addr() + 8);
         mem_ready = false;
         load_prefetch();  // completes before the next frame's bit 64 (section 2.4)

@@ -1,0 +1,214 @@
+// Register file behaviour and every error flag of docs/protocol.md sections 5 and 13.
+#include <gtest/gtest.h>
+
+#include "gpubridge/protocol/registers.hpp"
+#include "sim_test_util.hpp"
+
+namespace gpubridge::sim::test {
+namespace {
+
+using namespace protocol;
+
+TEST(SimRegisters, ResetValuesIdAndCaps) {
+  DeviceOptions o;
+  o.vram_bytes = 2u << 20;
+  o.fifo_depth = 100;
+  o.variant = 7;
+  o.max_width = 320;
+  o.max_height = 240;
+  auto d = make_device(o);
+  EXPECT_EQ(rd(*d, Reg::ID), 0x5350475501000007ull);
+  const std::uint64_t caps = rd(*d, Reg::CAPS);
+  EXPECT_EQ(caps & 0xFFFFFF, 2048u);                // VRAM_KIB
+  EXPECT_EQ((caps >> 24) & 0x7FF, 320u);            // MAX_WIDTH
+  EXPECT_EQ((caps >> 35) & 0x7FF, 240u);            // MAX_HEIGHT
+  EXPECT_EQ((caps >> 46) & 0x3FF, 100u);            // FIFO_DEPTH
+  EXPECT_EQ(caps >> 56, 0x3Fu);                     // FEATURES
+  for (const auto& r : register_table()) {
+    if (r.access != Access::ReadWrite || r.path != Path::Queued) continue;
+    EXPECT_EQ(d->read(r.index), r.reset) << r.name;
+  }
+  EXPECT_EQ(errors_of(*d), 0);
+  EXPECT_EQ((rd(*d, Reg::STATUS) >> 17) & 1, 1u);  // VBLANK always for the untimed simulator
+}
+
+TEST(SimRegisters, ReservedBitsAreIgnoredAndFlagged) {
+  auto d = make_device();
+  w(*d, Reg::TRI_MODE, (1ull << 40) | 1);
+  EXPECT_EQ(rd(*d, Reg::TRI_MODE), 1u);
+  EXPECT_EQ(errors_of(*d), ERR_RESERVED_BITS);
+}
+
+TEST(SimRegisters, UndefinedEnumBecomesZero) {
+  auto d = make_device();
+  w(*d, Reg::PRIM, 3);
+  EXPECT_EQ(rd(*d, Reg::PRIM), 0u);
+  EXPECT_EQ(errors_of(*d), ERR_BAD_VALUE);
+  w(*d, Reg::ERR_CLEAR, 0xFFFF);
+  w(*d, Reg::TEX_FMT, (3ull << 8) | 0x55);  // WRAP_S = 3 undefined
+  EXPECT_EQ(rd(*d, Reg::TEX_FMT), 0x55u);
+  EXPECT_EQ(errors_of(*d), ERR_BAD_VALUE);
+}
+
+TEST(SimRegisters, BadRegisterAccess) {
+  auto d = make_device();
+  EXPECT_EQ(d->read(0x40), 0u);
+  EXPECT_EQ(errors_of(*d), ERR_BAD_REGISTER);
+  w(*d, Reg::ERR_CLEAR, ERR_BAD_REGISTER);
+  EXPECT_EQ(errors_of(*d), 0);
+  w(*d, Reg::STATUS, 0);  // read-only
+  EXPECT_EQ(errors_of(*d), ERR_BAD_REGISTER);
+  w(*d, Reg::ERR_CLEAR, 0xFFFF);
+  d->write(Frame{false, 0x55, 1});  // undefined
+  EXPECT_EQ(errors_of(*d), ERR_BAD_REGISTER);
+  w(*d, Reg::ERR_CLEAR, 0xFFFF);
+  EXPECT_EQ(rd(*d, Reg::CLEAR), 0u);  // write-only reads 0 without an error
+  EXPECT_EQ(errors_of(*d), 0);
+}
+
+TEST(SimRegisters, RangeRulesReplaceValues) {
+  DeviceOptions o;
+  o.max_width = 800;
+  o.max_height = 600;
+  auto d = make_device(o);
+  w(*d, Reg::TEX_FMT, 0xB2);  // HEIGHT_LOG2 11 → 10, WIDTH_LOG2 2 → 3
+  EXPECT_EQ(rd(*d, Reg::TEX_FMT), 0xA3u);
+  EXPECT_EQ(errors_of(*d), ERR_BAD_VALUE);
+  w(*d, Reg::ERR_CLEAR, 0xFFFF);
+  w(*d, Reg::FB_FORMAT, fb_format(0, 1000));
+  EXPECT_EQ(rd(*d, Reg::FB_FORMAT), fb_format(1, 600));
+  EXPECT_EQ(errors_of(*d), ERR_BAD_VALUE);
+  w(*d, Reg::ERR_CLEAR, 0xFFFF);
+  w(*d, Reg::SCISSOR, scissor(2000, 5, 1025, 1024));
+  EXPECT_EQ(rd(*d, Reg::SCISSOR), scissor(1024, 5, 1024, 1024));
+  EXPECT_EQ(errors_of(*d), ERR_BAD_VALUE);
+  w(*d, Reg::ERR_CLEAR, 0xFFFF);
+  w(*d, Reg::FB_FORMAT, fb_format(800, 600, 2));
+  EXPECT_EQ(errors_of(*d), 0);
+}
+
+TEST(SimRegisters, MissingFeatureFallsBack) {
+  DeviceOptions o;
+  o.features = FEATURE_BILINEAR;  // no RGB565, no blend
+  auto d = make_device(o);
+  w(*d, Reg::FB_FORMAT, fb_format(64, 64, 1));
+  EXPECT_EQ(rd(*d, Reg::FB_FORMAT), fb_format(64, 64, 0));
+  EXPECT_EQ(errors_of(*d), ERR_BAD_VALUE);
+  w(*d, Reg::ERR_CLEAR, 0xFFFF);
+  w(*d, Reg::TRI_MODE, 1u << 7);  // BLEND = ALPHA
+  EXPECT_EQ(rd(*d, Reg::TRI_MODE), 0u);
+  EXPECT_EQ(errors_of(*d), ERR_BAD_VALUE);
+}
+
+TEST(SimRegisters, ResetNeedsMagicAndKeepsMemory) {
+  auto d = make_device();
+  w(*d, Reg::HOST_TAG, 0x1234);
+  w(*d, Reg::TRI_MODE, 0x41);
+  w(*d, Reg::MEM_ADDR, 0x40);
+  w(*d, Reg::MEM_DATA, 0x0102030405060708ull);
+  w(*d, Reg::RESET, 0x5245534555);  // wrong magic
+  EXPECT_EQ(rd(*d, Reg::HOST_TAG), 0x1234u);
+  EXPECT_EQ(errors_of(*d), ERR_BAD_VALUE);
+  w(*d, Reg::RESET, kResetMagic);
+  EXPECT_EQ(rd(*d, Reg::HOST_TAG), 0u);
+  EXPECT_EQ(rd(*d, Reg::TRI_MODE), 0u);
+  EXPECT_EQ(errors_of(*d), 0);
+  EXPECT_EQ(d->memory()[0x40], 1);
+  EXPECT_EQ(d->memory()[0x47], 8);
+}
+
+TEST(SimRegisters, FenceAndHostTag) {
+  auto d = make_device();
+  w(*d, Reg::FENCE, 0xDEADBEEFCAFEull);
+  EXPECT_EQ(rd(*d, Reg::FENCE), 0xDEADBEEFCAFEull);
+  w(*d, Reg::HOST_TAG, ~0ull);
+  EXPECT_EQ(rd(*d, Reg::HOST_TAG), ~0ull);
+}
+
+TEST(SimRegisters, MemoryWriteAndPrefetchedReads) {
+  auto d = make_device();
+  w(*d, Reg::MEM_ADDR, 0x100);
+  w(*d, Reg::MEM_DATA, 0x1111111111111111ull);
+  w(*d, Reg::MEM_DATA, 0x2222222222222222ull);
+  EXPECT_EQ(rd(*d, Reg::MEM_ADDR), 0x110u);
+  EXPECT_EQ(d->memory()[0x100], 0x11);
+  EXPECT_EQ(d->memory()[0x108], 0x22);
+  w(*d, Reg::MEM_ADDR, 0x100);
+  EXPECT_EQ((rd(*d, Reg::STATUS) >> 18) & 1, 1u);  // MEM_READY
+  EXPECT_NE(d->miso_status() & MISO_MEM_READY, 0);
+  EXPECT_EQ(rd(*d, Reg::MEM_DATA), 0x1111111111111111ull);
+  EXPECT_EQ(rd(*d, Reg::MEM_DATA), 0x2222222222222222ull);
+  EXPECT_EQ(rd(*d, Reg::MEM_DATA), 0u);
+  EXPECT_EQ(rd(*d, Reg::MEM_ADDR), 0x118u);
+  EXPECT_EQ(errors_of(*d), 0);
+}
+
+TEST(SimRegisters, MemoryBeyondVramReadsZeroAndFlags) {
+  DeviceOptions o;
+  o.vram_bytes = 64 << 10;
+  auto d = make_device(o);
+  w(*d, Reg::MEM_ADDR, (64 << 10) - 8);
+  w(*d, Reg::MEM_DATA, 0xFFFFFFFFFFFFFFFFull);
+  EXPECT_EQ(errors_of(*d), 0);  // the last word of memory is a legal write
+  w(*d, Reg::MEM_DATA, 5);      // entirely beyond: dropped
+  EXPECT_EQ(errors_of(*d), ERR_MEM_RANGE);
+  w(*d, Reg::ERR_CLEAR, 0xFFFF);
+  w(*d, Reg::MEM_ADDR, (64 << 10) - 8);
+  EXPECT_EQ(rd(*d, Reg::MEM_DATA), ~0ull);
+  EXPECT_EQ(errors_of(*d), 0);
+  EXPECT_EQ(rd(*d, Reg::MEM_DATA), 0u);
+  EXPECT_EQ(errors_of(*d), ERR_MEM_RANGE);
+}
+
+TEST(SimRegisters, MisoStatusByte) {
+  auto d = make_device();
+  std::uint8_t s = d->miso_status();
+  EXPECT_TRUE(miso_status_valid(s));
+  EXPECT_EQ(s & MISO_ERROR, 0);
+  d->read(0x44);
+  s = d->miso_status();
+  EXPECT_NE(s & MISO_ERROR, 0);
+  EXPECT_NE(s & MISO_VBLANK, 0);
+}
+
+TEST(SimRegisters, FramingErrorIsSticky) {
+  auto d = make_device();
+  d->frame_aborted();
+  EXPECT_EQ(errors_of(*d), ERR_FRAMING);
+  EXPECT_EQ(errors_of(*d), ERR_FRAMING);
+  w(*d, Reg::ERR_CLEAR, ERR_LINK_CRC);  // clears only the named flags
+  EXPECT_EQ(errors_of(*d), ERR_FRAMING);
+  w(*d, Reg::ERR_CLEAR, ERR_FRAMING);
+  EXPECT_EQ(errors_of(*d), 0);
+}
+
+TEST(SimRegisters, OptionsAreValidated) {
+  DeviceOptions o;
+  o.fifo_depth = 10;
+  EXPECT_FALSE(Device::create(o).ok());
+  o = {};
+  o.vram_bytes = 1000;
+  EXPECT_FALSE(Device::create(o).ok());
+  o = {};
+  o.threads = 0;
+  EXPECT_FALSE(Device::create(o).ok());
+}
+
+TEST(SimKnobs, ParseAndErrors) {
+  AccuracyKnobs k;
+  EXPECT_TRUE(apply_knob(k, "recip_bits=8").ok());
+  EXPECT_TRUE(apply_knob(k, "fast=1").ok());
+  EXPECT_EQ(k.recip_bits, 8u);
+  EXPECT_TRUE(k.fast);
+  EXPECT_FALSE(k.exact());
+  auto bad = apply_knob(k, "recip_bits=40");
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.error().message.find("1..16"), std::string::npos);
+  EXPECT_FALSE(apply_knob(k, "nosuch=1").ok());
+  EXPECT_FALSE(apply_knob(k, "z_bits").ok());
+  EXPECT_FALSE(apply_knob(k, "z_bits=abc").ok());
+  EXPECT_TRUE(AccuracyKnobs{}.exact());
+}
+
+}  // namespace
+}  // namespace gpubridge::sim::test
