@@ -79,6 +79,9 @@ Result<ParsedCommandLine> parse_command_line(int argc, const char* const* argv) 
     return make_error(std::string(e.what()) + " (see gpubridge-view --help)", 2);
   }
 
+  // Range checks let NaN through (every comparison with NaN is false): check it positively.
+  if (!(o.timeout_s >= 0.1 && o.timeout_s <= 86400.0))
+    return make_error("--timeout: expected seconds from 0.1 to 86400", 2);
   auto scale_mode = parse_scale(scale);
   if (!scale_mode) return Error{scale_mode.error().message, 2};
   o.scale = *scale_mode;

@@ -1,0 +1,57 @@
+// DaemonFrameSource pieces that need no daemon: the WELCOME description and the failure paths.
+#include <gtest/gtest.h>
+
+#include "gpubridge/viewer/daemon_frame_source.hpp"
+
+namespace gpubridge::viewer {
+namespace {
+
+using namespace std::chrono_literals;
+
+TEST(DaemonSource, ReadsBackendAndBoardFromTheWelcome) {
+  EXPECT_EQ(backend_and_board(R"({"backend":"usb","board":"ulx3s-85f","x":1})"),
+            (std::pair<std::string, std::string>{"usb", "ulx3s-85f"}));
+  EXPECT_EQ(backend_and_board(R"({"backend":"sim"})"), (std::pair<std::string, std::string>{"sim", ""}));
+  EXPECT_EQ(backend_and_board(R"({"backend":5})"), (std::pair<std::string, std::string>{"", ""}));
+  EXPECT_EQ(backend_and_board("not json"), (std::pair<std::string, std::string>{"?", ""}));
+  EXPECT_EQ(backend_and_board("[1,2]"), (std::pair<std::string, std::string>{"?", ""}));
+}
+
+SourceStatus wait_for_end(FrameSource& s) {
+  for (int i = 0; i < 100; ++i) {
+    const auto v = s.status_version();
+    const auto st = s.status();
+    if (st.state == SourceStatus::State::Failed || st.state == SourceStatus::State::Waiting) return st;
+    s.wait(100ms, v);
+  }
+  return s.status();
+}
+
+TEST(DaemonSource, FailsWithOneClearLineWhenNothingListens) {
+  DaemonFrameSource s({"unix:/nonexistent-dir-for-gpubridge-view-test/x.sock", "", 60, false});
+  s.start();
+  const auto st = wait_for_end(s);
+  EXPECT_EQ(st.state, SourceStatus::State::Failed);
+  EXPECT_EQ(st.address, "unix:/nonexistent-dir-for-gpubridge-view-test/x.sock");
+  EXPECT_NE(st.message.find("is gpubridged running"), std::string::npos) << st.message;
+  EXPECT_EQ(st.message.find('\n'), std::string::npos);
+}
+
+TEST(DaemonSource, WaitsInsteadWhenAskedTo) {
+  DaemonFrameSource s({"unix:/nonexistent-dir-for-gpubridge-view-test/x.sock", "", 60, true});
+  s.start();
+  const auto st = wait_for_end(s);
+  EXPECT_EQ(st.state, SourceStatus::State::Waiting);
+  s.stop();
+}
+
+TEST(DaemonSource, RefusesAMalformedAddress) {
+  DaemonFrameSource s({"carrier-pigeon:somewhere", "", 60, true});
+  s.start();
+  const auto st = wait_for_end(s);
+  EXPECT_EQ(st.state, SourceStatus::State::Failed);
+  EXPECT_FALSE(st.message.empty());
+}
+
+}  // namespace
+}  // namespace gpubridge::viewer
