@@ -1,0 +1,41 @@
+#pragma once
+// A CommandSink that streams to a gpubridged daemon over its socket protocol (Client from
+// gpubridge_client). Only built when that library is in the tree.
+#include <memory>
+#include <string_view>
+
+#include "gpubridge/client/client.hpp"
+#include "gpubridge/draw/sink.hpp"
+
+namespace gpubridge::draw {
+
+class ClientSink final : public CommandSink {
+ public:
+  // Uses a connected, handshaken client that holds the device lease.
+  explicit ClientSink(client::Client& client);
+  // Connects to `address` ("" = the default socket), says hello as `name` and acquires the lease
+  // (waiting for it up to `timeout`).
+  static Result<std::unique_ptr<ClientSink>> connect(std::string_view address, std::string_view name,
+                                                     std::string_view token = {},
+                                                     client::Timeout timeout = client::kDefaultTimeout);
+
+  Result<void> write_frames(protocol::FrameView frames) override { return client_->write_frames(frames); }
+  Result<void> upload(std::uint32_t address, std::span<const std::uint8_t> bytes) override {
+    return client_->upload(address, bytes);
+  }
+  Result<std::vector<std::uint8_t>> readback(std::uint32_t address, std::uint32_t length) override {
+    return client_->readback(address, length);
+  }
+  Result<void> flush() override { return client_->fence(); }
+  // From the daemon's WELCOME device description ("vram_bytes"); 8 MiB if it does not say.
+  std::uint64_t vram_bytes() const override { return vram_; }
+
+  client::Client& client() { return *client_; }
+
+ private:
+  std::unique_ptr<client::Client> owned_;
+  client::Client* client_;
+  std::uint64_t vram_ = 8u << 20;
+};
+
+}  // namespace gpubridge::draw

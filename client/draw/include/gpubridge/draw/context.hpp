@@ -1,0 +1,138 @@
+#pragma once
+// The drawing API: state, textures, indexed triangle lists with transforms and clipping, clears,
+// swaps — on any CommandSink (simulator, board, daemon, recorder).
+//
+//   draw::BackendSink sink(simulator);
+//   auto ctx = draw::Context::create(sink, {.width = 320, .height = 240});
+//   auto tex = ctx->load_texture("bricks.png", {.format = protocol::PixelFormat::RGB565});
+//   ctx->clear({0, 0, 0, 1});
+//   ctx->clear_depth(1.0);
+//   ctx->state().z_test = ctx->state().z_write = true;
+//   ctx->set_transform(projection * view * model);
+//   ctx->bind_texture(&*tex);
+//   ctx->draw_indexed(cube_vertices, cube_indices);
+//   ctx->swap();
+//
+// Video memory is allocated from address 0 upwards (256-byte aligned): the colour buffers (two
+// when double-buffered), the depth buffer, then textures in creation order. Textures live until
+// the Context is destroyed.
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "gpubridge/common/image.hpp"
+#include "gpubridge/common/result.hpp"
+#include "gpubridge/draw/sink.hpp"
+#include "gpubridge/geometry/encode.hpp"
+#include "gpubridge/geometry/math.hpp"
+#include "gpubridge/geometry/pipeline.hpp"
+
+namespace gpubridge::draw {
+
+struct ContextOptions {
+  unsigned width = 640, height = 480;
+  protocol::PixelFormat format = protocol::PixelFormat::RGBA8888;
+  bool depth_buffer = true;
+  bool double_buffer = true;
+  std::size_t batch_frames = 8192;  // pending register writes sent to the sink in one go
+};
+
+// A vertex of an indexed mesh, in model space.
+struct Vertex {
+  geometry::Vec3 position;
+  geometry::Vec4 color{1, 1, 1, 1};
+  geometry::Vec2 uv;
+
+  Vertex() = default;
+  Vertex(geometry::Vec3 p, geometry::Vec4 c = {1, 1, 1, 1}, geometry::Vec2 t = {}) : position(p), color(c), uv(t) {}
+};
+
+struct TextureOptions {
+  protocol::PixelFormat format = protocol::PixelFormat::RGBA8888;
+  protocol::Wrap wrap_s = protocol::Wrap::Repeat;
+  protocol::Wrap wrap_t = protocol::Wrap::Repeat;
+  bool bilinear = false;
+};
+
+struct Texture {
+  std::uint32_t address = 0;
+  geometry::TextureFormat format;
+};
+
+class Context {
+ public:
+  // Places the buffers and sets up FB_FORMAT, FB_DRAW, FB_Z, SCISSOR. Errors: bad size, not
+  // enough video memory, or the sink's error.
+  static Result<Context> create(CommandSink& sink, const ContextOptions& options = {});
+
+  // --- state (applied to the following draws) ---
+  // Everything in TRI_MODE except TEXTURED, which follows the bound texture.
+  geometry::RenderState& state() { return state_; }
+  void set_cull(geometry::CullMode mode, geometry::FrontFace front = geometry::FrontFace::CounterClockwise);
+  // Model-view-projection matrix (clip space as in geometry/math.hpp).
+  void set_transform(const geometry::Mat4& mvp) { mvp_ = mvp; }
+  // Defaults to the whole framebuffer.
+  void set_viewport(const geometry::Viewport& vp) { viewport_ = vp; }
+  Result<void> set_scissor(unsigned x0, unsigned y0, unsigned x1, unsigned y1);
+  void reset_scissor();
+
+  // --- textures ---
+  // Converts the image to the board format and uploads it. Sizes: powers of two 8..1024.
+  Result<Texture> create_texture(const Image& image, const TextureOptions& options = {});
+  Result<Texture> load_texture(const std::filesystem::path& png, const TextureOptions& options = {});
+  // nullptr unbinds (untextured drawing).
+  void bind_texture(const Texture* texture);
+
+  // --- drawing ---
+  Result<void> clear(geometry::Vec4 color);
+  Result<void> clear_depth(double z = 1.0);
+  // Indexed triangle list: every 3 indices form a triangle. Vertices are transformed once each.
+  Result<void> draw_indexed(std::span<const Vertex> vertices, std::span<const std::uint32_t> indices);
+  // Screen-space triangle list (pixels, y down; w for perspective-correct attributes).
+  Result<void> draw_screen(std::span<const geometry::ScreenVertex> vertices);
+  // Shows the back buffer (FB_DISPLAY) and, double-buffered, starts drawing into the other one.
+  Result<void> swap();
+  // Sends pending commands and waits until the device has executed them.
+  Result<void> flush();
+  // Reads the displayed buffer back (after swap) as an RGBA image.
+  Result<Image> read_display();
+
+  const geometry::PipelineStats& stats() const { return stats_; }
+  unsigned width() const { return options_.width; }
+  unsigned height() const { return options_.height; }
+  std::uint32_t back_buffer() const { return color_[back_]; }
+  std::uint32_t front_buffer() const { return color_[1 - back_]; }
+
+ private:
+  Context(CommandSink& sink, const ContextOptions& options) : sink_(&sink), options_(options) {}
+  Result<std::uint32_t> allocate(std::uint64_t bytes, const char* what);
+  void write(protocol::Reg reg, std::uint64_t data);
+  Result<void> send_pending();
+  Result<void> apply_state(geometry::PipelineOptions& opt);
+  Result<void> emit(const geometry::Triangle& tri, const geometry::PipelineOptions& opt, std::size_t first_index);
+
+  CommandSink* sink_;
+  ContextOptions options_;
+  std::uint64_t next_free_ = 0;
+  std::uint32_t color_[2] = {0, 0};
+  int back_ = 0;
+  std::optional<std::uint32_t> depth_;
+  geometry::RenderState state_;
+  geometry::CullMode cull_ = geometry::CullMode::None;
+  geometry::FrontFace front_ = geometry::FrontFace::CounterClockwise;
+  geometry::Mat4 mvp_ = geometry::identity();
+  std::optional<geometry::Viewport> viewport_;
+  std::optional<Texture> texture_;
+  std::uint64_t scissor_ = 0;
+  // Last values written, to skip redundant register writes.
+  std::optional<std::uint64_t> sent_tri_mode_, sent_tex_base_, sent_tex_fmt_;
+  std::vector<protocol::Frame> pending_;
+  std::vector<std::uint8_t> wire_;
+  std::vector<geometry::DeviceTriangle> scratch_;
+  std::vector<geometry::Vertex> transformed_;
+  geometry::PipelineStats stats_;
+};
+
+}  // namespace gpubridge::draw

@@ -1,0 +1,66 @@
+#pragma once
+// Where the drawing API's commands go. One small interface with implementations for any
+// Backend (the in-process simulator, a board), a daemon connection (client_sink.hpp) and a
+// recorder that keeps the commands as a CommandStream (for traces and tests).
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "gpubridge/backends/backend.hpp"
+#include "gpubridge/common/result.hpp"
+#include "gpubridge/protocol/command_stream.hpp"
+#include "gpubridge/protocol/frame.hpp"
+
+namespace gpubridge::draw {
+
+class CommandSink {
+ public:
+  virtual ~CommandSink() = default;
+  // Register writes (write frames only), executed in order with uploads.
+  virtual Result<void> write_frames(protocol::FrameView frames) = 0;
+  virtual Result<void> upload(std::uint32_t address, std::span<const std::uint8_t> bytes) = 0;
+  virtual Result<std::vector<std::uint8_t>> readback(std::uint32_t address, std::uint32_t length) = 0;
+  // Returns once every earlier command has executed.
+  virtual Result<void> flush() = 0;
+  // Size of the device's video memory (bytes), used to place buffers and textures.
+  virtual std::uint64_t vram_bytes() const = 0;
+};
+
+// Any backends::Backend: the simulator in-process, or a board through a USB-SPI bridge.
+class BackendSink final : public CommandSink {
+ public:
+  explicit BackendSink(backends::Backend& backend) : backend_(backend) {}
+  Result<void> write_frames(protocol::FrameView frames) override { return backend_.write_frames(frames); }
+  Result<void> upload(std::uint32_t address, std::span<const std::uint8_t> bytes) override {
+    return backend_.upload(address, bytes);
+  }
+  Result<std::vector<std::uint8_t>> readback(std::uint32_t address, std::uint32_t length) override {
+    return backend_.readback(address, length);
+  }
+  Result<void> flush() override { return backend_.flush(); }
+  std::uint64_t vram_bytes() const override { return backend_.info().vram_bytes; }
+
+ private:
+  backends::Backend& backend_;
+};
+
+// Records commands into a CommandStream (nothing executes; readback is an error). Use it to
+// write a trace of a drawing program or to inspect what the API sends.
+class RecordingSink final : public CommandSink {
+ public:
+  explicit RecordingSink(std::uint64_t vram_bytes = 8u << 20) : vram_(vram_bytes) {}
+  Result<void> write_frames(protocol::FrameView frames) override;
+  Result<void> upload(std::uint32_t address, std::span<const std::uint8_t> bytes) override;
+  Result<std::vector<std::uint8_t>> readback(std::uint32_t address, std::uint32_t length) override;
+  Result<void> flush() override { return {}; }
+  std::uint64_t vram_bytes() const override { return vram_; }
+
+  const protocol::CommandStream& stream() const { return stream_; }
+  protocol::CommandStream take() { return std::move(stream_); }
+
+ private:
+  std::uint64_t vram_;
+  protocol::CommandStream stream_;
+};
+
+}  // namespace gpubridge::draw

@@ -1,0 +1,219 @@
+#include "gpubridge/draw/context.hpp"
+
+#include <fmt/format.h>
+
+namespace gpubridge::draw {
+namespace {
+
+using protocol::Reg;
+constexpr std::uint64_t kAlignment = 256;
+
+}  // namespace
+
+Result<std::uint32_t> Context::allocate(std::uint64_t bytes, const char* what) {
+  const std::uint64_t at = next_free_;
+  const std::uint64_t end = (at + bytes + kAlignment - 1) / kAlignment * kAlignment;
+  const std::uint64_t vram = sink_->vram_bytes();
+  if (end > vram)
+    return make_error(fmt::format("not enough video memory for the {} ({} bytes at 0x{:x}; the device has {} bytes)", what,
+                                  bytes, at, vram));
+  next_free_ = end;
+  return static_cast<std::uint32_t>(at);
+}
+
+Result<Context> Context::create(CommandSink& sink, const ContextOptions& options) {
+  Context c(sink, options);
+  auto fb = geometry::fb_format_word(options.width, options.height, options.format);
+  if (!fb) return fb.error();
+  const std::uint64_t color_bytes = std::uint64_t{options.width} * options.height * protocol::bytes_per_pixel(options.format);
+  for (int i = 0; i < (options.double_buffer ? 2 : 1); ++i) {
+    auto a = c.allocate(color_bytes, "colour buffer");
+    if (!a) return a.error();
+    c.color_[i] = *a;
+  }
+  if (!options.double_buffer) c.color_[1] = c.color_[0];
+  if (options.depth_buffer) {
+    auto a = c.allocate(std::uint64_t{options.width} * options.height * 4, "depth buffer");
+    if (!a) return a.error();
+    c.depth_ = *a;
+  }
+  c.write(Reg::FB_FORMAT, *fb);
+  c.write(Reg::FB_DRAW, c.back_buffer());
+  if (c.depth_) c.write(Reg::FB_Z, *c.depth_);
+  c.reset_scissor();
+  if (auto r = c.send_pending(); !r) return r.error();
+  return c;
+}
+
+void Context::write(protocol::Reg reg, std::uint64_t data) { pending_.push_back(protocol::write_frame(reg, data)); }
+
+Result<void> Context::send_pending() {
+  if (pending_.empty()) return {};
+  wire_.clear();
+  wire_.reserve(pending_.size() * protocol::kFrameBytes);
+  for (const auto& f : pending_) protocol::append(wire_, f);
+  pending_.clear();
+  return sink_->write_frames(protocol::FrameView{wire_});
+}
+
+void Context::set_cull(geometry::CullMode mode, geometry::FrontFace front) {
+  cull_ = mode;
+  front_ = front;
+}
+
+Result<void> Context::set_scissor(unsigned x0, unsigned y0, unsigned x1, unsigned y1) {
+  auto w = geometry::scissor_word(x0, y0, x1, y1);
+  if (!w) return w.error();
+  if (*w != scissor_) write(Reg::SCISSOR, *w);
+  scissor_ = *w;
+  return {};
+}
+
+void Context::reset_scissor() {
+  const auto full = *geometry::scissor_word(0, 0, protocol::kMaxFramebufferDim, protocol::kMaxFramebufferDim);
+  if (full != scissor_) write(Reg::SCISSOR, full);  // scissor_ starts at 0, so creation writes it
+  scissor_ = full;
+}
+
+Result<Texture> Context::create_texture(const Image& image, const TextureOptions& o) {
+  Texture t;
+  t.format = geometry::TextureFormat{image.width, image.height, o.format, o.wrap_s, o.wrap_t, o.bilinear};
+  if (auto w = geometry::tex_fmt_word(t.format); !w) return w.error();
+  if (image.rgba.size() != std::size_t{image.width} * image.height * 4)
+    return make_error(fmt::format("texture image data holds {} bytes, not {}x{}x4", image.rgba.size(), image.width, image.height));
+  auto a = allocate(std::uint64_t{image.width} * image.height * protocol::bytes_per_pixel(o.format), "texture");
+  if (!a) return a.error();
+  t.address = *a;
+  if (auto r = send_pending(); !r) return r.error();  // keep uploads ordered with register writes
+  const auto bytes = device_from_image(o.format, image);
+  if (auto r = sink_->upload(t.address, bytes); !r) return r.error();
+  return t;
+}
+
+Result<Texture> Context::load_texture(const std::filesystem::path& png, const TextureOptions& options) {
+  auto img = load_png(png);
+  if (!img) return img.error();
+  auto t = create_texture(*img, options);
+  if (!t) return make_error(fmt::format("{}: {}", png.string(), t.error().message));
+  return t;
+}
+
+void Context::bind_texture(const Texture* texture) {
+  if (texture)
+    texture_ = *texture;
+  else
+    texture_.reset();
+}
+
+Result<void> Context::clear(geometry::Vec4 color) {
+  auto c = geometry::color_to_rgba8(color);
+  if (!c) return make_error("clear colour: " + c.error().message);
+  write(Reg::CLEAR_COLOR, *c);
+  write(Reg::CLEAR, 0);
+  return {};
+}
+
+Result<void> Context::clear_depth(double z) {
+  if (!depth_) return make_error("clear_depth: this context has no depth buffer (ContextOptions::depth_buffer)");
+  auto v = geometry::depth_to_z24(z);
+  if (!v) return make_error("clear_depth: " + v.error().message);
+  write(Reg::CLEAR_DEPTH, *v);
+  write(Reg::CLEAR_Z, 0);
+  return {};
+}
+
+Result<void> Context::apply_state(geometry::PipelineOptions& opt) {
+  if ((state_.z_test || state_.z_write) && !depth_)
+    return make_error("depth test/write requested but this context has no depth buffer (ContextOptions::depth_buffer)");
+  geometry::RenderState s = state_;
+  s.textured = texture_.has_value();
+  const std::uint64_t mode = geometry::tri_mode_word(s);
+  if (sent_tri_mode_ != mode) write(Reg::TRI_MODE, mode);
+  sent_tri_mode_ = mode;
+  opt.cull = cull_;
+  opt.front_face = front_;
+  opt.textured = s.textured;
+  if (texture_) {
+    const std::uint64_t fmt = *geometry::tex_fmt_word(texture_->format);  // validated at creation
+    if (sent_tex_base_ != texture_->address) write(Reg::TEX_BASE, texture_->address);
+    if (sent_tex_fmt_ != fmt) write(Reg::TEX_FMT, fmt);
+    sent_tex_base_ = texture_->address;
+    sent_tex_fmt_ = fmt;
+    opt.tex = {texture_->format.wrap_s, texture_->format.wrap_t};
+  }
+  write(Reg::PRIM, static_cast<unsigned>(protocol::PrimType::List));
+  return {};
+}
+
+Result<void> Context::emit(const geometry::Triangle& tri, const geometry::PipelineOptions& opt, std::size_t first_index) {
+  scratch_.clear();
+  auto r = geometry::process_triangle(tri, opt, scratch_, &stats_);
+  if (!r) return make_error(fmt::format("triangle at index {}: {}", first_index, r.error().message));
+  for (const auto& t : scratch_) geometry::encode_triangle(t, opt.textured, pending_);
+  if (pending_.size() >= options_.batch_frames) return send_pending();
+  return {};
+}
+
+Result<void> Context::draw_indexed(std::span<const Vertex> vertices, std::span<const std::uint32_t> indices) {
+  if (indices.size() % 3 != 0)
+    return make_error(fmt::format("draw_indexed: {} indices is not a multiple of 3 (a triangle list)", indices.size()));
+  for (std::size_t i = 0; i < indices.size(); ++i)
+    if (indices[i] >= vertices.size())
+      return make_error(fmt::format("draw_indexed: index {} at position {} is out of range ({} vertices)", indices[i], i,
+                                    vertices.size()));
+  geometry::PipelineOptions opt;
+  if (auto r = apply_state(opt); !r) return r;
+  const geometry::Viewport vp = viewport_.value_or(
+      geometry::Viewport{0, 0, static_cast<double>(options_.width), static_cast<double>(options_.height)});
+  const geometry::Mat4 m = geometry::viewport_matrix(vp) * mvp_;
+  transformed_.resize(vertices.size());
+  for (std::size_t i = 0; i < vertices.size(); ++i)
+    transformed_[i] = geometry::Vertex{m * geometry::point(vertices[i].position), vertices[i].color, vertices[i].uv};
+  for (std::size_t i = 0; i < indices.size(); i += 3) {
+    const geometry::Triangle tri{transformed_[indices[i]], transformed_[indices[i + 1]], transformed_[indices[i + 2]]};
+    if (auto r = emit(tri, opt, i); !r) return r;
+  }
+  return {};
+}
+
+Result<void> Context::draw_screen(std::span<const geometry::ScreenVertex> vertices) {
+  if (vertices.size() % 3 != 0)
+    return make_error(fmt::format("draw_screen: {} vertices is not a multiple of 3 (a triangle list)", vertices.size()));
+  geometry::PipelineOptions opt;
+  if (auto r = apply_state(opt); !r) return r;
+  for (std::size_t i = 0; i < vertices.size(); i += 3) {
+    for (std::size_t k = i; k < i + 3; ++k)
+      if (!(vertices[k].w > 0))
+        return make_error(fmt::format("draw_screen: vertex {}: w = {} must be > 0", k, vertices[k].w));
+    const geometry::Triangle tri{geometry::from_screen(vertices[i]), geometry::from_screen(vertices[i + 1]),
+                                 geometry::from_screen(vertices[i + 2])};
+    if (auto r = emit(tri, opt, i); !r) return r;
+  }
+  return {};
+}
+
+Result<void> Context::swap() {
+  write(Reg::FB_DISPLAY, back_buffer());
+  if (options_.double_buffer) {
+    back_ = 1 - back_;
+    write(Reg::FB_DRAW, back_buffer());
+  }
+  return send_pending();
+}
+
+Result<void> Context::flush() {
+  if (auto r = send_pending(); !r) return r;
+  return sink_->flush();
+}
+
+Result<Image> Context::read_display() {
+  if (auto r = flush(); !r) return r.error();
+  const std::uint32_t bytes = options_.width * options_.height * protocol::bytes_per_pixel(options_.format);
+  auto data = sink_->readback(front_buffer(), bytes);
+  if (!data) return data.error();
+  if (data->size() != bytes)
+    return make_error(fmt::format("readback returned {} bytes instead of {}", data->size(), bytes));
+  return image_from_device(options_.format, options_.width, options_.height, *data);
+}
+
+}  // namespace gpubridge::draw
