@@ -62,7 +62,8 @@ TEST_P(BoardEndToEnd, ScanoutFrameMatchesUploadedPixelsAndFrameCrc) {
   EXPECT_EQ(got->crc, protocol::crc32(pixels));
 }
 
-INSTANTIATE_TEST_SUITE_P(Chips, BoardEndToEnd, ::testing::Values(BridgeChip::FT232H, BridgeChip::FT2232H),
+INSTANTIATE_TEST_SUITE_P(Chips, BoardEndToEnd, ::testing::Values(BridgeChip::FT232H, BridgeChip::FT2232H, BridgeChip::FT4232H,
+                                                           BridgeChip::CH341A, BridgeChip::MCP2210, BridgeChip::CP2130),
                          [](const auto& i) { return std::string(to_string(i.param)); });
 
 TEST(BoardBackend, SlowDeviceWithBusyPinNeverOverflows) {

@@ -1,7 +1,13 @@
 #include "gpubridge/usb/emu/emulated_stack.hpp"
 
 #include "gpubridge/backends/backend.hpp"
+#include "gpubridge/usb/ch341a.hpp"
+#include "gpubridge/usb/cp2130.hpp"
+#include "gpubridge/usb/emu/ch341a_model.hpp"
+#include "gpubridge/usb/emu/cp2130_model.hpp"
+#include "gpubridge/usb/emu/mcp2210_model.hpp"
 #include "gpubridge/usb/emu/mpsse_model.hpp"
+#include "gpubridge/usb/mcp2210.hpp"
 #include "gpubridge/usb/emu/reference_target.hpp"
 #include "gpubridge/usb/ftdi_mpsse.hpp"
 #if GPUBRIDGE_HAVE_SIM
@@ -31,6 +37,9 @@ struct EmulatedStack::Impl {
   bool simulator = false;
   std::unique_ptr<SpiSlave> slave;
   std::unique_ptr<MpsseModel> mpsse;
+  std::unique_ptr<Ch341aModel> ch341a;
+  std::unique_ptr<Mcp2210Model> mcp2210;
+  std::unique_ptr<Cp2130Model> cp2130;
   FaultPlan no_faults;
 
   Result<std::unique_ptr<backends::SpiTarget>> make_target() {
@@ -99,20 +108,26 @@ Result<std::unique_ptr<EmulatedStack>> EmulatedStack::create(const BoardProfile&
       impl->mpsse = std::make_unique<MpsseModel>(c, impl->slave.get());
       break;
     }
-    default:
-      return make_error("emulated board '" + profile.name + "': no model for bridge chip " + std::string(to_string(profile.chip)),
-                        backends::kBadRequest);
+    case BridgeChip::CH341A: impl->ch341a = std::make_unique<Ch341aModel>(impl->slave.get(), opts.serial); break;
+    case BridgeChip::MCP2210: impl->mcp2210 = std::make_unique<Mcp2210Model>(impl->slave.get(), opts.serial); break;
+    case BridgeChip::CP2130: impl->cp2130 = std::make_unique<Cp2130Model>(impl->slave.get(), opts.serial); break;
   }
   return std::unique_ptr<EmulatedStack>(new EmulatedStack(std::move(impl)));
 }
 
 UsbDevice* EmulatedStack::usb() {
   if (impl_->mpsse) return impl_->mpsse.get();
+  if (impl_->ch341a) return impl_->ch341a.get();
+  if (impl_->cp2130) return impl_->cp2130.get();
   return nullptr;
 }
-HidDevice* EmulatedStack::hid() { return nullptr; }
+HidDevice* EmulatedStack::hid() { return impl_->mcp2210.get(); }
+Mcp2210Model* EmulatedStack::mcp2210() { return impl_->mcp2210.get(); }
 FaultPlan& EmulatedStack::usb_faults() {
   if (impl_->mpsse) return impl_->mpsse->faults();
+  if (impl_->ch341a) return impl_->ch341a->faults();
+  if (impl_->cp2130) return impl_->cp2130->faults();
+  if (impl_->mcp2210) return impl_->mcp2210->faults();
   return impl_->no_faults;
 }
 SpiFaults& EmulatedStack::spi_faults() { return impl_->slave->faults(); }
@@ -122,11 +137,13 @@ bool EmulatedStack::target_is_simulator() const { return impl_->simulator; }
 void EmulatedStack::power_cycle() { impl_->power_cycle(); }
 std::vector<std::string> EmulatedStack::violations() const {
   if (impl_->mpsse) return impl_->mpsse->violations();
+  if (impl_->ch341a) return impl_->ch341a->violations();
+  if (impl_->cp2130) return impl_->cp2130->violations();
+  if (impl_->mcp2210) return impl_->mcp2210->violations();
   return {};
 }
 
 Result<std::unique_ptr<SpiBridge>> open_bridge(const BoardProfile& p, UsbDevice* usb, HidDevice* hid) {
-  (void)hid;
   switch (p.chip) {
     case BridgeChip::FT232H:
     case BridgeChip::FT2232H:
@@ -143,9 +160,26 @@ Result<std::unique_ptr<SpiBridge>> open_bridge(const BoardProfile& p, UsbDevice*
       if (!b) return b.error();
       return std::unique_ptr<SpiBridge>(std::move(*b));
     }
-    default:
-      return make_error("no driver for bridge chip " + std::string(to_string(p.chip)), backends::kBadRequest);
+    case BridgeChip::CH341A: {
+      if (!usb) return make_error("CH341A driver needs a USB device", backends::kBadRequest);
+      auto b = Ch341aBridge::open(*usb);
+      if (!b) return b.error();
+      return std::unique_ptr<SpiBridge>(std::move(*b));
+    }
+    case BridgeChip::CP2130: {
+      if (!usb) return make_error("CP2130 driver needs a USB device", backends::kBadRequest);
+      auto b = Cp2130Bridge::open(*usb, p.cs_pin, p.spi_clock_hz);
+      if (!b) return b.error();
+      return std::unique_ptr<SpiBridge>(std::move(*b));
+    }
+    case BridgeChip::MCP2210: {
+      if (!hid) return make_error("MCP2210 driver needs a HID device", backends::kBadRequest);
+      auto b = Mcp2210Bridge::open(*hid, p.cs_pin, p.spi_clock_hz);
+      if (!b) return b.error();
+      return std::unique_ptr<SpiBridge>(std::move(*b));
+    }
   }
+  return make_error("no driver for bridge chip " + std::string(to_string(p.chip)), backends::kBadRequest);
 }
 
 Result<EmulatedBoard> open_emulated_board(const BoardProfile& profile, EmulationOptions opts, BoardOptions board) {

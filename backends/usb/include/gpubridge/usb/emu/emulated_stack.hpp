@@ -15,6 +15,8 @@
 
 namespace gpubridge::usb::emu {
 
+class Mcp2210Model;
+
 struct EmulationOptions {
   bool use_simulator = true;     // drive the simulator's device model when it is built
   unsigned drain_per_frame = 0;  // device slower than the link (flow-control tests); 0 = instant
@@ -30,6 +32,7 @@ class EmulatedStack {
   // The transport the driver uses: exactly one of these is non-null (HID for MCP2210).
   UsbDevice* usb();
   HidDevice* hid();
+  Mcp2210Model* mcp2210();  // for busy/external-master injection (nullptr for other chips)
   FaultPlan& usb_faults();
   SpiFaults& spi_faults();
   SpiSlave& slave();
