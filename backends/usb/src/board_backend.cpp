@@ -76,6 +76,12 @@ void BoardBackend::note_sent(const Frame& f) {
   host_crc_ = protocol::crc32_update(host_crc_, bytes);
 }
 
+void BoardBackend::track_memory_pointer(const Frame& f) {
+  if (f.read) return;
+  if (f.index == index_of(Reg::MEM_ADDR)) mem_addr_ = static_cast<std::uint32_t>(f.data & 0xFFFFFFF8u);
+  else if (f.index == index_of(Reg::MEM_DATA) && mem_addr_) *mem_addr_ += 8;
+}
+
 void BoardBackend::track(const Frame& f) {
   if (f.index == index_of(Reg::FB_FORMAT)) fb_format_ = f.data;
   if (f.index == index_of(Reg::FB_DISPLAY)) fb_display_ = f.data;
@@ -147,6 +153,7 @@ Result<void> BoardBackend::attach_locked() {
   vram_bytes_ = static_cast<std::uint32_t>(std::min<std::uint64_t>(caps_vram ? caps_vram : ~0ull, std::uint64_t{profile_.vram_kib} * 1024));
   fb_format_ = protocol::describe(Reg::FB_FORMAT).reset;
   fb_display_ = 0;
+  mem_addr_.reset();  // unknown until a MEM_ADDR write is accepted
 
   // Register echo through HOST_TAG: proves writes land and lets us detect board resets later.
   tag_ = opts_.host_tag;
@@ -208,6 +215,8 @@ Result<void> BoardBackend::check_host_tag() {
     if ((*v)[0] == tag_) return {};
     last = (*v)[0];
   }
+  ++board_resets_;
+  mem_addr_.reset();
   const std::string msg = "board '" + profile_.name + "' was reset (HOST_TAG reads 0x" + fmt::format("{:X}", last) +
                           "): power cycle or FPGA reconfiguration, device state lost; the board was re-attached and "
                           "state must be replayed";
@@ -264,6 +273,7 @@ Result<unsigned> BoardBackend::fifo_credits() {
 Result<void> BoardBackend::send_frames(std::span<const Frame> frames) {
   std::size_t done = 0;
   unsigned failures = 0;
+  bool resync_mem = false;
   std::string last_problem;
   const std::size_t batch_limit = std::max<std::size_t>(kGroupFrames, bridge_->preferred_batch_bytes() / kFrameBytes);
   while (done < frames.size()) {
@@ -291,16 +301,21 @@ Result<void> BoardBackend::send_frames(std::span<const Frame> frames) {
     SpiWindow batch;
     std::uint32_t crc = host_crc_;
     std::size_t at = done, in_batch = 0;
+    auto put = [&](const Frame& f) {
+      wire.push_back(f);
+      const auto bytes = protocol::encode(f);
+      crc = protocol::crc32_update(crc, bytes);
+      mosi.insert(mosi.end(), bytes.begin(), bytes.end());
+    };
+    // After a failed batch the MEM_DATA pointer may have moved (a corrupted frame can arrive as
+    // an immediate MEM_DATA read), so a resend re-establishes it before any MEM_DATA write.
+    const bool readdress = resync_mem && mem_addr_.has_value();
     while (at < frames.size() && in_batch < max_frames) {
-      const std::size_t n = std::min({kGroupFrames, frames.size() - at, max_frames - in_batch});
+      const std::size_t room = (readdress && group_sizes.empty()) ? kGroupFrames - 1 : kGroupFrames;
+      const std::size_t n = std::min({room, frames.size() - at, max_frames - in_batch});
       batch.busy_waits.push_back(mosi.size());
-      for (std::size_t k = 0; k < n; ++k) {
-        const Frame& f = frames[at + k];
-        wire.push_back(f);
-        const auto bytes = protocol::encode(f);
-        crc = protocol::crc32_update(crc, bytes);
-        mosi.insert(mosi.end(), bytes.begin(), bytes.end());
-      }
+      if (readdress && group_sizes.empty()) put(protocol::write_frame(Reg::MEM_ADDR, *mem_addr_));
+      for (std::size_t k = 0; k < n; ++k) put(frames[at + k]);
       if (strict_) {
         wire.push_back(protocol::write_frame(Reg::LINK_CHECK, crc));
         append_frame(mosi, wire.back());
@@ -351,6 +366,7 @@ Result<void> BoardBackend::send_frames(std::span<const Frame> frames) {
     } else {
       last_problem = r.error().message;
       ++failures;
+      resync_mem = true;
       if (auto f = on_fault(r.error()); !f) return f;
       if (!strict_)
         return make_error(r.error().message + " (strict link mode is off, so the batch cannot be resent safely)",
@@ -366,6 +382,7 @@ Result<void> BoardBackend::send_frames(std::span<const Frame> frames) {
         return make_error("board '" + profile_.name + "': device reports " + protocol::describe_errors(errors) +
                               " after a batch (strict link mode is off, so writes may have been lost)",
                           backends::kDeviceProtocol);
+      for (std::size_t k = done; k < at; ++k) track_memory_pointer(frames[k]);
       done = at;
       stats_.payload_frames += in_batch;
       continue;
@@ -376,10 +393,13 @@ Result<void> BoardBackend::send_frames(std::span<const Frame> frames) {
     accepted = std::min(accepted, group_sizes.size());
     groups_ok_ = ok_now;
     for (std::size_t g = 0; g < accepted; ++g) {
+      for (std::size_t k = 0; k < group_sizes[g]; ++k) track_memory_pointer(frames[done + k]);
       done += group_sizes[g];
       stats_.payload_frames += group_sizes[g];
     }
+    if (accepted > 0) resync_mem = false;
     if (accepted < group_sizes.size()) {
+      resync_mem = true;
       if (r) {
         last_problem = "link CRC check failed for " + std::to_string(group_sizes.size() - accepted) + " group(s)";
         ++failures;
@@ -457,7 +477,7 @@ Result<void> BoardBackend::emit_scanout() {
                             std::to_string(bytes) + " bytes does not fit video memory (" + std::to_string(vram_bytes_) + " bytes)",
                         backends::kBadRequest);
     for (unsigned attempt = 0;; ++attempt) {
-      auto px = readback_locked(base, static_cast<std::uint32_t>(bytes));
+      auto px = readback_locked(base, static_cast<std::uint32_t>(bytes), /*verify=*/false);  // FRAME_CRC checks it
       if (!px) return px.error();
       if (protocol::crc32(*px) == frame->crc) {
         frame->pixels = std::move(*px);
@@ -525,7 +545,7 @@ Result<void> BoardBackend::upload(std::uint32_t address, std::span<const std::ui
   if (bytes.size() % 8 != 0) {
     // The last partial word keeps the bytes already in memory.
     const std::uint32_t last = address + static_cast<std::uint32_t>(bytes.size() / 8 * 8);
-    auto old = readback_locked(last, 8);
+    auto old = readback_locked(last, 8, /*verify=*/true);
     if (!old) return old.error();
     tail.assign(bytes.begin(), bytes.end());
     tail.insert(tail.end(), old->begin() + static_cast<std::ptrdiff_t>(bytes.size() % 8), old->end());
@@ -549,12 +569,11 @@ Result<std::vector<std::uint8_t>> BoardBackend::readback(std::uint32_t address, 
     return make_error("readback: " + std::to_string(length) + " bytes at 0x" + fmt::format("{:X}", address) +
                           " exceed video memory (" + std::to_string(vram_bytes_) + " bytes)",
                       backends::kBadRequest);
-  return readback_locked(address, length);
+  return readback_locked(address, length, opts_.verify_readback);
 }
 
-Result<std::vector<std::uint8_t>> BoardBackend::readback_locked(std::uint32_t address, std::uint32_t length) {
-  const std::uint32_t start = address & ~7u;
-  const std::uint64_t end = (std::uint64_t{address} + length + 7) & ~std::uint64_t{7};
+// One pass: MEM_ADDR (queued), wait for MEM_READY, then back-to-back MEM_DATA reads in bursts.
+Result<std::vector<std::uint8_t>> BoardBackend::read_memory_once(std::uint32_t start, std::size_t words_total) {
   const Frame set_addr = protocol::write_frame(Reg::MEM_ADDR, start);
   if (auto r = send_frames(std::span(&set_addr, 1)); !r) return r.error();
   if (auto r = poll_status(kStatusBusy | kStatusLinkPending | kStatusMemReady | kStatusLevelMask, kStatusMemReady,
@@ -562,8 +581,7 @@ Result<std::vector<std::uint8_t>> BoardBackend::readback_locked(std::uint32_t ad
       !r)
     return r.error();
   std::vector<std::uint8_t> out;
-  out.reserve(static_cast<std::size_t>(end - start));
-  const std::size_t words_total = static_cast<std::size_t>((end - start) / 8);
+  out.reserve(words_total * 8);
   const std::size_t per_window = std::max<std::size_t>(1, bridge_->preferred_batch_bytes() / kFrameBytes);
   std::vector<std::uint8_t> mosi;
   std::vector<Frame> frames;
@@ -574,11 +592,7 @@ Result<std::vector<std::uint8_t>> BoardBackend::readback_locked(std::uint32_t ad
     for (const auto& f : frames) append_frame(mosi, f);
     const SpiWindow w{mosi, true, {}};
     auto r = exchange(std::span(&w, 1), frames);
-    if (!r) {
-      if (auto f = on_fault(r.error()); !f) return f.error();
-      if (strict_) if (auto rl = restart_link(); !rl) return rl.error();
-      return r.error();
-    }
+    if (!r) return r.error();
     for (std::size_t k = 0; k < n; ++k) {
       if (!((*r)[k * kFrameBytes] & protocol::MISO_MEM_READY))
         return make_error("board '" + profile_.name + "': MEM_READY dropped during readback at 0x" +
@@ -588,6 +602,48 @@ Result<std::vector<std::uint8_t>> BoardBackend::readback_locked(std::uint32_t ad
                  r->begin() + static_cast<std::ptrdiff_t>(k * kFrameBytes + kFrameBytes));
     }
     done += n;
+  }
+  return out;
+}
+
+// Memory reads carry no checksum on the wire, so unless the caller verifies another way (scanout
+// compares FRAME_CRC) every chunk is read twice and must agree; a MISO bit error costs a re-read,
+// never a silently wrong byte.
+Result<std::vector<std::uint8_t>> BoardBackend::readback_locked(std::uint32_t address, std::uint32_t length, bool verify) {
+  const std::uint32_t start = address & ~7u;
+  const std::uint64_t end = (std::uint64_t{address} + length + 7) & ~std::uint64_t{7};
+  const std::size_t chunk_words = std::max<std::size_t>(1, bridge_->preferred_batch_bytes() / kFrameBytes);
+  std::vector<std::uint8_t> out;
+  out.reserve(static_cast<std::size_t>(end - start));
+  for (std::uint64_t at = start; at < end;) {
+    const std::size_t words = static_cast<std::size_t>(std::min<std::uint64_t>(chunk_words, (end - at) / 8));
+    std::vector<std::uint8_t> previous;
+    bool agreed = !verify;
+    std::vector<std::uint8_t> got;
+    const std::uint64_t resets_before = board_resets_;
+    for (unsigned attempt = 0; attempt < 2 + opts_.max_link_retries && !(agreed && !got.empty()); ++attempt) {
+      auto r = read_memory_once(static_cast<std::uint32_t>(at), words);
+      if (!r) {
+        // A board reset lost device state: that must reach the caller, never be retried over.
+        if (r.error().code == backends::kDeviceGone || r.error().code == backends::kBadRequest ||
+            board_resets_ != resets_before)
+          return r.error();
+        if (auto f = on_fault(r.error()); !f) return f.error();
+        if (strict_) if (auto rl = restart_link(); !rl) return rl.error();
+        continue;
+      }
+      got = std::move(*r);
+      if (!verify) break;
+      agreed = !previous.empty() && previous == got;
+      previous = got;
+    }
+    if (got.empty() || (verify && !agreed))
+      return make_error("board '" + profile_.name + "': memory readback at 0x" + fmt::format("{:X}", at) +
+                            " never read the same twice (SPI bit errors); lower bridge.spi_clock_hz",
+                        backends::kDeviceProtocol);
+    out.insert(out.end(), got.begin(), got.end());
+    at += words * 8;
+    mem_addr_.reset();
   }
   return std::vector<std::uint8_t>(out.begin() + (address - start), out.begin() + (address - start) + length);
 }

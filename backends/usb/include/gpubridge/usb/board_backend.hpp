@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <memory>
 #include <mutex>
+#include <optional>
 
 #include "gpubridge/backends/backend.hpp"
 #include "gpubridge/usb/board_profile.hpp"
@@ -16,6 +17,7 @@ struct BoardOptions {
   unsigned max_link_retries = 8;   // resends of one batch before giving up with kDeviceProtocol
   unsigned max_status_polls = 20000;  // bounded polling of STATUS (flow control, flush, swap)
   std::uint64_t host_tag = 0;      // written to HOST_TAG at attach (0 = derived from the clock)
+  bool verify_readback = true;     // read memory twice and compare (MISO has no checksum)
 };
 
 // Link counters for tests, benchmarks and `gpubridge bringup`.
@@ -61,9 +63,11 @@ class BoardBackend final : public backends::Backend {
   Result<std::uint64_t> poll_status(std::uint64_t mask, std::uint64_t want, const char* waiting_for);
   Result<unsigned> fifo_credits();
   Result<void> emit_scanout();
-  Result<std::vector<std::uint8_t>> readback_locked(std::uint32_t address, std::uint32_t length);
+  Result<std::vector<std::uint8_t>> readback_locked(std::uint32_t address, std::uint32_t length, bool verify);
+  Result<std::vector<std::uint8_t>> read_memory_once(std::uint32_t start, std::size_t words);
   void note_sent(const protocol::Frame& f);
   void track(const protocol::Frame& f);
+  void track_memory_pointer(const protocol::Frame& f);
   Error gone_error() const;
 
   BoardProfile profile_;
@@ -81,6 +85,8 @@ class BoardBackend final : public backends::Backend {
   std::uint64_t tag_ = 0;
   std::uint64_t fb_format_ = 0, fb_display_ = 0;
   std::uint32_t frame_number_ = 0;
+  std::optional<std::uint32_t> mem_addr_;  // device MEM_ADDR pointer after the last accepted write
+  std::uint64_t board_resets_ = 0;        // resets (power cycles) detected through HOST_TAG
   LinkStats stats_;
   std::vector<std::shared_ptr<const backends::ScanoutFrame>> pending_frames_;  // emitted after unlocking
 };
