@@ -1,0 +1,46 @@
+#pragma once
+// The demo scenes of issue 7, one per seed, all procedural. Each example draws frames through the
+// drawing API, so the same code renders on the in-process simulator or streams to a daemon.
+#include <functional>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "gpubridge/common/result.hpp"
+#include "gpubridge/draw/context.hpp"
+
+namespace gpubridge::examples {
+
+struct ExampleInfo {
+  std::string name;         // command-line name ("tetrahedron")
+  std::string seed;         // the seed it illustrates ("DMC-1")
+  std::string description;  // one line
+};
+
+class Example {
+ public:
+  virtual ~Example() = default;
+  virtual ExampleInfo info() const = 0;
+  // Framebuffer size/format and buffers the example wants.
+  virtual draw::ContextOptions options() const;
+  // Once per context: textures.
+  virtual Result<void> setup(draw::Context& ctx) = 0;
+  // Draws frame `n` (clears included), without swapping. Frame n is a pure function of n.
+  virtual Result<void> frame(draw::Context& ctx, unsigned n) = 0;
+};
+
+// Every example, in presentation order.
+std::vector<std::unique_ptr<Example>> make_examples();
+// nullptr for an unknown name.
+std::unique_ptr<Example> make_example(std::string_view name);
+std::vector<std::string> example_names();
+
+// The frame each example's golden image shows.
+inline constexpr unsigned kGoldenFrame = 12;
+
+// setup, then frames first..first+count-1, swapping after each and calling after_swap(n).
+Result<void> run_frames(Example& ex, draw::Context& ctx, unsigned first, unsigned count,
+                        const std::function<Result<void>(unsigned)>& after_swap = {});
+
+}  // namespace gpubridge::examples

@@ -1,0 +1,79 @@
+// ICEpi: a Gouraud-shaded cube next to a textured one (the register protocol's two basic paths).
+#include <cmath>
+
+#include "examples_internal.hpp"
+#include "mesh.hpp"
+
+namespace gpubridge::examples {
+namespace {
+
+// A cube of half-size 1: 4 vertices per face (own UVs), counter-clockwise from outside.
+Mesh cube_mesh(bool corner_colours) {
+  Mesh m;
+  const geometry::Vec3 normals[6] = {{0, 0, 1}, {0, 0, -1}, {1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}};
+  for (const auto& n : normals) {
+    const geometry::Vec3 u = std::abs(n.y) > 0 ? geometry::Vec3{1, 0, 0} : geometry::Vec3{0, 1, 0};
+    const geometry::Vec3 v = geometry::cross(n, u);
+    // Corners n ∓ u ∓ v with u × v = n: counter-clockwise from outside.
+    const geometry::Vec3 p[4] = {n - u - v, n + u - v, n + u + v, n - u + v};
+    const geometry::Vec2 t[4] = {{0, 1}, {1, 1}, {1, 0}, {0, 0}};
+    const auto base = static_cast<std::uint32_t>(m.vertices.size());
+    for (int k = 0; k < 4; ++k) {
+      const geometry::Vec4 c = corner_colours ? geometry::Vec4{(p[k].x + 1) / 2, (p[k].y + 1) / 2, (p[k].z + 1) / 2, 1}
+                                              : geometry::Vec4{1, 1, 1, 1};
+      m.vertices.emplace_back(p[k], c, t[k]);
+    }
+    for (std::uint32_t k : {0u, 1u, 2u, 0u, 2u, 3u}) m.indices.push_back(base + k);
+  }
+  return m;
+}
+
+class Cubes final : public Example {
+ public:
+  ExampleInfo info() const override {
+    return {"cubes", "ICEpi SPI GPU", "a Gouraud-shaded cube and a bilinear-textured cube, rotating"};
+  }
+
+  Result<void> setup(draw::Context& ctx) override {
+    Image img = make_image(32, 32);
+    for (unsigned y = 0; y < 32; ++y)
+      for (unsigned x = 0; x < 32; ++x) {
+        const bool border = x < 2 || y < 2 || x > 29 || y > 29;
+        const double d = std::hypot(x - 15.5, y - 15.5);
+        const bool ring = d > 7 && d < 10;
+        put(img, x, y, border ? 0.1 : ring ? 1.0 : 0.9, border ? 0.1 : ring ? 0.45 : 0.9, border ? 0.15 : ring ? 0.1 : 0.85);
+      }
+    auto t = ctx.create_texture(img, {.bilinear = true});
+    if (!t) return t.error();
+    texture_ = *t;
+    gouraud_ = cube_mesh(true);
+    textured_ = cube_mesh(false);
+    return {};
+  }
+
+  Result<void> frame(draw::Context& ctx, unsigned n) override {
+    if (auto r = ctx.clear({0.12, 0.1, 0.16, 1}); !r) return r;
+    if (auto r = ctx.clear_depth(1.0); !r) return r;
+    ctx.state() = {};
+    ctx.state().z_test = ctx.state().z_write = true;
+    ctx.set_cull(geometry::CullMode::Back);
+    const double t = n * 0.08;
+    const auto vp = projection(ctx, 0.8, 0.5, 30) * geometry::look_at({0, 1.2, 7}, {0, 0, 0}, {0, 1, 0});
+    ctx.set_transform(vp * geometry::translate({-1.7, 0, 0}) * geometry::rotate_y(t) * geometry::rotate_x(t * 0.7));
+    ctx.bind_texture(nullptr);
+    if (auto r = ctx.draw_indexed(gouraud_.vertices, gouraud_.indices); !r) return r;
+    ctx.set_transform(vp * geometry::translate({1.7, 0, 0}) * geometry::rotate_y(-t * 0.8) * geometry::rotate_z(t * 0.5));
+    ctx.bind_texture(&texture_);
+    return ctx.draw_indexed(textured_.vertices, textured_.indices);
+  }
+
+ private:
+  draw::Texture texture_;
+  Mesh gouraud_, textured_;
+};
+
+}  // namespace
+
+std::unique_ptr<Example> make_cubes() { return std::make_unique<Cubes>(); }
+
+}  // namespace gpubridge::examples

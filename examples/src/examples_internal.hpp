@@ -1,0 +1,23 @@
+#pragma once
+// Factories of the individual examples and small helpers they share.
+#include <memory>
+
+#include "gpubridge/examples/example.hpp"
+#include "gpubridge/geometry/math.hpp"
+
+namespace gpubridge::examples {
+
+std::unique_ptr<Example> make_tetrahedron();
+std::unique_ptr<Example> make_terrain();
+std::unique_ptr<Example> make_torus();
+std::unique_ptr<Example> make_voxels();
+std::unique_ptr<Example> make_room();
+std::unique_ptr<Example> make_cubes();
+std::unique_ptr<Example> make_lightmap();
+
+// Perspective projection with the context's aspect ratio.
+inline geometry::Mat4 projection(const draw::Context& ctx, double fovy, double near_z, double far_z) {
+  return geometry::perspective(fovy, static_cast<double>(ctx.width()) / ctx.height(), near_z, far_z);
+}
+
+}  // namespace gpubridge::examples

@@ -1,0 +1,55 @@
+#include "gpubridge/examples/golden.hpp"
+
+#include <algorithm>
+#include <cstdlib>
+
+#include <fmt/format.h>
+
+#include "gpubridge/draw/sim_sink.hpp"
+
+namespace gpubridge::examples {
+
+Result<Image> render_golden_frame(Example& ex, const sim::DeviceOptions& device) {
+  auto sink = draw::SimulatorSink::create(device);
+  if (!sink) return sink.error();
+  auto ctx = draw::Context::create(**sink, ex.options());
+  if (!ctx) return make_error(ex.info().name + ": " + ctx.error().message);
+  if (auto r = run_frames(ex, *ctx, 0, kGoldenFrame + 1); !r) return r.error();
+  const auto f = (*sink)->latest_frame();
+  if (!f) return make_error(ex.info().name + ": no frame was scanned out");
+  if (const auto errors = (*sink)->backend().device().errors())
+    return make_error(fmt::format("{}: the device reported errors: {}", ex.info().name, protocol::describe_errors(errors)));
+  return image_from_device(f->format, f->width, f->height, f->pixels);
+}
+
+std::filesystem::path golden_path(const std::filesystem::path& dir, const std::string& name) {
+  return dir / (name + ".png");
+}
+
+ImageDiff compare_images(const Image& expected, const Image& actual) {
+  ImageDiff d;
+  if (expected.width != actual.width || expected.height != actual.height) {
+    d.size_mismatch = true;
+    return d;
+  }
+  for (unsigned y = 0; y < expected.height; ++y)
+    for (unsigned x = 0; x < expected.width; ++x) {
+      int m = 0;
+      for (int c = 0; c < 4; ++c) m = std::max(m, std::abs(int{expected.pixel(x, y)[c]} - int{actual.pixel(x, y)[c]}));
+      if (m == 0) continue;
+      ++d.differing_pixels;
+      d.max_difference = std::max(d.max_difference, m);
+      if (d.first_differences.size() < 10) d.first_differences.emplace_back(x, y);
+    }
+  return d;
+}
+
+std::string ImageDiff::summary() const {
+  if (size_mismatch) return "the image size differs from the golden";
+  if (differing_pixels == 0) return "identical";
+  std::string s = fmt::format("{} pixels differ (max channel difference {}), first at", differing_pixels, max_difference);
+  for (const auto& [x, y] : first_differences) s += fmt::format(" ({}, {})", x, y);
+  return s;
+}
+
+}  // namespace gpubridge::examples

@@ -1,0 +1,92 @@
+// DMC-1 / Comanche: a height-map terrain flown over, with one planar colour map projected from
+// above (u = x / size, v = z / size) and sampled perspective-correctly.
+#include <cmath>
+
+#include "examples_internal.hpp"
+#include "mesh.hpp"
+
+namespace gpubridge::examples {
+namespace {
+
+constexpr int kGrid = 64;        // vertices per side
+constexpr double kCell = 1.0;    // world units per cell
+constexpr double kSize = (kGrid - 1) * kCell;
+
+double height_at(double x, double z) {
+  return 7.0 * value_noise(x / 9.0, z / 9.0, 11) + 2.5 * value_noise(x / 3.5, z / 3.5, 12) - 2.0;
+}
+
+class Terrain final : public Example {
+ public:
+  ExampleInfo info() const override {
+    return {"terrain", "DMC-1 (Comanche)", "a height-map terrain fly-over with a planar perspective-correct colour map"};
+  }
+  draw::ContextOptions options() const override {
+    auto o = Example::options();
+    o.format = protocol::PixelFormat::RGB565;
+    return o;
+  }
+
+  Result<void> setup(draw::Context& ctx) override {
+    // The colour map: height bands shaded by the slope towards the light, like Comanche's voxel map.
+    constexpr unsigned kTex = 256;
+    Image map = make_image(kTex, kTex);
+    for (unsigned j = 0; j < kTex; ++j)
+      for (unsigned i = 0; i < kTex; ++i) {
+        const double x = (i + 0.5) / kTex * kSize, z = (j + 0.5) / kTex * kSize;
+        const double h = height_at(x, z);
+        const double shade = 0.75 + 0.6 * (height_at(x - 0.3, z - 0.3) - h);
+        geometry::Vec3 c;
+        if (h < 0.2) c = {0.15, 0.3, 0.6};
+        else if (h < 1.0) c = {0.75, 0.7, 0.45};
+        else if (h < 4.2) c = {0.25 + 0.1 * value_noise(x, z, 5), 0.55, 0.2};
+        else if (h < 6.0) c = {0.5, 0.45, 0.4};
+        else c = {0.95, 0.95, 0.97};
+        put(map, i, j, c.x * shade, c.y * shade, c.z * shade);
+      }
+    auto t = ctx.create_texture(map, {.format = protocol::PixelFormat::RGB565,
+                                      .wrap_s = protocol::Wrap::Clamp,
+                                      .wrap_t = protocol::Wrap::Clamp});
+    if (!t) return t.error();
+    texture_ = *t;
+    for (int j = 0; j < kGrid; ++j)
+      for (int i = 0; i < kGrid; ++i) {
+        const double x = i * kCell, z = j * kCell;
+        mesh_.vertices.emplace_back(geometry::Vec3{x, std::max(0.2, height_at(x, z)), z}, geometry::Vec4{1, 1, 1, 1},
+                                    geometry::Vec2{x / kSize, z / kSize});
+      }
+    for (int j = 0; j + 1 < kGrid; ++j)
+      for (int i = 0; i + 1 < kGrid; ++i) {
+        const std::uint32_t a = j * kGrid + i, b = a + 1, c = a + kGrid, d = c + 1;
+        // Counter-clockwise seen from above (+y).
+        for (std::uint32_t k : {a, c, b, b, c, d}) mesh_.indices.push_back(k);
+      }
+    return {};
+  }
+
+  Result<void> frame(draw::Context& ctx, unsigned n) override {
+    if (auto r = ctx.clear({0.55, 0.72, 0.95, 1}); !r) return r;
+    if (auto r = ctx.clear_depth(1.0); !r) return r;
+    ctx.state() = {};
+    ctx.state().z_test = ctx.state().z_write = true;
+    ctx.set_cull(geometry::CullMode::Back);
+    // Fly north along a gentle curve, keeping above the ground.
+    const double t = n * 0.35;
+    const double cz = kSize - 4 - t, cx = kSize / 2 + 6 * std::sin(t * 0.08);
+    const double cy = std::max(height_at(cx, cz), 0.2) + 4.0;
+    const geometry::Vec3 eye{cx, cy, cz}, target{cx + 2 * std::sin(t * 0.08 + 0.3), cy - 1.6, cz - 6};
+    ctx.set_transform(projection(ctx, 1.0, 0.3, 80) * geometry::look_at(eye, target, {0, 1, 0}));
+    ctx.bind_texture(&texture_);
+    return ctx.draw_indexed(mesh_.vertices, mesh_.indices);
+  }
+
+ private:
+  draw::Texture texture_;
+  Mesh mesh_;
+};
+
+}  // namespace
+
+std::unique_ptr<Example> make_terrain() { return std::make_unique<Terrain>(); }
+
+}  // namespace gpubridge::examples
