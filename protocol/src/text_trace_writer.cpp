@@ -2,9 +2,8 @@
 // commands (timestamps excepted), so binary → text → binary is byte-identical.
 #include <cstdio>
 
-#include <nlohmann/json.hpp>
-
 #include "gpubridge/protocol/text_trace.hpp"
+#include "gpubridge/protocol/trace.hpp"
 
 namespace gpubridge::protocol {
 namespace {
@@ -24,19 +23,12 @@ std::string hex32(std::uint32_t v) {
   return buf;
 }
 
-// `.meta` must stay on one line: re-serialise compactly (this is also the binary trace's form).
-std::string one_line_json(const std::string& json) {
-  auto j = nlohmann::json::parse(json, nullptr, /*allow_exceptions=*/false);
-  if (j.is_discarded() || !j.is_object()) return {};
-  return j.dump();
-}
-
 }  // namespace
 
 std::string write_text_trace(const CommandStream& s) {
   std::string out = "# gpubridge text trace (spigpu v1); see docs/protocol.md, \"Traces\"\n";
-  if (const std::string meta = one_line_json(s.metadata_json); !meta.empty() && meta != "{}")
-    out += ".meta " + meta + "\n";
+  // `.meta` must stay on one line; the binary writer stores the same form.
+  if (const std::string meta = trace_metadata_line(s.metadata_json); meta != "{}") out += ".meta " + meta + "\n";
   bool previous_was_frames = false;
   for (const auto& tc : s.commands) {
     const Command& c = tc.command;

@@ -144,15 +144,16 @@ Result<void> append_trace_header(std::string_view metadata_json, std::vector<std
   const std::string_view text = metadata_json.empty() ? std::string_view("{}") : metadata_json;
   if (auto problem = json_object_problem(text); !problem.empty())
     return make_error("trace metadata " + problem + "; pass a JSON object such as {\"created_by\": \"me\"}");
-  // Stored compact so binary -> text (one .meta line) -> binary is byte-identical.
-  const std::string compact = nlohmann::json::parse(text).dump();
-  if (compact.size() > kMaxTraceJson)
-    return make_error("trace metadata of " + std::to_string(compact.size()) + " bytes exceeds the 65536-byte limit");
+  // Kept verbatim when it fits on one line (so binary -> text -> binary is byte-identical);
+  // multi-line metadata is stored compactly, which is also how the text form writes it.
+  const std::string stored = trace_metadata_line(text);
+  if (stored.size() > kMaxTraceJson)
+    return make_error("trace metadata of " + std::to_string(stored.size()) + " bytes exceeds the 65536-byte limit");
   out.insert(out.end(), std::begin(kTraceMagic), std::end(kTraceMagic));
   put_le(out, kTraceVersion);
   put_le(out, std::uint16_t{0});
-  put_le(out, static_cast<std::uint32_t>(compact.size()));
-  out.insert(out.end(), compact.begin(), compact.end());
+  put_le(out, static_cast<std::uint32_t>(stored.size()));
+  out.insert(out.end(), stored.begin(), stored.end());
   return {};
 }
 
@@ -177,6 +178,12 @@ Result<std::vector<std::uint8_t>> write_binary_trace(const CommandStream& s) {
     if (auto r = append_trace_record(c, i + 1, out); !r) return r.error();
   }
   return out;
+}
+
+std::string trace_metadata_line(std::string_view metadata_json) {
+  if (metadata_json.find_first_of("\r\n") == std::string_view::npos) return std::string(metadata_json);
+  auto j = nlohmann::json::parse(metadata_json, nullptr, /*allow_exceptions=*/false);
+  return j.is_discarded() ? std::string("{}") : j.dump();
 }
 
 bool looks_like_binary_trace(std::span<const std::uint8_t> bytes) {

@@ -70,11 +70,16 @@ class BinaryTraceReader {
 // Reads a whole binary trace held in memory.
 Result<CommandStream> read_binary_trace(std::span<const std::uint8_t> bytes, const std::string& name_for_errors);
 
-// Writing. The metadata must be a JSON object (stored in compact form); records get request id
-// = record number (1-based). Commands are validated with command_problem().
+// Writing. The metadata must be a JSON object (stored verbatim, or compacted when it spans
+// several lines); records get request id = record number (1-based). Commands are validated with
+// command_problem().
 Result<void> append_trace_header(std::string_view metadata_json, std::vector<std::uint8_t>& out);
 Result<void> append_trace_record(const TimedCommand& c, std::uint64_t record_number, std::vector<std::uint8_t>& out);
 Result<std::vector<std::uint8_t>> write_binary_trace(const CommandStream& s);
+
+// The one-line form metadata is stored in (binary header and text `.meta`): verbatim when it has
+// no line break, else re-serialised compactly.
+std::string trace_metadata_line(std::string_view metadata_json);
 
 // True when bytes start with the binary trace magic (format sniffing).
 bool looks_like_binary_trace(std::span<const std::uint8_t> bytes);

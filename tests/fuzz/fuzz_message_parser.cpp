@@ -1,0 +1,55 @@
+// Fuzzes MessageParser with the input fed in pieces whose sizes derive from the input. Properties: no crash/UB, the
+// buffer stays bounded, offsets advance exactly by each message's size, every accepted message
+// re-encodes to the very bytes it was parsed from, and a poisoned parser stays poisoned.
+#include <cstring>
+#include <vector>
+
+#include "fuzz_check.hpp"
+#include "gpubridge/protocol/messages.hpp"
+
+using namespace gpubridge::protocol;
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  if (size == 0) return 0;
+  // Byte 0 picks the receive limit: odd = small (byte 1 × 16, so TOO_LARGE is reachable with
+  // small inputs), even = the 16 MiB ceiling. The rest is the stream.
+  std::uint32_t max_payload = kMaxPayload;
+  std::size_t skip = 1;
+  if ((data[0] & 1) && size >= 2) {
+    max_payload = std::uint32_t{data[1]} * 16;
+    skip = 2;
+  }
+  const std::vector<std::uint8_t> stream(data + skip, data + size);
+  // Split points come from the stream itself so no input bytes are wasted on them.
+  MessageParser parser(max_payload);
+  std::size_t fed = 0, parsed_until = 0, step = 1;
+  bool failed = false;
+  while (fed < stream.size() && !failed) {
+    step = (step * 7 + (stream[fed] & 31)) % 97 + 1;
+    const std::size_t n = std::min(step, stream.size() - fed);
+    parser.feed(std::span(stream).subspan(fed, n));
+    fed += n;
+    // Lazy compaction keeps consumed bytes below max(4096, unconsumed), and unconsumed bytes are at
+    // most one partial message plus this feed.
+    FUZZ_CHECK(parser.held_bytes() <= 4096 + 2 * (std::size_t{max_payload} + kHeaderBytes) + n);
+    for (;;) {
+      Message m;
+      const auto st = parser.next(m);
+      if (st == MessageParser::Status::NeedMore) break;
+      if (st == MessageParser::Status::Error) {
+        failed = true;
+        FUZZ_CHECK(!parser.error().message.empty());
+        Message again;
+        FUZZ_CHECK(parser.next(again) == MessageParser::Status::Error);
+        break;
+      }
+      const std::size_t end = parser.stream_offset();
+      FUZZ_CHECK(end > parsed_until && end <= fed);
+      const auto re = encode(m);
+      FUZZ_CHECK(re.size() == end - parsed_until);
+      FUZZ_CHECK(std::memcmp(re.data(), stream.data() + parsed_until, re.size()) == 0);
+      parsed_until = end;
+    }
+  }
+  return 0;
+}
