@@ -1,0 +1,249 @@
+// `gpubridge render INPUT --out frame.png`: runs a trace (text or binary) or a scene file through
+// the in-process simulator and writes the last scanned-out frame (or FB_DRAW when nothing was
+// swapped). Options expose the simulator's accuracy knobs, threads, the timing model and a dump of
+// every covered pixel's interpolated attributes.
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "command.hpp"
+#include "gpubridge/common/image.hpp"
+#include "gpubridge/common/trace_files.hpp"
+#include "gpubridge/sim/device.hpp"
+#include "gpubridge/sim/run_stream.hpp"
+#include "gpubridge/sim/timing.hpp"
+#if __has_include("gpubridge/scene/scene.hpp")
+#include "gpubridge/scene/scene.hpp"
+#define GPUBRIDGE_RENDER_HAS_SCENES 1
+#endif
+
+namespace gpubridge::cli {
+namespace {
+
+namespace fs = std::filesystem;
+using protocol::PixelFormat;
+
+struct RenderArgs {
+  std::string input, out, dump_attributes, frames_dir;
+  std::vector<std::string> accuracy, timing_params;
+  unsigned threads = 1;
+  bool timing = false;
+  std::uint64_t vram_mib = 8;
+};
+
+struct FrameRecord {
+  std::shared_ptr<const backends::ScanoutFrame> frame;
+  sim::DeviceStats work;  // what the device did for this frame
+};
+
+int fail(const std::string& msg, int code = 1) {
+  std::fprintf(stderr, "gpubridge render: %s\n", msg.c_str());
+  return code;
+}
+
+Result<protocol::CommandStream> load_input(const RenderArgs& a, std::uint64_t vram_bytes, std::string& kind) {
+  const fs::path p(a.input);
+  if (!fs::exists(p)) return make_error(a.input + ": no such file");
+  if (p.extension() == ".json") {
+#ifdef GPUBRIDGE_RENDER_HAS_SCENES
+    kind = "scene";
+    scene::BuildOptions bo;
+    bo.vram_bytes = vram_bytes;
+    auto built = scene::load_scene(p, bo);
+    if (!built) return built.error();
+    return std::move(built->stream);
+#else
+    (void)vram_bytes;
+    return make_error(a.input + ": scene files need the scene library, which this build lacks; render a trace");
+#endif
+  }
+  kind = "trace";
+  return load_trace(p);
+}
+
+nlohmann::json timing_json(const sim::TimingEstimate& e) {
+  return {{"board_cycles", e.board_cycles}, {"pipeline_cycles", e.pipeline_cycles}, {"memory_cycles", e.memory_cycles},
+          {"memory_bytes", e.memory_bytes}, {"board_ms", e.board_ms},               {"spi_ms", e.spi_ms},
+          {"frame_ms", e.frame_ms},         {"fps", e.fps}};
+}
+
+int run_render(const GlobalOptions& g, const RenderArgs& a) {
+  if (a.out.empty() && a.frames_dir.empty() && !a.timing && a.dump_attributes.empty())
+    return fail("nothing to produce; pass --out FILE.png (or --frames-dir, --timing, --dump-attributes)", 2);
+  sim::DeviceOptions opt;
+  auto knobs = sim::parse_knobs(a.accuracy);
+  if (!knobs) return fail(knobs.error().message, 2);
+  opt.accuracy = *knobs;
+  opt.threads = a.threads;
+  if (a.vram_mib < 1 || a.vram_mib > 4096) return fail("--vram-mib " + std::to_string(a.vram_mib) + ": expected 1..4096", 2);
+  opt.vram_bytes = a.vram_mib << 20;
+  sim::BoardTiming board;
+  for (const auto& s : a.timing_params)
+    if (auto r = sim::apply_timing_setting(board, s); !r) return fail(r.error().message, 2);
+  auto dev = sim::Device::create(opt);
+  if (!dev) return fail(dev.error().message, 2);
+  sim::Device& d = **dev;
+
+  std::string kind;
+  auto stream = load_input(a, opt.vram_bytes, kind);
+  if (!stream) return fail(stream.error().message);
+
+  if (!a.frames_dir.empty()) {
+    std::error_code ec;
+    fs::create_directories(a.frames_dir, ec);
+    if (ec) return fail("--frames-dir " + a.frames_dir + ": " + ec.message());
+  }
+  std::FILE* dump = nullptr;
+  if (!a.dump_attributes.empty()) {
+    dump = std::fopen(a.dump_attributes.c_str(), "w");
+    if (!dump) return fail("--dump-attributes " + a.dump_attributes + ": cannot create the file");
+    std::fputs("x,y,triangle,z,r,g,b,a,u,v\n", dump);
+    d.set_pixel_observer([dump](const sim::CoveredPixel& p) {
+      std::fprintf(dump, "%d,%d,%llu,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", p.x, p.y,
+                   static_cast<unsigned long long>(p.triangle), p.z, p.r, p.g, p.b, p.a, p.u, p.v);
+    });
+  }
+
+  std::vector<FrameRecord> frames;
+  std::string frame_error;
+  sim::DeviceStats last_stats;
+  d.set_scanout_callback([&](std::shared_ptr<const backends::ScanoutFrame> f) {
+    const sim::DeviceStats now = d.stats();
+    FrameRecord rec{f, sim::stats_difference(now, last_stats)};
+    last_stats = now;
+    if (!a.frames_dir.empty() && frame_error.empty()) {
+      char name[32];
+      std::snprintf(name, sizeof name, "frame-%05u.png", f->number);
+      const Image img = image_from_device(f->format, f->width, f->height, f->pixels);
+      if (auto r = save_png(fs::path(a.frames_dir) / name, img); !r) frame_error = r.error().message;
+    }
+    // Keep pixels only for the last frame (bounded memory for long traces).
+    if (!frames.empty()) frames.back().frame = std::make_shared<backends::ScanoutFrame>(backends::ScanoutFrame{
+                             frames.back().frame->number, frames.back().frame->width, frames.back().frame->height,
+                             frames.back().frame->format, {}, frames.back().frame->crc, frames.back().frame->swap_time});
+    frames.push_back(std::move(rec));
+  });
+
+  const auto t0 = std::chrono::steady_clock::now();
+  auto ran = sim::run_stream(d, *stream);
+  const double elapsed_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  if (dump) {
+    d.set_pixel_observer(nullptr);
+    const bool bad = std::ferror(dump) != 0;
+    std::fclose(dump);
+    if (bad) return fail("--dump-attributes " + a.dump_attributes + ": write failed (disk full?)");
+  }
+  if (!ran) return fail(a.input + ": " + ran.error().message);
+  if (!frame_error.empty()) return fail(frame_error);
+
+  // The image: last scanned-out frame, else the draw buffer.
+  Image img;
+  std::string source;
+  std::uint32_t crc = 0;
+  if (!frames.empty()) {
+    const auto& f = *frames.back().frame;
+    img = image_from_device(f.format, f.width, f.height, f.pixels);
+    source = "scanout";
+    crc = f.crc;
+  } else {
+    const std::uint64_t fmt = d.read_register(protocol::index_of(protocol::Reg::FB_FORMAT));
+    const std::uint64_t base = d.read_register(protocol::index_of(protocol::Reg::FB_DRAW)) & 0xFFFFFFF0u;
+    const auto pf = static_cast<PixelFormat>((fmt >> 32) & 3);
+    const unsigned w = fmt & 0x7FF, h = (fmt >> 16) & 0x7FF;
+    const std::uint64_t len = std::uint64_t{w} * h * protocol::bytes_per_pixel(pf);
+    auto mem = d.memory();
+    std::vector<std::uint8_t> bytes(len, 0);
+    for (std::uint64_t i = 0; i < len && base + i < mem.size(); ++i) bytes[i] = mem[base + i];
+    img = image_from_device(pf, w, h, bytes);
+    source = "fb_draw";
+  }
+  if (!a.out.empty())
+    if (auto r = save_png(a.out, img); !r) return fail(r.error().message);
+
+  const sim::DeviceStats& st = d.stats();
+  const std::uint16_t errors = d.errors();
+  nlohmann::json timing = nlohmann::json::array();
+  if (a.timing) {
+    std::vector<FrameRecord> work = frames;
+    const sim::DeviceStats tail = sim::stats_difference(st, last_stats);
+    if (work.empty() || tail.triangles_kicked || tail.clear_bytes) work.push_back({nullptr, tail});
+    for (const auto& rec : work) {
+      const unsigned bpp = rec.frame ? protocol::bytes_per_pixel(rec.frame->format) : 4;
+      const auto e = sim::estimate_timing(rec.work, board, bpp, 4, false);
+      auto j = timing_json(e);
+      j["frame"] = rec.frame ? nlohmann::json(rec.frame->number) : nlohmann::json("unswapped");
+      j["triangles"] = rec.work.triangles_rasterised;
+      j["pixels"] = rec.work.pixels_depth_passed;
+      timing.push_back(j);
+    }
+  }
+
+  if (g.json) {
+    nlohmann::json j{{"input", a.input},
+                     {"kind", kind},
+                     {"output", a.out},
+                     {"image_source", source},
+                     {"width", img.width},
+                     {"height", img.height},
+                     {"frames", frames.size()},
+                     {"crc", crc},
+                     {"triangles_kicked", st.triangles_kicked},
+                     {"triangles_rasterised", st.triangles_rasterised},
+                     {"pixels_written", st.pixels_depth_passed},
+                     {"device_errors", protocol::describe_errors(errors)},
+                     {"accuracy", sim::to_string(opt.accuracy)},
+                     {"threads", opt.threads},
+                     {"elapsed_ms", elapsed_ms}};
+    if (a.timing) j["timing"] = timing;
+    std::puts(j.dump(2).c_str());
+  } else {
+    std::printf("rendered %s (%s): %zu frame(s) scanned out, %llu triangles, %llu pixels written in %.2f ms\n",
+                a.input.c_str(), kind.c_str(), frames.size(), static_cast<unsigned long long>(st.triangles_kicked),
+                static_cast<unsigned long long>(st.pixels_depth_passed), elapsed_ms);
+    if (!a.out.empty())
+      std::printf("wrote %s: %ux%u, %s\n", a.out.c_str(), img.width, img.height,
+                  source == "scanout" ? "the last scanned-out frame" : "FB_DRAW (nothing was swapped)");
+    if (!opt.accuracy.exact()) std::printf("accuracy knobs: %s (not the exact hardware)\n", sim::to_string(opt.accuracy).c_str());
+    for (const auto& t : timing)
+      std::printf("timing frame %s: %.0f board cycles (pipeline %.0f, memory %.0f) = %.3f ms at %.1f MHz; SPI %.3f ms at "
+                  "%.1f MHz; frame %.3f ms (%.1f fps)\n",
+                  t["frame"].dump().c_str(), t["board_cycles"].get<double>(), t["pipeline_cycles"].get<double>(),
+                  t["memory_cycles"].get<double>(), t["board_ms"].get<double>(), board.clock_mhz,
+                  t["spi_ms"].get<double>(), board.spi_clock_mhz, t["frame_ms"].get<double>(), t["fps"].get<double>());
+  }
+  if (errors)
+    std::fprintf(stderr, "gpubridge render: warning: the device raised error flags %s while running %s\n",
+                 protocol::describe_errors(errors).c_str(), a.input.c_str());
+  return 0;
+}
+
+}  // namespace
+
+GPUBRIDGE_COMMAND("render", 10, [](CLI::App& app, GlobalOptions& g, auto& runners) {
+  auto* sub = app.add_subcommand(
+      "render", "render a trace (text/binary) or a scene file (.json) in-process on the simulator and write a PNG");
+  auto a = std::make_shared<RenderArgs>();
+  sub->add_option("INPUT", a->input, "trace (.trace/.txt text, .gbt binary) or scene (.json)")->required();
+  sub->add_option("--out,-o", a->out, "PNG of the last scanned-out frame (FB_DRAW if nothing was swapped)");
+  sub->add_option("--accuracy", a->accuracy,
+                  "simulator knobs KNOB=VALUE: recip_bits=1..16 nr_steps=0..4 subpixel_bits=0..4 z_bits=1..24 fast=0|1")
+      ->expected(1, 16);
+  sub->add_option("--threads", a->threads, "rasteriser threads (output is identical for any count)")
+      ->check(CLI::Range(1u, 64u))
+      ->capture_default_str();
+  sub->add_flag("--timing", a->timing, "predict board time per frame with the timing model (docs/protocol.md section 19)");
+  sub->add_option("--board-timing", a->timing_params, "timing model settings KEY=VALUE (clock_mhz, spi_clock_mhz, ...)")
+      ->expected(1, 32);
+  sub->add_option("--dump-attributes", a->dump_attributes,
+                  "CSV of every covered pixel: x,y,triangle,z,r,g,b,a,u,v (exact values, docs/simulator.md)");
+  sub->add_option("--frames-dir", a->frames_dir, "write every scanned-out frame as DIR/frame-NNNNN.png");
+  sub->add_option("--vram-mib", a->vram_mib, "simulated video memory in MiB")->capture_default_str();
+  runners.emplace_back(sub, [&g, a] { return run_render(g, *a); });
+});
+
+}  // namespace gpubridge::cli
