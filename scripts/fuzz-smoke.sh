@@ -1,0 +1,55 @@
+#!/usr/bin/env bash
+# Short libFuzzer runs of the three protocol fuzz targets under ASan+UBSan.
+#   scripts/fuzz-smoke.sh [seconds-per-target]   (default 20)
+# Configures build-fuzz/ with clang++ (-DGPUBRIDGE_FUZZ=ON -DGPUBRIDGE_SANITIZE=ON), builds only the
+# fuzz targets, runs each from its seed corpus (tests/fuzz/corpus/<target>/, copied so the repo is
+# not modified) and exits non-zero if any run finds a crash, leak, UB or failed property.
+# Crash inputs are left in build-fuzz/fuzz-artifacts/.
+set -euo pipefail
+
+seconds="${1:-20}"
+if ! [[ "$seconds" =~ ^[0-9]+$ ]] || [ "$seconds" -lt 1 ]; then
+  echo "fuzz-smoke: seconds must be a positive integer, got '$seconds'" >&2
+  exit 2
+fi
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+build="${GPUBRIDGE_FUZZ_BUILD_DIR:-$root/build-fuzz}"
+cxx="${CXX_FUZZ:-$(command -v clang++ || command -v clang++-14 || true)}"
+cc="${CC_FUZZ:-$(command -v clang || command -v clang-14 || true)}"
+if [ -z "$cxx" ] || [ -z "$cc" ]; then
+  echo "fuzz-smoke: clang/clang++ not found; install clang (scripts/install-deps.sh) to run the fuzzers" >&2
+  exit 2
+fi
+
+generator=()
+command -v ninja >/dev/null && generator=(-G Ninja)
+cmake -S "$root" -B "$build" "${generator[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DCMAKE_C_COMPILER="$cc" -DCMAKE_CXX_COMPILER="$cxx" \
+  -DGPUBRIDGE_FUZZ=ON -DGPUBRIDGE_SANITIZE=ON -DGPUBRIDGE_BUILD_BENCH=OFF >/dev/null
+cmake --build "$build" --target fuzz_targets -j"$(nproc)"
+
+artifacts="$build/fuzz-artifacts"
+mkdir -p "$artifacts"
+declare -A max_len=([message_parser]=65536 [binary_trace]=65536 [text_trace]=16384)
+status=0
+for target in message_parser binary_trace text_trace; do
+  work="$build/fuzz-corpus/$target"
+  mkdir -p "$work"
+  cp -n "$root/tests/fuzz/corpus/$target/"* "$work/" 2>/dev/null || true
+  log="$build/fuzz-$target.log"
+  echo "fuzz-smoke: $target for ${seconds}s"
+  if ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+      "$build/tests/fuzz/fuzz_$target" -max_total_time="$seconds" -rss_limit_mb=2048 \
+      -max_len="${max_len[$target]}" -timeout=10 -print_final_stats=1 \
+      -artifact_prefix="$artifacts/$target-" "$work" >"$log" 2>&1; then
+    execs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' || echo 0)
+    rate=$(grep -o 'stat::average_exec_per_sec: *[0-9]*' "$log" | grep -o '[0-9]*$' || echo 0)
+    cov=$(grep -o 'cov: [0-9]*' "$log" | tail -1 || true)
+    echo "fuzz-smoke: $target ok: $execs runs, $rate exec/s, $cov"
+  else
+    echo "fuzz-smoke: $target FAILED; log $log, inputs in $artifacts:" >&2
+    grep -E 'ERROR|runtime error|fuzz property failed|SUMMARY' "$log" | head -20 >&2 || tail -20 "$log" >&2
+    status=1
+  fi
+done
+exit $status
