@@ -23,6 +23,32 @@ inline DivMod floor_divmod128(i128 a, std::int64_t b) {
   if (r < 0) { r += b; --q; }
   return {static_cast<std::int64_t>(q), static_cast<std::int64_t>(r)};
 }
+// Floor division by a fixed positive divisor without a hardware divide: a double estimate of the
+// quotient (exact to within one for |a| < 2^52) corrected with integer arithmetic, so the result
+// is exactly floor_divmod's. Larger numerators use the integer divide.
+class Divider {
+ public:
+  explicit Divider(std::int64_t d) : d_(d), inv_(1.0 / static_cast<double>(d)) {}
+  DivMod operator()(std::int64_t a) const {
+    constexpr std::int64_t kExact = std::int64_t{1} << 52;
+    if (a >= kExact || a <= -kExact) return floor_divmod(a, d_);
+    std::int64_t q = static_cast<std::int64_t>(static_cast<double>(a) * inv_);
+    std::int64_t r = a - q * d_;
+    while (r < 0) { r += d_; --q; }
+    while (r >= d_) { r -= d_; ++q; }
+    return {q, r};
+  }
+  DivMod operator()(i128 a) const {
+    if (a >= INT64_MIN && a <= INT64_MAX) return (*this)(static_cast<std::int64_t>(a));
+    return floor_divmod128(a, d_);
+  }
+  std::int64_t divisor() const { return d_; }
+
+ private:
+  std::int64_t d_;
+  double inv_;
+};
+
 inline std::int64_t floor_div(std::int64_t a, std::int64_t b) { return floor_divmod(a, b).q; }
 inline std::int64_t ceil_div(std::int64_t a, std::int64_t b) { return -floor_div(-a, b); }
 

@@ -5,6 +5,7 @@
 #include <utility>
 
 #include "pixel.hpp"
+#include "span_simd.hpp"
 #include "texture.hpp"
 
 namespace gpubridge::sim {
@@ -41,6 +42,11 @@ class Kernel {
     } else {
       flat_ = {t.flat[0], t.flat[1], t.flat[2], t.flat[3]};
     }
+    for (int i = 0; i < 3; ++i) {
+      const std::int64_t ex = t.edge[i].ex;
+      edge_div_[i] = Divider(ex < 0 ? -ex : (ex == 0 ? 1 : ex));
+    }
+    prepare_simd();
     if (kTextured && t.plane[kQ].constant && t.plane[kQ].q != 0) {
       q_const_ = true;  // affine: the reciprocal is the same at every pixel
       const_rc_ = ctx.recip(static_cast<std::uint32_t>(t.plane[kQ].q));
@@ -64,16 +70,21 @@ class Kernel {
         std::int64_t kl = 0, kr = w - 1;
         for (int i = 0; i < 3; ++i) {
           const std::int64_t ex = t_.edge[i].ex;
-          if (ex > 0) kl = std::max(kl, ceil_div(-e[i], ex));
-          else if (ex < 0) kr = std::min(kr, floor_div(e[i], -ex));
+          // E + k·ex >= 0  ⇔  k >= ceil(−E / ex) (ex > 0)  or  k <= floor(E / −ex) (ex < 0)
+          if (ex > 0) kl = std::max(kl, -edge_div_[i](e[i]).q);
+          else if (ex < 0) kr = std::min(kr, edge_div_[i](e[i]).q);
           else if (e[i] < 0) kr = -1;
         }
         if (kl <= kr) {
           Steppers s = row;
           jump_x(s, kl);
-          for (std::int64_t kx = kl; kx <= kr; ++kx) {
-            pixel(t_.x0 + static_cast<int>(kx), y, s);
-            step_x(s);
+          if (simd_ && kr - kl + 1 >= 8) {
+            simd_span(s, t_.x0 + static_cast<int>(kl), y, static_cast<unsigned>(kr - kl + 1));
+          } else {
+            for (std::int64_t kx = kl; kx <= kr; ++kx) {
+              pixel(t_.x0 + static_cast<int>(kx), y, s);
+              step_x(s);
+            }
           }
           ctx_.counters.scanned += static_cast<std::uint64_t>(kr - kl + 1);
           ctx_.counters.covered += static_cast<std::uint64_t>(kr - kl + 1);
@@ -128,6 +139,56 @@ class Kernel {
     }
     for (unsigned i = 0; i < kAttrCount; ++i)
       if ((kPlanes >> i) & 1) Plane::advance(s.q[i], s.r[i], t_.plane[i].qx, t_.plane[i].rx, k, t_.den);
+  }
+
+  // The vector routine applies to untextured direct RGBA8888 stores with both buffers inside VRAM
+  // and values that fit 32-bit lanes (2·den < 2^31 and per-8-pixel steps below 2^30).
+  void prepare_simd() {
+    if constexpr (kTextured || !kSimple) {
+      return;
+    } else {
+      if (!st_.color_in_vram || (kDepth && !st_.z_in_vram) || skip_colour_) return;
+      if (t_.den >= (std::int64_t{1} << 30)) return;
+      simd_tpl_.den = static_cast<std::uint32_t>(t_.den);
+      for (unsigned p = 0; p < SimdSpan::kPlanes; ++p) {
+        const Plane& pl = t_.plane[kR + p];
+        const bool used = p < 4 ? kGouraud : kDepth;
+        if (!used) {
+          simd_tpl_.q8[p] = simd_tpl_.r8[p] = 0;
+          continue;
+        }
+        const DivMod d = floor_divmod(8 * pl.rx, t_.den);
+        const std::int64_t q8 = 8 * pl.qx + d.q;
+        if (q8 >= (std::int64_t{1} << 30) || q8 <= -(std::int64_t{1} << 30)) return;
+        simd_tpl_.q8[p] = static_cast<std::uint32_t>(q8);
+        simd_tpl_.r8[p] = static_cast<std::uint32_t>(d.r);
+      }
+      simd_tpl_.flat = std::uint32_t{flat_.r} | (std::uint32_t{flat_.g} << 8) | (std::uint32_t{flat_.b} << 16) |
+                       (std::uint32_t{flat_.a} << 24);
+      simd_tpl_.zmask = zmask_;
+      simd_tpl_.gouraud = kGouraud;
+      simd_tpl_.z_test = kDepth && st_.z_test;
+      simd_tpl_.z_write = kDepth && st_.z_write;
+      simd_tpl_.z_func = static_cast<unsigned>(st_.z_func);
+      simd_ = true;
+    }
+  }
+
+  void simd_span(Steppers s, int x, int y, unsigned count) {
+    SimdSpan& sp = simd_tpl_;
+    for (unsigned k = 0; k < 8; ++k) {
+      for (unsigned p = 0; p < SimdSpan::kPlanes; ++p) {
+        const bool used = p < 4 ? kGouraud : kDepth;
+        sp.q[p][k] = used ? static_cast<std::uint32_t>(s.q[kR + p]) : 0;
+        sp.r[p][k] = used ? static_cast<std::uint32_t>(s.r[kR + p]) : 0;
+      }
+      step_x(s);
+    }
+    const std::size_t pix = static_cast<std::size_t>(y) * width_ + static_cast<std::size_t>(x);
+    sp.colour = color_ + pix * 4;
+    sp.depth = kDepth ? zbuf_ + pix * 4 : nullptr;
+    sp.count = count;
+    ctx_.counters.passed += shade_span_simd(sp);
   }
 
   void pixel(int x, int y, const Steppers& s) {
@@ -207,6 +268,9 @@ class Kernel {
   Rgba8 flat_;
   bool q_const_ = false;
   Reciprocal const_rc_;
+  Divider edge_div_[3] = {Divider(1), Divider(1), Divider(1)};
+  bool simd_ = false;
+  SimdSpan simd_tpl_{};
 };
 
 template <bool G, bool T, bool Z, bool S>

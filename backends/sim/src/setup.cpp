@@ -24,7 +24,7 @@ Edge make_edge(const Vertex& a, const Vertex& b, std::int64_t sx, std::int64_t s
 }
 
 void setup_plane(Plane& p, std::int64_t a0, std::int64_t a1, std::int64_t a2, const Edge& b1, const Edge& b2,
-                 std::int64_t D, std::int64_t den) {
+                 std::int64_t D, const Divider& den) {
   const std::int64_t d1 = a1 - a0, d2 = a2 - a0;
   if (d1 == 0 && d2 == 0) {
     p = Plane{};
@@ -33,11 +33,11 @@ void setup_plane(Plane& p, std::int64_t a0, std::int64_t a1, std::int64_t a2, co
   }
   p.constant = false;
   const i128 m0 = 2 * (i128{d1} * b1.e + i128{d2} * b2.e) + D;
-  const DivMod o = floor_divmod128(m0, den);
+  const DivMod o = den(m0);
   p.q = a0 + o.q;
   p.r = o.r;
-  const DivMod sx = floor_divmod(2 * (d1 * b1.ex + d2 * b2.ex), den);
-  const DivMod sy = floor_divmod(2 * (d1 * b1.ey + d2 * b2.ey), den);
+  const DivMod sx = den(2 * (d1 * b1.ex + d2 * b2.ex));
+  const DivMod sy = den(2 * (d1 * b1.ey + d2 * b2.ey));
   p.qx = sx.q;
   p.rx = sx.r;
   p.qy = sy.q;
@@ -88,17 +88,18 @@ bool setup_triangle(const Vertex& va, const Vertex& vb, const Vertex& vc, const 
   t.edge[2].e += edge_bias(t.v[0], t.v[1]);
 
   const Vertex* v = t.v;
+  const Divider div(t.den);
   const bool colour = all_attributes || state.gouraud;
   const bool depth = all_attributes || state.z_test || state.z_write;
   const bool tex = all_attributes || state.textured;
   for (unsigned i = 0; i < kAttrCount; ++i) t.plane[i] = Plane{};
   if (colour)
-    for (unsigned ch = 0; ch < 4; ++ch) setup_plane(t.plane[kR + ch], v[0].c[ch], v[1].c[ch], v[2].c[ch], e20, e01, D, t.den);
-  if (depth) setup_plane(t.plane[kZ], v[0].z, v[1].z, v[2].z, e20, e01, D, t.den);
+    for (unsigned ch = 0; ch < 4; ++ch) setup_plane(t.plane[kR + ch], v[0].c[ch], v[1].c[ch], v[2].c[ch], e20, e01, D, div);
+  if (depth) setup_plane(t.plane[kZ], v[0].z, v[1].z, v[2].z, e20, e01, D, div);
   if (tex) {
-    setup_plane(t.plane[kS], v[0].s, v[1].s, v[2].s, e20, e01, D, t.den);
-    setup_plane(t.plane[kT], v[0].t, v[1].t, v[2].t, e20, e01, D, t.den);
-    setup_plane(t.plane[kQ], v[0].q, v[1].q, v[2].q, e20, e01, D, t.den);
+    setup_plane(t.plane[kS], v[0].s, v[1].s, v[2].s, e20, e01, D, div);
+    setup_plane(t.plane[kT], v[0].t, v[1].t, v[2].t, e20, e01, D, div);
+    setup_plane(t.plane[kQ], v[0].q, v[1].q, v[2].q, e20, e01, D, div);
   }
   return true;
 }

@@ -1,0 +1,79 @@
+#include "span_simd.hpp"
+
+#include <cstring>
+
+namespace gpubridge::sim {
+namespace {
+
+typedef std::uint32_t u32x8 __attribute__((vector_size(32)));
+typedef std::int32_t i32x8 __attribute__((vector_size(32)));
+
+// Helpers are macros so they inline into every target clone (a plain inline function compiled
+// for the default target would not inline into the AVX2 clone).
+#define GB_LOAD8(dst, p) std::memcpy(&(dst), (p), sizeof(u32x8))
+#define GB_BSWAP(w) (((w) >> 24) | (((w) >> 8) & 0xFF00u) | (((w) << 8) & 0xFF0000u) | ((w) << 24))
+#define GB_MASK(m) ((u32x8)(m))
+
+}  // namespace
+
+__attribute__((target_clones("avx2", "default"))) std::uint64_t shade_span_simd(const SimdSpan& s) {
+  u32x8 q[SimdSpan::kPlanes], r[SimdSpan::kPlanes];
+  const unsigned first = s.gouraud ? 0 : 4;
+  for (unsigned p = first; p < SimdSpan::kPlanes; ++p) {
+    GB_LOAD8(q[p], s.q[p]);
+    GB_LOAD8(r[p], s.r[p]);
+  }
+  const u32x8 den = u32x8{} + s.den;
+  const u32x8 lane = {0, 1, 2, 3, 4, 5, 6, 7};
+  const bool depth = s.z_test || s.z_write;
+  std::uint64_t passed = 0;
+  for (unsigned i = 0; i < s.count; i += 8) {
+    const unsigned n = s.count - i < 8 ? s.count - i : 8;
+    u32x8 pass = GB_MASK((i32x8)lane < static_cast<std::int32_t>(n));
+    std::uint32_t cbuf[8], zbuf[8];
+    std::uint8_t* cp = s.colour + std::size_t{i} * 4;
+    std::memcpy(cbuf, cp, n * 4);
+    if (depth) {
+      std::uint8_t* zp = s.depth + std::size_t{i} * 4;
+      std::memcpy(zbuf, zp, n * 4);
+      const u32x8 z = q[4] & s.zmask;
+      u32x8 old;
+      GB_LOAD8(old, zbuf);
+      if (s.z_test) {
+        const i32x8 zi = (i32x8)z, di = (i32x8)(GB_BSWAP(old) & 0xFFFFFFu);  // both < 2^24
+        switch (s.z_func) {
+          case 1: pass &= GB_MASK(zi < di); break;
+          case 2: pass &= GB_MASK(zi == di); break;
+          case 3: pass &= GB_MASK(zi <= di); break;
+          case 4: pass &= GB_MASK(zi > di); break;
+          case 5: pass &= GB_MASK(zi != di); break;
+          case 6: pass &= GB_MASK(zi >= di); break;
+          case 7: break;
+          default: pass = u32x8{}; break;
+        }
+      }
+      if (s.z_write) {
+        const u32x8 zs = GB_BSWAP(z);
+        const u32x8 out = (zs & pass) | (old & ~pass);
+        std::memcpy(zp, &out, n * 4);
+      }
+    }
+    u32x8 word = u32x8{} + s.flat;
+    if (s.gouraud) word = (q[0] & 255u) | ((q[1] & 255u) << 8) | ((q[2] & 255u) << 16) | (q[3] << 24);
+    u32x8 cold;
+    GB_LOAD8(cold, cbuf);
+    const u32x8 out = (word & pass) | (cold & ~pass);
+    std::memcpy(cp, &out, n * 4);
+    for (unsigned k = 0; k < 8; ++k) passed += pass[k] & 1;
+    for (unsigned p = first; p < SimdSpan::kPlanes; ++p) {
+      q[p] += s.q8[p];
+      r[p] += s.r8[p];
+      const u32x8 carry = GB_MASK((i32x8)r[p] >= (i32x8)den);
+      r[p] -= den & carry;
+      q[p] -= carry;  // carry lanes are all ones (−1)
+    }
+  }
+  return passed;
+}
+
+}  // namespace gpubridge::sim

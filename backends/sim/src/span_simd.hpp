@@ -1,0 +1,29 @@
+#pragma once
+// The vectorised span routine for the commonest draw: untextured, RGBA8888 store without blend or
+// mask, optional depth test/write, both buffers inside VRAM. Eight pixels per step: lanes k = 0..7
+// hold (q, r) of each attribute plane for x + k and advance by (Q8, R8) = divmod(8·step) with
+// add, add, compare, and, subtract, subtract — no division per pixel, and integer-exact, so the
+// output equals the scalar routine's byte for byte (tests compare them).
+#include <cstdint>
+
+namespace gpubridge::sim {
+
+struct SimdSpan {
+  static constexpr unsigned kPlanes = 5;  // R, G, B, A, Z
+  std::uint32_t q[kPlanes][8];  // lane values at the first 8 pixels
+  std::uint32_t r[kPlanes][8];
+  std::uint32_t q8[kPlanes], r8[kPlanes];  // advance per 8 pixels (r8 < den)
+  std::uint32_t den = 1;                   // < 2^30, so r + r8 < 2^31
+  std::uint32_t flat = 0;                  // colour word (memory order R,G,B,A) when !gouraud
+  std::uint32_t zmask = 0xFFFFFF;
+  std::uint8_t* colour = nullptr;          // first pixel of the span
+  std::uint8_t* depth = nullptr;           // first depth word of the span (when z_test or z_write)
+  unsigned count = 0;                      // pixels in the span
+  unsigned z_func = 0;                     // protocol::DepthFunc
+  bool gouraud = false, z_test = false, z_write = false;
+};
+
+// Returns the number of pixels that passed the depth test (all of them without a test).
+std::uint64_t shade_span_simd(const SimdSpan& span);
+
+}  // namespace gpubridge::sim
