@@ -2,7 +2,7 @@
 // sheet (section 5.3): 640x480 RGBA8888 + Z, N random Gouraud triangles of fixed area, depth test
 // LESS, "front" order (every pixel passes and writes colour + Z). Frames are encoded before the
 // clock starts; the timed part is command decode + setup + rasterisation (Device::write).
-// Usage: sim_throughput [--threads N] [--repeat R] [--accuracy KNOB=VALUE ...]
+// Usage: sim_throughput [--threads N] [--repeat R] [--only 10|1000|50000] [--accuracy KNOB=VALUE ...]
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -63,8 +63,10 @@ std::vector<std::uint8_t> make_scene(unsigned count, double area, std::uint32_t 
 int main(int argc, char** argv) {
   sim::DeviceOptions opt;
   unsigned repeat = 5;
+  std::string only;  // "10", "1000" or "50000": run one workload
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--threads") && i + 1 < argc) opt.threads = static_cast<unsigned>(std::atoi(argv[++i]));
+    else if (!std::strcmp(argv[i], "--only") && i + 1 < argc) only = argv[++i];
     else if (!std::strcmp(argv[i], "--repeat") && i + 1 < argc) repeat = static_cast<unsigned>(std::atoi(argv[++i]));
     else if (!std::strcmp(argv[i], "--accuracy") && i + 1 < argc) {
       if (auto r = sim::apply_knob(opt.accuracy, argv[++i]); !r) {
@@ -72,7 +74,7 @@ int main(int argc, char** argv) {
         return 2;
       }
     } else {
-      std::fprintf(stderr, "usage: sim_throughput [--threads N] [--repeat R] [--accuracy KNOB=VALUE]...\n");
+      std::fprintf(stderr, "usage: sim_throughput [--threads N] [--repeat R] [--only 10|1000|50000] [--accuracy KNOB=VALUE]...\n");
       return 2;
     }
   }
@@ -86,6 +88,7 @@ int main(int argc, char** argv) {
   std::printf("| workload | triangles | Mtri/s | Mpix/s | ns/tri | ns/px | cpu ns/tri | cpu ns/px |\n");
   std::printf("|---|---|---|---|---|---|---|---|\n");
   for (const auto& w : works) {
+    if (!only.empty() && std::to_string(static_cast<int>(w.area)) != only) continue;
     const auto frames = make_scene(w.count, w.area, 1);
     double best = 1e30, best_cpu = 1e30;
     std::uint64_t pixels = 0;

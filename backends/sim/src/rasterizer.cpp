@@ -20,7 +20,7 @@ struct Steppers {
 // Rows this long or longer find their covered span by division instead of testing every pixel.
 constexpr int kSpanSolveWidth = 16;
 // Jumps along a span shorter than this are stepped instead of divided.
-constexpr std::int64_t kStepJump = 24;
+constexpr std::int64_t kStepJump = 4;
 
 template <bool kGouraud, bool kTextured, bool kDepth, bool kSimple>
 class Kernel {
@@ -28,7 +28,7 @@ class Kernel {
   static constexpr unsigned kPlanes = (kGouraud ? 0x0Fu : 0u) | (kDepth ? 1u << kZ : 0u) | (kTextured ? 0xE0u : 0u);
 
   Kernel(const Triangle& t, const DrawState& st, RasterContext& ctx)
-      : t_(t), st_(st), ctx_(ctx), tex_(st.tex, ctx.mem) {
+      : t_(t), st_(st), ctx_(ctx), tex_(st.tex, ctx.mem), den_div_(t.den) {
     width_ = st.fb_width;
     color_ = ctx.mem.data() + st.fb_draw;
     zbuf_ = ctx.mem.data() + st.fb_z;
@@ -42,11 +42,12 @@ class Kernel {
     } else {
       flat_ = {t.flat[0], t.flat[1], t.flat[2], t.flat[3]};
     }
-    for (int i = 0; i < 3; ++i) {
-      const std::int64_t ex = t.edge[i].ex;
-      edge_div_[i] = Divider(ex < 0 ? -ex : (ex == 0 ? 1 : ex));
+    if (t.x1 - t.x0 >= kSpanSolveWidth) {  // only wide rows solve their spans
+      for (int i = 0; i < 3; ++i) {
+        const std::int64_t ex = t.edge[i].ex;
+        edge_div_[i] = Divider(ex < 0 ? -ex : (ex == 0 ? 1 : ex));
+      }
     }
-    prepare_simd();
     if (kTextured && t.plane[kQ].constant && t.plane[kQ].q != 0) {
       q_const_ = true;  // affine: the reciprocal is the same at every pixel
       const_rc_ = ctx.recip(static_cast<std::uint32_t>(t.plane[kQ].q));
@@ -78,7 +79,7 @@ class Kernel {
         if (kl <= kr) {
           Steppers s = row;
           jump_x(s, kl);
-          if (simd_ && kr - kl + 1 >= 8) {
+          if (kr - kl + 1 >= 8 && simd_ready()) {
             simd_span(s, t_.x0 + static_cast<int>(kl), y, static_cast<unsigned>(kr - kl + 1));
           } else {
             for (std::int64_t kx = kl; kx <= kr; ++kx) {
@@ -137,12 +138,24 @@ class Kernel {
       for (std::int64_t j = 0; j < k; ++j) step_x(s);
       return;
     }
-    for (unsigned i = 0; i < kAttrCount; ++i)
-      if ((kPlanes >> i) & 1) Plane::advance(s.q[i], s.r[i], t_.plane[i].qx, t_.plane[i].rx, k, t_.den);
+    for (unsigned i = 0; i < kAttrCount; ++i) {
+      if (!((kPlanes >> i) & 1)) continue;
+      // rx < den < 2^36 and k < 2^11: r + rx·k fits 64 bits.
+      const DivMod d = den_div_(s.r[i] + t_.plane[i].rx * k);
+      s.q[i] += t_.plane[i].qx * k + d.q;
+      s.r[i] = d.r;
+    }
   }
 
   // The vector routine applies to untextured direct RGBA8888 stores with both buffers inside VRAM
   // and values that fit 32-bit lanes (2·den < 2^31 and per-8-pixel steps below 2^30).
+  bool simd_ready() {
+    if (!simd_checked_) {
+      simd_checked_ = true;
+      prepare_simd();
+    }
+    return simd_;
+  }
   void prepare_simd() {
     if constexpr (kTextured || !kSimple) {
       return;
@@ -260,6 +273,7 @@ class Kernel {
   const DrawState& st_;
   RasterContext& ctx_;
   TextureUnit tex_;
+  Divider den_div_;
   std::size_t width_ = 0;
   std::uint8_t* color_ = nullptr;
   std::uint8_t* zbuf_ = nullptr;
@@ -269,7 +283,7 @@ class Kernel {
   bool q_const_ = false;
   Reciprocal const_rc_;
   Divider edge_div_[3] = {Divider(1), Divider(1), Divider(1)};
-  bool simd_ = false;
+  bool simd_ = false, simd_checked_ = false;
   SimdSpan simd_tpl_{};
 };
 

@@ -39,9 +39,17 @@ void Renderer::draw(const Vertex& a, const Vertex& b, const Vertex& c, const std
   // No work when nothing is written (unless someone watches the attributes).
   if (st.writes_nothing && !observing) return;
   const bool batching = pool_.workers() > 1 && !observing && can_batch(st);
-  if (batching && batch_state_ != state) flush();
-  if (!batching) flush();
-  Triangle& t = batching ? batch_.emplace_back() : scratch_;
+  if (batching) {
+    draw_pending();
+    if (batch_state_ != state) flush();
+  } else if (!batch_.empty()) {
+    flush();
+  }
+  if (!batching) prefetch_rows(a, b, c, st);
+  // Single thread: set up into the free slot; the previous triangle is drawn after this setup so
+  // the prefetched rows of this one arrive while it is drawn (order of pixel writes unchanged).
+  const int slot = pending_ == 0 ? 1 : 0;
+  Triangle& t = batching ? batch_.emplace_back() : slots_[slot];
   if (!setup_triangle(a, b, c, st, knobs_.subpixel_bits, observing, t)) {
     if (batching) batch_.pop_back();
     return;
@@ -51,17 +59,43 @@ void Renderer::draw(const Vertex& a, const Vertex& b, const Vertex& c, const std
   if (observing) observe_triangle(t, st, observer_);
   if (!batching) {
     if (st.writes_nothing) return;
-    RasterContext ctx{mem_, recip_, knobs_.z_bits, 0, {}};
-    rasterize_rows(t, st, ctx, t.y0, t.y1);
-    errors_ |= ctx.errors;
-    counters_.add(ctx.counters);
+    draw_pending();
+    pending_ = slot;
+    pending_state_ = state;
     return;
   }
   batch_state_ = state;
   if (batch_.size() >= kMaxBatch) flush();
 }
 
+void Renderer::draw_pending() {
+  if (pending_ < 0) return;
+  const Triangle& t = slots_[pending_];
+  RasterContext ctx{mem_, recip_, knobs_.z_bits, 0, {}};
+  rasterize_rows(t, *pending_state_, ctx, t.y0, t.y1);
+  errors_ |= ctx.errors;
+  counters_.add(ctx.counters);
+  pending_ = -1;
+  pending_state_.reset();
+}
+
+// Small triangles are bound by the latency of their first depth and colour reads (random screen
+// positions miss the caches); start those loads before setup so they overlap its arithmetic.
+void Renderer::prefetch_rows(const Vertex& a, const Vertex& b, const Vertex& c, const DrawState& st) const {
+  if (!st.color_in_vram || !st.z_in_vram) return;
+  const int x = std::clamp((std::min({a.x, b.x, c.x}) >> 4), st.clip.x0, st.clip.x1 - 1);
+  const int y0 = std::clamp((std::min({a.y, b.y, c.y}) >> 4), st.clip.y0, st.clip.y1 - 1);
+  const int y1 = std::min(std::clamp((std::max({a.y, b.y, c.y}) >> 4), st.clip.y0, st.clip.y1 - 1), y0 + 7);
+  const bool depth = st.z_test || st.z_write;
+  for (int y = y0; y <= y1; ++y) {
+    const std::size_t pix = static_cast<std::size_t>(y) * st.fb_width + static_cast<std::size_t>(x);
+    __builtin_prefetch(mem_.data() + st.fb_draw + pix * st.bpp, 1);
+    if (depth) __builtin_prefetch(mem_.data() + st.fb_z + pix * 4, 1);
+  }
+}
+
 void Renderer::flush() {
+  draw_pending();
   if (batch_.empty()) {
     batch_state_.reset();
     return;

@@ -25,7 +25,8 @@ class Renderer {
   // Draws (or queues) one triangle. A state object different from the batch's flushes the batch.
   void draw(const Vertex& a, const Vertex& b, const Vertex& c, const std::shared_ptr<const DrawState>& state,
             std::uint64_t index);
-  // Completes every queued triangle. Call before anything reads or writes video memory.
+  // Completes every queued triangle (the batch, or the one pending triangle of the single-thread
+  // pipeline). Call before anything reads or writes video memory.
   void flush();
 
   // ERR_* flags raised by drawing since the last call.
@@ -42,6 +43,8 @@ class Renderer {
 
  private:
   bool can_batch(const DrawState& st) const;
+  void draw_pending();
+  void prefetch_rows(const Vertex& a, const Vertex& b, const Vertex& c, const DrawState& st) const;
 
   VideoMemory& mem_;
   AccuracyKnobs knobs_;
@@ -50,7 +53,9 @@ class Renderer {
   PixelObserver observer_;
   std::vector<Triangle> batch_;
   std::shared_ptr<const DrawState> batch_state_;
-  Triangle scratch_;
+  Triangle slots_[2];
+  int pending_ = -1;  // slot set up but not yet drawn (single-thread pipelining)
+  std::shared_ptr<const DrawState> pending_state_;
   std::uint16_t errors_ = 0;
   std::uint64_t rasterised_ = 0;
   RasterCounters counters_;

@@ -13,6 +13,8 @@ typedef std::int32_t i32x8 __attribute__((vector_size(32)));
 #define GB_LOAD8(dst, p) std::memcpy(&(dst), (p), sizeof(u32x8))
 #define GB_BSWAP(w) (((w) >> 24) | (((w) >> 8) & 0xFF00u) | (((w) << 8) & 0xFF0000u) | ((w) << 24))
 #define GB_MASK(m) ((u32x8)(m))
+// Full chunks copy a constant 32 bytes (inlined); only the tail copies n words.
+#define GB_COPY(dst, src, n) ((n) == 8 ? std::memcpy((dst), (src), 32) : std::memcpy((dst), (src), (n) * 4))
 
 }  // namespace
 
@@ -26,16 +28,16 @@ __attribute__((target_clones("avx2", "default"))) std::uint64_t shade_span_simd(
   const u32x8 den = u32x8{} + s.den;
   const u32x8 lane = {0, 1, 2, 3, 4, 5, 6, 7};
   const bool depth = s.z_test || s.z_write;
-  std::uint64_t passed = 0;
+  u32x8 passed = {};
   for (unsigned i = 0; i < s.count; i += 8) {
     const unsigned n = s.count - i < 8 ? s.count - i : 8;
     u32x8 pass = GB_MASK((i32x8)lane < static_cast<std::int32_t>(n));
     std::uint32_t cbuf[8], zbuf[8];
     std::uint8_t* cp = s.colour + std::size_t{i} * 4;
-    std::memcpy(cbuf, cp, n * 4);
+    GB_COPY(cbuf, cp, n);
     if (depth) {
       std::uint8_t* zp = s.depth + std::size_t{i} * 4;
-      std::memcpy(zbuf, zp, n * 4);
+      GB_COPY(zbuf, zp, n);
       const u32x8 z = q[4] & s.zmask;
       u32x8 old;
       GB_LOAD8(old, zbuf);
@@ -55,7 +57,7 @@ __attribute__((target_clones("avx2", "default"))) std::uint64_t shade_span_simd(
       if (s.z_write) {
         const u32x8 zs = GB_BSWAP(z);
         const u32x8 out = (zs & pass) | (old & ~pass);
-        std::memcpy(zp, &out, n * 4);
+        GB_COPY(zp, &out, n);
       }
     }
     u32x8 word = u32x8{} + s.flat;
@@ -63,8 +65,8 @@ __attribute__((target_clones("avx2", "default"))) std::uint64_t shade_span_simd(
     u32x8 cold;
     GB_LOAD8(cold, cbuf);
     const u32x8 out = (word & pass) | (cold & ~pass);
-    std::memcpy(cp, &out, n * 4);
-    for (unsigned k = 0; k < 8; ++k) passed += pass[k] & 1;
+    GB_COPY(cp, &out, n);
+    passed -= pass;  // pass lanes are all ones (−1)
     for (unsigned p = first; p < SimdSpan::kPlanes; ++p) {
       q[p] += s.q8[p];
       r[p] += s.r8[p];
@@ -73,7 +75,9 @@ __attribute__((target_clones("avx2", "default"))) std::uint64_t shade_span_simd(
       q[p] -= carry;  // carry lanes are all ones (−1)
     }
   }
-  return passed;
+  std::uint64_t total = 0;
+  for (unsigned k = 0; k < 8; ++k) total += passed[k];
+  return total;
 }
 
 }  // namespace gpubridge::sim
