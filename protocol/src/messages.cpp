@@ -602,9 +602,9 @@ MessageParser::Status MessageParser::next(Message& out) {
   if (avail < kHeaderBytes) {
     // Reject a wrong stream as early as its first bytes allow (an HTTP client, a stray byte).
     std::uint8_t probe[kHeaderBytes] = {kMagic0, kMagic1, kSocketVersion, static_cast<std::uint8_t>(MsgType::Ping)};
-    std::memcpy(probe, p, avail);  // absent length bytes stay 0
     Header ignored;
     if (avail > 0) {
+      std::memcpy(probe, p, avail);  // absent length bytes stay 0
       if (auto e = decode_header(std::span<const std::uint8_t, kHeaderBytes>(probe, kHeaderBytes), max_payload_, ignored))
         return fail(std::move(*e));
     }
