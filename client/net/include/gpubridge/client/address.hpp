@@ -1,0 +1,33 @@
+#pragma once
+// Daemon addresses as users type them: `unix:PATH` or `tcp:HOST:PORT` (HOST may be [v6]).
+// Shared by the daemon (listen addresses) and the Client (connect addresses) so both accept
+// exactly the same spelling.
+#include <cstdint>
+#include <string>
+#include <string_view>
+
+#include "gpubridge/common/result.hpp"
+
+namespace gpubridge::client {
+
+struct Address {
+  enum class Kind { Unix, Tcp } kind = Kind::Unix;
+  std::string path;    // Unix
+  std::string host;    // TCP (without brackets)
+  std::uint16_t port = 0;
+
+  std::string to_string() const;  // "unix:/run/..." / "tcp:127.0.0.1:7420"
+};
+
+// Parses `unix:PATH` | `tcp:HOST:PORT`; a bare absolute path is taken as a Unix socket.
+// "unix:" with an empty path (or the word "default") means default_socket_path().
+Result<Address> parse_address(std::string_view text);
+
+// $XDG_RUNTIME_DIR/gpubridge/gpubridge.sock; /run/gpubridge/gpubridge.sock for root without
+// XDG_RUNTIME_DIR; otherwise /tmp/gpubridge-<uid>/gpubridge.sock.
+std::string default_socket_path();
+
+// True for 127.0.0.0/8, ::1 and "localhost": addresses only this machine can reach.
+bool is_loopback_host(std::string_view host);
+
+}  // namespace gpubridge::client

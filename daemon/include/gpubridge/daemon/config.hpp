@@ -1,0 +1,45 @@
+#pragma once
+// gpubridged configuration: a JSON file (configs/gpubridged.json) overridden by command-line flags.
+// Every problem is reported as "<source>: <key.path>: <what is wrong>".
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json_fwd.hpp>
+
+#include "gpubridge/common/result.hpp"
+
+namespace gpubridge::daemon {
+
+struct Limits {
+  std::uint32_t max_message_bytes = 16u << 20;  // largest accepted message payload (≤ protocol::kMaxPayload)
+  unsigned max_clients = 64;                    // connections beyond this get SERVER_FULL
+  unsigned handshake_timeout_ms = 10000;        // HELLO must arrive within this
+  unsigned idle_timeout_ms = 300000;            // no bytes at all (subscribers exempt); 0 = off
+  unsigned trickle_window_ms = 5000;            // an unfinished message must grow by ...
+  unsigned min_bytes_per_sec = 256;             // ... at least this rate over each window
+  std::uint64_t queue_bytes = 64ull << 20;      // outgoing bytes queued per session before reading pauses
+};
+
+struct DaemonConfig {
+  std::vector<std::string> listen;  // "unix:PATH" | "tcp:HOST:PORT"; empty = the default Unix socket
+  std::string token;                // required from TCP clients when set
+  std::string token_file;           // alternative to token (first line, trimmed)
+  std::string backend = "sim";      // "sim" | "discard" | "fake" | board name | "auto"
+  bool fallback_to_sim = true;      // board lost → continue on the simulator
+  std::string boards_dir;           // board profiles (JSON)
+  std::string frames_dir;           // write every scanned-out frame as PNG here
+  std::string record_dir;           // write each session's stream as a binary trace here
+  std::string log_level = "info";
+  Limits limits;
+};
+
+// Parses a configuration document; `source` names it in error messages.
+Result<DaemonConfig> parse_config(const nlohmann::json& doc, const std::string& source);
+Result<DaemonConfig> load_config(const std::filesystem::path& path);
+// Cross-field checks after flags were applied: addresses parse, non-loopback TCP has a token,
+// token_file is read into token.
+Result<void> finalize_config(DaemonConfig& cfg);
+
+}  // namespace gpubridge::daemon

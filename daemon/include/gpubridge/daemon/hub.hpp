@@ -1,0 +1,114 @@
+#pragma once
+// Hub: the daemon's shared state, owned by the network thread: sessions, the device lease (one
+// holder, FIFO waiters), frame fan-out to subscribers, status. The backend lives on the device
+// executor: every backend call goes through device_call(), which runs the work there and posts
+// the result back to the network executor, so a slow device never blocks another session's I/O.
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <deque>
+#include <map>
+#include <memory>
+#include <string>
+
+#include <utility>  // before Asio: Boost 1.74's awaitable.hpp uses std::exchange without it
+#include <boost/asio.hpp>
+#include <nlohmann/json.hpp>
+
+#include "gpubridge/backends/backend.hpp"
+#include "gpubridge/daemon/config.hpp"
+#include "gpubridge/protocol/messages.hpp"
+
+namespace gpubridge::daemon {
+
+class Session;
+
+struct HubOptions {
+  Limits limits;
+  std::string token;       // required from TCP sessions when non-empty
+  std::string frames_dir;  // PNG per scanned-out frame when non-empty
+  std::string record_dir;  // binary trace per session when non-empty
+};
+
+// A scanned-out frame encoded once per requested format and shared by every subscriber.
+class FrameFanout {
+ public:
+  explicit FrameFanout(std::shared_ptr<const backends::ScanoutFrame> frame) : frame_(std::move(frame)) {}
+  // The complete FRAME message for `format` (encoded on first use).
+  std::shared_ptr<const std::vector<std::uint8_t>> message(protocol::FrameFormat format);
+  const backends::ScanoutFrame& frame() const { return *frame_; }
+
+ private:
+  std::shared_ptr<const backends::ScanoutFrame> frame_;
+  std::shared_ptr<const std::vector<std::uint8_t>> encoded_[4];
+};
+
+class Hub {
+ public:
+  using Executor = boost::asio::any_io_executor;
+  // Fallback factory: builds the simulator when a board disappears (empty = no fallback).
+  using BackendFactory = std::function<Result<std::unique_ptr<backends::Backend>>()>;
+
+  Hub(Executor net, Executor device, std::unique_ptr<backends::Backend> backend, HubOptions options,
+      BackendFactory fallback = {});
+  ~Hub();
+  Hub(const Hub&) = delete;
+  Hub& operator=(const Hub&) = delete;
+
+  const HubOptions& options() const { return options_; }
+  Executor net_executor() const { return net_; }
+
+  // --- sessions (network thread) ---
+  std::uint32_t add_session(const std::shared_ptr<Session>& s);
+  void remove_session(std::uint32_t id);
+  std::size_t session_count() const { return sessions_.size(); }
+  // Asks every session to close (SHUTTING_DOWN); returns how many were open.
+  std::size_t shutdown_sessions();
+
+  // --- lease (network thread) ---
+  enum class LeaseResult { Granted, Queued, Busy };
+  LeaseResult acquire_lease(std::uint32_t id, protocol::LeaseMode mode);
+  // Releases the lease if `id` holds it (the device is reset before the next holder gets it) or
+  // removes `id` from the waiters. Returns true if it held the lease.
+  bool release_lease(std::uint32_t id);
+  bool holds_lease(std::uint32_t id) const { return lease_holder_ == id; }
+
+  // --- device (runs `work(backend)` on the device executor, `done(result)` on the network one) ---
+  template <class T, class Work, class Done>
+  void device_call(Work work, Done done) {
+    boost::asio::post(device_, [this, work = std::move(work), done = std::move(done)]() mutable {
+      Result<T> r = work(*backend_);
+      if (!r.ok() && r.error().code == backends::kDeviceGone) on_device_gone(r.error());
+      boost::asio::post(net_, [r = std::move(r), done = std::move(done)]() mutable { done(std::move(r)); });
+    });
+  }
+
+  std::string device_json() const;     // WELCOME's device description
+  nlohmann::json status_json() const;  // STATUS_REPLY
+  std::uint64_t frames_seen() const { return frames_seen_; }
+
+ private:
+  void on_scanout(std::shared_ptr<const backends::ScanoutFrame> frame);  // device thread
+  void fan_out(std::shared_ptr<const backends::ScanoutFrame> frame);     // network thread
+  void on_device_gone(const Error& e);                                   // device thread
+  void broadcast_event(const nlohmann::json& event);                     // network thread
+  void grant_next();
+
+  Executor net_, device_;
+  std::unique_ptr<backends::Backend> backend_;  // touched only on the device executor
+  backends::DeviceInfo info_;                   // network-thread copy of backend_->info()
+  HubOptions options_;
+  BackendFactory fallback_;
+
+  std::map<std::uint32_t, std::weak_ptr<Session>> sessions_;
+  std::uint32_t next_session_id_ = 1;
+  std::uint32_t lease_holder_ = 0;  // 0 = free
+  std::deque<std::uint32_t> lease_waiters_;
+  bool resetting_ = false;          // a released lease is being reset; grant after it finishes
+  std::uint64_t frames_seen_ = 0;
+  std::uint32_t last_frame_number_ = 0;
+  std::atomic<std::uint64_t> frame_pngs_written_{0};  // incremented on the device thread
+  std::chrono::steady_clock::time_point started_ = std::chrono::steady_clock::now();
+};
+
+}  // namespace gpubridge::daemon

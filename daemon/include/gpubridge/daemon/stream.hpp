@@ -1,0 +1,50 @@
+#pragma once
+// The byte stream a Session talks over. AsioStream wraps a real socket (Unix or TCP); tests and
+// the fuzzer use an in-memory implementation, so the same session dispatch runs everywhere.
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <utility>  // before Asio: Boost 1.74's awaitable.hpp uses std::exchange without it
+#include <boost/asio.hpp>
+
+namespace gpubridge::daemon {
+
+class Stream {
+ public:
+  using Handler = std::function<void(const boost::system::error_code&, std::size_t)>;
+  virtual ~Stream() = default;
+  // Reads at least one byte into buf (like socket::async_read_some).
+  virtual void async_read_some(boost::asio::mutable_buffer buf, Handler handler) = 0;
+  // Writes every byte of bufs (like asio::async_write).
+  virtual void async_write(const std::vector<boost::asio::const_buffer>& bufs, Handler handler) = 0;
+  virtual void close() = 0;
+  virtual std::string transport() const = 0;  // "unix" | "tcp" | "memory"
+  virtual std::string peer() const = 0;       // for logs and status
+};
+
+template <class Socket>
+class AsioStream final : public Stream {
+ public:
+  AsioStream(Socket socket, std::string transport, std::string peer)
+      : socket_(std::move(socket)), transport_(std::move(transport)), peer_(std::move(peer)) {}
+  void async_read_some(boost::asio::mutable_buffer buf, Handler handler) override {
+    socket_.async_read_some(buf, std::move(handler));
+  }
+  void async_write(const std::vector<boost::asio::const_buffer>& bufs, Handler handler) override {
+    boost::asio::async_write(socket_, bufs, std::move(handler));
+  }
+  void close() override {
+    boost::system::error_code ignored;
+    socket_.shutdown(Socket::shutdown_both, ignored);
+    socket_.close(ignored);
+  }
+  std::string transport() const override { return transport_; }
+  std::string peer() const override { return peer_; }
+
+ private:
+  Socket socket_;
+  std::string transport_, peer_;
+};
+
+}  // namespace gpubridge::daemon

@@ -1,0 +1,158 @@
+#include "gpubridge/daemon/config.hpp"
+
+#include <fstream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "gpubridge/client/address.hpp"
+#include "gpubridge/protocol/messages.hpp"
+
+namespace gpubridge::daemon {
+namespace {
+
+using nlohmann::json;
+
+class Reader {
+ public:
+  Reader(const std::string& source) : source_(source) {}
+
+  Error fail(const std::string& key, const std::string& what) const {
+    return make_error(source_ + ": " + key + ": " + what);
+  }
+  static std::string shown(const json& v) {
+    std::string s = v.dump();
+    return s.size() > 40 ? s.substr(0, 37) + "..." : s;
+  }
+
+  Result<void> read_string(const json& obj, const std::string& prefix, const char* key, std::string& out) const {
+    if (!obj.contains(key)) return {};
+    const auto& v = obj.at(key);
+    if (!v.is_string()) return fail(prefix + key, "expected a string, got " + shown(v));
+    out = v.get<std::string>();
+    return {};
+  }
+  Result<void> read_bool(const json& obj, const std::string& prefix, const char* key, bool& out) const {
+    if (!obj.contains(key)) return {};
+    const auto& v = obj.at(key);
+    if (!v.is_boolean()) return fail(prefix + key, "expected true or false, got " + shown(v));
+    out = v.get<bool>();
+    return {};
+  }
+  template <class T>
+  Result<void> read_uint(const json& obj, const std::string& prefix, const char* key, std::uint64_t lo, std::uint64_t hi,
+                         T& out) const {
+    if (!obj.contains(key)) return {};
+    const auto& v = obj.at(key);
+    const std::string range = std::to_string(lo) + ".." + std::to_string(hi);
+    if (!v.is_number_unsigned() && !(v.is_number_integer() && v.get<std::int64_t>() >= 0))
+      return fail(prefix + key, "expected an integer " + range + ", got " + shown(v));
+    const auto n = v.get<std::uint64_t>();
+    if (n < lo || n > hi) return fail(prefix + key, "expected an integer " + range + ", got " + shown(v));
+    out = static_cast<T>(n);
+    return {};
+  }
+  Result<void> known_keys(const json& obj, const std::string& prefix, std::initializer_list<const char*> keys) const {
+    for (const auto& [k, v] : obj.items()) {
+      bool found = false;
+      for (const char* key : keys) found = found || k == key;
+      if (!found) return fail(prefix + k, "unknown key (check the spelling; see docs/daemon.md)");
+    }
+    return {};
+  }
+
+ private:
+  std::string source_;
+};
+
+#define GPUBRIDGE_TRY(expr) \
+  do {                      \
+    auto r_ = (expr);       \
+    if (!r_) return r_.error(); \
+  } while (0)
+
+}  // namespace
+
+Result<DaemonConfig> parse_config(const json& doc, const std::string& source) {
+  Reader rd(source);
+  if (!doc.is_object()) return rd.fail("(top level)", "expected a JSON object");
+  GPUBRIDGE_TRY(rd.known_keys(doc, "", {"listen", "token", "token_file", "backend", "fallback_to_sim", "boards_dir",
+                                        "frames_dir", "record_dir", "log_level", "limits", "comment"}));
+  DaemonConfig cfg;
+  if (doc.contains("listen")) {
+    const auto& l = doc.at("listen");
+    if (!l.is_array()) return rd.fail("listen", "expected an array of \"unix:PATH\" / \"tcp:HOST:PORT\" strings");
+    for (std::size_t i = 0; i < l.size(); ++i) {
+      const std::string key = "listen[" + std::to_string(i) + "]";
+      if (!l[i].is_string()) return rd.fail(key, "expected a string, got " + Reader::shown(l[i]));
+      auto a = client::parse_address(l[i].get<std::string>());
+      if (!a) return rd.fail(key, a.error().message);
+      cfg.listen.push_back(l[i].get<std::string>());
+    }
+  }
+  GPUBRIDGE_TRY(rd.read_string(doc, "", "token", cfg.token));
+  GPUBRIDGE_TRY(rd.read_string(doc, "", "token_file", cfg.token_file));
+  GPUBRIDGE_TRY(rd.read_string(doc, "", "backend", cfg.backend));
+  if (cfg.backend.empty()) return rd.fail("backend", "expected \"sim\", \"auto\" or a board name, got \"\"");
+  GPUBRIDGE_TRY(rd.read_bool(doc, "", "fallback_to_sim", cfg.fallback_to_sim));
+  GPUBRIDGE_TRY(rd.read_string(doc, "", "boards_dir", cfg.boards_dir));
+  GPUBRIDGE_TRY(rd.read_string(doc, "", "frames_dir", cfg.frames_dir));
+  GPUBRIDGE_TRY(rd.read_string(doc, "", "record_dir", cfg.record_dir));
+  GPUBRIDGE_TRY(rd.read_string(doc, "", "log_level", cfg.log_level));
+  if (doc.contains("limits")) {
+    const auto& l = doc.at("limits");
+    if (!l.is_object()) return rd.fail("limits", "expected an object");
+    GPUBRIDGE_TRY(rd.known_keys(l, "limits.", {"max_message_bytes", "max_clients", "handshake_timeout_ms", "idle_timeout_ms",
+                                               "trickle_window_ms", "min_bytes_per_sec", "queue_bytes"}));
+    auto& lim = cfg.limits;
+    GPUBRIDGE_TRY(rd.read_uint(l, "limits.", "max_message_bytes", 4096, protocol::kMaxPayload, lim.max_message_bytes));
+    GPUBRIDGE_TRY(rd.read_uint(l, "limits.", "max_clients", 1, 4096, lim.max_clients));
+    GPUBRIDGE_TRY(rd.read_uint(l, "limits.", "handshake_timeout_ms", 10, 600000, lim.handshake_timeout_ms));
+    GPUBRIDGE_TRY(rd.read_uint(l, "limits.", "idle_timeout_ms", 0, 86400000, lim.idle_timeout_ms));
+    GPUBRIDGE_TRY(rd.read_uint(l, "limits.", "trickle_window_ms", 10, 600000, lim.trickle_window_ms));
+    GPUBRIDGE_TRY(rd.read_uint(l, "limits.", "min_bytes_per_sec", 0, 1u << 30, lim.min_bytes_per_sec));
+    GPUBRIDGE_TRY(rd.read_uint(l, "limits.", "queue_bytes", 1u << 20, 1ull << 32, lim.queue_bytes));
+  }
+  return cfg;
+}
+
+Result<DaemonConfig> load_config(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  if (!in) return make_error(path.string() + ": cannot open the configuration file");
+  json doc;
+  try {
+    doc = json::parse(in, nullptr, true, /*ignore_comments=*/true);
+  } catch (const json::parse_error& e) {
+    return make_error(path.string() + ": not valid JSON: " + e.what());
+  }
+  return parse_config(doc, path.string());
+}
+
+Result<void> finalize_config(DaemonConfig& cfg) {
+  if (!cfg.token_file.empty()) {
+    std::ifstream in(cfg.token_file);
+    if (!in) return make_error("token_file: cannot read " + cfg.token_file);
+    std::string line;
+    std::getline(in, line);
+    while (!line.empty() && (line.back() == '\r' || line.back() == ' ' || line.back() == '\t')) line.pop_back();
+    if (line.empty()) return make_error("token_file: " + cfg.token_file + " is empty (expected the token on its first line)");
+    cfg.token = line;
+  }
+  if (cfg.token.size() > protocol::kMaxTokenBytes)
+    return make_error("token: longer than " + std::to_string(protocol::kMaxTokenBytes) + " bytes");
+  if (cfg.listen.empty()) cfg.listen.push_back("unix:");
+  for (const auto& text : cfg.listen) {
+    auto a = client::parse_address(text);
+    if (!a) return make_error("listen: " + a.error().message);
+    if (a->kind == client::Address::Kind::Tcp && !client::is_loopback_host(a->host) && cfg.token.empty())
+      return make_error("listen: " + a->to_string() +
+                        " is reachable from other machines; set a token (\"token\" / \"token_file\" or --token) "
+                        "or bind 127.0.0.1");
+  }
+  if (cfg.limits.max_message_bytes > protocol::kMaxPayload || cfg.limits.max_message_bytes < 4096)
+    return make_error("limits.max_message_bytes: expected 4096.." + std::to_string(protocol::kMaxPayload));
+  if (cfg.limits.max_clients < 1 || cfg.limits.max_clients > 4096) return make_error("limits.max_clients: expected 1..4096");
+  return {};
+}
+
+}  // namespace gpubridge::daemon

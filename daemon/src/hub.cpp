@@ -1,0 +1,212 @@
+#include "gpubridge/daemon/hub.hpp"
+
+#include <cstdio>
+#include <filesystem>
+
+#include "gpubridge/common/image.hpp"
+#include "gpubridge/common/log.hpp"
+#include "gpubridge/daemon/session.hpp"
+#include "gpubridge/protocol/crc32.hpp"
+#include "gpubridge/version.hpp"
+
+namespace gpubridge::daemon {
+namespace {
+
+using protocol::FrameFormat;
+using protocol::PixelFormat;
+
+std::optional<PixelFormat> pixel_format_for(FrameFormat f, PixelFormat native) {
+  switch (f) {
+    case FrameFormat::Native: return native;
+    case FrameFormat::RGBA8888: return PixelFormat::RGBA8888;
+    case FrameFormat::RGB565: return PixelFormat::RGB565;
+    case FrameFormat::RGBA2222: return PixelFormat::RGBA2222;
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+std::shared_ptr<const std::vector<std::uint8_t>> FrameFanout::message(FrameFormat format) {
+  const auto slot = static_cast<std::size_t>(format) & 3;
+  if (encoded_[slot]) return encoded_[slot];
+  const auto& f = *frame_;
+  const PixelFormat target = pixel_format_for(format, f.format).value_or(f.format);
+  std::vector<std::uint8_t> converted;
+  std::span<const std::uint8_t> pixels = f.pixels;
+  if (target != f.format) {
+    converted = device_from_image(target, image_from_device(f.format, f.width, f.height, f.pixels));
+    pixels = converted;
+  }
+  protocol::FrameData d;
+  d.number = f.number;
+  d.width = static_cast<std::uint16_t>(f.width);
+  d.height = static_cast<std::uint16_t>(f.height);
+  d.format = target;
+  d.crc = target == f.format ? f.crc : protocol::crc32(pixels);
+  d.swap_ns = static_cast<std::uint64_t>(
+      std::chrono::duration_cast<std::chrono::nanoseconds>(f.swap_time.time_since_epoch()).count());
+  d.pixels = pixels;
+  auto bytes = std::make_shared<std::vector<std::uint8_t>>();
+  protocol::encode(protocol::Message{0, d}, *bytes);
+  encoded_[slot] = std::move(bytes);
+  return encoded_[slot];
+}
+
+Hub::Hub(Executor net, Executor device, std::unique_ptr<backends::Backend> backend, HubOptions options,
+         BackendFactory fallback)
+    : net_(std::move(net)),
+      device_(std::move(device)),
+      backend_(std::move(backend)),
+      info_(backend_->info()),
+      options_(std::move(options)),
+      fallback_(std::move(fallback)) {
+  backend_->set_scanout_callback([this](std::shared_ptr<const backends::ScanoutFrame> f) { on_scanout(std::move(f)); });
+}
+
+Hub::~Hub() {
+  if (backend_) backend_->set_scanout_callback({});
+}
+
+std::uint32_t Hub::add_session(const std::shared_ptr<Session>& s) {
+  const auto id = next_session_id_++;
+  sessions_[id] = s;
+  return id;
+}
+
+void Hub::remove_session(std::uint32_t id) {
+  release_lease(id);
+  sessions_.erase(id);
+}
+
+std::size_t Hub::shutdown_sessions() {
+  std::vector<std::shared_ptr<Session>> live;
+  for (auto& [id, w] : sessions_)
+    if (auto s = w.lock()) live.push_back(std::move(s));
+  for (auto& s : live) s->fail(protocol::ErrorCode::ShuttingDown, "gpubridged is shutting down");
+  return live.size();
+}
+
+Hub::LeaseResult Hub::acquire_lease(std::uint32_t id, protocol::LeaseMode mode) {
+  if (lease_holder_ == id) return LeaseResult::Granted;
+  if (lease_holder_ == 0 && !resetting_ && lease_waiters_.empty()) {
+    lease_holder_ = id;
+    return LeaseResult::Granted;
+  }
+  if (mode == protocol::LeaseMode::FailIfBusy) return LeaseResult::Busy;
+  lease_waiters_.push_back(id);
+  return LeaseResult::Queued;
+}
+
+bool Hub::release_lease(std::uint32_t id) {
+  std::erase(lease_waiters_, id);
+  if (lease_holder_ != id || id == 0) return false;
+  lease_holder_ = 0;
+  // Leave the device in a defined state for the next holder: reset, then grant.
+  resetting_ = true;
+  device_call<void>([](backends::Backend& b) { return b.reset(); },
+                    [this](Result<void> r) {
+                      if (!r) logger("daemon")->warn("device reset after lease release failed: {}", r.error().message);
+                      resetting_ = false;
+                      grant_next();
+                    });
+  return true;
+}
+
+void Hub::grant_next() {
+  while (lease_holder_ == 0 && !resetting_ && !lease_waiters_.empty()) {
+    const auto id = lease_waiters_.front();
+    lease_waiters_.pop_front();
+    auto it = sessions_.find(id);
+    if (it == sessions_.end()) continue;
+    auto s = it->second.lock();
+    if (!s) continue;
+    lease_holder_ = id;
+    s->on_lease_granted();
+  }
+}
+
+std::string Hub::device_json() const {
+  nlohmann::json j{{"backend", info_.backend},     {"board", info_.board},
+                   {"bridge", info_.bridge},       {"max_width", info_.max_width},
+                   {"max_height", info_.max_height}, {"vram_bytes", info_.vram_bytes},
+                   {"id", info_.id},               {"caps", info_.caps},
+                   {"daemon_version", kVersion}};
+  return j.dump();
+}
+
+nlohmann::json Hub::status_json() const {
+  nlohmann::json clients = nlohmann::json::array();
+  std::string holder_name;
+  for (const auto& [id, w] : sessions_) {
+    auto s = w.lock();
+    if (!s) continue;
+    if (id == lease_holder_) holder_name = s->name();
+    clients.push_back({{"session", id},
+                       {"name", s->name()},
+                       {"transport", s->transport()},
+                       {"handshaken", s->handshaken()},
+                       {"subscribed", s->subscribed()},
+                       {"lease", id == lease_holder_},
+                       {"bytes_in", s->bytes_in()}});
+  }
+  nlohmann::json lease = nullptr;
+  if (lease_holder_) lease = {{"session", lease_holder_}, {"name", holder_name}};
+  const auto uptime = std::chrono::duration<double>(std::chrono::steady_clock::now() - started_).count();
+  return {{"daemon_version", kVersion},
+          {"backend", info_.backend},
+          {"board", info_.board},
+          {"bridge", info_.bridge},
+          {"lease", lease},
+          {"lease_waiters", lease_waiters_.size()},
+          {"client_count", clients.size()},
+          {"clients", clients},
+          {"frames", {{"count", frames_seen_}, {"last_number", last_frame_number_},
+                      {"pngs_written", frame_pngs_written_.load()}}},
+          {"uptime_s", uptime}};
+}
+
+void Hub::on_scanout(std::shared_ptr<const backends::ScanoutFrame> frame) {
+  if (!options_.frames_dir.empty()) {
+    char name[32];
+    std::snprintf(name, sizeof name, "frame_%06u.png", frame->number);
+    const auto path = std::filesystem::path(options_.frames_dir) / name;
+    if (auto r = save_png(path, image_from_device(frame->format, frame->width, frame->height, frame->pixels)); !r)
+      logger("daemon")->warn("frames dir: {}", r.error().message);
+    else
+      frame_pngs_written_.fetch_add(1, std::memory_order_relaxed);
+  }
+  boost::asio::post(net_, [this, frame = std::move(frame)]() mutable { fan_out(std::move(frame)); });
+}
+
+void Hub::fan_out(std::shared_ptr<const backends::ScanoutFrame> frame) {
+  ++frames_seen_;
+  last_frame_number_ = frame->number;
+  FrameFanout fanout(std::move(frame));
+  for (auto& [id, w] : sessions_)
+    if (auto s = w.lock(); s && s->subscribed()) s->offer_frame(fanout);
+}
+
+void Hub::on_device_gone(const Error& e) {
+  logger("daemon")->error("device gone: {}", e.message);
+  nlohmann::json event{{"event", "device_gone"}, {"message", e.message}};
+  if (fallback_) {
+    if (auto sim = fallback_(); sim) {
+      backend_ = std::move(*sim);
+      backend_->set_scanout_callback([this](std::shared_ptr<const backends::ScanoutFrame> f) { on_scanout(std::move(f)); });
+      event["fallback"] = backend_->info().backend;
+      auto info = backend_->info();
+      boost::asio::post(net_, [this, info] { info_ = info; });
+    }
+  }
+  boost::asio::post(net_, [this, event] { broadcast_event(event); });
+}
+
+void Hub::broadcast_event(const nlohmann::json& event) {
+  // Events use the reply path of each session, so they obey the same byte caps.
+  for (auto& [id, w] : sessions_) {
+    if (auto s = w.lock(); s && s->handshaken()) s->send_event(event.dump());
+  }
+}
+
+}  // namespace gpubridge::daemon

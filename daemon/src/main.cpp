@@ -1,0 +1,171 @@
+// gpubridged: serves the spigpu socket protocol over Unix/TCP sockets and routes it to the
+// simulator or a board (see docs/daemon.md). Prints "listening on ADDRESS" per endpoint and
+// "ready" on stdout once it accepts connections.
+#include <cstdio>
+#include <thread>
+
+#include <CLI/CLI.hpp>
+
+#ifdef GPUBRIDGE_HAVE_SYSTEMD
+#include <systemd/sd-daemon.h>
+#endif
+
+#include "gpubridge/common/log.hpp"
+#include "gpubridge/daemon/backend_factory.hpp"
+#include "gpubridge/daemon/config.hpp"
+#include "gpubridge/daemon/hub.hpp"
+#include "gpubridge/daemon/server.hpp"
+#include "gpubridge/version.hpp"
+
+namespace {
+
+using namespace gpubridge;
+namespace asio = boost::asio;
+
+void notify(const char* state) {
+#ifdef GPUBRIDGE_HAVE_SYSTEMD
+  sd_notify(0, state);
+#else
+  (void)state;
+#endif
+}
+
+int run(daemon::DaemonConfig cfg) {
+  auto log = logger("daemon");
+  auto backend = daemon::make_backend(cfg.backend, cfg);
+  if (!backend) {
+    std::fprintf(stderr, "gpubridged: %s\n", backend.error().message.c_str());
+    return 1;
+  }
+  asio::io_context net(1);
+  asio::io_context device(1);
+  auto device_guard = asio::make_work_guard(device);
+  std::thread device_thread([&device] { device.run(); });
+  auto join_device = [&] {
+    device_guard.reset();
+    device.stop();
+    if (device_thread.joinable()) device_thread.join();
+  };
+
+  daemon::HubOptions opts{cfg.limits, cfg.token, cfg.frames_dir, cfg.record_dir};
+  daemon::Hub::BackendFactory fallback;
+  if (cfg.fallback_to_sim && cfg.backend != "sim" && daemon::simulator_available()) fallback = daemon::make_simulator;
+  int exit_code = 0;
+  {
+    daemon::Hub hub(net.get_executor(), device.get_executor(), std::move(*backend), opts, fallback);
+    daemon::Server server(net, hub);
+    for (const auto& text : cfg.listen) {
+      auto addr = client::parse_address(text);
+      auto bound = addr ? server.listen(*addr) : Result<client::Address>(addr.error());
+      if (!bound) {
+        std::fprintf(stderr, "gpubridged: %s\n", bound.error().message.c_str());
+        server.stop();
+        join_device();
+        return 1;
+      }
+      std::printf("listening on %s\n", bound->to_string().c_str());
+      log->info("listening on {}", bound->to_string());
+    }
+    std::printf("ready\n");
+    std::fflush(stdout);
+    notify("READY=1");
+
+    asio::signal_set signals(net, SIGINT, SIGTERM);
+    asio::steady_timer force_stop(net);
+    signals.async_wait([&](const boost::system::error_code& ec, int sig) {
+      if (ec) return;
+      log->info("signal {}: shutting down", sig);
+      notify("STOPPING=1");
+      server.stop();  // no new connections; socket and lock removed now
+      const auto open = hub.shutdown_sessions();
+      // Sessions close once their last reply is flushed; never wait longer than 1.5 s in total.
+      force_stop.expires_after(std::chrono::milliseconds(open ? 1500 : 0));
+      force_stop.async_wait([&net](const boost::system::error_code&) { net.stop(); });
+    });
+    net.run();
+    server.stop();
+  }
+  join_device();
+  log->info("stopped");
+  return exit_code;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"gpubridged: serves spigpu devices (simulator or boards) to gpubridge clients over Unix/TCP sockets"};
+  app.set_version_flag("--version", std::string("gpubridged ") + gpubridge::kVersion);
+  std::string config_path;
+  std::vector<std::string> listen;
+  std::string token, token_file, backend, boards_dir, frames_dir, record_dir, log_level;
+  std::optional<unsigned> max_clients, handshake_ms, idle_ms, trickle_ms, min_rate;
+  std::optional<std::uint32_t> max_message;
+  std::optional<std::uint64_t> queue_bytes;
+  bool foreground = false;
+  bool no_fallback = false;
+  app.add_option("-c,--config", config_path, "JSON configuration file (see configs/gpubridged.json)");
+  app.add_option("-l,--listen", listen, "unix:PATH or tcp:HOST:PORT (repeatable; replaces the config's list)");
+  app.add_option("--token", token, "token TCP clients must present (required for non-loopback TCP)");
+  app.add_option("--token-file", token_file, "read the token from the first line of this file");
+  app.add_option("-b,--backend", backend, "sim | auto | BOARD | fake | discard");
+  app.add_flag("--no-fallback", no_fallback, "do not switch to the simulator when a board disappears");
+  app.add_option("--boards-dir", boards_dir, "directory of board profiles (JSON)");
+  app.add_option("--frames-dir", frames_dir, "write every scanned-out frame as frame_NNNNNN.png here");
+  app.add_option("--record", record_dir, "write each session's command stream as a binary trace here");
+  app.add_option("--max-clients", max_clients, "connection cap (1..4096)");
+  app.add_option("--max-message", max_message, "largest accepted message payload in bytes");
+  app.add_option("--handshake-timeout-ms", handshake_ms, "HELLO deadline");
+  app.add_option("--idle-timeout-ms", idle_ms, "close sessions silent this long (0 = never; subscribers exempt)");
+  app.add_option("--trickle-window-ms", trickle_ms, "window of the minimum-byte-rate check");
+  app.add_option("--min-bytes-per-sec", min_rate, "minimum rate while a message is incomplete");
+  app.add_option("--queue-bytes", queue_bytes, "outgoing bytes queued per session before reading pauses");
+  app.add_option("--log-level", log_level, "trace|debug|info|warn|error|off");
+  app.add_flag("--foreground", foreground,
+               "stay in the foreground (gpubridged never forks; run it under systemd or your shell's job control)");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 2;
+  }
+
+  gpubridge::daemon::DaemonConfig cfg;
+  if (!config_path.empty()) {
+    auto loaded = gpubridge::daemon::load_config(config_path);
+    if (!loaded) {
+      std::fprintf(stderr, "gpubridged: %s\n", loaded.error().message.c_str());
+      return 2;
+    }
+    cfg = std::move(*loaded);
+  }
+  if (!listen.empty()) cfg.listen = listen;
+  if (!token.empty()) cfg.token = token;
+  if (!token_file.empty()) cfg.token_file = token_file;
+  if (!backend.empty()) cfg.backend = backend;
+  if (no_fallback) cfg.fallback_to_sim = false;
+  if (!boards_dir.empty()) cfg.boards_dir = boards_dir;
+  if (!frames_dir.empty()) cfg.frames_dir = frames_dir;
+  if (!record_dir.empty()) cfg.record_dir = record_dir;
+  if (!log_level.empty()) cfg.log_level = log_level;
+  if (max_clients) cfg.limits.max_clients = *max_clients;
+  if (max_message) cfg.limits.max_message_bytes = *max_message;
+  if (handshake_ms) cfg.limits.handshake_timeout_ms = std::max(10u, *handshake_ms);
+  if (idle_ms) cfg.limits.idle_timeout_ms = *idle_ms;
+  if (trickle_ms) cfg.limits.trickle_window_ms = std::max(10u, *trickle_ms);
+  if (min_rate) cfg.limits.min_bytes_per_sec = *min_rate;
+  if (queue_bytes) cfg.limits.queue_bytes = std::max<std::uint64_t>(*queue_bytes, 64 * 1024);
+  if (auto r = gpubridge::daemon::finalize_config(cfg); !r) {
+    std::fprintf(stderr, "gpubridged: %s\n", r.error().message.c_str());
+    return 2;
+  }
+  for (const auto& dir : {cfg.frames_dir, cfg.record_dir}) {
+    std::error_code ec;
+    if (!dir.empty()) std::filesystem::create_directories(dir, ec);
+    if (ec) {
+      std::fprintf(stderr, "gpubridged: cannot create %s: %s\n", dir.c_str(), ec.message().c_str());
+      return 1;
+    }
+  }
+  gpubridge::init_logging(cfg.log_level);
+  (void)foreground;
+  return run(std::move(cfg));
+}

@@ -1,0 +1,306 @@
+// End-to-end tests against a real gpubridged process on a Unix socket / loopback TCP.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <future>
+#include <nlohmann/json.hpp>
+
+#include "daemon_process.hpp"
+#include "gpubridge/client/client.hpp"
+#include "gpubridge/common/image.hpp"
+#include "gpubridge/protocol/frame.hpp"
+
+namespace gpubridge::test {
+namespace {
+
+using namespace std::chrono_literals;
+using protocol::LeaseMode;
+using protocol::Reg;
+
+class DaemonE2E : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = make_temp_dir(::testing::UnitTest::GetInstance()->current_test_info()->name());
+    socket_ = (dir_ / "d.sock").string();
+  }
+  void TearDown() override {
+    daemon_.stop();
+    std::error_code ec;
+    fs::remove_all(dir_, ec);
+  }
+  void start(std::vector<std::string> extra = {}) {
+    std::vector<std::string> args{"--listen", "unix:" + socket_, "--backend", "fake", "--log-level", "warn"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    ASSERT_TRUE(daemon_.start(args)) << daemon_.error();
+  }
+  client::Client connect(const std::string& name, const std::string& address = "") {
+    auto c = client::Client::connect(address.empty() ? "unix:" + socket_ : address, 2000ms);
+    EXPECT_TRUE(c) << (c ? "" : c.error().message);
+    auto h = c->handshake(name, "", 2000ms);
+    EXPECT_TRUE(h) << (h ? "" : h.error().message);
+    return std::move(*c);
+  }
+  std::vector<std::string> cli(std::vector<std::string> args) {
+    args.insert(args.begin(), GPUBRIDGE_CLI_PATH);
+    return args;
+  }
+
+  fs::path dir_;
+  std::string socket_;
+  Daemon daemon_;
+};
+
+std::vector<std::uint8_t> frames_of(std::initializer_list<protocol::Frame> fs) {
+  std::vector<std::uint8_t> out;
+  for (const auto& f : fs) protocol::append(out, f);
+  return out;
+}
+
+TEST_F(DaemonE2E, SocketIsPrivateAndWelcomeDescribesDevice) {
+  start();
+  struct stat st{};
+  ASSERT_EQ(::stat(socket_.c_str(), &st), 0);
+  EXPECT_EQ(st.st_mode & 0777, 0600u);
+  auto c = connect("welcome");
+  const auto j = nlohmann::json::parse(c.session().device_json);
+  EXPECT_EQ(j["backend"], "fake");
+  EXPECT_GT(c.session().session_id, 0u);
+}
+
+TEST_F(DaemonE2E, SecondDaemonOnTheSameSocketIsRefused) {
+  start();
+  const auto r = run_process({GPUBRIDGED_PATH, "--listen", "unix:" + socket_, "--backend", "fake"}, 5s);
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find("another gpubridged"), std::string::npos) << r.err;
+  // The first daemon still serves.
+  auto c = connect("still-there");
+  EXPECT_TRUE(c.ping(1000ms));
+}
+
+TEST_F(DaemonE2E, StaleSocketFileIsReplaced) {
+  { std::ofstream(socket_) << "stale"; }
+  start();
+  auto c = connect("after-stale");
+  EXPECT_TRUE(c.ping(1000ms));
+}
+
+TEST_F(DaemonE2E, RegisterWritesReadBackThroughTheLease) {
+  start();
+  auto c = connect("writer");
+  // Without the lease, drawing is refused.
+  const auto w = frames_of({protocol::write_frame(Reg::CLEAR_COLOR, 0x11223344)});
+  ASSERT_TRUE(c.write_frames(protocol::FrameView{w}, 1000ms));
+  auto fenced = c.fence(1000ms);
+  ASSERT_FALSE(fenced);
+  EXPECT_TRUE(client::is_protocol_error(fenced.error(), protocol::ErrorCode::NoLease)) << fenced.error().message;
+
+  ASSERT_TRUE(c.acquire_lease(LeaseMode::FailIfBusy, 1000ms));
+  ASSERT_TRUE(c.write_frames(protocol::FrameView{w}, 1000ms));
+  ASSERT_TRUE(c.fence(1000ms));
+  auto v = c.read_register(protocol::index_of(Reg::CLEAR_COLOR), 1000ms);
+  ASSERT_TRUE(v) << v.error().message;
+  EXPECT_EQ(*v, 0x11223344u);
+}
+
+TEST_F(DaemonE2E, TwoClientsCompeteForTheLease) {
+  start();
+  auto a = connect("a");
+  auto b = connect("b");
+  ASSERT_TRUE(a.acquire_lease(LeaseMode::Wait, 1000ms));
+  // Fail-if-busy gets BUSY at once.
+  auto busy = b.acquire_lease(LeaseMode::FailIfBusy, 1000ms);
+  ASSERT_FALSE(busy);
+  EXPECT_TRUE(client::is_protocol_error(busy.error(), protocol::ErrorCode::Busy)) << busy.error().message;
+  // Wait mode: b is granted only after a releases.
+  std::atomic<bool> released{false};
+  auto waiter = std::async(std::launch::async, [&] {
+    auto r = b.acquire_lease(LeaseMode::Wait, 5000ms);
+    return std::make_pair(static_cast<bool>(r), released.load());
+  });
+  EXPECT_EQ(waiter.wait_for(300ms), std::future_status::timeout);  // still waiting while a holds it
+  // a leaves the device in some state; the release must reset it before b draws.
+  const auto w = frames_of({protocol::write_frame(Reg::CLEAR_COLOR, 0xDEADBEEF)});
+  ASSERT_TRUE(a.write_frames(protocol::FrameView{w}, 1000ms));
+  ASSERT_TRUE(a.fence(1000ms));
+  released = true;
+  ASSERT_TRUE(a.release_lease(1000ms));
+  const auto [granted, after_release] = waiter.get();
+  EXPECT_TRUE(granted);
+  EXPECT_TRUE(after_release);
+  auto v = b.read_register(protocol::index_of(Reg::CLEAR_COLOR), 1000ms);
+  ASSERT_TRUE(v);
+  EXPECT_EQ(*v, protocol::describe(Reg::CLEAR_COLOR).reset);
+  // The status shows b as the holder.
+  auto s = b.status(1000ms);
+  ASSERT_TRUE(s);
+  EXPECT_EQ(nlohmann::json::parse(*s)["lease"]["name"], "b");
+}
+
+TEST_F(DaemonE2E, LeaseIsReleasedWhenTheHolderDisconnects) {
+  start();
+  auto b = connect("b");
+  {
+    auto a = connect("a");
+    ASSERT_TRUE(a.acquire_lease(LeaseMode::Wait, 1000ms));
+  }  // a's socket closes without BYE
+  EXPECT_TRUE(b.acquire_lease(LeaseMode::Wait, 3000ms));
+}
+
+TEST_F(DaemonE2E, UploadAndReadbackRoundTripThroughTheCli) {
+  start();
+  std::vector<std::uint8_t> data(200000);
+  std::mt19937 rng(7);
+  for (auto& b : data) b = static_cast<std::uint8_t>(rng());
+  const auto in = (dir_ / "in.bin").string(), out = (dir_ / "out.bin").string();
+  std::ofstream(in, std::ios::binary).write(reinterpret_cast<const char*>(data.data()), static_cast<std::streamsize>(data.size()));
+  // Upload and readback run as separate clients: memory survives the lease reset between them.
+  auto up = run_process(cli({"upload", "0x1000", in, "--connect", "unix:" + socket_}));
+  ASSERT_EQ(up.exit_code, 0) << up.err;
+  auto rb = run_process(cli({"readback", "0x1000", std::to_string(data.size()), "--out", out, "--connect", "unix:" + socket_, "--json"}));
+  ASSERT_EQ(rb.exit_code, 0) << rb.err;
+  EXPECT_EQ(nlohmann::json::parse(rb.out)["bytes"], data.size());
+  std::ifstream f(out, std::ios::binary);
+  std::vector<std::uint8_t> back((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(back, data);
+  // Beyond the fake device's 1 MiB memory: a one-line error, exit 1.
+  auto bad = run_process(cli({"readback", "0xFFF00", "0x1000", "--out", out, "--connect", "unix:" + socket_}));
+  EXPECT_EQ(bad.exit_code, 1);
+  EXPECT_NE(bad.err.find("RANGE"), std::string::npos) << bad.err;
+}
+
+TEST_F(DaemonE2E, CliRegStatusAndErrors) {
+  start();
+  auto wr = run_process(cli({"reg", "write", "CLEAR_COLOR", "0x55667788", "--connect", "unix:" + socket_}));
+  ASSERT_EQ(wr.exit_code, 0) << wr.err;
+  // The write's client disconnected, which reset the device: the value is back to reset.
+  auto rd = run_process(cli({"reg", "read", "ID", "--connect", "unix:" + socket_, "--json"}));
+  ASSERT_EQ(rd.exit_code, 0) << rd.err;
+  EXPECT_EQ(nlohmann::json::parse(rd.out)["register"], "ID");
+  auto st = run_process(cli({"status", "--json", "--connect", "unix:" + socket_}));
+  ASSERT_EQ(st.exit_code, 0) << st.err;
+  const auto j = nlohmann::json::parse(st.out);
+  EXPECT_EQ(j["backend"], "fake");
+  EXPECT_EQ(j["client_count"], 1);  // the status client itself
+  auto usage = run_process(cli({"reg", "read", "NO_SUCH_REG", "--connect", "unix:" + socket_}));
+  EXPECT_EQ(usage.exit_code, 2);
+  auto missing = run_process(cli({"status", "--connect", "unix:" + (dir_ / "nope.sock").string()}));
+  EXPECT_EQ(missing.exit_code, 1);
+  EXPECT_NE(missing.err.find("is gpubridged running?"), std::string::npos) << missing.err;
+  EXPECT_EQ(std::count(missing.err.begin(), missing.err.end(), '\n'), 1) << missing.err;
+}
+
+TEST_F(DaemonE2E, ConnectionCapRefusesExplicitly) {
+  start({"--max-clients", "2"});
+  auto a = connect("a");
+  auto b = connect("b");
+  auto c = client::Client::connect("unix:" + socket_, 1000ms);
+  ASSERT_TRUE(c);
+  auto h = c->handshake("c", "", 2000ms);
+  ASSERT_FALSE(h);
+  EXPECT_TRUE(client::is_protocol_error(h.error(), protocol::ErrorCode::ServerFull)) << h.error().message;
+  // After one leaves, a new client is admitted.
+  b.close();
+  std::this_thread::sleep_for(100ms);
+  auto d = connect("d");
+  EXPECT_TRUE(d.ping(1000ms));
+}
+
+TEST_F(DaemonE2E, SigtermDuringAStreamExitsCleanlyWithinTwoSeconds) {
+  start();
+  auto c = connect("streamer");
+  ASSERT_TRUE(c.acquire_lease(LeaseMode::Wait, 1000ms));
+  std::atomic<bool> stop{false};
+  std::atomic<std::uint64_t> sent{0};
+  auto streamer = std::async(std::launch::async, [&] {
+    std::vector<std::uint8_t> batch;
+    for (int i = 0; i < 4096; ++i) protocol::append(batch, protocol::write_frame(Reg::COLOR, static_cast<std::uint64_t>(i)));
+    while (!stop) {
+      if (!c.write_frames(protocol::FrameView{batch}, 1000ms)) return;
+      sent += 4096;
+    }
+  });
+  while (sent < 100000) std::this_thread::sleep_for(1ms);
+  const auto t0 = std::chrono::steady_clock::now();
+  const int code = daemon_.terminate(5s);
+  const auto took = std::chrono::steady_clock::now() - t0;
+  stop = true;
+  streamer.get();
+  EXPECT_EQ(code, 0) << daemon_.error();
+  EXPECT_LT(took, 2s);
+  EXPECT_FALSE(fs::exists(socket_));
+  EXPECT_FALSE(fs::exists(socket_ + ".lock"));
+}
+
+TEST_F(DaemonE2E, NonLoopbackTcpNeedsAToken) {
+  auto r = run_process({GPUBRIDGED_PATH, "--listen", "tcp:0.0.0.0:0", "--backend", "fake"}, 5s);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("token"), std::string::npos) << r.err;
+
+  start({"--listen", "tcp:0.0.0.0:0", "--token", "s3cret"});
+  ASSERT_EQ(daemon_.endpoints().size(), 2u);
+  const auto port = daemon_.endpoints()[1].substr(daemon_.endpoints()[1].rfind(':') + 1);
+  const std::string addr = "tcp:127.0.0.1:" + port;
+  {
+    auto c = client::Client::connect(addr, 1000ms);
+    ASSERT_TRUE(c) << c.error().message;
+    auto h = c->handshake("intruder", "wrong", 2000ms);
+    ASSERT_FALSE(h);
+    EXPECT_TRUE(client::is_protocol_error(h.error(), protocol::ErrorCode::AuthFailed)) << h.error().message;
+  }
+  {
+    auto c = client::Client::connect(addr, 1000ms);
+    ASSERT_TRUE(c);
+    auto h = c->handshake("friend", "s3cret", 2000ms);
+    ASSERT_TRUE(h) << h.error().message;
+    EXPECT_TRUE(c->ping(1000ms));
+  }
+  // The Unix socket needs no token: file permissions guard it.
+  auto u = connect("local");
+  EXPECT_TRUE(u.ping(1000ms));
+}
+
+TEST_F(DaemonE2E, BadConfigNamesTheKey) {
+  const auto cfg = (dir_ / "bad.json").string();
+  std::ofstream(cfg) << R"({"limits": {"max_clients": "ten"}})";
+  auto r = run_process({GPUBRIDGED_PATH, "--config", cfg}, 5s);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find(cfg + ": limits.max_clients: expected an integer 1..4096, got \"ten\""), std::string::npos) << r.err;
+}
+
+TEST_F(DaemonE2E, SubscriberGetsEveryFrameAndScreenshotWritesIt) {
+  start();
+  auto sub = connect("sub");
+  ASSERT_TRUE(sub.subscribe(protocol::FrameFormat::RGBA8888, 0, 1000ms));
+  auto shot = std::async(std::launch::async, [&] {
+    return run_process(cli({"screenshot", "--out", (dir_ / "shot.png").string(), "--connect", "unix:" + socket_, "--json"}));
+  });
+  // Wait until the screenshot client has subscribed (2 subscribers in the status).
+  for (int i = 0; i < 200; ++i) {
+    auto s = sub.status(1000ms);
+    ASSERT_TRUE(s);
+    int subs = 0;
+    for (const auto& cl : nlohmann::json::parse(*s)["clients"]) subs += cl["subscribed"].get<bool>();
+    if (subs == 2) break;
+    std::this_thread::sleep_for(10ms);
+  }
+  auto drawer = connect("drawer");
+  ASSERT_TRUE(drawer.acquire_lease(LeaseMode::Wait, 1000ms));
+  const auto w = frames_of({protocol::write_frame(Reg::CLEAR_COLOR, 0x10203040), protocol::write_frame(Reg::FB_DISPLAY, 0)});
+  ASSERT_TRUE(drawer.write_frames(protocol::FrameView{w}, 1000ms));
+  ASSERT_TRUE(drawer.fence(1000ms));
+  auto f = sub.next_frame(2000ms);
+  ASSERT_TRUE(f) << f.error().message;
+  EXPECT_EQ(f->pixels.size(), std::size_t{f->width} * f->height * 4);
+  EXPECT_EQ(f->pixels[0], 0x10);
+  EXPECT_EQ(f->pixels[1], 0x20);
+  EXPECT_EQ(f->pixels[2], 0x30);
+  const auto r = shot.get();
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  auto img = load_png(dir_ / "shot.png");
+  ASSERT_TRUE(img) << img.error().message;
+  EXPECT_EQ(img->width, f->width);
+  EXPECT_EQ(img->rgba, f->pixels);
+}
+
+}  // namespace
+}  // namespace gpubridge::test

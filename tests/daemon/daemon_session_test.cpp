@@ -1,0 +1,148 @@
+// In-process tests: configuration parsing and the session dispatch over an in-memory stream.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "gpubridge/daemon/config.hpp"
+#include "gpubridge/daemon/hub.hpp"
+#include "gpubridge/daemon/memory_stream.hpp"
+#include "gpubridge/daemon/session.hpp"
+#include "gpubridge/daemon/test_backends.hpp"
+
+namespace gpubridge::daemon {
+namespace {
+
+using protocol::Message;
+using protocol::Reg;
+
+TEST(DaemonConfig, ParsesEveryKey) {
+  const auto doc = nlohmann::json::parse(R"({
+    "listen": ["unix:/tmp/x.sock", "tcp:127.0.0.1:7420"], "token": "t", "backend": "fake",
+    "fallback_to_sim": false, "frames_dir": "f", "record_dir": "r", "log_level": "debug",
+    "limits": {"max_message_bytes": 65536, "max_clients": 8, "handshake_timeout_ms": 500,
+               "idle_timeout_ms": 0, "trickle_window_ms": 100, "min_bytes_per_sec": 10, "queue_bytes": 2097152}})");
+  auto cfg = parse_config(doc, "t.json");
+  ASSERT_TRUE(cfg) << cfg.error().message;
+  EXPECT_EQ(cfg->listen.size(), 2u);
+  EXPECT_EQ(cfg->backend, "fake");
+  EXPECT_FALSE(cfg->fallback_to_sim);
+  EXPECT_EQ(cfg->limits.max_clients, 8u);
+  EXPECT_EQ(cfg->limits.max_message_bytes, 65536u);
+  EXPECT_EQ(cfg->limits.queue_bytes, 2097152u);
+  EXPECT_EQ(cfg->limits.idle_timeout_ms, 0u);
+}
+
+TEST(DaemonConfig, ErrorsNameTheKeyAndTheProblem) {
+  struct Case {
+    const char* json;
+    const char* message;
+  } cases[] = {
+      {R"({"limits": {"max_clients": "ten"}})", "c.json: limits.max_clients: expected an integer 1..4096, got \"ten\""},
+      {R"({"limits": {"max_clients": 0}})", "c.json: limits.max_clients: expected an integer 1..4096, got 0"},
+      {R"({"limits": {"max_clients": -3}})", "c.json: limits.max_clients: expected an integer 1..4096, got -3"},
+      {R"({"limits": {"max_clients": 1.5}})", "c.json: limits.max_clients: expected an integer 1..4096, got 1.5"},
+      {R"({"listen": ["ftp:x"]})", "c.json: listen[0]: bad address \"ftp:x\": unknown scheme"},
+      {R"({"lisen": []})", "c.json: lisen: unknown key"},
+      {R"({"limits": {"max_message_bytes": 99999999999}})", "c.json: limits.max_message_bytes: expected an integer 4096..16777216"},
+      {R"({"token": 5})", "c.json: token: expected a string, got 5"},
+      {R"([1])", "c.json: (top level): expected a JSON object"},
+  };
+  for (const auto& c : cases) {
+    auto cfg = parse_config(nlohmann::json::parse(c.json), "c.json");
+    ASSERT_FALSE(cfg) << c.json;
+    EXPECT_NE(cfg.error().message.find(c.message), std::string::npos) << cfg.error().message;
+  }
+}
+
+TEST(DaemonConfig, NonLoopbackTcpWithoutTokenIsRefused) {
+  DaemonConfig cfg;
+  cfg.listen = {"tcp:0.0.0.0:7420"};
+  auto r = finalize_config(cfg);
+  ASSERT_FALSE(r);
+  EXPECT_NE(r.error().message.find("set a token"), std::string::npos);
+  cfg.token = "x";
+  EXPECT_TRUE(finalize_config(cfg));
+  DaemonConfig local;
+  local.listen = {"tcp:127.0.0.1:7420", "tcp:[::1]:1"};
+  EXPECT_TRUE(finalize_config(local));
+}
+
+// Runs one client byte stream through a real Session over a MemoryStream, split into reads of
+// `chunk` bytes, and returns the parsed replies.
+std::vector<Message> run_session(const std::vector<std::uint8_t>& input, std::size_t chunk, std::vector<std::uint8_t>& raw) {
+  boost::asio::io_context io;
+  HubOptions opts;
+  Hub hub(io.get_executor(), io.get_executor(), std::make_unique<FakeScanoutBackend>(), opts);
+  raw.clear();
+  auto stream = std::make_unique<MemoryStream>(io.get_executor(), input, std::vector<std::size_t>{chunk}, &raw);
+  std::make_shared<Session>(hub, std::move(stream), io.get_executor())->start();
+  io.run_for(std::chrono::seconds(5));
+  protocol::MessageParser p;
+  p.feed(raw);
+  std::vector<Message> out;
+  for (;;) {
+    Message m;
+    if (p.next(m) != protocol::MessageParser::Status::Ok) break;
+    out.push_back(std::move(m));
+  }
+  return out;
+}
+
+TEST(DaemonSession, DispatchIsIndependentOfReadSplitPoints) {
+  std::vector<std::uint8_t> in;
+  auto add = [&](std::uint32_t id, protocol::Payload p) { protocol::encode(Message{id, std::move(p)}, in); };
+  add(1, protocol::Hello{protocol::kSocketVersion, "split", ""});
+  add(2, protocol::LeaseAcquire{protocol::LeaseMode::FailIfBusy});
+  std::vector<std::uint8_t> frames;
+  protocol::append(frames, protocol::write_frame(Reg::CLEAR_COLOR, 0xCAFEF00D));
+  protocol::append(frames, protocol::write_frame(Reg::FB_DISPLAY, 0));
+  add(3, protocol::WriteFrames{protocol::FrameView{frames}});
+  add(4, protocol::ReadReg{protocol::index_of(Reg::CLEAR_COLOR)});
+  add(5, protocol::Fence{});
+  add(6, protocol::Bye{});
+
+  std::vector<std::uint8_t> whole_raw;
+  const auto whole = run_session(in, in.size(), whole_raw);
+  ASSERT_EQ(whole.size(), 5u);  // WELCOME, LEASE_GRANTED, REG_VALUE, FENCE_DONE, BYE
+  EXPECT_TRUE(std::holds_alternative<protocol::Welcome>(whole[0].payload));
+  EXPECT_TRUE(std::holds_alternative<protocol::LeaseGranted>(whole[1].payload));
+  ASSERT_TRUE(std::holds_alternative<protocol::RegValue>(whole[2].payload));
+  EXPECT_EQ(std::get<protocol::RegValue>(whole[2].payload).value, 0xCAFEF00Du);
+  EXPECT_EQ(whole[2].request_id, 4u);
+  EXPECT_TRUE(std::holds_alternative<protocol::FenceDone>(whole[3].payload));
+  EXPECT_TRUE(std::holds_alternative<protocol::Bye>(whole[4].payload));
+  for (std::size_t chunk : {1, 2, 3, 5, 8, 13, 100}) {
+    std::vector<std::uint8_t> raw;
+    run_session(in, chunk, raw);
+    EXPECT_EQ(raw, whole_raw) << "chunk " << chunk;
+  }
+}
+
+TEST(DaemonSession, MessagesBeforeHelloAreRefused) {
+  std::vector<std::uint8_t> in;
+  protocol::encode(Message{7, protocol::StatusReq{}}, in);
+  std::vector<std::uint8_t> raw;
+  const auto out = run_session(in, in.size(), raw);
+  ASSERT_EQ(out.size(), 1u);
+  ASSERT_TRUE(std::holds_alternative<protocol::ErrorMsg>(out[0].payload));
+  EXPECT_EQ(std::get<protocol::ErrorMsg>(out[0].payload).code, protocol::ErrorCode::NotHandshaken);
+  EXPECT_EQ(std::get<protocol::ErrorMsg>(out[0].payload).ref, 7u);
+}
+
+TEST(DaemonSession, ReadFramesInAWriteBatchAreRejected) {
+  std::vector<std::uint8_t> in;
+  protocol::encode(Message{1, protocol::Hello{protocol::kSocketVersion, "r", ""}}, in);
+  protocol::encode(Message{2, protocol::LeaseAcquire{protocol::LeaseMode::Wait}}, in);
+  std::vector<std::uint8_t> frames;
+  protocol::append(frames, protocol::read_frame(Reg::STATUS));
+  protocol::encode(Message{3, protocol::WriteFrames{protocol::FrameView{frames}}}, in);
+  std::vector<std::uint8_t> raw;
+  const auto out = run_session(in, in.size(), raw);
+  ASSERT_GE(out.size(), 3u);
+  ASSERT_TRUE(std::holds_alternative<protocol::ErrorMsg>(out[2].payload));
+  EXPECT_EQ(std::get<protocol::ErrorMsg>(out[2].payload).code, protocol::ErrorCode::BadFrame);
+  EXPECT_EQ(std::get<protocol::ErrorMsg>(out[2].payload).ref, 3u);
+}
+
+}  // namespace
+}  // namespace gpubridge::daemon

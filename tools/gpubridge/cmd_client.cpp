@@ -1,0 +1,407 @@
+// Daemon-client commands: status, play, screenshot, reg read|write, upload, readback.
+// All talk to gpubridged through the Client library (--connect unix:PATH|tcp:HOST:PORT).
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <charconv>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <thread>
+
+#include <nlohmann/json.hpp>
+
+#include "client_common.hpp"
+#include "gpubridge/common/image.hpp"
+#include "gpubridge/common/trace_files.hpp"
+#include "gpubridge/protocol/text_trace.hpp"
+
+namespace gpubridge::cli {
+
+void add_client_options(CLI::App* sub, GlobalOptions& g, ClientOptions& o) {
+  sub->add_option("--connect", g.connect, "daemon address: unix:PATH or tcp:HOST:PORT (default: the user's socket)");
+  sub->add_option("--token", o.token, "token for TCP daemons (default: $GPUBRIDGE_TOKEN)");
+  sub->add_option("--timeout", o.timeout_ms, "milliseconds to wait for each reply")->capture_default_str();
+}
+
+Result<client::Client> open_client(const GlobalOptions& g, const ClientOptions& o, const std::string& name) {
+  const client::Timeout timeout{o.timeout_ms};
+  auto c = client::Client::connect(g.connect, timeout);
+  if (!c) return c.error();
+  std::string token = o.token;
+  if (token.empty())
+    if (const char* env = std::getenv("GPUBRIDGE_TOKEN")) token = env;
+  if (auto r = c->handshake(name, token, timeout); !r) return r.error();
+  return std::move(*c);
+}
+
+int fail(const char* command, const std::string& message) {
+  std::fprintf(stderr, "gpubridge %s: %s\n", command, message.c_str());
+  return 1;
+}
+
+std::optional<std::uint64_t> parse_number(const std::string& text) {
+  std::uint64_t v = 0;
+  const char* b = text.data();
+  const char* e = text.data() + text.size();
+  int base = 10;
+  if (text.size() > 2 && text[0] == '0' && (text[1] == 'x' || text[1] == 'X')) {
+    b += 2;
+    base = 16;
+  }
+  const auto [p, ec] = std::from_chars(b, e, v, base);
+  if (ec != std::errc() || p != e || b == e) return std::nullopt;
+  return v;
+}
+
+ProgressBar::ProgressBar(std::string label, bool enabled) : label_(std::move(label)), enabled_(enabled && ::isatty(2)) {}
+ProgressBar::~ProgressBar() {
+  if (enabled_ && last_percent_ >= 0) std::fputc('\n', stderr);
+}
+void ProgressBar::update(std::uint64_t done, std::uint64_t total) {
+  if (!enabled_ || total == 0) return;
+  const int percent = static_cast<int>(done * 100 / total);
+  if (percent == last_percent_) return;
+  last_percent_ = percent;
+  char bar[31];
+  const int filled = percent * 30 / 100;
+  for (int i = 0; i < 30; ++i) bar[i] = i < filled ? '#' : ' ';
+  bar[30] = 0;
+  std::fprintf(stderr, "\r%s [%s] %3d%% %.1f/%.1f MiB", label_.c_str(), bar, percent, done / 1048576.0, total / 1048576.0);
+  std::fflush(stderr);
+}
+
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+constexpr std::uint64_t kMaxFileBytes = 1ull << 32;  // uploads: the 32-bit address space
+
+std::atomic<bool> g_interrupted{false};  // executable-level: set by SIGINT during `play --loop`
+
+void print_json(const nlohmann::json& j) { std::puts(j.dump(2).c_str()); }
+
+// ------------------------------------------------------------------------------ status
+int run_status(const GlobalOptions& g, const ClientOptions& o) {
+  auto c = open_client(g, o, "gpubridge status");
+  if (!c) return fail("status", c.error().message);
+  auto s = c->status(client::Timeout{o.timeout_ms});
+  if (!s) return fail("status", s.error().message);
+  const auto j = nlohmann::json::parse(*s, nullptr, false);
+  if (j.is_discarded() || !j.is_object()) return fail("status", "daemon sent a status that is not a JSON object");
+  c->close();
+  if (g.json) {
+    print_json(j);
+    return 0;
+  }
+  std::printf("daemon:    gpubridged %s at %s, up %.0f s\n", j.value("daemon_version", "?").c_str(),
+              c->address().to_string().c_str(), j.value("uptime_s", 0.0));
+  std::printf("backend:   %s%s%s\n", j.value("backend", "?").c_str(),
+              j.value("board", "").empty() ? "" : (" board " + j.value("board", "")).c_str(),
+              j.value("bridge", "").empty() ? "" : (" via " + j.value("bridge", "")).c_str());
+  if (j["lease"].is_object())
+    std::printf("lease:     session %u (%s), %zu waiting\n", j["lease"].value("session", 0u),
+                j["lease"].value("name", "").c_str(), j.value("lease_waiters", std::size_t{0}));
+  else
+    std::printf("lease:     free\n");
+  std::printf("clients:   %zu\n", j.value("client_count", std::size_t{0}));
+  for (const auto& cl : j["clients"])
+    std::printf("  #%-4u %-24s %-5s%s%s\n", cl.value("session", 0u), cl.value("name", "").c_str(),
+                cl.value("transport", "").c_str(), cl.value("lease", false) ? " lease" : "",
+                cl.value("subscribed", false) ? " subscribed" : "");
+  std::printf("frames:    %llu scanned out, last #%u\n",
+              static_cast<unsigned long long>(j["frames"].value("count", std::uint64_t{0})),
+              j["frames"].value("last_number", 0u));
+  return 0;
+}
+
+// ------------------------------------------------------------------------------ play
+struct PlayOptions {
+  std::string trace;
+  bool loop = false;
+  unsigned repeat = 1;
+  double fps = 0;
+  bool fail_if_busy = false;
+};
+
+std::size_t count_swaps(protocol::FrameView v) {
+  std::size_t n = 0;
+  const auto display = protocol::index_of(protocol::Reg::FB_DISPLAY);
+  for (std::size_t i = 0; i < v.bytes.size(); i += protocol::kFrameBytes) n += (v.bytes[i] & 0x7F) == display;
+  return n;
+}
+
+int run_play(const GlobalOptions& g, const ClientOptions& o, const PlayOptions& p) {
+  if (p.fps < 0 || p.fps > 100000 || p.fps != p.fps) return fail("play", "--fps must be 0 (unpaced) .. 100000");
+  auto stream = load_trace(p.trace);
+  if (!stream) return fail("play", stream.error().message);
+  auto c = open_client(g, o, "gpubridge play");
+  if (!c) return fail("play", c.error().message);
+  const client::Timeout timeout{o.timeout_ms};
+  if (auto r = c->acquire_lease(p.fail_if_busy ? protocol::LeaseMode::FailIfBusy : protocol::LeaseMode::Wait,
+                                p.fail_if_busy ? timeout : client::Timeout{24 * 3600 * 1000});
+      !r)
+    return fail("play", r.error().message);
+  std::signal(SIGINT, [](int) { g_interrupted = true; });
+
+  const auto start = Clock::now();
+  std::uint64_t frames = 0, swaps = 0, commands = 0, passes = 0;
+  nlohmann::json reads = nlohmann::json::array();
+  for (unsigned pass = 0; (p.loop || pass < p.repeat) && !g_interrupted; ++pass, ++passes) {
+    for (const auto& tc : stream->commands) {
+      if (g_interrupted) break;
+      ++commands;
+      Result<void> r;
+      if (auto* f = std::get_if<protocol::FramesCmd>(&tc.command)) {
+        r = c->write_frames(f->view(), timeout);
+        frames += f->size();
+        const auto n = count_swaps(f->view());
+        swaps += n;
+        if (n && p.fps > 0) {
+          // Pace on swaps: the next swap may not happen before swaps/fps seconds after the start.
+          if (auto fr = c->fence(timeout); !fr) return fail("play", fr.error().message);
+          const auto due = start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(swaps / p.fps));
+          std::this_thread::sleep_until(due);
+        }
+      } else if (auto* u = std::get_if<protocol::UploadCmd>(&tc.command)) {
+        r = c->upload(u->address, u->data, {}, timeout);
+      } else if (auto* fe = std::get_if<protocol::FenceCmd>(&tc.command)) {
+        (void)fe;
+        r = c->fence(timeout);
+      } else if (auto* rr = std::get_if<protocol::ReadRegCmd>(&tc.command)) {
+        auto v = c->read_register(rr->index, timeout);
+        if (!v) return fail("play", v.error().message);
+        const auto* desc = protocol::find_register(rr->index);
+        if (pass == 0) reads.push_back({{"register", desc ? std::string(desc->name) : std::to_string(rr->index)}, {"value", *v}});
+      } else if (auto* rb = std::get_if<protocol::ReadbackCmd>(&tc.command)) {
+        auto data = c->readback(rb->address, rb->length, {}, timeout);
+        if (!data) return fail("play", data.error().message);
+      }
+      if (!r) return fail("play", r.error().message);
+    }
+  }
+  if (auto r = c->fence(timeout); !r) return fail("play", r.error().message);
+  const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  c->close();
+  if (g.json) {
+    print_json({{"trace", p.trace}, {"passes", passes}, {"commands", commands}, {"register_writes", frames},
+                {"swaps", swaps}, {"seconds", seconds}, {"reads", reads}, {"interrupted", g_interrupted.load()}});
+  } else {
+    for (const auto& rd : reads)
+      std::printf("%s = 0x%016llx\n", rd["register"].get<std::string>().c_str(),
+                  static_cast<unsigned long long>(rd["value"].get<std::uint64_t>()));
+    std::printf("played %s: %llu register writes, %llu swaps in %.3f s\n", p.trace.c_str(),
+                static_cast<unsigned long long>(frames), static_cast<unsigned long long>(swaps), seconds);
+  }
+  return 0;
+}
+
+// ------------------------------------------------------------------------------ screenshot
+int run_screenshot(const GlobalOptions& g, const ClientOptions& o, const std::string& out, unsigned skip) {
+  auto c = open_client(g, o, "gpubridge screenshot");
+  if (!c) return fail("screenshot", c.error().message);
+  const client::Timeout timeout{o.timeout_ms};
+  if (auto r = c->subscribe(protocol::FrameFormat::RGBA8888, 0, timeout); !r) return fail("screenshot", r.error().message);
+  if (!g.json) {
+    std::printf("waiting for a frame...\n");
+    std::fflush(stdout);
+  }
+  Result<client::ReceivedFrame> f = make_error("no frame");
+  for (unsigned i = 0; i <= skip; ++i) {
+    f = c->next_frame(timeout);
+    if (!f) return fail("screenshot", f.error().message + " (is anything drawing? run `gpubridge play TRACE`)");
+  }
+  const auto img = image_from_device(f->format, f->width, f->height, f->pixels);
+  if (auto r = save_png(out, img); !r) return fail("screenshot", r.error().message);
+  c->close();
+  if (g.json)
+    print_json({{"out", out}, {"frame", f->number}, {"width", f->width}, {"height", f->height}, {"crc", f->crc}});
+  else
+    std::printf("frame #%u (%ux%u) written to %s\n", f->number, f->width, f->height, out.c_str());
+  return 0;
+}
+
+// ------------------------------------------------------------------------------ reg read / write
+Result<std::uint8_t> register_index(const std::string& text) {
+  if (const auto* d = protocol::find_register(text)) return d->index;
+  if (auto n = parse_number(text); n && *n < protocol::kRegisterCount) return static_cast<std::uint8_t>(*n);
+  return make_error("unknown register \"" + text + "\" (use a name from `gpubridge regs` or an index 0..127)");
+}
+
+int run_reg_read(const GlobalOptions& g, const ClientOptions& o, const std::string& reg) {
+  auto index = register_index(reg);
+  if (!index) {
+    std::fprintf(stderr, "gpubridge reg read: %s\n", index.error().message.c_str());
+    return 2;
+  }
+  auto c = open_client(g, o, "gpubridge reg");
+  if (!c) return fail("reg read", c.error().message);
+  if (*index == protocol::index_of(protocol::Reg::MEM_DATA))
+    if (auto r = c->acquire_lease(protocol::LeaseMode::FailIfBusy); !r) return fail("reg read", r.error().message);
+  auto v = c->read_register(*index, client::Timeout{o.timeout_ms});
+  if (!v) return fail("reg read", v.error().message);
+  c->close();
+  const auto* d = protocol::find_register(*index);
+  const std::string name = d ? std::string(d->name) : "0x" + std::to_string(*index);
+  if (g.json) {
+    nlohmann::json j{{"register", name}, {"index", *index}, {"value", *v}};
+    if (d)
+      for (const auto& f : d->fields)
+        if (f.width) j["fields"][std::string(f.name)] = f.get(*v);
+    print_json(j);
+  } else {
+    std::printf("%s = 0x%016llx\n", name.c_str(), static_cast<unsigned long long>(*v));
+  }
+  return 0;
+}
+
+int run_reg_write(const GlobalOptions& g, const ClientOptions& o, const std::string& reg, const std::vector<std::string>& value) {
+  // Same syntax as a text-trace line: `NAME VALUE`, `NAME FIELD=V ...` or `0xIDX 0xDATA`.
+  auto index = register_index(reg);
+  std::string line = index && protocol::find_register(*index) ? std::string(protocol::find_register(*index)->name) : reg;
+  for (const auto& v : value) line += " " + v;
+  auto frame = protocol::parse_register_line(line);
+  if (!frame) {
+    std::fprintf(stderr, "gpubridge reg write: %s\n", frame.error().message.c_str());
+    return 2;
+  }
+  auto c = open_client(g, o, "gpubridge reg");
+  if (!c) return fail("reg write", c.error().message);
+  const client::Timeout timeout{o.timeout_ms};
+  if (auto r = c->acquire_lease(protocol::LeaseMode::Wait, timeout); !r) return fail("reg write", r.error().message);
+  const auto bytes = protocol::encode(*frame);
+  if (auto r = c->write_frames(protocol::FrameView{bytes}, timeout); !r) return fail("reg write", r.error().message);
+  if (auto r = c->fence(timeout); !r) return fail("reg write", r.error().message);
+  c->close();
+  if (g.json)
+    print_json({{"index", frame->index}, {"value", frame->data}, {"written", true}});
+  else
+    std::printf("wrote %s\n", protocol::format_register_write(frame->index, frame->data).c_str());
+  return 0;
+}
+
+// ------------------------------------------------------------------------------ upload / readback
+int run_upload(const GlobalOptions& g, const ClientOptions& o, const std::string& addr_text, const std::string& file) {
+  auto addr = parse_number(addr_text);
+  if (!addr || *addr > 0xFFFFFFFFull) {
+    std::fprintf(stderr, "gpubridge upload: address \"%s\" must be a number 0..0xFFFFFFFF\n", addr_text.c_str());
+    return 2;
+  }
+  std::ifstream in(file, std::ios::binary | std::ios::ate);
+  if (!in) return fail("upload", "cannot open " + file);
+  const auto size = static_cast<std::uint64_t>(in.tellg());
+  if (size == 0) return fail("upload", file + " is empty");
+  if (size > kMaxFileBytes - *addr) return fail("upload", file + " does not fit below the 4 GiB address limit");
+  std::vector<std::uint8_t> data(static_cast<std::size_t>(size));
+  in.seekg(0);
+  in.read(reinterpret_cast<char*>(data.data()), static_cast<std::streamsize>(size));
+  if (!in) return fail("upload", "cannot read " + file);
+  auto c = open_client(g, o, "gpubridge upload");
+  if (!c) return fail("upload", c.error().message);
+  const client::Timeout timeout{o.timeout_ms};
+  if (auto r = c->acquire_lease(protocol::LeaseMode::Wait, timeout); !r) return fail("upload", r.error().message);
+  ProgressBar bar("upload", !g.json);
+  const auto start = Clock::now();
+  if (auto r = c->upload(static_cast<std::uint32_t>(*addr), data, [&](auto d, auto t) { bar.update(d, t); }, timeout); !r)
+    return fail("upload", r.error().message);
+  const double s = std::chrono::duration<double>(Clock::now() - start).count();
+  c->close();
+  if (g.json)
+    print_json({{"address", *addr}, {"bytes", size}, {"seconds", s}});
+  else
+    std::printf("uploaded %llu bytes to 0x%llx in %.3f s\n", static_cast<unsigned long long>(size),
+                static_cast<unsigned long long>(*addr), s);
+  return 0;
+}
+
+int run_readback(const GlobalOptions& g, const ClientOptions& o, const std::string& addr_text, const std::string& len_text,
+                 const std::string& out) {
+  auto addr = parse_number(addr_text);
+  auto len = parse_number(len_text);
+  if (!addr || *addr > 0xFFFFFFFFull || !len || *len == 0 || *len > 0xFFFFFFFFull - *addr) {
+    std::fprintf(stderr, "gpubridge readback: ADDR and LEN must be numbers with LEN ≥ 1 and ADDR+LEN ≤ 4 GiB\n");
+    return 2;
+  }
+  auto c = open_client(g, o, "gpubridge readback");
+  if (!c) return fail("readback", c.error().message);
+  const client::Timeout timeout{o.timeout_ms};
+  if (auto r = c->acquire_lease(protocol::LeaseMode::Wait, timeout); !r) return fail("readback", r.error().message);
+  ProgressBar bar("readback", !g.json);
+  auto data = c->readback(static_cast<std::uint32_t>(*addr), static_cast<std::uint32_t>(*len),
+                          [&](auto d, auto t) { bar.update(d, t); }, timeout);
+  if (!data) return fail("readback", data.error().message);
+  c->close();
+  std::ofstream f(out, std::ios::binary | std::ios::trunc);
+  f.write(reinterpret_cast<const char*>(data->data()), static_cast<std::streamsize>(data->size()));
+  if (!f) return fail("readback", "cannot write " + out);
+  if (g.json)
+    print_json({{"address", *addr}, {"bytes", data->size()}, {"out", out}});
+  else
+    std::printf("read %zu bytes from 0x%llx into %s\n", data->size(), static_cast<unsigned long long>(*addr), out.c_str());
+  return 0;
+}
+
+}  // namespace
+
+GPUBRIDGE_COMMAND("client", 40, [](CLI::App& app, GlobalOptions& g, auto& runners) {
+  auto copts = std::make_shared<ClientOptions>();
+
+  auto* status = app.add_subcommand("status", "show the daemon's backend, lease holder, clients and frame counter");
+  add_client_options(status, g, *copts);
+  runners.emplace_back(status, [&g, copts] { return run_status(g, *copts); });
+
+  auto popts = std::make_shared<PlayOptions>();
+  auto* play = app.add_subcommand("play", "stream a text or binary trace to the daemon (holding the device lease)");
+  play->add_option("TRACE", popts->trace, "trace file (.trace/.txt text or .gbt binary)")->required()->check(CLI::ExistingFile);
+  play->add_flag("--loop", popts->loop, "repeat until interrupted (Ctrl-C)");
+  play->add_option("--repeat", popts->repeat, "play the trace N times")->check(CLI::Range(1u, 1000000u));
+  play->add_option("--fps", popts->fps, "at most N swaps (FB_DISPLAY writes) per second; 0 = as fast as possible");
+  play->add_flag("--no-wait", popts->fail_if_busy, "fail with BUSY instead of waiting when another client draws");
+  add_client_options(play, g, *copts);
+  runners.emplace_back(play, [&g, copts, popts] { return run_play(g, *copts, *popts); });
+
+  auto out = std::make_shared<std::string>();
+  auto skip = std::make_shared<unsigned>(0);
+  auto* shot = app.add_subcommand("screenshot", "save the next scanned-out frame as a PNG");
+  shot->add_option("--out,-o", *out, "PNG file to write")->required();
+  shot->add_option("--skip", *skip, "ignore this many frames first");
+  add_client_options(shot, g, *copts);
+  runners.emplace_back(shot, [&g, copts, out, skip] { return run_screenshot(g, *copts, *out, *skip); });
+
+  auto* reg = app.add_subcommand("reg", "read or write one device register through the daemon");
+  reg->require_subcommand(1);
+  auto reg_name = std::make_shared<std::string>();
+  auto reg_value = std::make_shared<std::vector<std::string>>();
+  auto* rd = reg->add_subcommand("read", "read a register: reg read NAME|INDEX");
+  rd->add_option("REGISTER", *reg_name, "register name (see `gpubridge regs`) or index")->required();
+  add_client_options(rd, g, *copts);
+  rd->fallthrough();  // global --json/--log-level after `reg read ...`
+  runners.emplace_back(rd, [&g, copts, reg_name] { return run_reg_read(g, *copts, *reg_name); });
+  auto* wr = reg->add_subcommand("write", "write a register: reg write NAME|INDEX VALUE | FIELD=V ...");
+  wr->add_option("REGISTER", *reg_name, "register name or index")->required();
+  wr->add_option("VALUE", *reg_value, "a number (0x.. hex) or FIELD=VALUE pairs, as in text traces")->required();
+  add_client_options(wr, g, *copts);
+  wr->fallthrough();
+  runners.emplace_back(wr, [&g, copts, reg_name, reg_value] { return run_reg_write(g, *copts, *reg_name, *reg_value); });
+
+  auto addr = std::make_shared<std::string>();
+  auto file = std::make_shared<std::string>();
+  auto* up = app.add_subcommand("upload", "copy a file into device memory: upload ADDR FILE");
+  up->add_option("ADDR", *addr, "device byte address (decimal or 0x hex)")->required();
+  up->add_option("FILE", *file, "bytes to upload")->required();
+  add_client_options(up, g, *copts);
+  runners.emplace_back(up, [&g, copts, addr, file] { return run_upload(g, *copts, *addr, *file); });
+
+  auto len = std::make_shared<std::string>();
+  auto* rb = app.add_subcommand("readback", "copy device memory into a file: readback ADDR LEN --out FILE");
+  rb->add_option("ADDR", *addr, "device byte address")->required();
+  rb->add_option("LEN", *len, "number of bytes")->required();
+  rb->add_option("--out,-o", *file, "file to write")->required();
+  add_client_options(rb, g, *copts);
+  runners.emplace_back(rb, [&g, copts, addr, len, file] { return run_readback(g, *copts, *addr, *len, *file); });
+});
+
+}  // namespace gpubridge::cli
