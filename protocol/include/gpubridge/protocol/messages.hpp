@@ -175,6 +175,8 @@ class MessageParser {
   const DecodeError& error() const { return error_; }
   // Bytes buffered but not yet returned as messages (for trickle/idle accounting).
   std::size_t buffered() const { return buf_.size() - pos_; }
+  // Bytes the parser holds in memory, including consumed bytes not yet compacted away.
+  std::size_t held_bytes() const { return buf_.size(); }
   // Total stream offset of the first byte of the message being parsed (for error messages).
   std::uint64_t stream_offset() const { return consumed_ + pos_; }
 
