@@ -101,9 +101,9 @@ ProcessResult run_process(const std::vector<std::string>& argv, const std::vecto
 BackgroundProcess::BackgroundProcess(const std::vector<std::string>& argv, const std::vector<std::string>& env,
                                      const std::filesystem::path& log_dir, const std::string& name) {
   err_path_ = log_dir / (name + ".err");
-  const auto out_path = (log_dir / (name + ".out")).string();
+  out_path_ = log_dir / (name + ".out");
   pid_ = fork();
-  if (pid_ == 0) exec_child(argv, env, out_path, err_path_.string());
+  if (pid_ == 0) exec_child(argv, env, out_path_.string(), err_path_.string());
 }
 
 BackgroundProcess::~BackgroundProcess() { kill_and_wait(SIGKILL); }
@@ -118,6 +118,20 @@ bool BackgroundProcess::running() {
   return true;
 }
 
+std::optional<int> BackgroundProcess::wait_exit(std::chrono::milliseconds limit) {
+  if (pid_ <= 0) return std::nullopt;
+  const auto deadline = std::chrono::steady_clock::now() + limit;
+  int status = 0;
+  do {
+    if (waitpid(pid_, &status, WNOHANG) == pid_) {
+      pid_ = -1;
+      return wait_status_to_code(status);
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  } while (std::chrono::steady_clock::now() < deadline);
+  return std::nullopt;
+}
+
 void BackgroundProcess::kill_and_wait(int signal) {
   if (pid_ <= 0) return;
   kill(pid_, signal);
@@ -127,6 +141,7 @@ void BackgroundProcess::kill_and_wait(int signal) {
 }
 
 std::string BackgroundProcess::log() const { return read_file(err_path_); }
+std::string BackgroundProcess::output() const { return read_file(out_path_); }
 
 Xvfb::Xvfb() {
   int fds[2];

@@ -30,13 +30,16 @@ class BackgroundProcess {
   BackgroundProcess& operator=(const BackgroundProcess&) = delete;
   ~BackgroundProcess();
   bool running();
+  // Waits up to `limit` for the process to exit: its exit code, or nullopt if still running.
+  std::optional<int> wait_exit(std::chrono::milliseconds limit);
   void kill_and_wait(int signal);
+  std::string output() const;  // its stdout so far
   std::string log() const;  // its stderr so far
   pid_t pid() const { return pid_; }
 
  private:
   pid_t pid_ = -1;
-  std::filesystem::path err_path_;
+  std::filesystem::path err_path_, out_path_;
 };
 
 // A private X server for the GL tests. display() is empty when Xvfb could not be started

@@ -4,6 +4,7 @@
 // Expected pixels come from the test pattern's documented formula, computed here independently.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <memory>
 

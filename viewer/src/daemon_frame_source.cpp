@@ -67,7 +67,7 @@ void DaemonFrameSource::run(std::stop_token stop) {
     auto connection = client::Client::connect(config_.address, kConnectTimeout);
     if (!connection) {
       if (!ever_connected && !config_.wait_at_start) {
-        fail(connection.error().message + "; is gpubridged running? (--wait keeps trying)");
+        fail(connection.error().message + " (--wait keeps trying)");
         return;
       }
       if (status.state != SourceStatus::State::Waiting || status.message != connection.error().message) {
