@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <cstdlib>
 #include <memory>
 
@@ -184,6 +185,50 @@ TEST_F(ViewerGl, UsageErrorsExitWithTwoAndSayWhy) {
   const auto t = view({"--test-source", "5000x1", "--frames", "1", "--screenshot", "x.png", "--offscreen"});
   EXPECT_EQ(t.exit_code, 2);
   EXPECT_NE(t.err.find("5000x1"), std::string::npos) << t.err;
+}
+
+TEST_F(ViewerGl, KeysFlipZoomAndSaveTheFrame) {
+  // Keys typed when the first frame arrives (hidden --press): F flips, 2 zooms 2:1 (centred),
+  // S saves the frame's own pixels into --screenshot-dir.
+  const auto grab = (dir_.path() / "keys.png").string();
+  const auto r = view({"--test-source", "64x48:rgb565", "--frames", "1", "--grab-window", grab, "--size", "256x192",
+                       "--no-overlay", "--offscreen", "--json", "--press", "F2S", "--screenshot-dir",
+                       dir_.path().string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const unsigned n = summary(r)["frame"];
+  auto img = load_png(grab);
+  ASSERT_TRUE(img.ok());
+  for (unsigned y = 0; y < 48; ++y)
+    for (unsigned x = 0; x < 64; ++x)
+      ASSERT_TRUE(pixel_is(*img, 64 + 2 * x, 48 + 2 * (47 - y) + 1, expected_pixel(x, y, n, "RGB565")));
+  EXPECT_LT(img->pixel(10, 10)[0], 40);  // outside the 2:1 frame: background
+  char name[64];
+  std::snprintf(name, sizeof name, "gpubridge-frame-%06u.png", n);
+  auto saved = load_png(dir_.path() / name);
+  ASSERT_TRUE(saved.ok()) << saved.error().message;
+  ASSERT_EQ(saved->width, 64u);
+  for (unsigned y = 0; y < 48; ++y)
+    for (unsigned x = 0; x < 64; ++x) ASSERT_TRUE(pixel_is(*saved, x, y, expected_pixel(x, y, n, "RGB565")));
+
+  // I: largest whole factor (3 in 200x200: 192x144 at 4,28); the same zoom key twice: back to fit.
+  const auto r2 = view({"--test-source", "64x48", "--frames", "1", "--grab-window", grab, "--size", "200x200",
+                        "--no-overlay", "--offscreen", "--json", "--press", "I"});
+  ASSERT_EQ(r2.exit_code, 0) << r2.err;
+  const unsigned n2 = summary(r2)["frame"];
+  img = load_png(grab);
+  ASSERT_TRUE(img.ok());
+  for (unsigned y = 0; y < 48; ++y)
+    for (unsigned x = 0; x < 64; ++x)
+      ASSERT_TRUE(pixel_is(*img, 4 + 3 * x + 1, 28 + 3 * y + 1, expected_pixel(x, y, n2, "RGBA8888")));
+  const auto r3 = view({"--test-source", "64x48", "--frames", "1", "--grab-window", grab, "--size", "256x192",
+                        "--no-overlay", "--offscreen", "--json", "--press", "33"});
+  ASSERT_EQ(r3.exit_code, 0) << r3.err;
+  const unsigned n3 = summary(r3)["frame"];
+  img = load_png(grab);
+  ASSERT_TRUE(img.ok());
+  for (unsigned y = 0; y < 48; ++y)
+    for (unsigned x = 0; x < 64; ++x)
+      ASSERT_TRUE(pixel_is(*img, 4 * x + 2, 4 * y + 2, expected_pixel(x, y, n3, "RGBA8888")));  // fit = 4x here
 }
 
 #ifdef GPUBRIDGE_VIEW_HAS_CLIENT

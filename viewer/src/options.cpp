@@ -64,6 +64,7 @@ Result<ParsedCommandLine> parse_command_line(int argc, const char* const* argv) 
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "off"}));
   // Hidden (empty group): a generated test pattern instead of the daemon, for tests of the display.
   app.add_option("--test-source", o.test_source, "WxH[:FORMAT][@FPS]")->group("");
+  app.add_option("--press", o.press, "keys typed when the first frame arrives")->group("");
 
   try {
     app.parse(argc, argv);

@@ -240,6 +240,9 @@ int WindowApp::run() {
     if (new_frame) {
       fit_window_to_frame();
       dirty_ = true;
+      if (taken_ == 1) {
+        for (char key : options_.press) on_char(static_cast<unsigned char>(key));  // scripted keys (tests)
+      }
     }
     const std::uint64_t now = monotonic_ns();
     if (new_frame || view_.status.state != status.state || now - last_overlay_ns_ >= kOverlayRefreshNs) {

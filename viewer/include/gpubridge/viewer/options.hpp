@@ -27,6 +27,7 @@ struct Options {
   std::optional<std::pair<int, int>> window_size;
   std::string screenshot_dir = ".";     // where the S key saves
   std::string test_source;              // hidden: generate frames instead of connecting
+  std::string press;                    // hidden: keys typed once the first frame arrived (tests)
   std::string log_level = "warn";
 };
 
