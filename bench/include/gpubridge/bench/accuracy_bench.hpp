@@ -1,0 +1,68 @@
+#pragma once
+// `gpubridge bench accuracy`: throughput and error of every simulator accuracy configuration on the
+// fixed scene set, with Mesa llvmpipe measured side by side as a peer (docs/accuracy-report.md).
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "gpubridge/bench/scenes.hpp"
+#include "gpubridge/common/result.hpp"
+#include "gpubridge/sim/options.hpp"
+
+namespace gpubridge::bench {
+
+struct AccuracyBenchOptions {
+  bool quick = false;         // small scenes, 1 timed run: the smoke test of the test command
+  unsigned runs = 5;          // timed runs per measurement (best is reported), after 1 warm-up
+  bool llvmpipe = true;       // measure the llvmpipe peer (omitted with a reason when unavailable)
+  std::vector<unsigned> threads{1, 2};
+};
+
+// Error of one renderer on one scene against the double-precision reference (the leading
+// `error_subset` triangles, drawn with depth ALWAYS + write and no blending, so the last triangle
+// covering a pixel owns it).
+struct ErrorStats {
+  std::uint64_t pixels = 0;              // reference-covered pixels judged
+  std::uint64_t coverage_mismatches = 0; // pixels whose hit count or owning triangle differs
+  double colour_max = 0, colour_mean = 0;   // 8-bit LSB (untextured scenes)
+  double z_max = 0;                          // 24-bit LSB
+  double texel_max = 0, texel_mean = 0;      // 1/256 texel of the 1024-texel probe (textured scenes)
+  bool has_colour = false, has_texel = false;
+};
+
+struct Row {
+  std::string renderer;  // "sim" or "llvmpipe"
+  std::string config;    // knob settings or llvmpipe's renderer string
+  std::string scene;
+  unsigned threads = 1;  // rasteriser threads (llvmpipe: 1 = LP_NUM_THREADS=0, 2 = two threads)
+  double seconds = 0;    // best frame time
+  double mtri_s = 0, mpix_s = 0;
+  std::optional<double> ratio_vs_llvmpipe;  // sim throughput / llvmpipe throughput, same scene & threads
+  std::optional<ErrorStats> error;
+};
+
+struct Report {
+  std::string machine;      // CPU model, core count, load average at start
+  std::string llvmpipe;     // renderer string, or why the llvmpipe rows are missing
+  bool llvmpipe_ok = false;
+  std::vector<Scene> scenes;  // descriptions only (triangles cleared after the run)
+  std::vector<std::uint64_t> scene_pixels;  // covered pixels per frame (exact simulator)
+  std::vector<std::size_t> scene_triangles;  // triangles per frame
+  std::vector<Row> rows;
+  std::vector<std::string> goals;  // the speed goals with their measured ratios
+};
+
+// The simulator configurations measured: the exact default first.
+std::vector<sim::AccuracyKnobs> bench_configs();
+
+Result<Report> run_accuracy_bench(const AccuracyBenchOptions& options, const std::function<void(const std::string&)>& progress);
+
+std::string report_markdown(const Report& r, const std::string& command);
+nlohmann::json report_json(const Report& r);
+std::string report_svg(const Report& r);
+
+}  // namespace gpubridge::bench

@@ -1,0 +1,176 @@
+// Orchestration of `gpubridge bench accuracy` (see accuracy_bench.hpp): llvmpipe first (in child
+// processes, before any simulator worker threads exist), then every simulator configuration.
+#include "gpubridge/bench/accuracy_bench.hpp"
+
+#include <fstream>
+#include <sstream>
+#include <thread>
+
+#include "error_measure.hpp"
+#include "llvmpipe_runner.hpp"
+#include "sim_runner.hpp"
+
+namespace gpubridge::bench {
+namespace {
+
+std::string machine_description() {
+  std::string cpu = "unknown CPU";
+  std::ifstream info("/proc/cpuinfo");
+  for (std::string line; std::getline(info, line);)
+    if (line.rfind("model name", 0) == 0) {
+      cpu = line.substr(line.find(':') + 2);
+      break;
+    }
+  std::string load;
+  std::ifstream la("/proc/loadavg");
+  std::getline(la, load);
+  std::ostringstream o;
+  o << cpu << ", " << std::thread::hardware_concurrency() << " hardware threads, load average at start: "
+    << load.substr(0, load.find(' ', load.find(' ', load.find(' ') + 1) + 1));
+  return o.str();
+}
+
+sim::AccuracyKnobs knobs(unsigned recip, unsigned nr, unsigned sub, unsigned zb, bool fast) {
+  sim::AccuracyKnobs k;
+  k.recip_bits = recip;
+  k.nr_steps = nr;
+  k.subpixel_bits = sub;
+  k.z_bits = zb;
+  k.fast = fast;
+  return k;
+}
+
+}  // namespace
+
+std::vector<sim::AccuracyKnobs> bench_configs() {
+  return {
+      knobs(10, 1, 4, 24, false),  // exact: the hardware (docs/protocol.md)
+      knobs(8, 1, 4, 24, false),   // smaller reciprocal table
+      knobs(8, 0, 4, 24, false),   // table only, no Newton-Raphson
+      knobs(6, 0, 4, 24, false),   // tiny table only
+      knobs(12, 2, 4, 24, false),  // more precise than the hardware
+      knobs(10, 1, 2, 24, false),  // 1/4-pixel vertices
+      knobs(10, 1, 0, 24, false),  // whole-pixel vertices
+      knobs(10, 1, 4, 16, false),  // 16-bit depth
+      knobs(10, 1, 4, 24, true),   // floating-point fast mode
+  };
+}
+
+Result<Report> run_accuracy_bench(const AccuracyBenchOptions& opt, const std::function<void(const std::string&)>& progress) {
+  Report rep;
+  rep.machine = machine_description();
+  progress("generating scenes");
+  auto scenes_r = make_scenes(opt.quick ? 200 : 1);
+  if (!scenes_r) return scenes_r.error();
+  rep.scenes = std::move(scenes_r).value();
+  const unsigned runs = opt.quick ? 1 : std::max(1u, opt.runs);
+
+  progress("reference rasterisation of the error subsets");
+  std::vector<ReferenceFrame> refs;
+  for (const auto& s : rep.scenes) refs.push_back(reference_frame(s));
+
+  // llvmpipe: one child process per thread count (LP_NUM_THREADS 0 = one core, 2 = two threads).
+  std::vector<std::optional<LlvmpipeResult>> lp(opt.threads.size());
+  if (opt.llvmpipe) {
+    for (std::size_t ti = 0; ti < opt.threads.size(); ++ti) {
+      const unsigned t = opt.threads[ti];
+      progress("llvmpipe, " + std::to_string(t) + " thread(s)");
+      auto r = run_llvmpipe(rep.scenes, refs, t == 1 ? 0 : t, runs, t == 1);
+      if (!r) {
+        rep.llvmpipe = r.error().message;
+        break;
+      }
+      rep.llvmpipe = r->renderer;
+      rep.llvmpipe_ok = true;
+      lp[ti] = std::move(r).value();
+    }
+    if (!rep.llvmpipe_ok) lp.assign(opt.threads.size(), std::nullopt);
+  } else {
+    rep.llvmpipe = "not measured (--no-llvmpipe)";
+  }
+
+  const auto configs = bench_configs();
+  rep.scene_pixels.assign(rep.scenes.size(), 0);
+  for (std::size_t ci = 0; ci < configs.size(); ++ci) {
+    const auto& k = configs[ci];
+    for (std::size_t si = 0; si < rep.scenes.size(); ++si) {
+      const Scene& s = rep.scenes[si];
+      progress("sim " + sim::to_string(k) + ", " + s.name);
+      std::optional<ErrorStats> err;
+      auto frame = render_sim_error_pass(s, k);
+      if (!frame) return frame.error();
+      err = measure_error(s, refs[si], *frame);
+      for (std::size_t ti = 0; ti < opt.threads.size(); ++ti) {
+        const unsigned t = opt.threads[ti];
+        auto timing = time_sim(s, k, t, runs);
+        if (!timing) return timing.error();
+        if (ci == 0 && ti == 0) rep.scene_pixels[si] = timing->pixels_covered;
+        Row row;
+        row.renderer = "sim";
+        row.config = ci == 0 ? "exact" : sim::to_string(k);
+        row.scene = s.name;
+        row.threads = t;
+        row.seconds = timing->best_seconds;
+        row.mtri_s = double(s.triangles.size()) / row.seconds / 1e6;
+        row.mpix_s = double(rep.scene_pixels[si]) / row.seconds / 1e6;
+        if (lp[ti]) row.ratio_vs_llvmpipe = lp[ti]->seconds[si] / row.seconds;
+        if (ti == 0) row.error = err;  // error does not depend on the thread count (tested)
+        rep.rows.push_back(row);
+      }
+    }
+  }
+  for (std::size_t ti = 0; ti < opt.threads.size(); ++ti) {
+    if (!lp[ti]) continue;
+    for (std::size_t si = 0; si < rep.scenes.size(); ++si) {
+      Row row;
+      row.renderer = "llvmpipe";
+      row.config = opt.threads[ti] == 1 ? "LP_NUM_THREADS=0" : "LP_NUM_THREADS=" + std::to_string(opt.threads[ti]);
+      row.scene = rep.scenes[si].name;
+      row.threads = opt.threads[ti];
+      row.seconds = lp[ti]->seconds[si];
+      row.mtri_s = double(rep.scenes[si].triangles.size()) / row.seconds / 1e6;
+      row.mpix_s = double(rep.scene_pixels[si]) / row.seconds / 1e6;
+      row.error = lp[ti]->error[si];
+      rep.rows.push_back(row);
+    }
+  }
+
+  // Speed goals of issue 3 with the measured values.
+  auto find = [&](const std::string& renderer, const std::string& config, const std::string& scene, unsigned t) -> const Row* {
+    for (const auto& r : rep.rows)
+      if (r.renderer == renderer && r.config == config && r.scene == scene && r.threads == t) return &r;
+    return nullptr;
+  };
+  auto goal = [&](const std::string& text, const Row* a, double target, bool pixels) {
+    if (!a || !a->ratio_vs_llvmpipe) {
+      rep.goals.push_back(text + ": not measured (no llvmpipe row)");
+      return;
+    }
+    std::ostringstream o;
+    o.precision(3);
+    o << text << ": " << *a->ratio_vs_llvmpipe << "x (goal >= " << target << "x, "
+      << (*a->ratio_vs_llvmpipe >= target ? "met" : "MISSED") << "; sim " << (pixels ? a->mpix_s : a->mtri_s)
+      << (pixels ? " Mpix/s" : " Mtri/s") << ")";
+    rep.goals.push_back(o.str());
+  };
+  goal("exact, 1 thread, 10-px triangles (front), tri/s vs llvmpipe", find("sim", "exact", "tri10-front", 1), 2.0, false);
+  goal("exact, 1 thread, 1,000-px triangles (front), tri/s vs llvmpipe", find("sim", "exact", "tri1k-front", 1), 1.5, false);
+  goal("exact, 1 thread, 50,000-px triangles (front), px/s vs llvmpipe", find("sim", "exact", "tri50k-front", 1), 1.0, true);
+  for (const char* scene : {"tri50k-front", "tri50k-random", "tri1k-front"}) {
+    const Row* one = find("sim", "exact", scene, 1);
+    const Row* two = find("sim", "exact", scene, 2);
+    if (one && two) {
+      std::ostringstream o;
+      o.precision(3);
+      const double ratio = one->seconds / two->seconds;
+      o << "exact, 2 threads vs 1 thread, " << scene << ": " << ratio << "x (goal >= 1.8x on large triangles, "
+        << (ratio >= 1.8 ? "met" : "MISSED") << ")";
+      rep.goals.push_back(o.str());
+    }
+  }
+  for (auto& s : rep.scenes) rep.scene_triangles.push_back(s.triangles.size());
+  for (auto& s : rep.scenes) s.triangles.clear();  // descriptions only from here on
+  return rep;
+}
+
+}  // namespace gpubridge::bench

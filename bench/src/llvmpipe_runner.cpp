@@ -1,0 +1,120 @@
+// llvmpipe side of the bench (see llvmpipe_runner.hpp).
+#include "llvmpipe_runner.hpp"
+
+#include <chrono>
+
+#include <nlohmann/json.hpp>
+
+#include "gpubridge/accuracy/texel_probe.hpp"
+#include "gpubridge/bench/llvmpipe_peer.hpp"
+
+namespace gpubridge::bench {
+namespace {
+
+std::vector<GlVertex> vertices_of(const Scene& s, std::size_t count) {
+  std::vector<GlVertex> v(std::min(count, s.triangles.size()) * 3);
+  for (std::size_t i = 0; i * 3 < v.size(); ++i) to_gl(s.triangles[i], &v[i * 3]);
+  return v;
+}
+
+GlDrawState throughput_state(const Scene& s) {
+  GlDrawState st;
+  if (s.state.z_test) {
+    st.depth = s.state.z_func == protocol::DepthFunc::LessEqual ? GlDrawState::Depth::LessEqual
+               : s.state.z_func == protocol::DepthFunc::Always  ? GlDrawState::Depth::Always
+                                                                : GlDrawState::Depth::Less;
+  }
+  st.blend = s.state.blend == protocol::BlendMode::Alpha ? GlDrawState::Blend::Alpha
+             : s.state.blend == protocol::BlendMode::Add ? GlDrawState::Blend::Add
+                                                         : GlDrawState::Blend::Off;
+  st.output = s.textured ? GlDrawState::Output::TextureDecal : GlDrawState::Output::Colour;
+  return st;
+}
+
+nlohmann::json error_json(const ErrorStats& e) {
+  return {{"pixels", e.pixels}, {"coverage_mismatches", e.coverage_mismatches}, {"colour_max", e.colour_max},
+          {"colour_mean", e.colour_mean}, {"z_max", e.z_max}, {"texel_max", e.texel_max},
+          {"texel_mean", e.texel_mean}, {"has_colour", e.has_colour}, {"has_texel", e.has_texel}};
+}
+ErrorStats error_from_json(const nlohmann::json& j) {
+  ErrorStats e;
+  e.pixels = j.at("pixels");
+  e.coverage_mismatches = j.at("coverage_mismatches");
+  e.colour_max = j.at("colour_max");
+  e.colour_mean = j.at("colour_mean");
+  e.z_max = j.at("z_max");
+  e.texel_max = j.at("texel_max");
+  e.texel_mean = j.at("texel_mean");
+  e.has_colour = j.at("has_colour");
+  e.has_texel = j.at("has_texel");
+  return e;
+}
+
+ErrorStats llvmpipe_error(LlvmpipePeer& peer, const Scene& s, const ReferenceFrame& ref) {
+  auto verts = vertices_of(s, s.error_subset);
+  RenderedFrame got;
+  // Hit counts: additive blending of red = 1/255 (exact in RGBA8).
+  auto counting = verts;
+  for (auto& v : counting) v.r = 1.0f / 255.0f, v.g = v.b = v.a = 0.0f;
+  peer.set_vertices(counting);
+  peer.render({.depth = GlDrawState::Depth::Off, .blend = GlDrawState::Blend::Add, .output = GlDrawState::Output::Colour});
+  const auto counts = peer.read_colour();
+  got.count.resize(counts.size() / 4);
+  for (std::size_t i = 0; i < got.count.size(); ++i) got.count[i] = counts[i * 4];
+  // Values: depth ALWAYS + write, no blending, the last triangle owns each pixel.
+  peer.set_vertices(verts);
+  peer.render({.depth = GlDrawState::Depth::Always, .output = GlDrawState::Output::Colour});
+  got.rgba = peer.read_colour();
+  got.depth = peer.read_depth24();
+  if (s.textured) {
+    peer.render({.depth = GlDrawState::Depth::Always, .output = GlDrawState::Output::TexelCoordinates});
+    got.texel_coordinates = peer.read_texel_coordinates();
+  }
+  return measure_error(s, ref, got);
+}
+
+}  // namespace
+
+Result<LlvmpipeResult> run_llvmpipe(const std::vector<Scene>& scenes, const std::vector<ReferenceFrame>& refs,
+                                    unsigned lp_threads, unsigned runs, bool measure) {
+  auto text = run_isolated(lp_threads, [&]() -> Result<std::string> {
+    auto peer_r = LlvmpipePeer::create(640, 480);
+    if (!peer_r) return peer_r.error();
+    auto& peer = **peer_r;
+    const auto tex = accuracy::make_probe_texture(kTextureLog2, kTextureLog2);
+    peer.set_texture(tex, 1u << kTextureLog2, 1u << kTextureLog2, true);
+    nlohmann::json out{{"renderer", peer.renderer()}, {"scenes", nlohmann::json::array()}};
+    for (std::size_t k = 0; k < scenes.size(); ++k) {
+      const Scene& s = scenes[k];
+      if (s.width != 640 || s.height != 480) return make_error("llvmpipe peer: scenes must be 640x480");
+      peer.set_vertices(vertices_of(s, s.triangles.size()));
+      const GlDrawState st = throughput_state(s);
+      double best = 1e30;
+      for (unsigned r = 0; r <= runs; ++r) {
+        const auto t0 = std::chrono::steady_clock::now();
+        peer.render(st);
+        const double sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        if (r > 0) best = std::min(best, sec);
+      }
+      nlohmann::json js{{"seconds", best}};
+      if (measure) js["error"] = error_json(llvmpipe_error(peer, s, refs[k]));
+      out["scenes"].push_back(js);
+    }
+    return out.dump();
+  });
+  if (!text) return text.error();
+  LlvmpipeResult res;
+  try {
+    const auto j = nlohmann::json::parse(*text);
+    res.renderer = j.at("renderer");
+    for (const auto& s : j.at("scenes")) {
+      res.seconds.push_back(s.at("seconds"));
+      res.error.push_back(s.contains("error") ? std::optional(error_from_json(s.at("error"))) : std::nullopt);
+    }
+  } catch (const std::exception& e) {
+    return make_error(std::string("llvmpipe peer: unreadable result from the child process: ") + e.what());
+  }
+  return res;
+}
+
+}  // namespace gpubridge::bench

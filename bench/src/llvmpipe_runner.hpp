@@ -1,0 +1,21 @@
+#pragma once
+// Runs the scenes on llvmpipe in a child process per thread count (internal to the bench).
+#include <string>
+#include <vector>
+
+#include "error_measure.hpp"
+
+namespace gpubridge::bench {
+
+struct LlvmpipeResult {
+  std::string renderer;
+  std::vector<double> seconds;                  // best frame time per scene
+  std::vector<std::optional<ErrorStats>> error; // per scene (only when measured)
+};
+
+// lp_threads: LP_NUM_THREADS (0 = rasterise in the calling thread). Errors say why llvmpipe is
+// unavailable; the caller then omits the llvmpipe rows.
+Result<LlvmpipeResult> run_llvmpipe(const std::vector<Scene>& scenes, const std::vector<ReferenceFrame>& refs,
+                                    unsigned lp_threads, unsigned runs, bool measure_error);
+
+}  // namespace gpubridge::bench
