@@ -77,7 +77,7 @@ std::vector<DeviceTriangle> quad(int x0, int y0, int x1, int y1, std::array<std:
 // Bound: texel error within the section-15 bound (texel_bound) for q at every exponent of the
 // 32-bit range (W tiny to W huge, a W ratio of 2 inside each quad). Exponents whose bound exceeds 64
 // texels (q < 2^11: the registers cannot express the coordinate) are drawn but not judged: the
-// probe measures positions modulo 256 texels.
+// probe searches kProbeWindow = 100 texels around the reference.
 TEST(Texture, OneOverWAllExponents_WithinReciprocalBound) {
   SimHarness h({.width = 64, .height = 64});
   bind_probe(h);

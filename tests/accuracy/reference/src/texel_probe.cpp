@@ -2,7 +2,9 @@
 #include "gpubridge/accuracy/texel_probe.hpp"
 
 #include <cmath>
+#include <array>
 #include <cstdlib>
+#include <vector>
 
 namespace gpubridge::accuracy {
 namespace {
@@ -31,30 +33,32 @@ std::vector<std::uint8_t> make_probe_texture(unsigned log2_w, unsigned log2_h) {
 }
 
 ProbeReading read_probe_axis(std::uint8_t fine, std::uint8_t coarse, double expected, unsigned size) {
+  // For each parity of the left column, the weights fu that produce each fine value (one or two).
+  struct Inverse {
+    std::array<std::array<std::vector<int>, 256>, 2> fu;
+    Inverse() {
+      for (int parity = 0; parity < 2; ++parity)
+        for (int w = 0; w < 256; ++w) fu[parity][blend(fine_of(parity), fine_of(parity + 1), w)].push_back(w);
+    }
+  };
+  static const Inverse inverse;
   ProbeReading best{0, true};
   double best_dist = INFINITY;
+  // Candidates up to kProbeWindow texels away; the coarse channel (+-1) rejects the wrong ones.
   const long long centre = static_cast<long long>(std::floor(expected - 0.5));
-  for (long long i0 = centre - 2; i0 <= centre + 2; ++i0) {
-    for (int fu = 0; fu < 256; ++fu) {
-      if (blend(fine_of(i0), fine_of(i0 + 1), fu) != fine) continue;
+  for (long long i0 = centre - kProbeWindow; i0 <= centre + kProbeWindow; ++i0) {
+    for (int fu : inverse.fu[i0 & 1][fine]) {
+      const int coarse_expected = blend(coarse_of(i0, size), coarse_of(i0 + 1, size), fu);
+      if (std::abs(coarse_expected - coarse) > 1) continue;
       const double pos = double(i0) + (fu + 0.5) / 256.0 + 0.5;
       const double dist = std::fabs(pos - expected);
-      const int coarse_expected = blend(coarse_of(i0, size), coarse_of(i0 + 1, size), fu);
-      const bool coarse_ok = std::abs(coarse_expected - coarse) <= 1;
-      if (coarse_ok && dist < best_dist) {
+      if (dist < best_dist) {
         best_dist = dist;
         best = ProbeReading{pos, false};
       }
     }
   }
-  if (best.gross) {
-    // Far off: the coarse channel alone says where (mod 256 texels), at whole-texel resolution.
-    const double period = size < 256 ? size : 256;
-    double d = std::fmod(double(coarse) + 0.5 - expected, period);
-    if (d < -period / 2) d += period;
-    if (d > period / 2) d -= period;
-    best.position = expected + (std::fabs(d) < 2 ? (d < 0 ? -2.0 : 2.0) : d);
-  }
+  if (best.gross) best.position = expected + kProbeWindow;  // at least this far off
   return best;
 }
 
