@@ -1,0 +1,19 @@
+#pragma once
+// Opens the board a profile describes: through libusb/hidapi, or fully emulated (chip model +
+// simulator) so the same driver code runs without hardware.
+#include <memory>
+
+#include "gpubridge/usb/board_backend.hpp"
+#include "gpubridge/usb/board_profile.hpp"
+
+namespace gpubridge::usb {
+
+struct BoardOpenOptions {
+  bool emulate = false;
+  std::uint32_t emulated_max_reliable_hz = 0;  // emulation only: MISO errors above this SCK (0 = none)
+  BoardOptions board;
+};
+
+Result<std::unique_ptr<BoardBackend>> open_board(const BoardProfile& profile, const BoardOpenOptions& opts = {});
+
+}  // namespace gpubridge::usb

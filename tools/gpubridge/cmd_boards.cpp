@@ -1,0 +1,86 @@
+// `gpubridge boards` and `gpubridge cables`: the board profiles and bridge cables, from the data
+// in configs/boards/*.json and configs/cables/*.json.
+#include <cstdio>
+
+#include <nlohmann/json.hpp>
+
+#include "command.hpp"
+#include "gpubridge/usb/board_profile.hpp"
+
+namespace gpubridge::cli {
+namespace {
+
+std::string hex4(std::uint16_t v) {
+  char b[8];
+  std::snprintf(b, sizeof b, "%04x", v);
+  return b;
+}
+
+int run_boards(const GlobalOptions& g, const std::string& dir) {
+  auto boards = usb::load_board_profiles(dir.empty() ? usb::default_config_dir() : std::filesystem::path(dir));
+  if (!boards) {
+    std::fprintf(stderr, "gpubridge boards: %s\n", boards.error().message.c_str());
+    return 1;
+  }
+  if (g.json) {
+    nlohmann::json out = nlohmann::json::array();
+    for (const auto& p : *boards)
+      out.push_back({{"name", p.name},
+                     {"description", p.description},
+                     {"fpga", p.fpga},
+                     {"file", p.file.string()},
+                     {"bridge",
+                      {{"chip", usb::to_string(p.chip)},
+                       {"vid", hex4(p.vid)},
+                       {"pid", hex4(p.pid)},
+                       {"interface", p.interface == 0 ? "A" : "B"},
+                       {"spi_clock_hz", p.spi_clock_hz},
+                       {"cs_pin", p.cs_pin},
+                       {"busy_pin", p.busy_pin}}},
+                     {"device",
+                      {{"vram_kib", p.vram_kib}, {"max_width", p.max_width}, {"max_height", p.max_height}, {"fifo_depth", p.fifo_depth}}},
+                     {"strict_link", p.strict_link}});
+    std::puts(out.dump(2).c_str());
+    return 0;
+  }
+  std::printf("%-16s %-8s %-10s %8s %9s %9s  %s\n", "BOARD", "BRIDGE", "VID:PID", "SPI MHz", "VRAM KiB", "MAX", "FPGA");
+  for (const auto& p : *boards)
+    std::printf("%-16s %-8s %s:%s %8.3g %9u %4ux%-4u  %s\n", p.name.c_str(), std::string(usb::to_string(p.chip)).c_str(),
+                hex4(p.vid).c_str(), hex4(p.pid).c_str(), p.spi_clock_hz / 1e6, p.vram_kib, p.max_width, p.max_height, p.fpga.c_str());
+  return 0;
+}
+
+int run_cables(const GlobalOptions& g, const std::string& dir) {
+  auto cables = usb::load_cables(dir.empty() ? usb::default_config_dir() : std::filesystem::path(dir));
+  if (!cables) {
+    std::fprintf(stderr, "gpubridge cables: %s\n", cables.error().message.c_str());
+    return 1;
+  }
+  if (g.json) {
+    nlohmann::json out = nlohmann::json::array();
+    for (const auto& c : *cables)
+      out.push_back({{"name", c.name}, {"chip", c.chip}, {"vid", hex4(c.vid)}, {"pid", hex4(c.pid)}, {"api", c.api},
+                     {"max_spi_hz", c.max_spi_hz}, {"interfaces", c.interfaces}, {"description", c.description}});
+    std::puts(out.dump(2).c_str());
+    return 0;
+  }
+  std::printf("%-10s %-10s %-7s %8s  %s\n", "CABLE", "VID:PID", "API", "MAX MHz", "DESCRIPTION");
+  for (const auto& c : *cables)
+    std::printf("%-10s %s:%s %-7s %8.3g  %s\n", c.name.c_str(), hex4(c.vid).c_str(), hex4(c.pid).c_str(), c.api.c_str(),
+                c.max_spi_hz / 1e6, c.description.c_str());
+  return 0;
+}
+
+}  // namespace
+
+GPUBRIDGE_COMMAND("boards", 70, [](CLI::App& app, GlobalOptions& g, auto& runners) {
+  auto dir = std::make_shared<std::string>();
+  auto* boards = app.add_subcommand("boards", "list the board profiles (configs/boards/*.json): bridge chip, wiring, SPI clock, video memory");
+  boards->add_option("--config-dir", *dir, "directory holding boards/ and cables/ (default: $GPUBRIDGE_CONFIG_DIR or the source tree's configs/)");
+  runners.emplace_back(boards, [&g, dir] { return run_boards(g, *dir); });
+  auto* cables = app.add_subcommand("cables", "list the USB-SPI bridge chips gpubridge can drive (configs/cables/*.json)");
+  cables->add_option("--config-dir", *dir, "directory holding boards/ and cables/");
+  runners.emplace_back(cables, [&g, dir] { return run_cables(g, *dir); });
+});
+
+}  // namespace gpubridge::cli
