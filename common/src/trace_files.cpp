@@ -37,7 +37,7 @@ Result<std::string> read_small_file(const std::filesystem::path& path, std::uint
 
 std::optional<TraceFormat> trace_format_for_path(const std::filesystem::path& path) {
   const std::string ext = lower(path.extension().string());
-  if (ext == ".gbt") return TraceFormat::Binary;
+  if (ext == ".gbt" || ext == ".gbtrace") return TraceFormat::Binary;  // .gbtrace: daemon recordings
   if (ext == ".trace" || ext == ".txt") return TraceFormat::Text;
   return std::nullopt;
 }

@@ -91,6 +91,7 @@ TEST_F(TraceFiles, SaveAndLoadBothFormats) {
 
 TEST_F(TraceFiles, FormatDetectionAndMissingFiles) {
   EXPECT_EQ(trace_format_for_path("a.GBT"), TraceFormat::Binary);
+  EXPECT_EQ(trace_format_for_path("session-1.gbtrace"), TraceFormat::Binary);
   EXPECT_EQ(trace_format_for_path("a.trace"), TraceFormat::Text);
   EXPECT_EQ(trace_format_for_path("a.txt"), TraceFormat::Text);
   EXPECT_FALSE(trace_format_for_path("a.png").has_value());

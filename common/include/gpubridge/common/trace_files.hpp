@@ -19,7 +19,7 @@ enum class TraceFormat { Binary, Text };
 inline constexpr std::uint64_t kMaxTextTraceBytes = 256ull << 20;  // text traces are read whole
 inline constexpr std::uint64_t kMaxTraceAssetBytes = 64ull << 20;  // one .upload file (hex or converted PNG)
 
-// By extension: .gbt → Binary; .trace / .txt → Text; anything else → nullopt.
+// By extension: .gbt / .gbtrace → Binary; .trace / .txt → Text; anything else → nullopt.
 std::optional<TraceFormat> trace_format_for_path(const std::filesystem::path& path);
 
 // Loads .upload assets: PNG (converted to the directive's pixel format) or whitespace-separated
