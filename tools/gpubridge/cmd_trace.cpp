@@ -170,7 +170,7 @@ GPUBRIDGE_COMMAND("trace", 40, [](CLI::App& app, GlobalOptions& g, auto& runners
       "trace", "convert and inspect command traces (binary .gbt recordings and text .trace files)");
   trace->require_subcommand(1);
   trace->footer(
-      "Formats are chosen by extension: .gbt = binary, .trace/.txt = text (docs/protocol.md, \"Traces\").\n"
+      "Formats are chosen by extension: .gbt/.gbtrace = binary, .trace/.txt = text (docs/protocol.md, \"Traces\").\n"
       "Binary -> text -> binary is byte-identical except timestamps (text traces carry none).");
 
   struct ConvertArgs {
@@ -179,7 +179,7 @@ GPUBRIDGE_COMMAND("trace", 40, [](CLI::App& app, GlobalOptions& g, auto& runners
   auto conv = std::make_shared<ConvertArgs>();
   auto* convert = trace->add_subcommand("convert", "convert a trace between the binary and text forms");
   convert->add_option("IN", conv->in, "input trace (format detected from its content)")->required();
-  convert->add_option("OUT", conv->out, "output trace (.gbt binary, .trace/.txt text)")->required();
+  convert->add_option("OUT", conv->out, "output trace (.gbt/.gbtrace binary, .trace/.txt text)")->required();
   convert->add_option("--to", conv->to, "output format when the extension does not say: text|binary");
   runners.emplace_back(convert, [&g, conv] { return run_convert(g, conv->in, conv->out, conv->to); });
 
