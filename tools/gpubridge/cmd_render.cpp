@@ -174,7 +174,7 @@ int run_render(const GlobalOptions& g, const RenderArgs& a) {
     if (work.empty() || tail.triangles_kicked || tail.clear_bytes) work.push_back({nullptr, tail});
     for (const auto& rec : work) {
       const unsigned bpp = rec.frame ? protocol::bytes_per_pixel(rec.frame->format) : 4;
-      const auto e = sim::estimate_timing(rec.work, board, bpp, 4, false);
+      const auto e = sim::estimate_timing(rec.work, board, bpp);
       auto j = timing_json(e);
       j["frame"] = rec.frame ? nlohmann::json(rec.frame->number) : nlohmann::json("unswapped");
       j["triangles"] = rec.work.triangles_rasterised;

@@ -550,6 +550,7 @@ const DeviceStats& Device::stats() const {
   st.pixels_depth_passed = c.passed;
   st.pixels_textured = c.textured;
   st.pixels_blended = c.blended;
+  st.texel_bytes = c.texel_bytes;
   return st;
 }
 void Device::reset_stats() {

@@ -15,13 +15,14 @@
 namespace gpubridge::sim {
 
 struct RasterCounters {
-  std::uint64_t scanned = 0, covered = 0, passed = 0, textured = 0, blended = 0;
+  std::uint64_t scanned = 0, covered = 0, passed = 0, textured = 0, blended = 0, texel_bytes = 0;
   void add(const RasterCounters& o) {
     scanned += o.scanned;
     covered += o.covered;
     passed += o.passed;
     textured += o.textured;
     blended += o.blended;
+    texel_bytes += o.texel_bytes;
   }
 };
 
@@ -29,6 +30,7 @@ struct RasterContext {
   VideoMemory& mem;
   const ReciprocalUnit& recip;
   unsigned z_bits = 24;
+  bool fast = false;         // floating-point attribute evaluation (accuracy knob `fast`)
   std::uint16_t errors = 0;  // ERR_MEM_RANGE from out-of-memory accesses
   RasterCounters counters;
 };

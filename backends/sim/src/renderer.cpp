@@ -71,7 +71,7 @@ void Renderer::draw(const Vertex& a, const Vertex& b, const Vertex& c, const std
 void Renderer::draw_pending() {
   if (pending_ < 0) return;
   const Triangle& t = slots_[pending_];
-  RasterContext ctx{mem_, recip_, knobs_.z_bits, 0, {}};
+  RasterContext ctx{mem_, recip_, knobs_.z_bits, knobs_.fast, 0, {}};
   rasterize_rows(t, *pending_state_, ctx, t.y0, t.y1);
   errors_ |= ctx.errors;
   counters_.add(ctx.counters);
@@ -104,7 +104,7 @@ void Renderer::flush() {
   const unsigned n = pool_.workers();
   std::vector<RasterContext> ctx;
   ctx.reserve(n);
-  for (unsigned w = 0; w < n; ++w) ctx.push_back(RasterContext{mem_, recip_, knobs_.z_bits, 0, {}});
+  for (unsigned w = 0; w < n; ++w) ctx.push_back(RasterContext{mem_, recip_, knobs_.z_bits, knobs_.fast, 0, {}});
   pool_.run([&](unsigned w) {
     RasterContext& c = ctx[w];
     for (const Triangle& t : batch_) {

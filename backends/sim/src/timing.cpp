@@ -7,8 +7,7 @@
 
 namespace gpubridge::sim {
 
-TimingEstimate estimate_timing(const DeviceStats& w, const BoardTiming& b, unsigned colour_bpp, unsigned texel_bpp,
-                               bool bilinear) {
+TimingEstimate estimate_timing(const DeviceStats& w, const BoardTiming& b, unsigned colour_bpp) {
   TimingEstimate e;
   e.pipeline_cycles = double(w.queued_executed) * b.cycles_per_command +
                       double(w.triangles_rasterised) * b.cycles_per_triangle +
@@ -20,9 +19,8 @@ TimingEstimate estimate_timing(const DeviceStats& w, const BoardTiming& b, unsig
   // Memory: depth read + write (4 + 4) for every covered pixel (an upper bound: not every draw
   // tests or writes Z), colour write, destination read when blending, texels fetched, clears,
   // uploads (8 bytes per MEM_DATA).
-  const std::uint64_t texels = w.pixels_textured * (bilinear ? 4u : 1u);
   e.memory_bytes = w.pixels_covered * 8 + w.pixels_depth_passed * colour_bpp + w.pixels_blended * colour_bpp +
-                   texels * texel_bpp + w.clear_bytes + w.mem_data_writes * 8;
+                   w.texel_bytes + w.clear_bytes + w.mem_data_writes * 8;
   e.memory_cycles = double(e.memory_bytes) / b.memory_bytes_per_cycle;
   e.board_cycles = std::max(e.pipeline_cycles, e.memory_cycles);
   e.board_ms = e.board_cycles / (b.clock_mhz * 1e3);
@@ -45,6 +43,7 @@ DeviceStats stats_difference(const DeviceStats& a, const DeviceStats& b) {
   d.pixels_depth_passed = a.pixels_depth_passed - b.pixels_depth_passed;
   d.pixels_textured = a.pixels_textured - b.pixels_textured;
   d.pixels_blended = a.pixels_blended - b.pixels_blended;
+  d.texel_bytes = a.texel_bytes - b.texel_bytes;
   d.clear_bytes = a.clear_bytes - b.clear_bytes;
   d.mem_data_writes = a.mem_data_writes - b.mem_data_writes;
   d.swaps = a.swaps - b.swaps;

@@ -34,6 +34,7 @@ struct DeviceStats {
   std::uint64_t pixels_depth_passed = 0;  // covered pixels that passed the depth test
   std::uint64_t pixels_textured = 0;      // passed pixels that sampled the texture
   std::uint64_t pixels_blended = 0;       // passed pixels that read the destination colour
+  std::uint64_t texel_bytes = 0;          // texture bytes fetched (4 texels per bilinear sample)
   std::uint64_t clear_bytes = 0;          // bytes written by CLEAR / CLEAR_Z
   std::uint64_t mem_data_writes = 0;      // MEM_DATA writes (8 bytes each)
   std::uint64_t swaps = 0;                // scanned-out frames

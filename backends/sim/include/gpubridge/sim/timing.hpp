@@ -38,9 +38,8 @@ struct TimingEstimate {
 };
 
 // Counters of `work` (e.g. the difference of two DeviceStats snapshots) under profile `board`;
-// bytes per pixel of the colour buffer and texels decide the memory traffic.
-TimingEstimate estimate_timing(const DeviceStats& work, const BoardTiming& board, unsigned colour_bpp,
-                               unsigned texel_bpp, bool bilinear);
+// colour_bpp (bytes per pixel of the colour buffer) sizes the colour traffic.
+TimingEstimate estimate_timing(const DeviceStats& work, const BoardTiming& board, unsigned colour_bpp);
 // a − b, field by field.
 DeviceStats stats_difference(const DeviceStats& a, const DeviceStats& b);
 // "clock_mhz=25 spi_clock_mhz=10 ..." settings applied to a profile (errors name the key).
