@@ -16,6 +16,8 @@ class Lightmap final : public Example {
   }
 
   Result<void> setup(draw::Context& ctx) override {
+    wall_ = {};
+    floor_ = {};
     auto b = ctx.create_texture(brick_texture(64), {});
     if (!b) return b.error();
     bricks_ = *b;

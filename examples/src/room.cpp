@@ -17,6 +17,9 @@ class Room final : public Example {
   }
 
   Result<void> setup(draw::Context& ctx) override {
+    floor_ = {};
+    ceiling_ = {};
+    walls_ = {};
     auto bricks = ctx.create_texture(brick_texture(64), {});
     if (!bricks) return bricks.error();
     bricks_ = *bricks;

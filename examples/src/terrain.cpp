@@ -28,6 +28,7 @@ class Terrain final : public Example {
   }
 
   Result<void> setup(draw::Context& ctx) override {
+    mesh_ = {};
     // The colour map: height bands shaded by the slope towards the light, like Comanche's voxel map.
     constexpr unsigned kTex = 256;
     Image map = make_image(kTex, kTex);

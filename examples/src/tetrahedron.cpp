@@ -20,6 +20,7 @@ class Tetrahedron final : public Example {
   }
 
   Result<void> setup(draw::Context& ctx) override {
+    mesh_ = {};
     // A 64x64 texture: a checkerboard with a diagonal stripe, so perspective errors would show.
     Image img = make_image(64, 64);
     for (unsigned y = 0; y < 64; ++y)

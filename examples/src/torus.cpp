@@ -23,6 +23,9 @@ class Torus final : public Example {
   }
 
   Result<void> setup(draw::Context&) override {
+    positions_.clear();
+    normals_.clear();
+    indices_.clear();
     for (int i = 0; i < kMajor; ++i)
       for (int j = 0; j < kMinor; ++j) {
         const double a = 2 * std::numbers::pi * i / kMajor, b = 2 * std::numbers::pi * j / kMinor;

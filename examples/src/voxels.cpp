@@ -18,6 +18,8 @@ class Voxels final : public Example {
   }
 
   Result<void> setup(draw::Context& ctx) override {
+    solid_ = {};
+    water_ = {};
     // Atlas 64x64: four 32x32 tiles (grass top, dirt, stone, water).
     Image atlas = make_image(64, 64);
     for (unsigned y = 0; y < 64; ++y)

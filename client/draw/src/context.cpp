@@ -1,5 +1,7 @@
 #include "gpubridge/draw/context.hpp"
 
+#include <algorithm>
+
 #include <fmt/format.h>
 
 namespace gpubridge::draw {
@@ -140,6 +142,7 @@ Result<void> Context::apply_state(geometry::PipelineOptions& opt) {
     sent_tex_base_ = texture_->address;
     sent_tex_fmt_ = fmt;
     opt.tex = {texture_->format.wrap_s, texture_->format.wrap_t};
+    opt.texture_size = std::max(texture_->format.width, texture_->format.height);
   }
   write(Reg::PRIM, static_cast<unsigned>(protocol::PrimType::List));
   return {};

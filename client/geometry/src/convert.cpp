@@ -63,7 +63,10 @@ double texture_offset(double min_coord, protocol::Wrap wrap) {
 
 Result<DeviceTriangle> convert_triangle(const std::array<ScreenVertex, 3>& tri, const TexAddressing& tex) {
   DeviceTriangle out;
+  // Names are constants: formatting them per vertex would dominate the cost of a conversion.
   static constexpr std::string_view vnames[3] = {"vertex 0", "vertex 1", "vertex 2"};
+  static constexpr std::string_view xnames[3] = {"vertex 0: x", "vertex 1: x", "vertex 2: x"};
+  static constexpr std::string_view ynames[3] = {"vertex 0: y", "vertex 1: y", "vertex 2: y"};
   double qmax = 0;
   std::array<double, 3> q{};
   for (int i = 0; i < 3; ++i) {
@@ -71,9 +74,9 @@ Result<DeviceTriangle> convert_triangle(const std::array<ScreenVertex, 3>& tri, 
     for (double a : {v.w, v.uv.x, v.uv.y})
       if (!std::isfinite(a)) return not_finite(fmt::format("{}: w/u/v", vnames[i]), a);
     if (!(v.w > 0)) return make_error(fmt::format("{}: w = {} must be > 0 (clip against the near plane first)", vnames[i], v.w));
-    auto x = snap_12_4(v.x, fmt::format("{}: x", vnames[i]));
+    auto x = snap_12_4(v.x, xnames[i]);
     if (!x) return x.error();
-    auto y = snap_12_4(v.y, fmt::format("{}: y", vnames[i]));
+    auto y = snap_12_4(v.y, ynames[i]);
     if (!y) return y.error();
     auto z = depth_to_z24(v.z);
     if (!z) return make_error(fmt::format("{}: {}", vnames[i], z.error().message));

@@ -16,9 +16,9 @@ bool finite(const Vertex& v) {
 
 // Whether edge a-b needs splitting for texture precision. Depends only on the two endpoints
 // (and symmetrically on them), so both triangles sharing the edge decide the same.
-bool edge_over_bound(const Vertex& a, const Vertex& b, const PipelineOptions& opt) {
+bool edge_over_bound(const Vertex& a, const Vertex& b, const PipelineOptions& opt, double w_ratio) {
   const double wmin = std::min(a.pos.w, b.pos.w), wmax = std::max(a.pos.w, b.pos.w);
-  if (wmax > opt.max_w_ratio * wmin) return true;
+  if (wmax > w_ratio * wmin) return true;
   return std::fabs(a.uv.x - b.uv.x) > opt.max_uv_extent || std::fabs(a.uv.y - b.uv.y) > opt.max_uv_extent;
 }
 
@@ -30,12 +30,17 @@ Vertex midpoint(const Vertex& a, const Vertex& b) {
 class Emitter {
  public:
   Emitter(const PipelineOptions& opt, std::vector<DeviceTriangle>& out, PipelineStats& st)
-      : opt_(opt), out_(out), st_(st) {}
+      : opt_(opt), out_(out), st_(st) {
+    // The texel error terms that grow with the W ratio are proportional to the texture size
+    // (docs/protocol.md section 15), so smaller textures tolerate proportionally larger ratios.
+    const unsigned size = std::clamp(opt.texture_size, 1u, 1024u);
+    w_ratio_ = opt.max_w_ratio * (1024.0 / size);
+  }
 
   Result<void> subdivide(const Triangle& t, unsigned depth) {
     if (!opt_.textured || !opt_.subdivide) return emit(t);
-    const bool split[3] = {edge_over_bound(t[0], t[1], opt_), edge_over_bound(t[1], t[2], opt_),
-                           edge_over_bound(t[2], t[0], opt_)};
+    const bool split[3] = {edge_over_bound(t[0], t[1], opt_, w_ratio_), edge_over_bound(t[1], t[2], opt_, w_ratio_),
+                           edge_over_bound(t[2], t[0], opt_, w_ratio_)};
     const int n = split[0] + split[1] + split[2];
     if (n == 0) return emit(t);
     if (depth >= opt_.max_subdivision_depth) {
@@ -106,6 +111,7 @@ class Emitter {
   const PipelineOptions& opt_;
   std::vector<DeviceTriangle>& out_;
   PipelineStats& st_;
+  double w_ratio_ = 32.0;
 };
 
 }  // namespace
@@ -134,17 +140,27 @@ Result<void> process_triangle(const Triangle& tri, const PipelineOptions& opt, s
       return make_error(fmt::format("vertex {}: NaN or Inf in position, colour or texture coordinate "
                                     "(every value must be a finite number)", i));
 
+  Emitter emitter(opt, out, st);
+  // Fast path (the common case): every vertex strictly inside every plane, nothing to clip.
+  bool all_inside = true;
+  for (const auto& v : tri) {
+    const Vec4& p = v.pos;
+    all_inside = all_inside && p.z >= 0 && (!opt.clip_far || p.z <= p.w) && p.w >= opt.min_w &&
+                 p.x >= opt.guard_band.min * p.w && p.x <= opt.guard_band.max * p.w &&
+                 p.y >= opt.guard_band.min * p.w && p.y <= opt.guard_band.max * p.w;
+  }
+  if (all_inside) return emitter.subdivide(tri, 0);
+
   // Planes in the order the seeds' pipeline applies them: the near plane first (Foenix), then
   // the ones that only matter for unusual input.
   Polygon poly = polygon_from(tri);
   bool clipped = false;
   auto clip = [&](Vec4 plane, double offset = 0.0) {
-    const std::size_t before = poly.count;
-    Polygon next = clip_polygon(poly, plane, offset);
-    bool changed = next.count != before;
-    for (std::size_t i = 0; !changed && i < next.count; ++i) changed = !(next.v[i] == poly.v[i]);
-    clipped |= changed;
-    poly = next;
+    bool outside = false;
+    for (std::size_t i = 0; i < poly.count && !outside; ++i) outside = dot(plane, poly.v[i].pos) + offset < 0;
+    if (!outside) return;  // nothing to cut: skip the copy
+    clipped = true;
+    poly = clip_polygon(poly, plane, offset);
   };
   clip(kNearPlane);
   if (opt.clip_far && poly.count) clip(kFarPlane);
@@ -165,7 +181,6 @@ Result<void> process_triangle(const Triangle& tri, const PipelineOptions& opt, s
   }
   if (clipped) ++st.clipped;
 
-  Emitter emitter(opt, out, st);
   for (std::size_t i = 1; i + 1 < poly.count; ++i)
     if (auto r = emitter.subdivide(Triangle{poly.v[0], poly.v[i], poly.v[i + 1]}, 0); !r) return r;
   return {};

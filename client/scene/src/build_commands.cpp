@@ -1,4 +1,6 @@
 // Scene → memory layout + command stream, through the host geometry pipeline.
+#include <algorithm>
+
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
@@ -124,6 +126,7 @@ Result<BuiltScene> build_commands(const Scene& scene, const BuildOptions& option
       geometry::TextureFormat tf{tex.image.width, tex.image.height, tex.format, d.wrap_s.value_or(tex.wrap_s),
                                  d.wrap_t.value_or(tex.wrap_t), d.bilinear.value_or(tex.bilinear)};
       opt.tex = {tf.wrap_s, tf.wrap_t};
+      opt.texture_size = std::max(tf.width, tf.height);
       auto fmt_word = geometry::tex_fmt_word(tf);
       if (!fmt_word) return make_error(fmt::format("{}: {}", where, fmt_word.error().message));
       const std::uint64_t base = out.layout.textures[*d.texture];

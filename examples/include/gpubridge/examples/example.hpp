@@ -24,7 +24,7 @@ class Example {
   virtual ExampleInfo info() const = 0;
   // Framebuffer size/format and buffers the example wants.
   virtual draw::ContextOptions options() const;
-  // Once per context: textures.
+  // Once per context: textures and meshes (calling it again starts over, for a new context).
   virtual Result<void> setup(draw::Context& ctx) = 0;
   // Draws frame `n` (clears included), without swapping. Frame n is a pure function of n.
   virtual Result<void> frame(draw::Context& ctx, unsigned n) = 0;

@@ -41,7 +41,9 @@ struct PipelineOptions {
   bool textured = false;           // enables S/T (TEXCOORD) and precision subdivision
   TexAddressing tex{};
   bool subdivide = true;           // texture-precision subdivision (textured only)
-  double max_w_ratio = 32.0;       // bound on max W / min W per triangle (docs section 15)
+  double max_w_ratio = 32.0;       // bound on max W / min W per triangle for 1024-texel textures
+  unsigned texture_size = 1024;    // larger of the bound texture's width and height: the W-ratio
+                                   // bound scales by 1024 / texture_size (docs section 16.6)
   double max_uv_extent = 3.0;      // bound on max−min of U and of V: keeps |u − u_off| < 4
   unsigned max_subdivision_depth = 6;  // at most 4^depth triangles per clipped triangle
 };
