@@ -68,8 +68,9 @@ void BoardBackend::set_scanout_callback(backends::ScanoutCallback cb) {
 
 void BoardBackend::note_sent(const Frame& f) {
   ++stats_.frames_sent;
-  if (!f.read && (f.index == index_of(Reg::LINK_CHECK) || f.index == index_of(Reg::LINK_CTRL))) {
-    host_crc_ = 0;
+  // Frames with index LINK_CTRL/LINK_CHECK (read or write) are outside the link CRC; writes restart it.
+  if (f.index == index_of(Reg::LINK_CHECK) || f.index == index_of(Reg::LINK_CTRL)) {
+    if (!f.read) host_crc_ = 0;
     return;
   }
   const auto bytes = protocol::encode(f);
@@ -594,7 +595,9 @@ Result<std::vector<std::uint8_t>> BoardBackend::read_memory_once(std::uint32_t s
     auto r = exchange(std::span(&w, 1), frames);
     if (!r) return r.error();
     for (std::size_t k = 0; k < n; ++k) {
-      if (!((*r)[k * kFrameBytes] & protocol::MISO_MEM_READY))
+      // Only the first read of a burst must see MEM_READY in its status byte: later ones may
+      // legitimately show the look-ahead load still in flight (it completes before bit 64).
+      if (k == 0 && !((*r)[k * kFrameBytes] & protocol::MISO_MEM_READY))
         return make_error("board '" + profile_.name + "': MEM_READY dropped during readback at 0x" +
                               fmt::format("{:X}", start + (done + k) * 8),
                           backends::kDeviceProtocol);

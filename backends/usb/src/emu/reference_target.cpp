@@ -93,8 +93,8 @@ std::uint64_t ReferenceTarget::read_register(std::uint8_t index) {
 }
 
 void ReferenceTarget::frame_complete(const protocol::Frame& f) {
-  const bool restarts_link = !f.read && (f.index == index_of(Reg::LINK_CHECK) || f.index == index_of(Reg::LINK_CTRL));
-  if (!restarts_link) {
+  const bool link_register = f.index == index_of(Reg::LINK_CHECK) || f.index == index_of(Reg::LINK_CTRL);
+  if (!link_register) {
     const auto bytes = protocol::encode(f);
     link_crc_ = protocol::crc32_update(link_crc_, bytes);
     ++link_frames_;
