@@ -60,7 +60,7 @@ Result<Report> run_accuracy_bench(const AccuracyBenchOptions& opt, const std::fu
   Report rep;
   rep.machine = machine_description();
   progress("generating scenes");
-  auto scenes_r = make_scenes(opt.quick ? 200 : 1);
+  auto scenes_r = make_scenes(opt.quick ? 200 : std::max(1u, opt.scale));
   if (!scenes_r) return scenes_r.error();
   rep.scenes = std::move(scenes_r).value();
   const unsigned runs = opt.quick ? 1 : std::max(1u, opt.runs);

@@ -19,6 +19,7 @@ namespace {
 struct AccuracyArgs {
   bool quick = false;
   unsigned runs = 5;
+  unsigned scale = 1;
   bool no_llvmpipe = false;
   std::string out_dir;
 };
@@ -39,6 +40,7 @@ int run_accuracy(const GlobalOptions& g, const AccuracyArgs& a) {
   bench::AccuracyBenchOptions opt;
   opt.quick = a.quick;
   opt.runs = a.runs;
+  opt.scale = a.scale;
   opt.llvmpipe = !a.no_llvmpipe;
   if (!a.out_dir.empty()) {
     std::error_code ec;
@@ -57,6 +59,7 @@ int run_accuracy(const GlobalOptions& g, const AccuracyArgs& a) {
   std::string command = "gpubridge bench accuracy";
   if (a.quick) command += " --quick";
   if (a.runs != 5) command += " --runs " + std::to_string(a.runs);
+  if (a.scale != 1) command += " --scale " + std::to_string(a.scale);
   if (!a.out_dir.empty()) command += " --out-dir " + a.out_dir;
   const std::string md = bench::report_markdown(*report, command);
   const auto json = bench::report_json(*report);
@@ -88,6 +91,9 @@ GPUBRIDGE_COMMAND("bench", 80, [](CLI::App& app, GlobalOptions& g, auto& runners
   sub->add_flag("--quick", args->quick, "small scenes and one timed run (smoke test; figures are not meaningful)");
   sub->add_option("--runs", args->runs, "timed runs per measurement after one warm-up; the best is reported")
       ->check(CLI::Range(1u, 100u))
+      ->capture_default_str();
+  sub->add_option("--scale", args->scale, "divide the triangle counts of the scenes by this (1 = the full set)")
+      ->check(CLI::Range(1u, 1000u))
       ->capture_default_str();
   sub->add_flag("--no-llvmpipe", args->no_llvmpipe, "skip the llvmpipe peer rows");
   sub->add_option("--out-dir", args->out_dir, "directory for accuracy-report.md, accuracy-report.json, accuracy-front.svg");

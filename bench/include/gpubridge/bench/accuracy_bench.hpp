@@ -17,6 +17,7 @@ namespace gpubridge::bench {
 
 struct AccuracyBenchOptions {
   bool quick = false;         // small scenes, 1 timed run: the smoke test of the test command
+  unsigned scale = 1;         // divides the scene triangle counts (quick: 200)
   unsigned runs = 5;          // timed runs per measurement (best is reported), after 1 warm-up
   bool llvmpipe = true;       // measure the llvmpipe peer (omitted with a reason when unavailable)
   std::vector<unsigned> threads{1, 2};
