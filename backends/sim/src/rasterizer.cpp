@@ -84,6 +84,7 @@ class Kernel {
           else if (e[i] < 0) kr = -1;
         }
         if (kl <= kr) {
+          if (simd_ && y + 2 < yz) prefetch_row(y + 2, t_.x0 + static_cast<int>(kl), static_cast<int>(kr - kl + 1));
           Steppers s = row;
           jump_x(s, kl);
           if (kr - kl + 1 >= 8 && simd_ready()) {
@@ -223,6 +224,7 @@ class Kernel {
         const bool used = p < 4 ? kGouraud : kDepth;
         if (!used) {
           simd_tpl_.q8[p] = simd_tpl_.r8[p] = 0;
+          for (unsigned k = 0; k < 8; ++k) simd_tpl_.qk[p][k] = simd_tpl_.rk[p][k] = 0;
           continue;
         }
         const DivMod d = floor_divmod(8 * pl.rx, t_.den);
@@ -230,6 +232,17 @@ class Kernel {
         if (q8 >= (std::int64_t{1} << 30) || q8 <= -(std::int64_t{1} << 30)) return;
         simd_tpl_.q8[p] = static_cast<std::uint32_t>(q8);
         simd_tpl_.r8[p] = static_cast<std::uint32_t>(d.r);
+        std::int64_t qk = 0, rk = 0;  // lane k's offset: k steps from (0, 0)
+        for (unsigned k = 0; k < 8; ++k) {
+          simd_tpl_.qk[p][k] = static_cast<std::uint32_t>(qk);
+          simd_tpl_.rk[p][k] = static_cast<std::uint32_t>(rk);
+          qk += pl.qx;
+          rk += pl.rx;
+          if (rk >= t_.den) {
+            rk -= t_.den;
+            ++qk;
+          }
+        }
       }
       simd_tpl_.flat = std::uint32_t{flat_.r} | (std::uint32_t{flat_.g} << 8) | (std::uint32_t{flat_.b} << 16) |
                        (std::uint32_t{flat_.a} << 24);
@@ -242,15 +255,21 @@ class Kernel {
     }
   }
 
-  void simd_span(Steppers s, int x, int y, unsigned count) {
+  // Rows two ahead are fetched while this one is drawn (random triangles miss the caches).
+  void prefetch_row(int y, int x, int count) const {
+    const std::size_t pix = static_cast<std::size_t>(y) * width_ + static_cast<std::size_t>(x);
+    for (int b = 0; b < count * 4; b += 64) {
+      __builtin_prefetch(color_ + pix * 4 + static_cast<std::size_t>(b), 1);
+      if (kDepth) __builtin_prefetch(zbuf_ + pix * 4 + static_cast<std::size_t>(b), 1);
+    }
+  }
+
+  void simd_span(const Steppers& s, int x, int y, unsigned count) {
     SimdSpan& sp = simd_tpl_;
-    for (unsigned k = 0; k < 8; ++k) {
-      for (unsigned p = 0; p < SimdSpan::kPlanes; ++p) {
-        const bool used = p < 4 ? kGouraud : kDepth;
-        sp.q[p][k] = used ? static_cast<std::uint32_t>(s.q[kR + p]) : 0;
-        sp.r[p][k] = used ? static_cast<std::uint32_t>(s.r[kR + p]) : 0;
-      }
-      step_x(s);
+    for (unsigned p = 0; p < SimdSpan::kPlanes; ++p) {
+      const bool used = p < 4 ? kGouraud : kDepth;
+      sp.q0[p] = used ? static_cast<std::uint32_t>(s.q[kR + p]) : 0;
+      sp.r0[p] = used ? static_cast<std::uint32_t>(s.r[kR + p]) : 0;
     }
     const std::size_t pix = static_cast<std::size_t>(y) * width_ + static_cast<std::size_t>(x);
     sp.colour = color_ + pix * 4;

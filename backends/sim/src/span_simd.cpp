@@ -21,11 +21,17 @@ typedef std::int32_t i32x8 __attribute__((vector_size(32)));
 __attribute__((target_clones("avx2", "default"))) std::uint64_t shade_span_simd(const SimdSpan& s) {
   u32x8 q[SimdSpan::kPlanes], r[SimdSpan::kPlanes];
   const unsigned first = s.gouraud ? 0 : 4;
-  for (unsigned p = first; p < SimdSpan::kPlanes; ++p) {
-    GB_LOAD8(q[p], s.q[p]);
-    GB_LOAD8(r[p], s.r[p]);
-  }
   const u32x8 den = u32x8{} + s.den;
+  for (unsigned p = first; p < SimdSpan::kPlanes; ++p) {
+    u32x8 qk, rk;
+    GB_LOAD8(qk, s.qk[p]);
+    GB_LOAD8(rk, s.rk[p]);
+    q[p] = qk + s.q0[p];
+    r[p] = rk + s.r0[p];
+    const u32x8 carry = GB_MASK((i32x8)r[p] >= (i32x8)den);
+    r[p] -= den & carry;
+    q[p] -= carry;
+  }
   const u32x8 lane = {0, 1, 2, 3, 4, 5, 6, 7};
   const bool depth = s.z_test || s.z_write;
   u32x8 passed = {};

@@ -10,8 +10,8 @@ namespace gpubridge::sim {
 
 struct SimdSpan {
   static constexpr unsigned kPlanes = 5;  // R, G, B, A, Z
-  std::uint32_t q[kPlanes][8];  // lane values at the first 8 pixels
-  std::uint32_t r[kPlanes][8];
+  std::uint32_t q0[kPlanes], r0[kPlanes];      // (q, r) at the span's first pixel
+  std::uint32_t qk[kPlanes][8], rk[kPlanes][8];  // offsets of lane k: divmod(k·step), rk < den
   std::uint32_t q8[kPlanes], r8[kPlanes];  // advance per 8 pixels (r8 < den)
   std::uint32_t den = 1;                   // < 2^30, so r + r8 < 2^31
   std::uint32_t flat = 0;                  // colour word (memory order R,G,B,A) when !gouraud
