@@ -38,9 +38,9 @@ __attribute__((target_clones("avx2", "default"))) std::uint64_t shade_span_simd(
   for (unsigned i = 0; i < s.count; i += 8) {
     const unsigned n = s.count - i < 8 ? s.count - i : 8;
     u32x8 pass = GB_MASK((i32x8)lane < static_cast<std::int32_t>(n));
-    std::uint32_t cbuf[8], zbuf[8];
+    std::uint32_t zbuf[8] = {};  // tail lanes beyond n stay defined (they are masked off)
     std::uint8_t* cp = s.colour + std::size_t{i} * 4;
-    GB_COPY(cbuf, cp, n);
+    bool none = false, all = n == 8;
     if (depth) {
       std::uint8_t* zp = s.depth + std::size_t{i} * 4;
       GB_COPY(zbuf, zp, n);
@@ -60,19 +60,32 @@ __attribute__((target_clones("avx2", "default"))) std::uint64_t shade_span_simd(
           default: pass = u32x8{}; break;
         }
       }
-      if (s.z_write) {
+      std::uint64_t m[4];
+      std::memcpy(m, &pass, sizeof m);
+      none = (m[0] | m[1] | m[2] | m[3]) == 0;
+      all = all && (m[0] & m[1] & m[2] & m[3]) == ~std::uint64_t{0};
+      if (s.z_write && !none) {
         const u32x8 zs = GB_BSWAP(z);
         const u32x8 out = (zs & pass) | (old & ~pass);
         GB_COPY(zp, &out, n);
       }
     }
-    u32x8 word = u32x8{} + s.flat;
-    if (s.gouraud) word = (q[0] & 255u) | ((q[1] & 255u) << 8) | ((q[2] & 255u) << 16) | (q[3] << 24);
-    u32x8 cold;
-    GB_LOAD8(cold, cbuf);
-    const u32x8 out = (word & pass) | (cold & ~pass);
-    GB_COPY(cp, &out, n);
-    passed -= pass;  // pass lanes are all ones (−1)
+    // Rejected chunks touch no colour; fully passing chunks store without reading.
+    if (!none) {
+      u32x8 word = u32x8{} + s.flat;
+      if (s.gouraud) word = (q[0] & 255u) | ((q[1] & 255u) << 8) | ((q[2] & 255u) << 16) | (q[3] << 24);
+      if (all) {
+        std::memcpy(cp, &word, 32);
+      } else {
+        std::uint32_t cbuf[8] = {};
+        GB_COPY(cbuf, cp, n);
+        u32x8 cold;
+        GB_LOAD8(cold, cbuf);
+        const u32x8 out = (word & pass) | (cold & ~pass);
+        GB_COPY(cp, &out, n);
+      }
+      passed -= pass;  // pass lanes are all ones (−1)
+    }
     for (unsigned p = first; p < SimdSpan::kPlanes; ++p) {
       q[p] += s.q8[p];
       r[p] += s.r8[p];
