@@ -23,6 +23,9 @@ Result<void> finish_capture(const Options& options, const Frame& frame, const Im
     };
     if (!options.screenshot.empty()) j["screenshot"] = options.screenshot;
     if (!result.window_grab.empty()) j["window_grab"] = result.window_grab;
+    if (result.fps_drawn) j["fps_drawn"] = *result.fps_drawn;
+    if (result.latency_ms_mean) j["latency_ms_mean"] = *result.latency_ms_mean;
+    if (result.latency_ms_max) j["latency_ms_max"] = *result.latency_ms_max;
     std::cout << j.dump() << std::endl;
   } else {
     std::cout << fmt::format("frame {} ({}, crc {:08x}{})", frame.number, describe_size(frame), frame.crc,

@@ -15,6 +15,9 @@ struct CaptureResult {
   std::uint32_t frames_taken = 0;  // N
   std::uint64_t dropped = 0;
   std::string window_grab;  // path when a grab was saved
+  // Window runs only: frames drawn per second over the run, and swap-to-display latency.
+  std::optional<double> fps_drawn;
+  std::optional<double> latency_ms_mean, latency_ms_max;
 };
 
 // Saves the frame's pixels (when options ask for it) and prints the summary on stdout.

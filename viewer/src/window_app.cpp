@@ -2,6 +2,7 @@
 
 #include <GLFW/glfw3.h>
 
+#include <algorithm>
 #include <chrono>
 #include <iostream>
 
@@ -62,6 +63,9 @@ class WindowApp {
   Image current_rgba_;
   std::uint32_t taken_ = 0;
   std::uint64_t drawn_ = 0, pending_swap_ns_ = 0, last_overlay_ns_ = 0;
+  std::uint64_t first_draw_ns_ = 0, frames_drawn_ = 0;  // frames (not redraws) shown, for the summary
+  double latency_sum_ms_ = 0, latency_max_ms_ = 0;
+  std::uint64_t latency_count_ = 0;
   RateMeter received_rate_, drawn_rate_;
   std::string title_;
   std::vector<std::string> overlay_text_;
@@ -170,6 +174,13 @@ int WindowApp::finish_headless(const Image& grab) {
   CaptureResult result;
   result.frames_taken = taken_;
   result.dropped = source_.counters().dropped;
+  const std::uint64_t elapsed_ns = monotonic_ns() - first_draw_ns_;
+  if (frames_drawn_ > 1 && elapsed_ns > 0)
+    result.fps_drawn = static_cast<double>(frames_drawn_ - 1) * 1e9 / static_cast<double>(elapsed_ns);
+  if (latency_count_) {
+    result.latency_ms_mean = latency_sum_ms_ / static_cast<double>(latency_count_);
+    result.latency_ms_max = latency_max_ms_;
+  }
   if (!options_.grab_window.empty()) {
     if (auto saved = save_png(options_.grab_window, grab); !saved) {
       std::cerr << "gpubridge-view: " << saved.error().message << "\n";
@@ -262,10 +273,14 @@ int WindowApp::run() {
     ++drawn_;
     drawn_rate_.sample(monotonic_ns(), drawn_);
     if (new_frame) {
+      if (frames_drawn_++ == 0) first_draw_ns_ = monotonic_ns();
       // swap_ns is the daemon's CLOCK_MONOTONIC: only meaningful on the same machine and never negative.
       const std::uint64_t shown = monotonic_ns();
       if (pending_swap_ns_ && shown >= pending_swap_ns_ && shown - pending_swap_ns_ < 60'000'000'000ull) {
         view_.latency_ms = static_cast<double>(shown - pending_swap_ns_) / 1e6;
+        latency_sum_ms_ += *view_.latency_ms;
+        latency_max_ms_ = std::max(latency_max_ms_, *view_.latency_ms);
+        ++latency_count_;
       } else {
         view_.latency_ms.reset();
       }
