@@ -131,6 +131,10 @@ TEST(BoardBackend, RejectsReadFramesAndLinkRegistersInWriteBatches) {
   protocol::append(bytes, protocol::write_frame(Reg::LINK_CTRL, 0));
   EXPECT_FALSE(board->backend->write_frames(protocol::FrameView{bytes}));
   EXPECT_FALSE(board->backend->readback(0xFFFFFFF0u, 64)) << "beyond video memory";
+  auto none = board->backend->readback(13, 0);
+  ASSERT_TRUE(none);
+  EXPECT_TRUE(none->empty());
+  EXPECT_FALSE(board->backend->upload(3, std::vector<std::uint8_t>(8))) << "MEM_ADDR is 8-byte granular";
 }
 
 }  // namespace

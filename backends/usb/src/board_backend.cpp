@@ -613,6 +613,7 @@ Result<std::vector<std::uint8_t>> BoardBackend::read_memory_once(std::uint32_t s
 // compares FRAME_CRC) every chunk is read twice and must agree; a MISO bit error costs a re-read,
 // never a silently wrong byte.
 Result<std::vector<std::uint8_t>> BoardBackend::readback_locked(std::uint32_t address, std::uint32_t length, bool verify) {
+  if (length == 0) return std::vector<std::uint8_t>{};
   const std::uint32_t start = address & ~7u;
   const std::uint64_t end = (std::uint64_t{address} + length + 7) & ~std::uint64_t{7};
   const std::size_t chunk_words = std::max<std::size_t>(1, bridge_->preferred_batch_bytes() / kFrameBytes);
