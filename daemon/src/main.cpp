@@ -2,6 +2,7 @@
 // simulator or a board (see docs/daemon.md). Prints "listening on ADDRESS" per endpoint and
 // "ready" on stdout once it accepts connections.
 #include <cstdio>
+#include <functional>
 #include <thread>
 
 #include <CLI/CLI.hpp>
@@ -72,6 +73,7 @@ int run(daemon::DaemonConfig cfg) {
 
     asio::signal_set signals(net, SIGINT, SIGTERM);
     asio::steady_timer force_stop(net);
+    std::function<void()> stop_poll;  // lives as long as the loop: the timer handler calls it
     signals.async_wait([&](const boost::system::error_code& ec, int sig) {
       if (ec) return;
       log->info("signal {}: shutting down", sig);
@@ -79,8 +81,17 @@ int run(daemon::DaemonConfig cfg) {
       server.stop();  // no new connections; socket and lock removed now
       const auto open = hub.shutdown_sessions();
       // Sessions close once their last reply is flushed; never wait longer than 1.5 s in total.
-      force_stop.expires_after(std::chrono::milliseconds(open ? 1500 : 0));
-      force_stop.async_wait([&net](const boost::system::error_code&) { net.stop(); });
+      const auto give_up = std::chrono::steady_clock::now() + std::chrono::milliseconds(open ? 1500 : 0);
+      std::function<void()> poll = [&, give_up] {
+        if (hub.session_count() == 0 || std::chrono::steady_clock::now() >= give_up) {
+          net.stop();
+          return;
+        }
+        force_stop.expires_after(std::chrono::milliseconds(5));
+        force_stop.async_wait([&stop_poll](const boost::system::error_code&) { stop_poll(); });
+      };
+      stop_poll = std::move(poll);
+      stop_poll();
     });
     net.run();
     server.stop();

@@ -4,6 +4,8 @@
 #include <future>
 #include <random>
 
+#include <nlohmann/json.hpp>
+
 #include "daemon_process.hpp"
 #include "gpubridge/client/client.hpp"
 #include "gpubridge/protocol/messages.hpp"

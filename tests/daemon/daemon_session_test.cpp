@@ -98,7 +98,7 @@ TEST(DaemonSession, DispatchIsIndependentOfReadSplitPoints) {
   protocol::append(frames, protocol::write_frame(Reg::FB_DISPLAY, 0));
   add(3, protocol::WriteFrames{protocol::FrameView{frames}});
   add(4, protocol::ReadReg{protocol::index_of(Reg::CLEAR_COLOR)});
-  add(5, protocol::Fence{});
+  add(5, protocol::FenceMsg{5});
   add(6, protocol::Bye{});
 
   std::vector<std::uint8_t> whole_raw;
@@ -138,10 +138,11 @@ TEST(DaemonSession, ReadFramesInAWriteBatchAreRejected) {
   protocol::encode(Message{3, protocol::WriteFrames{protocol::FrameView{frames}}}, in);
   std::vector<std::uint8_t> raw;
   const auto out = run_session(in, in.size(), raw);
-  ASSERT_GE(out.size(), 3u);
+  // The parser already refuses read frames inside WRITE_FRAMES: ERROR BAD_FRAME, then the
+  // connection ends (nothing of the batch reaches the device).
+  ASSERT_EQ(out.size(), 3u);
   ASSERT_TRUE(std::holds_alternative<protocol::ErrorMsg>(out[2].payload));
   EXPECT_EQ(std::get<protocol::ErrorMsg>(out[2].payload).code, protocol::ErrorCode::BadFrame);
-  EXPECT_EQ(std::get<protocol::ErrorMsg>(out[2].payload).ref, 3u);
 }
 
 }  // namespace

@@ -170,7 +170,11 @@ Result<void> Client::send_raw(std::span<const std::uint8_t> a, std::span<const s
     int n_iov = 0;
     if (!a.empty()) iov[n_iov++] = {const_cast<std::uint8_t*>(a.data()), a.size()};
     if (!b.empty()) iov[n_iov++] = {const_cast<std::uint8_t*>(b.data()), b.size()};
-    const ssize_t n = ::writev(fd_, iov, n_iov);
+    msghdr msg{};
+    msg.msg_iov = iov;
+    msg.msg_iovlen = static_cast<std::size_t>(n_iov);
+    // MSG_NOSIGNAL: a daemon that went away is an error to return, not a SIGPIPE to die of.
+    const ssize_t n = ::sendmsg(fd_, &msg, MSG_NOSIGNAL);
     if (n > 0) {
       std::size_t done = static_cast<std::size_t>(n);
       const std::size_t from_a = std::min(done, a.size());
