@@ -16,7 +16,7 @@ using protocol::MsgType;
 namespace asio = boost::asio;
 
 constexpr std::size_t kPreAuthReadBytes = 4096;   // no pre-handshake allocation beyond a page
-constexpr std::size_t kReadBytes = 256 * 1024;
+constexpr std::size_t kReadBytes = 1024 * 1024;  // fewer syscalls and device hand-offs per MiB
 constexpr std::uint32_t kPreAuthMaxPayload = 1024;  // HELLO is at most ~200 bytes
 constexpr auto kCloseGrace = std::chrono::milliseconds(1000);
 

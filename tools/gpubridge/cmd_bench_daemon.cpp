@@ -135,7 +135,7 @@ RawResult raw_sink(bool tcp, const std::vector<std::uint8_t>& frames, std::uint6
   const std::uint64_t total = batches * (frames.size() + protocol::kHeaderBytes);
   auto sink = std::async(std::launch::async, [lfd, total] {
     const int fd = ::accept(lfd, nullptr, nullptr);
-    std::vector<std::uint8_t> buf(256 * 1024);  // the daemon's read size
+    std::vector<std::uint8_t> buf(1024 * 1024);  // the daemon's read size
     std::uint64_t got = 0;
     while (got < total) {
       const ssize_t n = ::read(fd, buf.data(), buf.size());
