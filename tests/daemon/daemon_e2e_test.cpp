@@ -8,6 +8,7 @@
 #include "daemon_process.hpp"
 #include "gpubridge/client/client.hpp"
 #include "gpubridge/common/image.hpp"
+#include "gpubridge/common/trace_files.hpp"
 #include "gpubridge/protocol/frame.hpp"
 
 namespace gpubridge::test {
@@ -363,3 +364,37 @@ TEST(DaemonSim, PlayedTraceScreenshotEqualsInProcessRender) {
 }  // namespace
 }  // namespace gpubridge::test
 #endif
+
+namespace gpubridge::test {
+namespace {
+
+// --record DIR: the session's stream is written as a binary trace holding exactly what was played.
+TEST(DaemonRecord, RecordedTraceReplaysThePlayedCommands) {
+  const auto dir = make_temp_dir("record");
+  const auto socket = (dir / "d.sock").string();
+  const std::string trace = std::string(GPUBRIDGE_TEST_DATA) + "/triangle.trace";
+  Daemon daemon;
+  ASSERT_TRUE(daemon.start({"--listen", "unix:" + socket, "--backend", "fake", "--record", (dir / "rec").string()}))
+      << daemon.error();
+  const auto play = run_process({GPUBRIDGE_CLI_PATH, "play", trace, "--connect", "unix:" + socket});
+  ASSERT_EQ(play.exit_code, 0) << play.err;
+  ASSERT_EQ(daemon.terminate(), 0);
+  std::vector<fs::path> files;
+  for (const auto& e : fs::directory_iterator(dir / "rec")) files.push_back(e.path());
+  ASSERT_EQ(files.size(), 1u);
+  EXPECT_NE(files[0].filename().string().find("gpubridge_play"), std::string::npos) << files[0];
+  auto recorded = load_trace(files[0]);
+  ASSERT_TRUE(recorded) << recorded.error().message;
+  auto original = load_trace(trace);
+  ASSERT_TRUE(original) << original.error().message;
+  // play sends the trace's commands, then one FENCE to wait for completion.
+  ASSERT_EQ(recorded->commands.size(), original->commands.size() + 1);
+  for (std::size_t i = 0; i < original->commands.size(); ++i)
+    EXPECT_TRUE(recorded->commands[i].command == original->commands[i].command) << "command " << i;
+  EXPECT_TRUE(std::holds_alternative<protocol::FenceCmd>(recorded->commands.back().command));
+  std::error_code ec;
+  fs::remove_all(dir, ec);
+}
+
+}  // namespace
+}  // namespace gpubridge::test
