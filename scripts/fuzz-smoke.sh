@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Short libFuzzer runs of the three protocol fuzz targets under ASan+UBSan.
+# Short libFuzzer runs of the three protocol fuzz targets and the daemon session fuzzer under ASan+UBSan.
 #   scripts/fuzz-smoke.sh [seconds-per-target]   (default 20)
 # Configures build-fuzz/ with clang++ (-DGPUBRIDGE_FUZZ=ON -DGPUBRIDGE_SANITIZE=ON), builds only the
 # fuzz targets, runs each from its seed corpus (tests/fuzz/corpus/<target>/, copied so the repo is
@@ -23,23 +23,31 @@ fi
 
 generator=()
 command -v ninja >/dev/null && generator=(-G Ninja)
-cmake -S "$root" -B "$build" "${generator[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-  -DCMAKE_C_COMPILER="$cc" -DCMAKE_CXX_COMPILER="$cxx" \
-  -DGPUBRIDGE_FUZZ=ON -DGPUBRIDGE_SANITIZE=ON -DGPUBRIDGE_BUILD_BENCH=OFF >/dev/null
-cmake --build "$build" --target fuzz_targets -j"$(nproc)"
+# Reuse a build directory that is already configured for fuzzing (scripts/test.sh passes its
+# sanitizer build); configure a fresh one otherwise.
+if ! grep -q '^GPUBRIDGE_FUZZ:BOOL=ON' "$build/CMakeCache.txt" 2>/dev/null; then
+  cmake -S "$root" -B "$build" "${generator[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+    -DCMAKE_C_COMPILER="$cc" -DCMAKE_CXX_COMPILER="$cxx" \
+    -DGPUBRIDGE_FUZZ=ON -DGPUBRIDGE_SANITIZE=ON -DGPUBRIDGE_BUILD_BENCH=OFF >/dev/null
+fi
+cmake --build "$build" --target fuzz_targets daemon_session_fuzz -j"$(nproc)"
 
 artifacts="$build/fuzz-artifacts"
 mkdir -p "$artifacts"
-declare -A max_len=([message_parser]=65536 [binary_trace]=65536 [text_trace]=16384)
+declare -A max_len=([message_parser]=65536 [binary_trace]=65536 [text_trace]=16384 [daemon_session]=65536)
+declare -A binary=([message_parser]=tests/fuzz/fuzz_message_parser [binary_trace]=tests/fuzz/fuzz_binary_trace
+                   [text_trace]=tests/fuzz/fuzz_text_trace [daemon_session]=tests/daemon/daemon_session_fuzz)
+declare -A corpus=([message_parser]=message_parser [binary_trace]=binary_trace [text_trace]=text_trace
+                   [daemon_session]=message_parser)
 status=0
-for target in message_parser binary_trace text_trace; do
+for target in message_parser binary_trace text_trace daemon_session; do
   work="$build/fuzz-corpus/$target"
   mkdir -p "$work"
-  cp -n "$root/tests/fuzz/corpus/$target/"* "$work/" 2>/dev/null || true
+  cp -n "$root/tests/fuzz/corpus/${corpus[$target]}/"* "$work/" 2>/dev/null || true
   log="$build/fuzz-$target.log"
   echo "fuzz-smoke: $target for ${seconds}s"
   if ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-      "$build/tests/fuzz/fuzz_$target" -max_total_time="$seconds" -rss_limit_mb=2048 \
+      "$build/${binary[$target]}" -max_total_time="$seconds" -rss_limit_mb=2048 \
       -max_len="${max_len[$target]}" -timeout=10 -print_final_stats=1 \
       -artifact_prefix="$artifacts/$target-" "$work" >"$log" 2>&1; then
     execs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' || echo 0)
