@@ -2,13 +2,72 @@
 
 #include <cstdio>
 
+#include "gpubridge/common/log.hpp"
 #include "gpubridge/daemon/test_backends.hpp"
 
 #ifdef GPUBRIDGE_HAVE_SIM
 #include "gpubridge/sim/sim_backend.hpp"
 #endif
+#ifdef GPUBRIDGE_HAVE_USB
+#include "gpubridge/usb/board_factory.hpp"
+#include "gpubridge/usb/board_profile.hpp"
+#endif
 
 namespace gpubridge::daemon {
+
+namespace {
+constexpr std::string_view kEmulatedPrefix = "emulated:";
+
+#ifdef GPUBRIDGE_HAVE_USB
+// `boards_dir` may name the configuration directory (holding boards/) or the boards/ directory
+// itself; the USB library wants the former.
+std::filesystem::path config_dir_of(const DaemonConfig& cfg) {
+  if (cfg.boards_dir.empty()) return usb::default_config_dir();
+  const std::filesystem::path dir(cfg.boards_dir);
+  std::error_code ec;
+  if (std::filesystem::is_directory(dir / "boards", ec)) return dir;
+  return dir.lexically_normal().parent_path();
+}
+
+Result<std::unique_ptr<backends::Backend>> open_named_board(const std::string& name, bool emulate, const DaemonConfig& cfg) {
+  auto profile = usb::find_board_profile(config_dir_of(cfg), name);
+  if (!profile) return make_error("backend \"" + std::string(emulate ? kEmulatedPrefix : "") + name + "\": " + profile.error().message);
+  usb::BoardOpenOptions opts;
+  opts.emulate = emulate;
+  auto board = usb::open_board(*profile, opts);
+  if (!board) {
+    std::string msg = "board \"" + profile->name + "\" (" + std::string(usb::to_string(profile->chip)) + ")" +
+                      (emulate ? " (emulated)" : "") + ": " + board.error().message;
+    if (!emulate)
+      msg += "; or run without it: --backend sim (simulator) or --backend emulated:" + profile->name +
+             " (this board's driver against an emulated bridge)";
+    return make_error(msg, board.error().code);
+  }
+  logger("daemon")->info("backend: board {} ({}){}", profile->name, usb::to_string(profile->chip), emulate ? ", emulated" : "");
+  return std::unique_ptr<backends::Backend>(std::move(*board));
+}
+
+// The first board whose real bridge opens and attaches; nullptr when none does. Profiles whose
+// bridge is absent fail at the USB open (no transfers), so this stays fast without hardware.
+std::unique_ptr<backends::Backend> first_present_board(const DaemonConfig& cfg) {
+  auto log = logger("daemon");
+  auto profiles = usb::load_board_profiles(config_dir_of(cfg));
+  if (!profiles) {
+    log->debug("auto: no board profiles: {}", profiles.error().message);
+    return nullptr;
+  }
+  for (const auto& p : *profiles) {
+    auto board = usb::open_board(p, usb::BoardOpenOptions{});
+    if (board) {
+      log->info("auto: using board {} ({})", p.name, usb::to_string(p.chip));
+      return std::move(*board);
+    }
+    log->debug("auto: skipped board {}: {}", p.name, board.error().message);
+  }
+  return nullptr;
+}
+#endif
+}  // namespace
 
 bool simulator_available() {
 #ifdef GPUBRIDGE_HAVE_SIM
@@ -29,7 +88,6 @@ Result<std::unique_ptr<backends::Backend>> make_simulator() {
 }
 
 Result<std::unique_ptr<backends::Backend>> make_backend(const std::string& name, const DaemonConfig& cfg) {
-  (void)cfg;
   if (name == "sim") return make_simulator();
   if (name == "discard") return std::unique_ptr<backends::Backend>(std::make_unique<DiscardBackend>());
   if (name == "fake") return std::unique_ptr<backends::Backend>(std::make_unique<FakeScanoutBackend>());
@@ -41,13 +99,25 @@ Result<std::unique_ptr<backends::Backend>> make_backend(const std::string& name,
       return make_error("backend \"" + name + "\": expected fake:WIDTHxHEIGHT with sizes 1..1024");
     return std::unique_ptr<backends::Backend>(std::make_unique<FakeScanoutBackend>(w, h));
   }
+#ifdef GPUBRIDGE_HAVE_USB
   if (name == "auto") {
-    // Board detection arrives with the USB board path; until it is linked in, auto = simulator.
+    if (auto board = first_present_board(cfg)) return board;
+    logger("daemon")->info("auto: no board attached (details at --log-level debug); using the simulator");
     return make_simulator();
   }
+  if (name.starts_with(kEmulatedPrefix)) {
+    const std::string profile = name.substr(kEmulatedPrefix.size());
+    if (profile.empty()) return make_error("backend \"" + name + "\": expected emulated:PROFILE (a board profile name or .json file)");
+    return open_named_board(profile, true, cfg);
+  }
+  return open_named_board(name, false, cfg);
+#else
+  (void)cfg;
+  if (name == "auto") return make_simulator();  // no USB board path: nothing to detect
   return make_error("backend \"" + name +
                     "\": board backends need the USB board path (gpubridge_usb), which this gpubridged was built "
                     "without; use \"sim\", \"auto\", \"fake\" or \"discard\"");
+#endif
 }
 
 }  // namespace gpubridge::daemon

@@ -1,7 +1,9 @@
 #pragma once
 // Builds the daemon's backend from its name: "sim" (the simulator, default), "discard" and
-// "fake" (test_backends.hpp), "auto" (a board when one is present, else the simulator) or a
-// board profile name (needs the USB board path, linked in when gpubridge_usb is built).
+// "fake" (test_backends.hpp), "auto" (the first board profile whose real bridge opens, else the
+// simulator), a board profile name or .json path (the real board), or "emulated:PROFILE" (that
+// board's bridge-chip model + simulator, same driver code). Boards need the USB board path,
+// linked in when gpubridge_usb is built.
 #include <memory>
 #include <string>
 
