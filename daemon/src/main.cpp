@@ -118,7 +118,7 @@ int main(int argc, char** argv) {
   app.add_option("-l,--listen", listen, "unix:PATH or tcp:HOST:PORT (repeatable; replaces the config's list)");
   app.add_option("--token", token, "token TCP clients must present (required for non-loopback TCP)");
   app.add_option("--token-file", token_file, "read the token from the first line of this file");
-  app.add_option("-b,--backend", backend, "sim | auto | BOARD | fake | discard");
+  app.add_option("-b,--backend", backend, "sim | auto | BOARD | emulated:BOARD | fake | discard");
   app.add_flag("--no-fallback", no_fallback, "do not switch to the simulator when a board disappears");
   app.add_option("--boards-dir", boards_dir, "directory of board profiles (JSON)");
   app.add_option("--frames-dir", frames_dir, "write every scanned-out frame as frame_NNNNNN.png here");
