@@ -93,7 +93,7 @@ Result<DaemonConfig> parse_config(const json& doc, const std::string& source) {
   GPUBRIDGE_TRY(rd.read_string(doc, "", "token", cfg.token));
   GPUBRIDGE_TRY(rd.read_string(doc, "", "token_file", cfg.token_file));
   GPUBRIDGE_TRY(rd.read_string(doc, "", "backend", cfg.backend));
-  if (cfg.backend.empty()) return rd.fail("backend", "expected \"sim\", \"auto\" or a board name, got \"\"");
+  if (cfg.backend.empty()) return rd.fail("backend", "expected \"sim\", \"auto\", a board name or \"emulated:BOARD\", got \"\"");
   GPUBRIDGE_TRY(rd.read_bool(doc, "", "fallback_to_sim", cfg.fallback_to_sim));
   GPUBRIDGE_TRY(rd.read_string(doc, "", "boards_dir", cfg.boards_dir));
   GPUBRIDGE_TRY(rd.read_string(doc, "", "frames_dir", cfg.frames_dir));

@@ -101,8 +101,8 @@ void Session::process() {
     const auto st = parser_.next(m);
     if (st == protocol::MessageParser::Status::NeedMore) break;
     if (st == protocol::MessageParser::Status::Error) {
-      const auto& e = parser_.error();
-      fail(e.code, e.message + " (stream offset " + std::to_string(parser_.stream_offset()) + ")");
+      const auto& e = parser_.error();  // the parser's message already names the stream offset
+      fail(e.code, e.message);
       return;
     }
     dispatch(m);
