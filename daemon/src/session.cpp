@@ -56,7 +56,7 @@ bool client_may_send(MsgType t) {
 }  // namespace
 
 Session::Session(Hub& hub, std::unique_ptr<Stream> stream, asio::any_io_executor executor)
-    : hub_(hub), stream_(std::move(stream)), tick_(executor), parser_(kPreAuthMaxPayload) {}
+    : hub_(hub), stream_(std::move(stream)), tick_(executor), frame_timer_(executor), parser_(kPreAuthMaxPayload) {}
 
 Session::~Session() = default;
 
@@ -161,6 +161,7 @@ void Session::dispatch(Message& m) {
     }
     case MsgType::Unsubscribe:
       subscribed_ = false;
+      held_frame_.reset();
       pending_frame_.reset();
       return;
     case MsgType::LeaseAcquire: handle_lease_acquire(m); return;
@@ -392,10 +393,29 @@ void Session::send(Buffer bytes) {
 void Session::offer_frame(FrameFanout& frame) {
   if (!subscribed_ || closing_ || terminated_ || !handshaken_) return;
   const auto now = Clock::now();
-  if (max_fps_ != 0 && last_frame_sent_ != Clock::time_point{} &&
-      now - last_frame_sent_ < std::chrono::microseconds(1000000 / max_fps_))
-    return;
+  if (max_fps_ != 0 && last_frame_sent_ != Clock::time_point{}) {
+    const auto due = last_frame_sent_ + std::chrono::microseconds(1000000 / max_fps_);
+    if (now < due) {
+      // Too early for the subscriber's rate: keep only the newest such frame and send it when the
+      // interval ends, so the last frame of an animation is never lost.
+      held_frame_ = frame.message(frame_format_);
+      if (!frame_timer_armed_) {
+        frame_timer_armed_ = true;
+        frame_timer_.expires_at(due);
+        frame_timer_.async_wait([self = shared_from_this()](const boost::system::error_code& ec) {
+          self->frame_timer_armed_ = false;
+          if (ec || self->terminated_ || self->closing_ || !self->subscribed_ || !self->held_frame_) return;
+          self->last_frame_sent_ = Clock::now();
+          self->pending_frame_ = std::move(self->held_frame_);  // newest wins
+          self->held_frame_.reset();
+          self->do_write();
+        });
+      }
+      return;
+    }
+  }
   last_frame_sent_ = now;
+  held_frame_.reset();
   pending_frame_ = frame.message(frame_format_);  // replaces an unsent older frame: newest wins
   do_write();
 }
@@ -446,9 +466,11 @@ void Session::terminate(const char* why) {
   closing_ = true;
   logger("daemon")->debug("session {}: {}", id_, why);
   tick_.cancel();
+  frame_timer_.cancel();
   stream_->close();
   queue_.clear();
   pending_frame_.reset();
+  held_frame_.reset();
   if (recording_) recording_->flush();
   hub_.remove_session(id_);
 }

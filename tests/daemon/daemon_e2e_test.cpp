@@ -316,6 +316,29 @@ TEST_F(DaemonE2E, SubscriberGetsEveryFrameAndScreenshotWritesIt) {
   EXPECT_EQ(img->rgba, f->pixels);
 }
 
+// A rate-limited subscriber (max_fps 2) skips frames that come too fast, but the newest one is
+// delivered when its interval ends: the last frame of an animation is never lost.
+TEST_F(DaemonE2E, RateLimitedSubscriberStillGetsTheLastFrame) {
+  start();
+  auto sub = connect("slow-viewer");
+  ASSERT_TRUE(sub.subscribe(protocol::FrameFormat::RGBA8888, 2, 1000ms));
+  auto drawer = connect("drawer");
+  ASSERT_TRUE(drawer.acquire_lease(LeaseMode::Wait, 1000ms));
+  for (std::uint32_t i = 1; i <= 5; ++i) {  // five swaps well inside one 500 ms interval
+    const auto w = frames_of({protocol::write_frame(Reg::CLEAR_COLOR, (i << 24) | 0xFF),
+                              protocol::write_frame(Reg::FB_DISPLAY, 0)});
+    ASSERT_TRUE(drawer.write_frames(protocol::FrameView{w}, 1000ms));
+  }
+  ASSERT_TRUE(drawer.fence(1000ms));
+  auto first = sub.next_frame(2000ms);
+  ASSERT_TRUE(first) << first.error().message;
+  EXPECT_EQ(first->pixels[0], 1);  // the first swap goes out at once
+  auto last = sub.next_frame(2000ms);
+  ASSERT_TRUE(last) << "the newest held-back frame never arrived: " << last.error().message;
+  EXPECT_EQ(last->pixels[0], 5);  // frames 2..4 were superseded, 5 arrived when the interval ended
+  EXPECT_FALSE(sub.next_frame(700ms)) << "only two frames may be sent for a burst inside one interval";
+}
+
 }  // namespace
 }  // namespace gpubridge::test
 

@@ -2,6 +2,7 @@
 // `gpubridge bringup --board NAME` (ID, register echo, memory test, SPI clock sweep, scenes vs
 // the simulator). Both run against an emulated board with --emulate.
 #include <cstdio>
+#include <unistd.h>
 
 #include <nlohmann/json.hpp>
 
@@ -142,7 +143,8 @@ int run_bringup(const GlobalOptions& g, const BringupArgs& a) {
     std::fprintf(stderr, "gpubridge bringup: %s\n", board.error().message.c_str());
     return 1;
   }
-  if (!g.json) opts.progress = [](const std::string& step, unsigned pct) { std::fprintf(stderr, "\r%s: %3u%%", step.c_str(), pct); if (pct >= 100) std::fputc('\n', stderr); };
+  // Progress only on a terminal; scripts and logs get the report alone.
+  if (!g.json && ::isatty(2)) opts.progress = [](const std::string& step, unsigned pct) { std::fprintf(stderr, "\r%s: %3u%%", step.c_str(), pct); if (pct >= 100) std::fputc('\n', stderr); };
   const auto rep = usb::run_bringup(**board, opts);
   if (g.json) {
     nlohmann::json steps = nlohmann::json::array();

@@ -73,6 +73,7 @@ class Session : public std::enable_shared_from_this<Session> {
   Hub& hub_;
   std::unique_ptr<Stream> stream_;
   boost::asio::steady_timer tick_;
+  boost::asio::steady_timer frame_timer_;  // releases a rate-limited frame when its interval ends
   protocol::MessageParser parser_;
   std::vector<std::uint8_t> read_buf_;
 
@@ -98,6 +99,8 @@ class Session : public std::enable_shared_from_this<Session> {
   protocol::FrameFormat frame_format_ = protocol::FrameFormat::Native;
   std::uint16_t max_fps_ = 0;
   Clock::time_point last_frame_sent_{};
+  Buffer held_frame_;  // newest frame that arrived too early for max_fps; sent when the interval ends
+  bool frame_timer_armed_ = false;
 
   // Timeouts.
   Clock::time_point accepted_at_ = Clock::now();
