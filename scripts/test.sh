@@ -3,7 +3,7 @@
 #  1. gcc build of everything + the whole CTest suite (unit, end-to-end daemon/viewer/USB-model tests).
 #  2. clang build with AddressSanitizer + UndefinedBehaviorSanitizer of the protocol, simulator and accuracy
 #     suites, which run again under the sanitizers, plus a short smoke run of every libFuzzer target.
-# Long fuzz and soak runs are not part of this; see docs/testing.md.
+# Long fuzz runs are not part of this; see "Testing" in README.md.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 start=$(date +%s)
