@@ -4,26 +4,13 @@
 #include <algorithm>
 #include <cmath>
 
+#include "gpubridge/accuracy/from_device.hpp"
 #include "gpubridge/accuracy/texel_probe.hpp"
 #include "gpubridge/bench/llvmpipe_peer.hpp"
 
 namespace gpubridge::bench {
 
 namespace {
-accuracy::FixedTriangle to_fixed(const geometry::DeviceTriangle& t) {
-  accuracy::FixedTriangle f;
-  for (int i = 0; i < 3; ++i) {
-    f[i].x = t[i].x;
-    f[i].y = t[i].y;
-    f[i].z = t[i].z & 0xFFFFFFu;
-    f[i].rgba = {std::uint8_t(t[i].rgba >> 24), std::uint8_t(t[i].rgba >> 16), std::uint8_t(t[i].rgba >> 8),
-                 std::uint8_t(t[i].rgba)};
-    f[i].q = t[i].q;
-    f[i].s = t[i].s;
-    f[i].t = t[i].t;
-  }
-  return f;
-}
 constexpr double kTextureSize = double(1u << kTextureLog2);
 }  // namespace
 
@@ -40,7 +27,7 @@ ReferenceFrame reference_frame(const Scene& scene) {
   r.v_texels.assign(n, 0);
   const accuracy::PixelRect clip{0, 0, int(scene.width), int(scene.height)};
   for (std::size_t k = 0; k < scene.error_subset && k < scene.triangles.size(); ++k) {
-    for (const auto& s : accuracy::rasterize(to_fixed(scene.triangles[k]), clip)) {
+    for (const auto& s : accuracy::rasterize(accuracy::to_fixed(scene.triangles[k]), clip)) {
       const std::size_t i = std::size_t(s.y) * scene.width + std::size_t(s.x);
       r.count[i] += 1;
       r.owner[i] = std::int64_t(k);

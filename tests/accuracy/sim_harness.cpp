@@ -23,21 +23,6 @@ geometry::DeviceVertex dv(int x16, int y16, std::uint32_t z, std::uint32_t rgba,
   return v;
 }
 
-FixedTriangle to_fixed(const geometry::DeviceTriangle& t) {
-  FixedTriangle f;
-  for (int i = 0; i < 3; ++i) {
-    f[i].x = t[i].x;
-    f[i].y = t[i].y;
-    f[i].z = t[i].z & 0xFFFFFFu;
-    f[i].rgba = {std::uint8_t(t[i].rgba >> 24), std::uint8_t(t[i].rgba >> 16), std::uint8_t(t[i].rgba >> 8),
-                 std::uint8_t(t[i].rgba)};
-    f[i].q = t[i].q;
-    f[i].s = t[i].s;
-    f[i].t = t[i].t;
-  }
-  return f;
-}
-
 geometry::DeviceTriangle to_device(const FixedTriangle& f) {
   geometry::DeviceTriangle t;
   for (int i = 0; i < 3; ++i) {

@@ -7,6 +7,7 @@
 #include <span>
 #include <vector>
 
+#include "gpubridge/accuracy/from_device.hpp"
 #include "gpubridge/accuracy/reference.hpp"
 #include "gpubridge/geometry/convert.hpp"
 #include "gpubridge/geometry/encode.hpp"
@@ -18,7 +19,6 @@ namespace gpubridge::accuracy {
 // Device vertex from whole-pixel or 1/16-pixel values, for readable test geometry.
 geometry::DeviceVertex dv(int x16, int y16, std::uint32_t z = 0, std::uint32_t rgba = 0xFFFFFFFFu,
                           std::uint32_t q = 0xFFFFFFFFu, std::int32_t s = 0, std::int32_t t = 0);
-FixedTriangle to_fixed(const geometry::DeviceTriangle& t);
 geometry::DeviceTriangle to_device(const FixedTriangle& t);
 
 class SimHarness {
