@@ -167,7 +167,10 @@ nlohmann::json Hub::status_json() const {
 }
 
 void Hub::on_scanout(std::shared_ptr<const backends::ScanoutFrame> frame) {
-  if (!options_.frames_dir.empty()) {
+  // A board whose profile says `"scanout": "crc"` reports the swap and its FRAME_CRC but no pixels:
+  // count it, but never turn it into a blank PNG or a blank frame for subscribers.
+  const bool has_pixels = !frame->pixels.empty();
+  if (has_pixels && !options_.frames_dir.empty()) {
     char name[32];
     std::snprintf(name, sizeof name, "frame_%06u.png", frame->number);
     const auto path = std::filesystem::path(options_.frames_dir) / name;
@@ -182,6 +185,7 @@ void Hub::on_scanout(std::shared_ptr<const backends::ScanoutFrame> frame) {
 void Hub::fan_out(std::shared_ptr<const backends::ScanoutFrame> frame) {
   ++frames_seen_;
   last_frame_number_ = frame->number;
+  if (frame->pixels.empty()) return;  // CRC-only scanout: nothing to show (see on_scanout)
   FrameFanout fanout(std::move(frame));
   for (auto& [id, w] : sessions_)
     if (auto s = w.lock(); s && s->subscribed()) s->offer_frame(fanout);

@@ -102,6 +102,29 @@ INSTANTIATE_TEST_SUITE_P(FourBridgeChips, DaemonBoard,
                          });
 
 // Errors name the problem and what to do.
+// A CRC-only board (the shipped ch341a-generic profile) counts its swaps but must not hand
+// subscribers a frame without pixels dressed up as a blank image.
+TEST(DaemonBoardCrcOnly, SwapsAreCountedButNoBlankFrameIsSent) {
+  const auto dir = make_temp_dir("brd-crc");
+  const auto socket = (dir / "d.sock").string();
+  Daemon daemon;
+  ASSERT_TRUE(daemon.start({"--listen", "unix:" + socket, "--backend", "emulated:ch341a-generic", "--no-fallback",
+                            "--log-level", "warn"}))
+      << daemon.error();
+  auto sub = client::Client::connect("unix:" + socket, 2000ms);
+  ASSERT_TRUE(sub);
+  ASSERT_TRUE(sub->handshake("sub", "", 2000ms));
+  // RGBA8888: the daemon converts, so a pixel-less frame would arrive as a well-formed blank image.
+  ASSERT_TRUE(sub->subscribe(protocol::FrameFormat::RGBA8888, 0, 2000ms));
+  const auto play = run_process({GPUBRIDGE_CLI_PATH, "play", std::string(GPUBRIDGE_TEST_DATA) + "/board_triangles.trace",
+                                 "--connect", "unix:" + socket});
+  ASSERT_EQ(play.exit_code, 0) << play.err << play.out;
+  EXPECT_FALSE(sub->next_frame(500ms)) << "a CRC-only board produced a frame with pixels";
+  auto s = sub->status(2000ms);
+  ASSERT_TRUE(s);
+  EXPECT_GE(nlohmann::json::parse(*s)["frames"]["count"].get<int>(), 1) << "the swap was not counted";
+}
+
 TEST(DaemonBoardErrors, UnknownProfileListsTheKnownOnes) {
   const auto dir = make_temp_dir("brd-unknown");
   const auto r = run_process({GPUBRIDGED_PATH, "--listen", "unix:" + (dir / "d.sock").string(), "--backend", "no-such-board"});

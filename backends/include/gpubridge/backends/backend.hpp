@@ -21,7 +21,8 @@ struct ScanoutFrame {
   std::uint32_t number = 0;  // full 32-bit frame counter (STATUS.FRAME_COUNT is its low 16 bits)
   unsigned width = 0, height = 0;
   protocol::PixelFormat format = protocol::PixelFormat::RGBA8888;
-  std::vector<std::uint8_t> pixels;  // width * height * bpp, rows top to bottom
+  std::vector<std::uint8_t> pixels;  // width * height * bpp, rows top to bottom; empty when the
+                                     // backend only knows the FRAME_CRC (board profile "scanout": "crc")
   std::uint32_t crc = 0;             // FRAME_CRC of these bytes
   std::chrono::steady_clock::time_point swap_time{};
 };
