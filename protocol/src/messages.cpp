@@ -219,6 +219,11 @@ void decode_into(const Header& h, PayloadReader& r, Payload& out) {
       m.address = r.get<std::uint32_t>("address");
       m.data = r.rest();
       if (!r.failed() && m.data.empty()) r.bad_field("data", 4, "is empty; an UPLOAD carries at least 1 byte");
+      // Device addresses are 32-bit: a range that wraps past 4 GiB is malformed, whoever sends it
+      // (socket, binary trace) — the text trace reader refuses the same range.
+      if (!r.failed() && std::uint64_t{m.address} + m.data.size() > (std::uint64_t{1} << 32))
+        r.bad_field("data", 4, std::to_string(m.data.size()) + " bytes at address " + std::to_string(m.address) +
+                                   " run past the 4 GiB address space");
       out = m;
       return;
     }
@@ -236,6 +241,9 @@ void decode_into(const Header& h, PayloadReader& r, Payload& out) {
       m.length = r.get<std::uint32_t>("length");
       if (!r.failed() && (m.length == 0 || m.length > (64u << 20)))
         r.bad_field("length", 4, std::to_string(m.length) + " is outside 1..67108864 (64 MiB)");
+      if (!r.failed() && std::uint64_t{m.address} + m.length > (std::uint64_t{1} << 32))
+        r.bad_field("length", 4, std::to_string(m.length) + " bytes at address " + std::to_string(m.address) +
+                                     " run past the 4 GiB address space");
       r.expect_end();
       out = m;
       return;

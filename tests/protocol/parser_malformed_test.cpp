@@ -41,6 +41,17 @@ std::vector<std::uint8_t> le32(std::uint32_t v) {
           static_cast<std::uint8_t>(v >> 24)};
 }
 
+// Found by the binary-trace fuzzer: the socket/binary path accepted an UPLOAD wrapping past 4 GiB
+// that the text trace refuses. Address ranges are checked where the message is decoded.
+TEST(ParserMalformed, UploadAndReadbackMayNotWrapPast4GiB) {
+  auto upload = encode(Message{7, Upload{0xFFFFFFFFu, std::span<const std::uint8_t>(le32(0x1234).data(), 2)}});
+  expect_error(upload, ErrorCode::Malformed, "run past the 4 GiB address space");
+  auto edge = encode(Message{7, Upload{0xFFFFFFFEu, std::span<const std::uint8_t>(le32(0x1234).data(), 2)}});
+  EXPECT_EQ(parse_one(edge).status, MessageParser::Status::Ok) << "the last two bytes of the address space are legal";
+  expect_error(encode(Message{8, Readback{0xFFFFFF00u, 0x101}}), ErrorCode::Malformed, "run past the 4 GiB");
+  EXPECT_EQ(parse_one(encode(Message{8, Readback{0xFFFFFF00u, 0x100}})).status, MessageParser::Status::Ok);
+}
+
 TEST(ParserMalformed, TruncatedAtEveryByteNeedsMore) {
   auto s = testing::make_samples();
   for (const auto& m : s.messages) {
