@@ -2,11 +2,13 @@
 // sheet (section 5.3): 640x480 RGBA8888 + Z, N random Gouraud triangles of fixed area, depth test
 // LESS, "front" order (every pixel passes and writes colour + Z). Frames are encoded before the
 // clock starts; the timed part is command decode + setup + rasterisation (Device::write).
-// Usage: sim_throughput [--threads N] [--repeat R] [--only 10|1000|50000] [--accuracy KNOB=VALUE ...]
+// Usage: sim_throughput [--threads N] [--repeat R] [--only 10|1000|50000] [--random-z] [--tri-mode WORD] [--accuracy KNOB=VALUE ...]
+// The last column is a CRC of video memory after the run: it must not change when the code gets faster.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <random>
 #include <string>
@@ -14,6 +16,7 @@
 
 #include <time.h>
 
+#include "gpubridge/protocol/crc32.hpp"
 #include "gpubridge/protocol/frame.hpp"
 #include "gpubridge/sim/device.hpp"
 
@@ -29,7 +32,8 @@ double cpu_seconds() {
   return double(ts.tv_sec) + double(ts.tv_nsec) * 1e-9;
 }
 
-std::vector<std::uint8_t> make_scene(unsigned count, double area, std::uint32_t seed) {
+std::vector<std::uint8_t> make_scene(unsigned count, double area, std::uint32_t seed, bool random_z,
+                                     std::uint64_t tri_mode) {
   std::vector<std::uint8_t> out;
   auto put = [&](Reg r, std::uint64_t d) { protocol::append(out, protocol::write_frame(r, d)); };
   put(Reg::FB_FORMAT, (480ull << 16) | 640);
@@ -37,7 +41,7 @@ std::vector<std::uint8_t> make_scene(unsigned count, double area, std::uint32_t 
   put(Reg::FB_Z, 0x200000);
   put(Reg::CLEAR, 0);
   put(Reg::CLEAR_Z, 0);
-  put(Reg::TRI_MODE, 1 | 4 | (1u << 3) | (1u << 6));  // Gouraud, Z test LESS, Z write
+  put(Reg::TRI_MODE, tri_mode);
   put(Reg::PRIM, 0);
   std::mt19937 rng(seed);
   const double r = std::sqrt(4 * area / (3 * std::sqrt(3.0)));
@@ -45,7 +49,8 @@ std::vector<std::uint8_t> make_scene(unsigned count, double area, std::uint32_t 
   std::uniform_int_distribution<std::uint32_t> col(0, 0xFFFFFFFFu);
   for (unsigned i = 0; i < count; ++i) {
     const double x = cx(rng), y = cy(rng), a = ang(rng);
-    const std::uint32_t z = 0xFFFFFF - static_cast<std::uint32_t>(std::uint64_t{i} * 0xFFFFF0 / count) - 1;
+    const std::uint32_t z = random_z ? col(rng) & 0xFFFFFF
+                                     : 0xFFFFFF - static_cast<std::uint32_t>(std::uint64_t{i} * 0xFFFFF0 / count) - 1;
     for (int k = 0; k < 3; ++k) {
       const double t = a + k * 2.0943951;
       const int vx = static_cast<int>(std::lround((x + r * std::cos(t)) * 16));
@@ -64,9 +69,13 @@ int main(int argc, char** argv) {
   sim::DeviceOptions opt;
   unsigned repeat = 5;
   std::string only;  // "10", "1000" or "50000": run one workload
+  std::uint64_t tri_mode = 1 | 4 | (1u << 3) | (1u << 6);  // Gouraud, Z test LESS, Z write (--tri-mode to change)
+  bool random_z = false;  // --random-z: random depth per triangle (most pixels fail LESS) instead of front to back
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--threads") && i + 1 < argc) opt.threads = static_cast<unsigned>(std::atoi(argv[++i]));
     else if (!std::strcmp(argv[i], "--only") && i + 1 < argc) only = argv[++i];
+    else if (!std::strcmp(argv[i], "--random-z")) random_z = true;
+    else if (!std::strcmp(argv[i], "--tri-mode") && i + 1 < argc) tri_mode = std::strtoull(argv[++i], nullptr, 0);
     else if (!std::strcmp(argv[i], "--repeat") && i + 1 < argc) repeat = static_cast<unsigned>(std::atoi(argv[++i]));
     else if (!std::strcmp(argv[i], "--accuracy") && i + 1 < argc) {
       if (auto r = sim::apply_knob(opt.accuracy, argv[++i]); !r) {
@@ -74,7 +83,7 @@ int main(int argc, char** argv) {
         return 2;
       }
     } else {
-      std::fprintf(stderr, "usage: sim_throughput [--threads N] [--repeat R] [--only 10|1000|50000] [--accuracy KNOB=VALUE]...\n");
+      std::fprintf(stderr, "usage: sim_throughput [--threads N] [--repeat R] [--only 10|1000|50000] [--random-z] [--tri-mode WORD] [--accuracy KNOB=VALUE]...\n");
       return 2;
     }
   }
@@ -85,13 +94,14 @@ int main(int argc, char** argv) {
   } const works[] = {{"10 px", 500000, 10}, {"1000 px", 50000, 1000}, {"50000 px", 2000, 50000}};
   std::printf("threads %u, accuracy %s\n", opt.threads, sim::to_string(opt.accuracy).c_str());
   std::printf("Wall-clock rates; cpu columns are process CPU time (all threads) per unit.\n");
-  std::printf("| workload | triangles | Mtri/s | Mpix/s | ns/tri | ns/px | cpu ns/tri | cpu ns/px |\n");
-  std::printf("|---|---|---|---|---|---|---|---|\n");
+  std::printf("| workload | triangles | Mtri/s | Mpix/s | ns/tri | ns/px | cpu ns/tri | cpu ns/px | memory CRC |\n");
+  std::printf("|---|---|---|---|---|---|---|---|---|\n");
   for (const auto& w : works) {
     if (!only.empty() && std::to_string(static_cast<int>(w.area)) != only) continue;
-    const auto frames = make_scene(w.count, w.area, 1);
+    const auto frames = make_scene(w.count, w.area, 1, random_z, tri_mode);
     double best = 1e30, best_cpu = 1e30;
     std::uint64_t pixels = 0;
+    std::uint32_t crc = 0;
     for (unsigned rep = 0; rep < repeat; ++rep) {
       auto dev = sim::Device::create(opt);
       if (!dev) return std::fprintf(stderr, "sim_throughput: %s\n", dev.error().message.c_str()), 1;
@@ -103,10 +113,11 @@ int main(int argc, char** argv) {
       best = std::min(best, s);
       best_cpu = std::min(best_cpu, cpu_seconds() - c0);
       pixels = (*dev)->stats().pixels_depth_passed;
+      crc = protocol::crc32((*dev)->memory());
     }
-    std::printf("| %s | %u | %.3f | %.1f | %.1f | %.3f | %.1f | %.3f |\n", w.name, w.count, w.count / best / 1e6,
+    std::printf("| %s | %u | %.3f | %.1f | %.1f | %.3f | %.1f | %.3f | %08x |\n", w.name, w.count, w.count / best / 1e6,
                 pixels / best / 1e6, best * 1e9 / w.count, best * 1e9 / double(pixels), best_cpu * 1e9 / w.count,
-                best_cpu * 1e9 / double(pixels));
+                best_cpu * 1e9 / double(pixels), crc);
   }
   return 0;
 }

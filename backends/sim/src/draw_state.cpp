@@ -48,6 +48,8 @@ DrawState decode_draw_state(const RegisterValues& r, std::uint64_t vram_bytes) {
   const bool some_masked = (s.keep_mask & stored) != 0;
   s.writes_nothing = (s.z_test && s.z_func == DepthFunc::Never) || (all_masked && !s.z_write);
   s.reads_color = s.blend != BlendMode::Off || (some_masked && !all_masked && s.fb_format != PixelFormat::RGBA8888);
+  const std::uint64_t clen = pixels * s.bpp, zlen = pixels * 4;
+  s.buffers_disjoint = s.fb_draw + clen <= s.fb_z || s.fb_z + zlen <= s.fb_draw;
   s.simple_color = s.fb_format == PixelFormat::RGBA8888 && s.blend == BlendMode::Off && !some_masked;
   return s;
 }

@@ -39,6 +39,7 @@ struct DrawState {
   bool writes_nothing = false;   // Z_FUNC NEVER with the test on, or nothing writable
   bool reads_color = false;      // blend or a partial write mask needs the destination
   bool simple_color = false;     // RGBA8888, no blend, no mask: store the 4 bytes directly
+  bool buffers_disjoint = false; // colour and depth buffers share no byte (pixel order between them is free)
 };
 
 // Register indices into the device's register file.

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <utility>
 
+#include "narrow_simd.hpp"
 #include "pixel.hpp"
 #include "span_simd.hpp"
 #include "texture.hpp"
@@ -68,6 +69,7 @@ class Kernel {
       if (k > 0) Plane::advance(row.q[i], row.r[i], t_.plane[i].qy, t_.plane[i].ry, k, t_.den);
     }
     const int w = t_.x1 - t_.x0;
+    int row_at = 0;  // narrow rows: x offset of `row` (see narrow_row)
     for (int y = ya; y < yz; ++y) {
       if (ctx_.fast) {
         fast_row(y, e, w);
@@ -99,20 +101,7 @@ class Kernel {
           ctx_.counters.covered += static_cast<std::uint64_t>(kr - kl + 1);
         }
       } else {
-        Steppers s = row;
-        std::int64_t e0 = e[0], e1 = e[1], e2 = e[2];
-        const std::int64_t x0 = t_.edge[0].ex, x1 = t_.edge[1].ex, x2 = t_.edge[2].ex;
-        for (int kx = 0; kx < w; ++kx) {
-          if ((e0 | e1 | e2) >= 0) {
-            ++ctx_.counters.covered;
-            pixel(t_.x0 + kx, y, s);
-          }
-          e0 += x0;
-          e1 += x1;
-          e2 += x2;
-          step_x(s);
-        }
-        ctx_.counters.scanned += static_cast<std::uint64_t>(w);
+        narrow_row(y, e, w, row, row_at);
       }
       for (int i = 0; i < 3; ++i) e[i] += t_.edge[i].ey;
       step_y(row);
@@ -120,6 +109,57 @@ class Kernel {
   }
 
  private:
+  // A row of a narrow box (w < kSpanSolveWidth): the edges are tested at every pixel (cheap),
+  // but the planes are stepped only to and along the covered run. `s` follows the run's first
+  // pixel from row to row (x offset `at`): one y step plus the small shift of the run start, so
+  // no plane work is spent on the uncovered part of the box. Exact: (q, r) is the floor-divmod
+  // of a linear numerator, so any path of steps to a pixel gives the same pair.
+  void narrow_row(int y, const std::int64_t* e, int w, Steppers& s, int& at) {
+    std::int64_t e0 = e[0], e1 = e[1], e2 = e[2];
+    const std::int64_t x0 = t_.edge[0].ex, x1 = t_.edge[1].ex, x2 = t_.edge[2].ex;
+    int kx = 0;
+    while (kx < w && (e0 | e1 | e2) < 0) {
+      e0 += x0;
+      e1 += x1;
+      e2 += x2;
+      ++kx;
+    }
+    ctx_.counters.scanned += static_cast<std::uint64_t>(w);
+    if (kx == w) return;
+    const int kl = kx;
+    // A row of a triangle is covered in one run (each edge test is monotonic along the row).
+    do {
+      e0 += x0;
+      e1 += x1;
+      e2 += x2;
+      ++kx;
+    } while (kx < w && (e0 | e1 | e2) >= 0);
+    const int n = kx - kl;
+    for (; at < kl; ++at) step_x(s);
+    for (; at > kl; --at) unstep_x(s);
+    ctx_.counters.covered += static_cast<std::uint64_t>(n);
+    if (n == 1) {
+      pixel(t_.x0 + kl, y, s);
+      return;
+    }
+    Steppers p = s;
+    for (int k = 0;; ++k) {
+      pixel(t_.x0 + kl + k, y, p);
+      if (k + 1 == n) break;
+      step_x(p);
+    }
+  }
+
+  void unstep_x(Steppers& s) const {
+    for (unsigned i = 0; i < kAttrCount; ++i) {
+      if (!((kPlanes >> i) & 1)) continue;
+      s.q[i] -= t_.plane[i].qx;
+      s.r[i] -= t_.plane[i].rx;
+      const bool borrow = s.r[i] < 0;
+      s.r[i] += borrow ? t_.den : 0;
+      s.q[i] -= borrow;
+    }
+  }
   void step_x(Steppers& s) const {
     for (unsigned i = 0; i < kAttrCount; ++i) {
       if (!((kPlanes >> i) & 1)) continue;
@@ -388,6 +428,56 @@ constexpr auto make_table(std::integer_sequence<unsigned, I...>) {
 }
 constexpr auto kKernels = make_table(std::make_integer_sequence<unsigned, 16>{});
 
+// The small-triangle vector routine (narrow_simd.hpp) when its conditions hold; false otherwise.
+bool draw_narrow(const Triangle& t, const DrawState& st, RasterContext& ctx, int ya, int yz, bool gouraud, bool depth) {
+  const int w = t.x1 - t.x0;
+  if (w > 8 || t.x0 + 8 > static_cast<int>(st.fb_width) || !st.color_in_vram) return false;
+  if (depth && (!st.z_in_vram || !st.buffers_disjoint)) return false;
+  if (t.den >= (std::int64_t{1} << 28)) return false;
+  NarrowTriangle n;
+  const std::int64_t k = ya - t.y0, rows = yz - ya;
+  for (int i = 0; i < 3; ++i) {
+    const Edge& e = t.edge[i];
+    const std::int64_t e0 = e.e + k * e.ey;
+    auto mag = [](std::int64_t v) { return v < 0 ? -v : v; };
+    if (mag(e0) + 7 * mag(e.ex) + rows * mag(e.ey) >= (std::int64_t{1} << 31)) return false;
+    n.e[i] = static_cast<std::int32_t>(e0);
+    n.ex[i] = static_cast<std::int32_t>(e.ex);
+    n.ey[i] = static_cast<std::int32_t>(e.ey);
+  }
+  for (unsigned p = gouraud ? 0 : 4; p < (depth ? 5u : 4u); ++p) {
+    const Plane& pl = t.plane[kR + p];
+    std::int64_t q = pl.q, r = pl.r;
+    if (k > 0) Plane::advance(q, r, pl.qy, pl.ry, k, t.den);
+    // Values modulo 2^32: covered pixels' attributes are exact (narrow_simd.cpp).
+    n.q[p] = static_cast<std::uint32_t>(q);
+    n.r[p] = static_cast<std::uint32_t>(r);
+    n.qx[p] = static_cast<std::uint32_t>(pl.qx);
+    n.rx[p] = static_cast<std::uint32_t>(pl.rx);
+    n.qy[p] = static_cast<std::uint32_t>(pl.qy);
+    n.ry[p] = static_cast<std::uint32_t>(pl.ry);
+  }
+  n.den = static_cast<std::uint32_t>(t.den);
+  n.width = static_cast<unsigned>(w);
+  n.rows = static_cast<unsigned>(rows);
+  n.flat = std::uint32_t{t.flat[0]} | (std::uint32_t{t.flat[1]} << 8) | (std::uint32_t{t.flat[2]} << 16) |
+           (std::uint32_t{t.flat[3]} << 24);
+  n.zmask = ctx.z_bits >= 24 ? 0xFFFFFFu : 0xFFFFFFu & ~((1u << (24 - ctx.z_bits)) - 1);
+  const std::size_t pix = static_cast<std::size_t>(ya) * st.fb_width + static_cast<std::size_t>(t.x0);
+  n.colour = ctx.mem.data() + st.fb_draw + pix * 4;
+  n.depth = depth ? ctx.mem.data() + st.fb_z + pix * 4 : nullptr;
+  n.pitch = std::size_t{st.fb_width} * 4;
+  n.z_func = static_cast<unsigned>(st.z_func);
+  n.gouraud = gouraud;
+  n.z_test = st.z_test;
+  n.z_write = st.z_write;
+  const NarrowCounts c = shade_narrow_simd(n);
+  ctx.counters.scanned += static_cast<std::uint64_t>(w) * static_cast<std::uint64_t>(rows);
+  ctx.counters.covered += c.covered;
+  ctx.counters.passed += c.passed;
+  return true;
+}
+
 }  // namespace
 
 void rasterize_rows(const Triangle& t, const DrawState& st, RasterContext& ctx, int row_begin, int row_end) {
@@ -397,6 +487,7 @@ void rasterize_rows(const Triangle& t, const DrawState& st, RasterContext& ctx, 
   for (unsigned ch = 0; ch < 4; ++ch) colours_differ |= !t.plane[kR + ch].constant;
   const bool gouraud = st.gouraud && colours_differ;  // Gouraud only when colours differ
   const bool depth = st.z_test || st.z_write;
+  if (st.simple_color && !st.textured && !ctx.fast && draw_narrow(t, st, ctx, ya, yz, gouraud, depth)) return;
   const unsigned key = (gouraud ? 1u : 0u) | (st.textured ? 2u : 0u) | (depth ? 4u : 0u) | (st.simple_color ? 8u : 0u);
   kKernels[key](t, st, ctx, ya, yz);
 }

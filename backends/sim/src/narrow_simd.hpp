@@ -1,0 +1,41 @@
+#pragma once
+// The vector routine for small triangles (boxes at most 8 pixels wide), the commonest draw of a
+// dense mesh: untextured, RGBA8888 store without blend or mask, optional depth test/write. One row
+// of the box is one 8-lane step: the three edge functions, the coverage mask, every attribute plane
+// and the depth compare are lane vectors, the colour and depth rows are read and written whole and
+// merged under the mask. There is no branch per pixel or per row (a small triangle's rows are too
+// short for per-pixel branches to predict), and the arithmetic is the exact (q, r) stepping of the
+// scalar routine with 32-bit lanes, so the output is the same byte for byte.
+//
+// The caller guarantees (narrow_simd_fits): the 8-pixel window lies inside the framebuffer row and
+// both buffers inside VRAM; colour and depth buffers do not overlap; 8·den < 2^31; every edge value
+// the walk meets fits 32 bits. Lanes outside the box or the triangle are written back unchanged;
+// those pixels are on the same row, so they belong to the same band worker.
+#include <cstddef>
+#include <cstdint>
+
+namespace gpubridge::sim {
+
+struct NarrowTriangle {
+  static constexpr unsigned kPlanes = 5;  // R, G, B, A, Z
+  std::int32_t e[3] = {}, ex[3] = {}, ey[3] = {};  // edge values at the first row's box origin, steps
+  std::uint32_t q[kPlanes] = {}, r[kPlanes] = {};  // planes at the first row's box origin (r < den)
+  std::uint32_t qx[kPlanes] = {}, rx[kPlanes] = {}, qy[kPlanes] = {}, ry[kPlanes] = {};  // rx, ry < den
+  std::uint32_t den = 1;
+  unsigned width = 0, rows = 0;  // box width (<= 8) and rows to draw
+  std::uint32_t flat = 0;        // colour word (memory order R,G,B,A) when !gouraud
+  std::uint32_t zmask = 0xFFFFFF;
+  std::uint8_t* colour = nullptr;  // first pixel of the first row
+  std::uint8_t* depth = nullptr;   // its depth word (when z_test or z_write)
+  std::size_t pitch = 0;           // bytes per framebuffer row (colour and depth alike: 4 per pixel)
+  unsigned z_func = 0;             // protocol::DepthFunc
+  bool gouraud = false, z_test = false, z_write = false;
+};
+
+struct NarrowCounts {
+  std::uint64_t covered = 0, passed = 0;
+};
+
+NarrowCounts shade_narrow_simd(const NarrowTriangle& t);
+
+}  // namespace gpubridge::sim
