@@ -77,7 +77,7 @@ Result<DaemonConfig> parse_config(const json& doc, const std::string& source) {
   Reader rd(source);
   if (!doc.is_object()) return rd.fail("(top level)", "expected a JSON object");
   GPUBRIDGE_TRY(rd.known_keys(doc, "", {"listen", "token", "token_file", "backend", "fallback_to_sim", "boards_dir",
-                                        "frames_dir", "record_dir", "log_level", "limits", "comment"}));
+                                        "frames_dir", "record_dir", "log_level", "limits", "mirror", "comment"}));
   DaemonConfig cfg;
   if (doc.contains("listen")) {
     const auto& l = doc.at("listen");
@@ -95,6 +95,7 @@ Result<DaemonConfig> parse_config(const json& doc, const std::string& source) {
   GPUBRIDGE_TRY(rd.read_string(doc, "", "backend", cfg.backend));
   if (cfg.backend.empty()) return rd.fail("backend", "expected \"sim\", \"auto\", a board name or \"emulated:BOARD\", got \"\"");
   GPUBRIDGE_TRY(rd.read_bool(doc, "", "fallback_to_sim", cfg.fallback_to_sim));
+  GPUBRIDGE_TRY(rd.read_bool(doc, "", "mirror", cfg.mirror));
   GPUBRIDGE_TRY(rd.read_string(doc, "", "boards_dir", cfg.boards_dir));
   GPUBRIDGE_TRY(rd.read_string(doc, "", "frames_dir", cfg.frames_dir));
   GPUBRIDGE_TRY(rd.read_string(doc, "", "record_dir", cfg.record_dir));

@@ -5,6 +5,7 @@
 
 #include "gpubridge/common/image.hpp"
 #include "gpubridge/common/log.hpp"
+#include "gpubridge/daemon/frame_diff.hpp"
 #include "gpubridge/daemon/session.hpp"
 #include "gpubridge/protocol/crc32.hpp"
 #include "gpubridge/version.hpp"
@@ -27,10 +28,27 @@ std::optional<PixelFormat> pixel_format_for(FrameFormat f, PixelFormat native) {
 
 }  // namespace
 
-std::shared_ptr<const std::vector<std::uint8_t>> FrameFanout::message(FrameFormat format) {
+std::shared_ptr<const backends::ScanoutFrame> FrameFanout::picture(protocol::FrameSource source) {
+  switch (source) {
+    case protocol::FrameSource::Board: return frame_->pixels.empty() ? nullptr : frame_;
+    case protocol::FrameSource::Sim:
+      return frame_->reference && !frame_->reference->pixels.empty() ? frame_->reference : nullptr;
+    case protocol::FrameSource::Diff:
+      if (!diff_done_ && frame_->reference) diff_ = diff_frame(*frame_, *frame_->reference);
+      diff_done_ = true;
+      return diff_;
+  }
+  return nullptr;
+}
+
+std::shared_ptr<const std::vector<std::uint8_t>> FrameFanout::message(protocol::FrameSource source, FrameFormat format) {
+  const auto src = static_cast<std::size_t>(source);
   const auto slot = static_cast<std::size_t>(format) & 3;
-  if (encoded_[slot]) return encoded_[slot];
-  const auto& f = *frame_;
+  if (src >= 3) return nullptr;
+  if (encoded_[src][slot]) return encoded_[src][slot];
+  const auto shown = picture(source);
+  if (!shown) return nullptr;
+  const auto& f = *shown;
   const PixelFormat target = pixel_format_for(format, f.format).value_or(f.format);
   std::vector<std::uint8_t> converted;
   std::span<const std::uint8_t> pixels = f.pixels;
@@ -47,10 +65,11 @@ std::shared_ptr<const std::vector<std::uint8_t>> FrameFanout::message(FrameForma
   d.swap_ns = static_cast<std::uint64_t>(
       std::chrono::duration_cast<std::chrono::nanoseconds>(f.swap_time.time_since_epoch()).count());
   d.pixels = pixels;
+  d.source = source;
   auto bytes = std::make_shared<std::vector<std::uint8_t>>();
   protocol::encode(protocol::Message{0, d}, *bytes);
-  encoded_[slot] = std::move(bytes);
-  return encoded_[slot];
+  encoded_[src][slot] = std::move(bytes);
+  return encoded_[src][slot];
 }
 
 Hub::Hub(Executor net, Executor device, std::unique_ptr<backends::Backend> backend, HubOptions options,
@@ -131,7 +150,7 @@ std::string Hub::device_json() const {
                    {"bridge", info_.bridge},       {"max_width", info_.max_width},
                    {"max_height", info_.max_height}, {"vram_bytes", info_.vram_bytes},
                    {"id", info_.id},               {"caps", info_.caps},
-                   {"daemon_version", kVersion}};
+                   {"mirror", options_.mirror},    {"daemon_version", kVersion}};
   return j.dump();
 }
 
@@ -147,12 +166,19 @@ nlohmann::json Hub::status_json() const {
                        {"transport", s->transport()},
                        {"handshaken", s->handshaken()},
                        {"subscribed", s->subscribed()},
+                       {"source", std::string(protocol::to_string(s->frame_source()))},
                        {"lease", id == lease_holder_},
                        {"bytes_in", s->bytes_in()}});
   }
   nlohmann::json lease = nullptr;
   if (lease_holder_) lease = {{"session", lease_holder_}, {"name", holder_name}};
   const auto uptime = std::chrono::duration<double>(std::chrono::steady_clock::now() - started_).count();
+  const auto frame_or_null = [](const std::optional<std::uint32_t>& n) { return n ? nlohmann::json(*n) : nlohmann::json(); };
+  const nlohmann::json mirror{{"enabled", options_.mirror},
+                              {"compared", mirror_.compared},
+                              {"mismatches", mirror_.mismatches},
+                              {"first_mismatch", frame_or_null(mirror_.first_mismatch)},
+                              {"last_mismatch", frame_or_null(mirror_.last_mismatch)}};
   return {{"daemon_version", kVersion},
           {"backend", info_.backend},
           {"board", info_.board},
@@ -163,6 +189,7 @@ nlohmann::json Hub::status_json() const {
           {"clients", clients},
           {"frames", {{"count", frames_seen_}, {"last_number", last_frame_number_},
                       {"pngs_written", frame_pngs_written_.load()}}},
+          {"mirror", mirror},
           {"uptime_s", uptime}};
 }
 
@@ -185,10 +212,37 @@ void Hub::on_scanout(std::shared_ptr<const backends::ScanoutFrame> frame) {
 void Hub::fan_out(std::shared_ptr<const backends::ScanoutFrame> frame) {
   ++frames_seen_;
   last_frame_number_ = frame->number;
-  if (frame->pixels.empty()) return;  // CRC-only scanout: nothing to show (see on_scanout)
-  FrameFanout fanout(std::move(frame));
+  if (frame->reference) compare_mirrored(*frame);
+  // CRC-only scanout has no board picture (see on_scanout); in mirror mode the simulator's
+  // picture still goes to its subscribers, so the fan-out decides per subscriber (null = none).
+  if (frame->pixels.empty() && !frame->reference) return;
+  auto fanout = std::make_shared<FrameFanout>(std::move(frame));
+  // Kept only in mirror mode, where subscribers switch pictures of the same swap.
+  if (options_.mirror) newest_fanout_ = fanout;
   for (auto& [id, w] : sessions_)
-    if (auto s = w.lock(); s && s->subscribed()) s->offer_frame(fanout);
+    if (auto s = w.lock(); s && s->subscribed()) s->offer_frame(*fanout);
+}
+
+void Hub::offer_newest_frame(Session& s) {
+  if (newest_fanout_) s.offer_frame(*newest_fanout_);
+}
+
+void Hub::compare_mirrored(const backends::ScanoutFrame& frame) {
+  // FRAME_CRC is the device's own CRC of the scanned-out bytes, so CRC-only boards compare too.
+  ++mirror_.compared;
+  if (frame.crc == frame.reference->crc) return;
+  ++mirror_.mismatches;
+  mirror_.last_mismatch = frame.number;
+  if (mirror_.first_mismatch) return;
+  mirror_.first_mismatch = frame.number;
+  std::string where;
+  if (!frame.pixels.empty()) {
+    std::uint64_t differing = 0;
+    if (diff_frame(frame, *frame.reference, &differing)) where = ", " + std::to_string(differing) + " pixels differ";
+  }
+  logger("daemon")->warn("mirror: frame {} differs from the simulator (board CRC 0x{:08X}, simulator CRC 0x{:08X}{}); "
+                         "first mismatch, later ones are counted in status (mirror.mismatches)",
+                         frame.number, frame.crc, frame.reference->crc, where);
 }
 
 void Hub::on_device_gone(const Error& e) {

@@ -15,6 +15,7 @@
 #include "gpubridge/daemon/backend_factory.hpp"
 #include "gpubridge/daemon/config.hpp"
 #include "gpubridge/daemon/hub.hpp"
+#include "gpubridge/daemon/mirror_backend.hpp"
 #include "gpubridge/daemon/server.hpp"
 #include "gpubridge/version.hpp"
 
@@ -38,6 +39,13 @@ int run(daemon::DaemonConfig cfg) {
     std::fprintf(stderr, "gpubridged: %s\n", backend.error().message.c_str());
     return 1;
   }
+  if (cfg.mirror) {  // the board behind a decorator that feeds the simulator the same commands
+    backend = daemon::make_mirror(std::move(*backend));
+    if (!backend) {
+      std::fprintf(stderr, "gpubridged: %s\n", backend.error().message.c_str());
+      return 2;
+    }
+  }
   asio::io_context net(1);
   asio::io_context device(1);
   auto device_guard = asio::make_work_guard(device);
@@ -49,6 +57,7 @@ int run(daemon::DaemonConfig cfg) {
   };
 
   daemon::HubOptions opts{cfg.limits, cfg.token, cfg.frames_dir, cfg.record_dir};
+  opts.mirror = cfg.mirror;
   daemon::Hub::BackendFactory fallback;
   if (cfg.fallback_to_sim && cfg.backend != "sim" && daemon::simulator_available()) fallback = daemon::make_simulator;
   int exit_code = 0;
@@ -114,12 +123,16 @@ int main(int argc, char** argv) {
   std::optional<std::uint64_t> queue_bytes;
   bool foreground = false;
   bool no_fallback = false;
+  bool mirror = false;
   app.add_option("-c,--config", config_path, "JSON configuration file (see configs/gpubridged.json)");
   app.add_option("-l,--listen", listen, "unix:PATH or tcp:HOST:PORT (repeatable; replaces the config's list)");
   app.add_option("--token", token, "token TCP clients must present (required for non-loopback TCP)");
   app.add_option("--token-file", token_file, "read the token from the first line of this file");
   app.add_option("-b,--backend", backend, "sim | auto | BOARD | emulated:BOARD | fake | discard");
   app.add_flag("--no-fallback", no_fallback, "do not switch to the simulator when a board disappears");
+  app.add_flag("--mirror", mirror,
+               "board backends: also run the simulator on the same commands and compare every frame "
+               "(subscribers may ask for the board, the simulator or a diff image)");
   app.add_option("--boards-dir", boards_dir, "directory of board profiles (JSON)");
   app.add_option("--frames-dir", frames_dir, "write every scanned-out frame as frame_NNNNNN.png here");
   app.add_option("--record", record_dir, "write each session's command stream as a binary trace here");
@@ -153,6 +166,7 @@ int main(int argc, char** argv) {
   if (!token_file.empty()) cfg.token_file = token_file;
   if (!backend.empty()) cfg.backend = backend;
   if (no_fallback) cfg.fallback_to_sim = false;
+  if (mirror) cfg.mirror = true;
   if (!boards_dir.empty()) cfg.boards_dir = boards_dir;
   if (!frames_dir.empty()) cfg.frames_dir = frames_dir;
   if (!record_dir.empty()) cfg.record_dir = record_dir;

@@ -154,9 +154,21 @@ void Session::dispatch(Message& m) {
       return;
     case MsgType::Subscribe: {
       const auto& s = std::get<protocol::Subscribe>(m.payload);
+      const auto source = s.source.value_or(protocol::FrameSource::Board);
+      if (source != protocol::FrameSource::Board && !hub_.options().mirror) {
+        // Not fatal: the session (and any earlier subscription) stays as it was.
+        reply_error(m.request_id, ErrorCode::Unavailable,
+                    "SUBSCRIBE source \"" + std::string(protocol::to_string(source)) +
+                        "\" needs mirror mode, which this gpubridged does not run: start it with --mirror and a board "
+                        "backend (e.g. --backend emulated:icebreaker --mirror), or subscribe to source \"board\"");
+        return;
+      }
+      const bool switched = subscribed_ && source != frame_source_;
       subscribed_ = true;
       frame_format_ = s.format;
+      frame_source_ = source;
       max_fps_ = s.max_fps;
+      if (switched) hub_.offer_newest_frame(*this);
       return;
     }
     case MsgType::Unsubscribe:
@@ -392,13 +404,15 @@ void Session::send(Buffer bytes) {
 
 void Session::offer_frame(FrameFanout& frame) {
   if (!subscribed_ || closing_ || terminated_ || !handshaken_) return;
+  auto message = frame.message(frame_source_, frame_format_);
+  if (!message) return;  // this swap has no picture of the subscribed source (CRC-only board)
   const auto now = Clock::now();
   if (max_fps_ != 0 && last_frame_sent_ != Clock::time_point{}) {
     const auto due = last_frame_sent_ + std::chrono::microseconds(1000000 / max_fps_);
     if (now < due) {
       // Too early for the subscriber's rate: keep only the newest such frame and send it when the
       // interval ends, so the last frame of an animation is never lost.
-      held_frame_ = frame.message(frame_format_);
+      held_frame_ = std::move(message);
       if (!frame_timer_armed_) {
         frame_timer_armed_ = true;
         frame_timer_.expires_at(due);
@@ -416,7 +430,7 @@ void Session::offer_frame(FrameFanout& frame) {
   }
   last_frame_sent_ = now;
   held_frame_.reset();
-  pending_frame_ = frame.message(frame_format_);  // replaces an unsent older frame: newest wins
+  pending_frame_ = std::move(message);  // replaces an unsent older frame: newest wins
   do_write();
 }
 

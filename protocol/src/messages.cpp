@@ -287,6 +287,12 @@ void decode_into(const Header& h, PayloadReader& r, Payload& out) {
       if (!r.failed() && format > 3) r.bad_field("format", 0, std::to_string(format) + " is not 0..3");
       m.format = static_cast<FrameFormat>(format);
       m.max_fps = r.get<std::uint16_t>("max_fps");
+      // Optional trailing source byte (absent in the original 3-byte form = board).
+      if (!r.failed() && r.remaining() > 0) {
+        const auto source = r.get<std::uint8_t>("source");
+        if (source > 2) r.bad_field("source", 3, std::to_string(source) + " is not 0 (board), 1 (sim) or 2 (diff)");
+        m.source = static_cast<FrameSource>(source);
+      }
       r.expect_end();
       out = m;
       return;
@@ -300,8 +306,9 @@ void decode_into(const Header& h, PayloadReader& r, Payload& out) {
       const auto format = r.get<std::uint8_t>("format");
       if (!r.failed() && format > 2) r.bad_field("format", 8, std::to_string(format) + " is not a pixel format (0..2)");
       m.format = static_cast<PixelFormat>(format);
-      const auto reserved = r.get<std::uint8_t>("reserved");
-      if (!r.failed() && reserved != 0) r.bad_field("reserved byte", 9, "must be 0");
+      const auto source = r.get<std::uint8_t>("source");
+      if (!r.failed() && source > 2) r.bad_field("source", 9, std::to_string(source) + " is not 0 (board), 1 (sim) or 2 (diff)");
+      m.source = static_cast<FrameSource>(source);
       m.crc = r.get<std::uint32_t>("crc");
       m.swap_ns = r.get<std::uint64_t>("swap_ns");
       m.pixels = r.rest();
@@ -401,6 +408,7 @@ struct PayloadEncoder {
   void operator()(const Subscribe& m) {
     put_le(o, static_cast<std::uint8_t>(m.format));
     put_le(o, m.max_fps);
+    if (m.source) put_le(o, static_cast<std::uint8_t>(*m.source));
   }
   void operator()(const Unsubscribe&) {}
   void operator()(const FrameData& m) {
@@ -408,7 +416,7 @@ struct PayloadEncoder {
     put_le(o, m.width);
     put_le(o, m.height);
     put_le(o, static_cast<std::uint8_t>(m.format));
-    put_le(o, std::uint8_t{0});
+    put_le(o, static_cast<std::uint8_t>(m.source));
     put_le(o, m.crc);
     put_le(o, m.swap_ns);
     put_bytes(o, m.pixels);
@@ -486,8 +494,25 @@ std::string_view to_string(ErrorCode c) {
     case ErrorCode::ShuttingDown: return "SHUTTING_DOWN";
     case ErrorCode::Internal: return "INTERNAL";
     case ErrorCode::BadFrame: return "BAD_FRAME";
+    case ErrorCode::Unavailable: return "UNAVAILABLE";
   }
   return "UNKNOWN_ERROR";
+}
+
+std::string_view to_string(FrameSource s) {
+  switch (s) {
+    case FrameSource::Board: return "board";
+    case FrameSource::Sim: return "sim";
+    case FrameSource::Diff: return "diff";
+  }
+  return "?";
+}
+
+std::optional<FrameSource> parse_frame_source(std::string_view s) {
+  if (s == "board") return FrameSource::Board;
+  if (s == "sim") return FrameSource::Sim;
+  if (s == "diff") return FrameSource::Diff;
+  return std::nullopt;
 }
 
 MsgType type_of(const Payload& p) { return kTypeOfIndex[p.index()]; }

@@ -6,6 +6,8 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "gpubridge/viewer/frame_source.hpp"
+
 namespace gpubridge::viewer {
 
 Result<void> finish_capture(const Options& options, const Frame& frame, const Image& rgba,
@@ -21,6 +23,7 @@ Result<void> finish_capture(const Options& options, const Frame& frame, const Im
         {"crc", fmt::format("{:08x}", frame.crc)}, {"crc_ok", crc_ok},
         {"frames_taken", result.frames_taken},     {"dropped", result.dropped},
     };
+    j["source"] = std::string(protocol::to_string(frame.source));
     if (!options.screenshot.empty()) j["screenshot"] = options.screenshot;
     if (!result.window_grab.empty()) j["window_grab"] = result.window_grab;
     if (result.fps_drawn) j["fps_drawn"] = *result.fps_drawn;
@@ -28,8 +31,9 @@ Result<void> finish_capture(const Options& options, const Frame& frame, const Im
     if (result.latency_ms_max) j["latency_ms_max"] = *result.latency_ms_max;
     std::cout << j.dump() << std::endl;
   } else {
-    std::cout << fmt::format("frame {} ({}, crc {:08x}{})", frame.number, describe_size(frame), frame.crc,
-                             crc_ok ? "" : " MISMATCH");
+    std::cout << fmt::format("frame {} ({}{}, crc {:08x}{})", frame.number, describe_size(frame),
+                             frame.source == protocol::FrameSource::Board ? "" : ", " + picture_name(frame.source),
+                             frame.crc, crc_ok ? "" : " MISMATCH");
     if (!options.screenshot.empty()) std::cout << " saved to " << options.screenshot;
     if (!result.window_grab.empty()) std::cout << "; window grab saved to " << result.window_grab;
     std::cout << std::endl;

@@ -14,6 +14,7 @@ constexpr auto kConnectTimeout = 2000ms;
 constexpr auto kHandshakeTimeout = 5000ms;
 constexpr auto kRetryDelay = 500ms;
 constexpr auto kPollInterval = 200ms;  // how often the reader checks for stop
+constexpr auto kMirrorStatusInterval = 500ms;  // mismatch count refresh in mirror mode
 
 Frame to_viewer_frame(client::ReceivedFrame&& f) {
   Frame out;
@@ -24,6 +25,7 @@ Frame to_viewer_frame(client::ReceivedFrame&& f) {
   out.crc = f.crc;
   out.swap_ns = f.swap_ns;
   out.pixels = std::move(f.pixels);
+  out.source = f.source;
   return out;
 }
 
@@ -39,6 +41,25 @@ std::pair<std::string, std::string> backend_and_board(const std::string& device_
     return it != j.end() && it->is_string() ? it->get<std::string>() : std::string();
   };
   return {text("backend"), text("board")};
+}
+
+bool mirror_enabled(const std::string& device_json) {
+  const auto j = nlohmann::json::parse(device_json, nullptr, false);
+  if (j.is_discarded() || !j.is_object()) return false;
+  const auto it = j.find("mirror");
+  return it != j.end() && it->is_boolean() && it->get<bool>();
+}
+
+std::optional<std::pair<std::uint64_t, std::uint64_t>> mirror_counts(const std::string& status_json) {
+  const auto j = nlohmann::json::parse(status_json, nullptr, false);
+  if (j.is_discarded() || !j.is_object()) return std::nullopt;
+  const auto m = j.find("mirror");
+  if (m == j.end() || !m->is_object()) return std::nullopt;
+  const auto compared = m->find("compared"), mismatches = m->find("mismatches");
+  if (compared == m->end() || mismatches == m->end() || !compared->is_number_unsigned() ||
+      !mismatches->is_number_unsigned())
+    return std::nullopt;
+  return std::pair{compared->get<std::uint64_t>(), mismatches->get<std::uint64_t>()};
 }
 
 DaemonFrameSource::DaemonFrameSource(DaemonSourceConfig config) : config_(std::move(config)) {
@@ -63,6 +84,8 @@ void DaemonFrameSource::run(std::stop_token stop) {
   }
 
   bool ever_connected = false;
+  protocol::FrameSource picture = config_.picture;  // kept across reconnects
+  status.picture = picture;
   while (!stop.stop_requested()) {
     auto connection = client::Client::connect(config_.address, kConnectTimeout);
     if (!connection) {
@@ -92,8 +115,21 @@ void DaemonFrameSource::run(std::stop_token stop) {
       continue;
     }
     std::tie(status.backend, status.board) = backend_and_board(session->device_json);
+    status.mirror = mirror_enabled(session->device_json);
     const auto max_fps = static_cast<std::uint16_t>(std::min(config_.max_fps, 65535u));
-    if (auto sub = c.subscribe(protocol::FrameFormat::Native, max_fps, kHandshakeTimeout); !sub) {
+    const auto subscribe = [&](protocol::FrameSource p) {
+      // The board in the original 3-byte form, which daemons without mirror mode understand too.
+      std::optional<protocol::FrameSource> source;
+      if (p != protocol::FrameSource::Board) source = p;
+      return c.subscribe(protocol::Subscribe{protocol::FrameFormat::Native, max_fps, source}, kHandshakeTimeout);
+    };
+    if (auto sub = subscribe(picture); !sub) {
+      if (client::is_protocol_error(sub.error(), protocol::ErrorCode::Unavailable)) {
+        // Asked for on the command line (--source): retrying cannot help.
+        fail("cannot show the " + picture_name(picture) + ": " + sub.error().message);
+        c.close();
+        return;
+      }
       status.state = SourceStatus::State::Waiting;
       status.message = "subscribe failed: " + sub.error().message;
       publish_status(status);
@@ -104,9 +140,33 @@ void DaemonFrameSource::run(std::stop_token stop) {
     status.state = SourceStatus::State::Streaming;
     status.message.clear();
     publish_status(status);
-    log->info("subscribed to {} (max {} fps)", display_address_, max_fps);
+    log->info("subscribed to {} ({}, max {} fps)", display_address_, picture_name(picture), max_fps);
 
+    auto next_mirror_poll = std::chrono::steady_clock::now();
     while (!stop.stop_requested()) {
+      if (auto want = take_picture_request(); want && *want != picture) {
+        if (auto sub = subscribe(*want); sub) {
+          picture = *want;
+          status.picture = picture;
+          status.picture_problem.clear();
+          log->info("now showing the {}", picture_name(picture));
+        } else {
+          // Refused (no mirror mode) or the connection broke (next_frame below notices).
+          status.picture_problem = "cannot show the " + picture_name(*want) + ": " + sub.error().message;
+        }
+        publish_status(status);
+      }
+      if (status.mirror && std::chrono::steady_clock::now() >= next_mirror_poll) {
+        next_mirror_poll = std::chrono::steady_clock::now() + kMirrorStatusInterval;
+        if (auto reply = c.status(kHandshakeTimeout); reply) {
+          if (auto counts = mirror_counts(*reply);
+              counts && (status.compared != counts->first || status.mismatches != counts->second)) {
+            status.compared = counts->first;
+            status.mismatches = counts->second;
+            publish_status(status);
+          }
+        }
+      }
       auto frame = c.next_frame(kPollInterval);
       if (frame) {
         publish_frame(to_viewer_frame(std::move(*frame)));

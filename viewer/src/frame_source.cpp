@@ -13,6 +13,15 @@ std::string_view to_string(SourceStatus::State s) {
   return "?";
 }
 
+std::string picture_name(protocol::FrameSource s) {
+  switch (s) {
+    case protocol::FrameSource::Board: return "board";
+    case protocol::FrameSource::Sim: return "simulator";
+    case protocol::FrameSource::Diff: return "diff board vs simulator";
+  }
+  return "?";
+}
+
 FrameSource::~FrameSource() {
   // Derived classes must call stop() in their own destructor (run() uses their members); this
   // is the safety net for sources that were never started.
@@ -83,6 +92,21 @@ void FrameSource::publish_status(SourceStatus status) {
     ++status_version_;
   }
   notify();
+}
+
+void FrameSource::request_picture(protocol::FrameSource picture) {
+  {
+    std::lock_guard lock(mutex_);
+    picture_request_ = picture;
+  }
+  notify();  // the producer picks it up at its next poll (at most a few hundred ms)
+}
+
+std::optional<protocol::FrameSource> FrameSource::take_picture_request() {
+  std::lock_guard lock(mutex_);
+  std::optional<protocol::FrameSource> out;
+  out.swap(picture_request_);
+  return out;
 }
 
 bool FrameSource::sleep_for(std::stop_token stop, std::chrono::microseconds d) {

@@ -32,7 +32,7 @@ gpubridge::Result<std::unique_ptr<FrameSource>> make_source(const Options& o, un
     return std::unique_ptr<FrameSource>(std::make_unique<TestFrameSource>(*spec));
   }
 #ifdef GPUBRIDGE_VIEW_HAS_CLIENT
-  DaemonSourceConfig config{o.connect, o.token, max_fps, o.wait};
+  DaemonSourceConfig config{o.connect, o.token, max_fps, o.wait, o.source};
   return std::unique_ptr<FrameSource>(std::make_unique<DaemonFrameSource>(std::move(config)));
 #else
   (void)max_fps;

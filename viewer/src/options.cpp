@@ -34,11 +34,12 @@ Result<ParsedCommandLine> parse_command_line(int argc, const char* const* argv) 
   Options& o = parsed.options;
   CLI::App app{
       "gpubridge-view: shows the frames gpubridged scans out, as they arrive.\n"
-      "Keys: S screenshot, F flip, I integer scaling, 1/2/3 zoom, P pause, O overlay, ? help, Q/Esc quit.\n"
+      "Keys: S screenshot, F flip, I integer scaling, 1/2/3 zoom, P pause, O overlay, ? help, Q/Esc quit;\n"
+      "with gpubridged --mirror: B board, M simulator (model), D diff (differing pixels magenta).\n"
       "Headless: --frames N --screenshot out.png [--offscreen] saves the N-th received frame and exits."};
   app.name("gpubridge-view");
   app.set_version_flag("--version", std::string("gpubridge-view ") + kVersion);
-  std::string scale = "fit", size;
+  std::string scale = "fit", size, source = "board";
   unsigned max_fps = 0;
   std::uint32_t frames = 0;
   app.add_option("--connect", o.connect, "daemon address: unix:PATH or tcp:HOST:PORT (default: the local socket)");
@@ -56,6 +57,9 @@ Result<ParsedCommandLine> parse_command_line(int argc, const char* const* argv) 
   app.add_option("--max-fps", max_fps, "frames per second to ask for (default: the display's refresh rate; 0 = all)")
       ->check(CLI::Range(0u, 1000u));
   app.add_option("--scale", scale, "fit | integer | 1 | 2 | 3 (default fit)");
+  app.add_option("--source", source,
+                 "board | sim | diff: the board's frames, the simulator's, or their difference (sim and diff "
+                 "need gpubridged --mirror; default board)");
   app.add_flag("--flip", o.flip, "start flipped vertically (boards whose scanout starts at the bottom)");
   app.add_flag("!--no-overlay", o.overlay, "start with the overlay hidden");
   app.add_option("--size", size, "initial window size WIDTHxHEIGHT (default: the frame at a whole-number scale)");
@@ -83,6 +87,9 @@ Result<ParsedCommandLine> parse_command_line(int argc, const char* const* argv) 
   // Range checks let NaN through (every comparison with NaN is false): check it positively.
   if (!(o.timeout_s >= 0.1 && o.timeout_s <= 86400.0))
     return make_error("--timeout: expected seconds from 0.1 to 86400", 2);
+  auto picture = protocol::parse_frame_source(source);
+  if (!picture) return make_error(fmt::format("--source {}: expected board, sim or diff", source), 2);
+  o.source = *picture;
   auto scale_mode = parse_scale(scale);
   if (!scale_mode) return Error{scale_mode.error().message, 2};
   o.scale = *scale_mode;

@@ -10,7 +10,19 @@ std::string device_name(const SourceStatus& s) {
   return s.board.empty() ? s.backend : s.backend + "/" + s.board;
 }
 
+// The picture on screen: the shown frame's own source once one arrived, else the one asked for.
+protocol::FrameSource shown_picture(const ViewState& v) { return v.frame ? v.frame->source : v.status.picture; }
+
 }  // namespace
+
+std::string picture_line(const ViewState& v) {
+  if (!v.status.mirror) return {};
+  std::string line = "showing " + picture_name(shown_picture(v));
+  if (v.frame && v.frame->source != v.status.picture) line += " (switching to " + picture_name(v.status.picture) + ")";
+  if (v.status.mismatches && v.status.compared)
+    line += fmt::format("  mismatches {} of {} frames", *v.status.mismatches, *v.status.compared);
+  return line;
+}
 
 std::string status_line(const SourceStatus& s) {
   using State = SourceStatus::State;
@@ -29,6 +41,8 @@ std::vector<std::string> overlay_lines(const ViewState& v) {
   std::vector<std::string> lines;
   lines.push_back(fmt::format("{}  {}", v.status.address, device_name(v.status)));
   if (auto s = status_line(v.status); !s.empty()) lines.push_back(std::move(s));
+  if (auto p = picture_line(v); !p.empty()) lines.push_back(std::move(p));
+  if (!v.status.picture_problem.empty()) lines.push_back(v.status.picture_problem);
   if (v.frame) {
     lines.push_back(fmt::format("frame {}  {}x{} {}{}", v.frame->number, v.frame->width, v.frame->height,
                                 protocol::to_string(v.frame->format), v.frame->crc_ok ? "" : "  CRC MISMATCH"));
@@ -58,6 +72,9 @@ std::vector<std::string> help_lines() {
       "  1 2 3  zoom 1:1 2:1 3:1 (again: fit)",
       "  P      pause / resume",
       "  O      overlay on/off",
+      "  B      board picture (gpubridged --mirror)",
+      "  M      simulator (model) picture",
+      "  D      diff: equal pixels grey, differing magenta",
       "  ?      this help",
       "  Q Esc  quit",
   };
@@ -65,6 +82,7 @@ std::vector<std::string> help_lines() {
 
 std::string window_title(const ViewState& v) {
   std::string title = "gpubridge-view - " + v.status.address + " - " + device_name(v.status);
+  if (v.status.mirror) title += " - " + picture_name(shown_picture(v));
   if (v.frame) {
     title += fmt::format(" - {}x{} {}", v.frame->width, v.frame->height, protocol::to_string(v.frame->format));
   }

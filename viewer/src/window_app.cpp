@@ -48,6 +48,7 @@ class WindowApp {
   void on_char(unsigned codepoint);
   void toggle_zoom(ScaleMode mode) { view_.scale = view_.scale == mode ? ScaleMode::Fit : mode; }
   void save_screenshot();
+  void request_picture(protocol::FrameSource picture);
   bool take_frame();  // true when a new frame was uploaded
   void refresh_overlay();
   void fit_window_to_frame();
@@ -81,12 +82,25 @@ void WindowApp::on_char(unsigned codepoint) {
     case '3': toggle_zoom(ScaleMode::Zoom3); break;
     case 'p': case 'P': view_.paused = !view_.paused; break;
     case 'o': case 'O': overlay_on_ = !overlay_on_; break;
+    case 'b': case 'B': request_picture(protocol::FrameSource::Board); break;
+    case 'm': case 'M': request_picture(protocol::FrameSource::Sim); break;
+    case 'd': case 'D': request_picture(protocol::FrameSource::Diff); break;
     case '?': help_on_ = !help_on_; break;
     case 'q': case 'Q': glfwSetWindowShouldClose(window_, GLFW_TRUE); break;
     default: return;
   }
   last_overlay_ns_ = 0;  // show the change now
   dirty_ = true;
+}
+
+void WindowApp::request_picture(protocol::FrameSource picture) {
+  const auto status = source_.status();
+  if (!status.mirror && picture != protocol::FrameSource::Board) {
+    view_.notice = "no " + picture_name(picture) + ": gpubridged is not in mirror mode (start it with --mirror)";
+    return;
+  }
+  source_.request_picture(picture);
+  view_.notice = "showing the " + picture_name(picture);
 }
 
 void WindowApp::save_screenshot() {
@@ -113,7 +127,7 @@ bool WindowApp::take_frame() {
   ++taken_;
   renderer_->upload_frame(*rgba);
   current_rgba_ = std::move(*rgba);
-  view_.frame = ShownFrame{frame->number, frame->width, frame->height, frame->format, crc_matches(*frame)};
+  view_.frame = ShownFrame{frame->number, frame->width, frame->height, frame->format, crc_matches(*frame), frame->source};
   pending_swap_ns_ = frame->swap_ns;
   current_ = std::move(frame);
   return true;

@@ -228,6 +228,7 @@ Result<void> Client::pump(Clock::time_point deadline, bool block) {
       rf.format = f->format;
       rf.crc = f->crc;
       rf.swap_ns = f->swap_ns;
+      rf.source = f->source;
       rf.pixels.assign(f->pixels.begin(), f->pixels.end());
       latest_frame_ = std::move(rf);  // newest wins, like the daemon
     } else if (auto* ev = std::get_if<protocol::DeviceEvent>(&m.payload)) {
@@ -422,9 +423,13 @@ Result<void> Client::ping(Timeout timeout) {
 }
 
 Result<void> Client::subscribe(protocol::FrameFormat format, std::uint16_t max_fps, Timeout timeout) {
+  return subscribe(protocol::Subscribe{format, max_fps}, timeout);
+}
+
+Result<void> Client::subscribe(const protocol::Subscribe& request, Timeout timeout) {
   // SUBSCRIBE has no reply of its own; a PING behind it confirms the daemon accepted it.
   const auto id = next_request_id();
-  if (auto r = send_message(Message{id, protocol::Subscribe{format, max_fps}}, timeout); !r) return r;
+  if (auto r = send_message(Message{id, request}, timeout); !r) return r;
   if (auto r = ping(timeout); !r) return r;
   return take_async_error();
 }

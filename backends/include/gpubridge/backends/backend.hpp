@@ -25,6 +25,9 @@ struct ScanoutFrame {
                                      // backend only knows the FRAME_CRC (board profile "scanout": "crc")
   std::uint32_t crc = 0;             // FRAME_CRC of these bytes
   std::chrono::steady_clock::time_point swap_time{};
+  // Mirror mode (daemon --mirror): the simulator's frame for the same swap, fed the same commands
+  // as the board (the golden model). Null everywhere else.
+  std::shared_ptr<const ScanoutFrame> reference = nullptr;
 };
 using ScanoutCallback = std::function<void(std::shared_ptr<const ScanoutFrame>)>;
 

@@ -28,6 +28,7 @@ struct DaemonConfig {
   std::string token_file;           // alternative to token (first line, trimmed)
   std::string backend = "sim";      // "sim" | "discard" | "fake" | board name | "auto"
   bool fallback_to_sim = true;      // board lost → continue on the simulator
+  bool mirror = false;              // board backends: run the simulator alongside and compare (docs/daemon.md)
   std::string boards_dir;           // board profiles (JSON)
   std::string frames_dir;           // write every scanned-out frame as PNG here
   std::string record_dir;           // write each session's stream as a binary trace here

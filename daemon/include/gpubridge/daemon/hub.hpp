@@ -9,6 +9,7 @@
 #include <deque>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include <utility>  // before Asio: Boost 1.74's awaitable.hpp uses std::exchange without it
@@ -28,19 +29,34 @@ struct HubOptions {
   std::string token;       // required from TCP sessions when non-empty
   std::string frames_dir;  // PNG per scanned-out frame when non-empty
   std::string record_dir;  // binary trace per session when non-empty
+  bool mirror = false;     // the backend is a MirrorBackend: frames carry the simulator's reference
 };
 
-// A scanned-out frame encoded once per requested format and shared by every subscriber.
+// Mirror mode bookkeeping (network thread): swaps compared and those whose CRCs differ.
+struct MirrorStats {
+  std::uint64_t compared = 0, mismatches = 0;
+  std::optional<std::uint32_t> first_mismatch, last_mismatch;  // frame numbers
+};
+
+// A scanned-out frame encoded once per requested source and format and shared by every subscriber.
 class FrameFanout {
  public:
   explicit FrameFanout(std::shared_ptr<const backends::ScanoutFrame> frame) : frame_(std::move(frame)) {}
-  // The complete FRAME message for `format` (encoded on first use).
-  std::shared_ptr<const std::vector<std::uint8_t>> message(protocol::FrameFormat format);
+  // The complete FRAME message for `source` in `format` (encoded on first use); null when this
+  // swap has no such picture (a CRC-only board has no board or diff pixels; without mirror mode
+  // there is no sim or diff picture).
+  std::shared_ptr<const std::vector<std::uint8_t>> message(protocol::FrameSource source, protocol::FrameFormat format);
+  std::shared_ptr<const std::vector<std::uint8_t>> message(protocol::FrameFormat format) {
+    return message(protocol::FrameSource::Board, format);
+  }
   const backends::ScanoutFrame& frame() const { return *frame_; }
 
  private:
+  std::shared_ptr<const backends::ScanoutFrame> picture(protocol::FrameSource source);
   std::shared_ptr<const backends::ScanoutFrame> frame_;
-  std::shared_ptr<const std::vector<std::uint8_t>> encoded_[4];
+  std::shared_ptr<const backends::ScanoutFrame> diff_;  // computed on first use
+  bool diff_done_ = false;
+  std::shared_ptr<const std::vector<std::uint8_t>> encoded_[3][4];
 };
 
 class Hub {
@@ -86,10 +102,15 @@ class Hub {
   std::string device_json() const;     // WELCOME's device description
   nlohmann::json status_json() const;  // STATUS_REPLY
   std::uint64_t frames_seen() const { return frames_seen_; }
+  const MirrorStats& mirror_stats() const { return mirror_; }
+  // A subscriber switched pictures (SUBSCRIBE with another source): offers it the newest swap
+  // again, so a still scene shows the new picture at once (network thread).
+  void offer_newest_frame(Session& s);
 
  private:
   void on_scanout(std::shared_ptr<const backends::ScanoutFrame> frame);  // device thread
   void fan_out(std::shared_ptr<const backends::ScanoutFrame> frame);     // network thread
+  void compare_mirrored(const backends::ScanoutFrame& frame);            // network thread
   void on_device_gone(const Error& e);                                   // device thread
   void broadcast_event(const nlohmann::json& event);                     // network thread
   void grant_next();
@@ -107,6 +128,8 @@ class Hub {
   bool resetting_ = false;          // a released lease is being reset; grant after it finishes
   std::uint64_t frames_seen_ = 0;
   std::uint32_t last_frame_number_ = 0;
+  MirrorStats mirror_;
+  std::shared_ptr<FrameFanout> newest_fanout_;  // the last swap, for offer_newest_frame
   std::atomic<std::uint64_t> frame_pngs_written_{0};  // incremented on the device thread
   std::chrono::steady_clock::time_point started_ = std::chrono::steady_clock::now();
 };

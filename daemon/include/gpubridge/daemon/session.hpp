@@ -42,6 +42,7 @@ class Session : public std::enable_shared_from_this<Session> {
   std::string peer() const { return stream_->peer(); }
   bool handshaken() const { return handshaken_; }
   bool subscribed() const { return subscribed_; }
+  protocol::FrameSource frame_source() const { return frame_source_; }
   std::uint64_t bytes_in() const { return bytes_in_; }
 
  private:
@@ -97,6 +98,7 @@ class Session : public std::enable_shared_from_this<Session> {
 
   bool subscribed_ = false;
   protocol::FrameFormat frame_format_ = protocol::FrameFormat::Native;
+  protocol::FrameSource frame_source_ = protocol::FrameSource::Board;
   std::uint16_t max_fps_ = 0;
   Clock::time_point last_frame_sent_{};
   Buffer held_frame_;  // newest frame that arrived too early for max_fps; sent when the interval ends

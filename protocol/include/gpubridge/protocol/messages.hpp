@@ -44,9 +44,9 @@ enum class MsgType : std::uint8_t {
   FenceDone = 0x21,     // s→c  u64 id: every earlier command of this client has executed
   StatusReq = 0x22,     // c→s  empty
   StatusReply = 0x23,   // s→c  JSON
-  Subscribe = 0x30,     // c→s  u8 format (FrameFormat), u16 max_fps (0 = every frame)
+  Subscribe = 0x30,     // c→s  u8 format (FrameFormat), u16 max_fps (0 = every frame) [, u8 source (FrameSource)]
   Unsubscribe = 0x31,   // c→s  empty
-  FrameMsg = 0x32,      // s→c  u32 number, u16 width, u16 height, u8 format, u8 0, u32 crc, u64 swap_ns, pixels
+  FrameMsg = 0x32,      // s→c  u32 number, u16 width, u16 height, u8 format, u8 source, u32 crc, u64 swap_ns, pixels
   LeaseAcquire = 0x40,  // c→s  u8 mode (LeaseMode)
   LeaseGranted = 0x41,  // s→c  u32 session_id
   LeaseRelease = 0x42,  // c→s  empty
@@ -75,11 +75,17 @@ enum class ErrorCode : std::uint16_t {
   ShuttingDown = 15,
   Internal = 16,
   BadFrame = 17,
+  Unavailable = 18,  // the request needs a daemon feature that is off (SUBSCRIBE source sim/diff without --mirror)
 };
 std::string_view to_string(ErrorCode c);
 
 enum class FrameFormat : std::uint8_t { Native = 0, RGBA8888 = 1, RGB565 = 2, RGBA2222 = 3 };
 enum class LeaseMode : std::uint8_t { Wait = 0, FailIfBusy = 1 };
+// Which picture a subscriber wants (docs/protocol.md 17.3, SUBSCRIBE): the device's own frames,
+// the mirror simulator's frames, or their difference image. Sim and Diff need mirror mode.
+enum class FrameSource : std::uint8_t { Board = 0, Sim = 1, Diff = 2 };
+std::string_view to_string(FrameSource s);  // "board" | "sim" | "diff"
+std::optional<FrameSource> parse_frame_source(std::string_view s);
 
 struct Header {
   std::uint8_t version = kSocketVersion;
@@ -107,7 +113,13 @@ struct FenceMsg { std::uint64_t id = 0; };
 struct FenceDone { std::uint64_t id = 0; };
 struct StatusReq {};
 struct StatusReply { std::string json; };
-struct Subscribe { FrameFormat format = FrameFormat::Native; std::uint16_t max_fps = 0; };
+// Without a source, SUBSCRIBE is encoded in the original 3-byte form (board; old daemons accept it).
+// An explicit source is a 4th byte, kept as decoded so that re-encoding gives the same bytes.
+struct Subscribe {
+  FrameFormat format = FrameFormat::Native;
+  std::uint16_t max_fps = 0;
+  std::optional<FrameSource> source = std::nullopt;  // absent = FrameSource::Board
+};
 struct Unsubscribe {};
 struct FrameData {
   std::uint32_t number = 0;
@@ -116,6 +128,7 @@ struct FrameData {
   std::uint32_t crc = 0;
   std::uint64_t swap_ns = 0;
   std::span<const std::uint8_t> pixels;  // width * height * bpp(format)
+  FrameSource source = FrameSource::Board;  // payload byte 9 (was reserved 0: board frames are unchanged)
 };
 struct LeaseAcquire { LeaseMode mode = LeaseMode::Wait; };
 struct LeaseGranted { std::uint32_t session_id = 0; };

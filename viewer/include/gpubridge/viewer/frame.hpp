@@ -7,6 +7,7 @@
 
 #include "gpubridge/common/image.hpp"
 #include "gpubridge/common/result.hpp"
+#include "gpubridge/protocol/messages.hpp"
 #include "gpubridge/protocol/registers.hpp"
 
 namespace gpubridge::viewer {
@@ -21,6 +22,7 @@ struct Frame {
   std::uint32_t crc = 0;      // CRC-32 the daemon computed over the frame bytes
   std::uint64_t swap_ns = 0;  // CLOCK_MONOTONIC of the swap (daemon side; same machine -> comparable)
   std::vector<std::uint8_t> pixels;
+  protocol::FrameSource source = protocol::FrameSource::Board;  // mirror mode: board, simulator or diff
 };
 
 // Empty when the frame's size, format and byte count are consistent and within kMaxFrameDim;

@@ -30,8 +30,16 @@ struct SourceStatus {
   std::string backend;  // "sim", "usb", ... (empty until known)
   std::string board;    // board name when the backend has one
   std::string message;  // for Waiting/Failed: the last error, one line
+  // Mirror mode (gpubridged --mirror): which picture is subscribed and how many swaps so far had a
+  // board frame whose CRC differs from the simulator's (from the daemon's status).
+  bool mirror = false;
+  protocol::FrameSource picture = protocol::FrameSource::Board;
+  std::optional<std::uint64_t> mismatches, compared;
+  std::string picture_problem;  // why the last requested picture switch was refused
 };
 std::string_view to_string(SourceStatus::State s);
+// "board", "simulator", "diff board vs simulator": what the window shows.
+std::string picture_name(protocol::FrameSource s);
 
 struct SourceCounters {
   std::uint64_t received = 0;  // frames handed to publish_frame
@@ -62,6 +70,9 @@ class FrameSource {
   SourceStatus status() const;
   std::uint64_t status_version() const;
   SourceCounters counters() const;
+  // Asks the producer to switch pictures (B/M/D keys). Sources without pictures ignore it; the
+  // daemon source resubscribes and reports the outcome in status().picture / picture_problem.
+  void request_picture(protocol::FrameSource picture);
 
  protected:
   // Runs on the producer thread until stop is requested (or the producer gives up).
@@ -71,6 +82,8 @@ class FrameSource {
   void publish_status(SourceStatus status);
   // Sleeps up to `d`, returning early (false) when stop is requested.
   bool sleep_for(std::stop_token stop, std::chrono::microseconds d);
+  // The picture asked for with request_picture() since the last call, if any.
+  std::optional<protocol::FrameSource> take_picture_request();
 
  private:
   void notify();
@@ -81,6 +94,7 @@ class FrameSource {
   SourceStatus status_;
   std::uint64_t status_version_ = 0;
   SourceCounters counters_;
+  std::optional<protocol::FrameSource> picture_request_;
   std::function<void()> on_change_;
   std::jthread thread_;
 };

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "gpubridge/common/result.hpp"
+#include "gpubridge/protocol/messages.hpp"
 #include "gpubridge/viewer/layout.hpp"
 
 namespace gpubridge::viewer {
@@ -21,6 +22,7 @@ struct Options {
   bool wait = false;                    // wait for the daemon at startup instead of failing
   double timeout_s = 30;                // headless: give up when frame N has not arrived by then
   std::optional<unsigned> max_fps;      // subscription rate; default: the display's refresh rate
+  protocol::FrameSource source = protocol::FrameSource::Board;  // mirror mode: board | sim | diff
   ScaleMode scale = ScaleMode::Fit;
   bool flip = false;
   bool overlay = true;

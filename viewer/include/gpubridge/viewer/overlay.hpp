@@ -16,6 +16,7 @@ struct ShownFrame {  // the frame on screen (metadata only)
   unsigned width = 0, height = 0;
   protocol::PixelFormat format = protocol::PixelFormat::RGBA8888;
   bool crc_ok = true;
+  protocol::FrameSource source = protocol::FrameSource::Board;  // which picture it is (mirror mode)
 };
 
 struct ViewState {
@@ -34,7 +35,10 @@ struct ViewState {
 std::string status_line(const SourceStatus& s);
 std::vector<std::string> overlay_lines(const ViewState& v);
 std::vector<std::string> help_lines();
-// "gpubridge-view - unix:/run/x.sock - sim/ulx3s - 640x480 RGBA8888 [paused]"
+// "gpubridge-view - unix:/run/x.sock - sim/ulx3s - 640x480 RGBA8888 [paused]"; in mirror mode the
+// picture follows the device: "... - board/icebreaker - diff board vs simulator - 64x48 RGBA8888".
 std::string window_title(const ViewState& v);
+// Mirror mode: "showing diff board vs simulator  mismatches 2 of 40 frames"; empty otherwise.
+std::string picture_line(const ViewState& v);
 
 }  // namespace gpubridge::viewer

@@ -42,6 +42,7 @@ struct ReceivedFrame {
   std::uint32_t crc = 0;
   std::uint64_t swap_ns = 0;  // daemon steady clock at the swap
   std::vector<std::uint8_t> pixels;
+  protocol::FrameSource source = protocol::FrameSource::Board;  // board, mirror simulator or diff image
 };
 
 // Progress: bytes done, bytes total.
@@ -78,6 +79,9 @@ class Client {
 
   Result<void> subscribe(protocol::FrameFormat format = protocol::FrameFormat::Native, std::uint16_t max_fps = 0,
                          Timeout timeout = kDefaultTimeout);
+  // Subscribes to one picture of a mirror-mode daemon (board, simulator or diff). A daemon without
+  // mirror mode refuses sim/diff with ERROR UNAVAILABLE (returned here).
+  Result<void> subscribe(const protocol::Subscribe& request, Timeout timeout = kDefaultTimeout);
   Result<void> unsubscribe(Timeout timeout = kDefaultTimeout);
   // The next frame not yet returned (the newest one if several arrived), waiting up to timeout.
   Result<ReceivedFrame> next_frame(Timeout timeout = kDefaultTimeout);

@@ -1,0 +1,168 @@
+#include "gpubridge/daemon/mirror_backend.hpp"
+
+#include <algorithm>
+
+#include "gpubridge/common/log.hpp"
+
+#ifdef GPUBRIDGE_HAVE_SIM
+#include "gpubridge/sim/sim_backend.hpp"
+#endif
+
+namespace gpubridge::daemon {
+namespace {
+
+// A swap the other side never matches (board scanout "off", a batch that failed half-way on one
+// side) must not grow a queue without bound: beyond this many waiting frames the oldest is dropped.
+constexpr std::size_t kMaxWaitingFrames = 4;
+
+template <class T>
+Result<void> as_void(const Result<T>& r) {
+  if (r) return {};
+  return r.error();
+}
+
+}  // namespace
+
+MirrorBackend::MirrorBackend(std::unique_ptr<backends::Backend> board, std::unique_ptr<backends::Backend> model)
+    : board_(std::move(board)), model_(std::move(model)) {
+  // Both callbacks run on the thread that called into the backend (the daemon's device thread);
+  // frames are queued and paired after the forwarded call returns from both sides.
+  board_->set_scanout_callback([this](std::shared_ptr<const backends::ScanoutFrame> f) {
+    std::lock_guard lock(mu_);
+    board_frames_.push_back(std::move(f));
+  });
+  model_->set_scanout_callback([this](std::shared_ptr<const backends::ScanoutFrame> f) {
+    std::lock_guard lock(mu_);
+    model_frames_.push_back(std::move(f));
+  });
+}
+
+MirrorBackend::~MirrorBackend() {
+  board_->set_scanout_callback({});
+  model_->set_scanout_callback({});
+}
+
+backends::DeviceInfo MirrorBackend::info() const { return board_->info(); }
+
+template <class T>
+Result<T> MirrorBackend::decide(Result<T> board_result, const Result<void>& model_result, const char* what) {
+  if (board_result && !model_result) {
+    std::uint64_t n;
+    {
+      std::lock_guard lock(mu_);
+      n = ++counters_.model_errors;
+    }
+    // The first few are worth a line each; after that the status counter tells the story.
+    if (n <= 3)
+      logger("daemon")->warn("mirror: the board accepted {} but the simulator refused it: {}", what,
+                             model_result.error().message);
+  }
+  emit_pairs();
+  return board_result;
+}
+
+Result<void> MirrorBackend::write_frames(protocol::FrameView frames) {
+  auto b = board_->write_frames(frames);
+  auto m = model_->write_frames(frames);
+  return decide(std::move(b), m, "a WRITE_FRAMES batch");
+}
+
+Result<std::uint64_t> MirrorBackend::read_register(std::uint8_t index) {
+  // The model reads too: reading MEM_DATA advances MEM_ADDR, and the two must stay in step.
+  auto b = board_->read_register(index);
+  auto m = model_->read_register(index);
+  return decide(std::move(b), as_void(m), "a register read");
+}
+
+Result<void> MirrorBackend::upload(std::uint32_t address, std::span<const std::uint8_t> bytes) {
+  auto b = board_->upload(address, bytes);
+  auto m = model_->upload(address, bytes);
+  return decide(std::move(b), m, "an upload");
+}
+
+Result<std::vector<std::uint8_t>> MirrorBackend::readback(std::uint32_t address, std::uint32_t length) {
+  auto b = board_->readback(address, length);
+  auto m = model_->readback(address, length);  // same side effects on MEM_ADDR; the data is the board's
+  return decide(std::move(b), as_void(m), "a readback");
+}
+
+Result<void> MirrorBackend::flush() {
+  auto b = board_->flush();
+  auto m = model_->flush();
+  return decide(std::move(b), m, "a flush");
+}
+
+Result<void> MirrorBackend::reset() {
+  auto b = board_->reset();
+  auto m = model_->reset();
+  auto r = decide(std::move(b), m, "a reset");
+  // A reset is the point where both sides are known to agree again: forget half-made pairs.
+  std::lock_guard lock(mu_);
+  counters_.unpaired_frames += board_frames_.size() + model_frames_.size();
+  board_frames_.clear();
+  model_frames_.clear();
+  return r;
+}
+
+void MirrorBackend::set_scanout_callback(backends::ScanoutCallback cb) {
+  std::lock_guard lock(mu_);
+  callback_ = std::move(cb);
+}
+
+MirrorCounters MirrorBackend::counters() const {
+  std::lock_guard lock(mu_);
+  return counters_;
+}
+
+void MirrorBackend::emit_pairs() {
+  std::vector<std::shared_ptr<const backends::ScanoutFrame>> ready;
+  backends::ScanoutCallback cb;
+  {
+    std::lock_guard lock(mu_);
+    while (!board_frames_.empty() && !model_frames_.empty()) {
+      auto paired = std::make_shared<backends::ScanoutFrame>(*board_frames_.front());
+      paired->reference = std::move(model_frames_.front());
+      board_frames_.pop_front();
+      model_frames_.pop_front();
+      ready.push_back(std::move(paired));
+    }
+    for (auto* q : {&board_frames_, &model_frames_}) {
+      while (q->size() > kMaxWaitingFrames) {
+        q->pop_front();
+        ++counters_.unpaired_frames;
+      }
+    }
+    cb = callback_;
+  }
+  // Outside the lock: the callback may take its time (PNG writing) and must not block the queues.
+  if (cb)
+    for (auto& f : ready) cb(std::move(f));
+}
+
+Result<std::unique_ptr<backends::Backend>> make_mirror(std::unique_ptr<backends::Backend> board) {
+  const auto info = board->info();
+  if (info.backend != "board")
+    return make_error("--mirror needs a board backend (a board profile name or emulated:BOARD), not \"" + info.backend +
+                      "\": mirror mode compares a board with the simulator");
+#ifdef GPUBRIDGE_HAVE_SIM
+  sim::DeviceOptions o;
+  // The model gets the board's memory and limits, so a command that does not fit the board does
+  // not fit the model either. CAPS layout: docs/protocol.md, CAPS.
+  o.vram_bytes = std::clamp<std::uint64_t>(info.vram_bytes / 1024 * 1024, 64 * 1024, sim::kMaxVramBytes);
+  o.max_width = std::clamp(info.max_width, 1u, protocol::kMaxFramebufferDim);
+  o.max_height = std::clamp(info.max_height, 1u, protocol::kMaxFramebufferDim);
+  if (info.caps != 0) {
+    o.fifo_depth = std::clamp(static_cast<unsigned>((info.caps >> 46) & 0x3FF), 64u, 1023u);
+    o.features = static_cast<std::uint8_t>((info.caps >> 56) & sim::kAllFeatures);
+  }
+  auto model = sim::SimBackend::create(o);
+  if (!model) return make_error("mirror: cannot create the simulator for board \"" + info.board + "\": " + model.error().message);
+  logger("daemon")->info("mirror: board {} mirrored by the simulator ({} KiB, {}x{} max)", info.board, o.vram_bytes / 1024,
+                         o.max_width, o.max_height);
+  return std::unique_ptr<backends::Backend>(std::make_unique<MirrorBackend>(std::move(board), std::move(*model)));
+#else
+  return make_error("--mirror needs the simulator, and this gpubridged was built without it (gpubridge_sim)");
+#endif
+}
+
+}  // namespace gpubridge::daemon

@@ -1,0 +1,335 @@
+// Mirror mode (issue 6, hardware-in-the-loop bring-up): gpubridged runs a board and the simulator
+// side by side and serves the board's frames, the simulator's frames or their difference image.
+// - A real gpubridged on an emulated board (`--backend emulated:icebreaker --mirror`) plays a trace:
+//   the board frame and the simulator frame both equal `gpubridge render` of the trace, the diff is
+//   all grey, and status reports 0 mismatches.
+// - A CRC-only board (ch341a-generic) is still compared through FRAME_CRC.
+// - A board whose video memory is changed behind the host's back (one pixel of the emulated
+//   board's VRAM, as a stuck bit or a stray write would) gives a CRC mismatch, and the diff frame
+//   is magenta exactly at that pixel.
+// - Without --mirror, SUBSCRIBE source sim/diff is refused with UNAVAILABLE.
+#include <gtest/gtest.h>
+
+#include <future>
+#include <thread>
+
+#include <nlohmann/json.hpp>
+
+#include "daemon_process.hpp"
+#include "gpubridge/client/client.hpp"
+#include "gpubridge/common/image.hpp"
+#include "gpubridge/common/trace_files.hpp"
+#include "gpubridge/daemon/hub.hpp"
+#include "gpubridge/daemon/mirror_backend.hpp"
+#include "gpubridge/daemon/server.hpp"
+#include "gpubridge/protocol/pixel.hpp"
+
+#if defined(GPUBRIDGE_HAVE_SIM) && defined(GPUBRIDGE_HAVE_USB)
+#include "gpubridge/sim/device.hpp"
+#include "gpubridge/usb/board_profile.hpp"
+#include "gpubridge/usb/emu/emulated_stack.hpp"
+
+namespace gpubridge::test {
+namespace {
+
+using namespace std::chrono_literals;
+using protocol::FrameFormat;
+using protocol::FrameSource;
+
+const std::string kTrace = std::string(GPUBRIDGE_TEST_DATA) + "/board_triangles.trace";  // 64x48 RGB565
+
+// The documented diff colours (docs/protocol.md, SUBSCRIBE source 2), written out here rather
+// than taken from the daemon's code.
+bool is_magenta(const std::uint8_t* p) { return p[0] == 255 && p[1] == 0 && p[2] == 255 && p[3] == 255; }
+bool is_dimmed_grey_of(const std::uint8_t* diff, const std::uint8_t* board_rgba) {
+  const unsigned luma = (77u * board_rgba[0] + 150u * board_rgba[1] + 29u * board_rgba[2]) >> 8;
+  const unsigned grey = luma / 2;
+  return diff[0] == grey && diff[1] == grey && diff[2] == grey && diff[3] == 255;
+}
+
+Image to_image(const client::ReceivedFrame& f) { return image_from_device(f.format, f.width, f.height, f.pixels); }
+
+nlohmann::json status_of(client::Client& c) {
+  auto s = c.status(2000ms);
+  EXPECT_TRUE(s) << (s ? "" : s.error().message);
+  return s ? nlohmann::json::parse(*s) : nlohmann::json::object();
+}
+
+std::unique_ptr<client::Client> subscriber(const std::string& address, FrameSource source,
+                                           FrameFormat format = FrameFormat::Native) {
+  auto c = client::Client::connect(address, 2000ms);
+  if (!c) return nullptr;
+  auto owned = std::make_unique<client::Client>(std::move(*c));
+  if (!owned->handshake(std::string("sub-") + std::string(protocol::to_string(source)), "", 2000ms)) return nullptr;
+  auto sub = owned->subscribe(protocol::Subscribe{format, 0, source}, 2000ms);
+  EXPECT_TRUE(sub) << (sub ? "" : sub.error().message);
+  return sub ? std::move(owned) : nullptr;
+}
+
+TEST(DaemonMirror, BoardAndSimulatorFramesBothEqualTheInProcessRender) {
+  const auto dir = make_temp_dir("mirror");
+  const std::string address = "unix:" + (dir / "d.sock").string();
+  Daemon daemon;
+  ASSERT_TRUE(daemon.start({"--listen", address, "--backend", "emulated:icebreaker", "--mirror", "--no-fallback",
+                            "--log-level", "warn"}))
+      << daemon.error();
+
+  auto board = subscriber(address, FrameSource::Board);
+  auto sim = subscriber(address, FrameSource::Sim);
+  auto diff = subscriber(address, FrameSource::Diff);
+  ASSERT_TRUE(board && sim && diff);
+  // The WELCOME tells clients that this daemon mirrors.
+  EXPECT_TRUE(nlohmann::json::parse(board->session().device_json).value("mirror", false));
+
+  const auto play = run_process({GPUBRIDGE_CLI_PATH, "play", kTrace, "--connect", address});
+  ASSERT_EQ(play.exit_code, 0) << play.err << play.out;
+  const auto render = run_process({GPUBRIDGE_CLI_PATH, "render", kTrace, "--out", (dir / "ref.png").string()});
+  ASSERT_EQ(render.exit_code, 0) << render.err;
+  auto want = load_png(dir / "ref.png");
+  ASSERT_TRUE(want) << want.error().message;
+
+  auto b = board->next_frame(5000ms);
+  auto s = sim->next_frame(5000ms);
+  auto d = diff->next_frame(5000ms);
+  ASSERT_TRUE(b) << b.error().message;
+  ASSERT_TRUE(s) << s.error().message;
+  ASSERT_TRUE(d) << d.error().message;
+  EXPECT_EQ(b->source, FrameSource::Board);
+  EXPECT_EQ(s->source, FrameSource::Sim);
+  EXPECT_EQ(d->source, FrameSource::Diff);
+  EXPECT_EQ(b->number, s->number) << "board and simulator frames of the same swap carry the same number";
+  EXPECT_EQ(b->format, protocol::PixelFormat::RGB565);
+  EXPECT_EQ(s->format, protocol::PixelFormat::RGB565);
+  // The triangles are there (not just the clear colour) ...
+  const Image bi = to_image(*b), si = to_image(*s);
+  ASSERT_EQ(bi.width, 64u);
+  ASSERT_EQ(bi.height, 48u);
+  EXPECT_NE(std::vector<std::uint8_t>(bi.pixel(30, 30), bi.pixel(30, 30) + 4),
+            std::vector<std::uint8_t>(bi.pixel(63, 47), bi.pixel(63, 47) + 4));
+  // ... and both pictures equal the golden in-process render pixel for pixel.
+  EXPECT_TRUE(bi.rgba == want->rgba) << "board frame differs from gpubridge render";
+  EXPECT_TRUE(si.rgba == want->rgba) << "simulator frame differs from gpubridge render";
+  EXPECT_EQ(b->crc, s->crc);
+
+  // The diff of equal pictures: every pixel the dimmed grey of the board's pixel, no magenta.
+  ASSERT_EQ(d->format, protocol::PixelFormat::RGBA8888);
+  const Image di = to_image(*d);
+  ASSERT_EQ(di.width, bi.width);
+  ASSERT_EQ(di.height, bi.height);
+  std::size_t grey = 0;
+  for (unsigned y = 0; y < di.height; ++y)
+    for (unsigned x = 0; x < di.width; ++x) grey += is_dimmed_grey_of(di.pixel(x, y), bi.pixel(x, y)) ? 1 : 0;
+  EXPECT_EQ(grey, std::size_t{di.width} * di.height);
+
+  const auto status = status_of(*board);
+  EXPECT_EQ(status["mirror"]["enabled"], true) << status.dump();
+  EXPECT_GE(status["mirror"]["compared"].get<int>(), 1) << status.dump();
+  EXPECT_EQ(status["mirror"]["mismatches"], 0) << status.dump();
+  EXPECT_TRUE(status["mirror"]["first_mismatch"].is_null()) << status.dump();
+  bool sources_listed = false;
+  for (const auto& cl : status["clients"]) sources_listed = sources_listed || cl.value("source", "") == "diff";
+  EXPECT_TRUE(sources_listed) << status.dump();
+  EXPECT_EQ(daemon.terminate(), 0);
+  std::error_code ec;
+  fs::remove_all(dir, ec);
+}
+
+// ch341a-generic ships "scanout": "crc": the board gives no pixels, only FRAME_CRC. The comparison
+// still happens (CRC against the simulator's CRC); simulator subscribers still get pictures.
+TEST(DaemonMirror, CrcOnlyBoardIsComparedThroughFrameCrc) {
+  const auto dir = make_temp_dir("mirror-crc");
+  const std::string address = "unix:" + (dir / "d.sock").string();
+  Daemon daemon;
+  ASSERT_TRUE(daemon.start({"--listen", address, "--backend", "emulated:ch341a-generic", "--mirror", "--no-fallback",
+                            "--log-level", "warn"}))
+      << daemon.error();
+  auto board = subscriber(address, FrameSource::Board);
+  auto sim = subscriber(address, FrameSource::Sim);
+  ASSERT_TRUE(board && sim);
+  const auto play = run_process({GPUBRIDGE_CLI_PATH, "play", kTrace, "--connect", address});
+  ASSERT_EQ(play.exit_code, 0) << play.err << play.out;
+  auto s = sim->next_frame(5000ms);
+  ASSERT_TRUE(s) << s.error().message;
+  EXPECT_EQ(s->width, 64u);
+  EXPECT_FALSE(board->next_frame(300ms)) << "a CRC-only board produced a board picture";
+  const auto status = status_of(*sim);
+  EXPECT_GE(status["mirror"]["compared"].get<int>(), 1) << status.dump();
+  EXPECT_EQ(status["mirror"]["mismatches"], 0) << status.dump();
+  EXPECT_EQ(daemon.terminate(), 0);
+  std::error_code ec;
+  fs::remove_all(dir, ec);
+}
+
+TEST(DaemonMirror, WithoutMirrorModeSimAndDiffAreRefusedButBoardStillWorks) {
+  const auto dir = make_temp_dir("mirror-off");
+  const std::string address = "unix:" + (dir / "d.sock").string();
+  Daemon daemon;
+  ASSERT_TRUE(daemon.start({"--listen", address, "--log-level", "warn"})) << daemon.error();
+  auto c = client::Client::connect(address, 2000ms);
+  ASSERT_TRUE(c);
+  ASSERT_TRUE(c->handshake("no-mirror", "", 2000ms));
+  EXPECT_FALSE(nlohmann::json::parse(c->session().device_json).value("mirror", true));
+  for (auto source : {FrameSource::Sim, FrameSource::Diff}) {
+    auto r = c->subscribe(protocol::Subscribe{FrameFormat::Native, 0, source}, 2000ms);
+    ASSERT_FALSE(r) << protocol::to_string(source);
+    EXPECT_TRUE(client::is_protocol_error(r.error(), protocol::ErrorCode::Unavailable)) << r.error().message;
+    EXPECT_NE(r.error().message.find("--mirror"), std::string::npos) << r.error().message;
+  }
+  // The refusal is not fatal: the same session subscribes to the board (old 3-byte form) and gets frames.
+  ASSERT_TRUE(c->subscribe(FrameFormat::Native, 0, 2000ms));
+  const auto play = run_process({GPUBRIDGE_CLI_PATH, "play", kTrace, "--connect", address});
+  ASSERT_EQ(play.exit_code, 0) << play.err << play.out;
+  auto f = c->next_frame(5000ms);
+  ASSERT_TRUE(f) << f.error().message;
+  EXPECT_EQ(f->source, FrameSource::Board);
+  EXPECT_EQ(daemon.terminate(), 0);
+  std::error_code ec;
+  fs::remove_all(dir, ec);
+}
+
+TEST(DaemonMirror, MirrorNeedsABoardBackend) {
+  const auto dir = make_temp_dir("mirror-sim");
+  const auto r = run_process({GPUBRIDGED_PATH, "--listen", "unix:" + (dir / "d.sock").string(), "--backend", "sim", "--mirror"});
+  EXPECT_EQ(r.exit_code, 2) << r.out << r.err;
+  EXPECT_NE(r.err.find("--mirror needs a board backend"), std::string::npos) << r.err;
+  std::error_code ec;
+  fs::remove_all(dir, ec);
+}
+
+// The tampered board: the hub, sessions and sockets are the daemon's own code, run in-process so
+// the test can reach the emulated board's video memory below the USB driver.
+class InProcessMirrorDaemon {
+ public:
+  bool start(const fs::path& dir, std::string& why) {
+    auto profile = usb::find_board_profile(fs::path(GPUBRIDGE_BOARDS_DIR).parent_path(), "icebreaker");
+    if (!profile) return (why = profile.error().message, false);
+    auto emulated = usb::emu::open_emulated_board(*profile);
+    if (!emulated) return (why = emulated.error().message, false);
+    stack_ = emulated->stack;
+    if (!stack_->target_is_simulator()) return (why = "emulated board without the simulator's device model", false);
+    auto mirror = daemon::make_mirror(std::move(emulated->backend));
+    if (!mirror) return (why = mirror.error().message, false);
+    daemon::HubOptions opts;
+    opts.mirror = true;
+    hub_.emplace(net_.get_executor(), device_.get_executor(), std::move(*mirror), opts);
+    server_.emplace(net_, *hub_);
+    auto a = client::parse_address("unix:" + (dir / "d.sock").string());
+    auto bound = server_->listen(*a);
+    if (!bound) return (why = bound.error().message, false);
+    address_ = bound->to_string();
+    device_thread_ = std::thread([this] { device_.run(); });
+    net_thread_ = std::thread([this] { net_.run(); });
+    return true;
+  }
+  ~InProcessMirrorDaemon() {
+    if (server_) boost::asio::post(net_, [this] { server_->stop(); hub_->shutdown_sessions(); });
+    std::this_thread::sleep_for(50ms);
+    net_.stop();
+    if (net_thread_.joinable()) net_thread_.join();
+    device_guard_.reset();
+    device_.stop();
+    if (device_thread_.joinable()) device_thread_.join();
+    server_.reset();
+    hub_.reset();
+  }
+  const std::string& address() const { return address_; }
+  // Changes the board's video memory on the device thread, between commands, like a stray write
+  // the host never sent.
+  void poke_board_memory(std::size_t offset, std::uint8_t xor_mask) {
+    std::promise<void> done;
+    boost::asio::post(device_, [&] {
+      auto& device = dynamic_cast<sim::Device&>(stack_->target());
+      device.memory()[offset] ^= xor_mask;
+      done.set_value();
+    });
+    done.get_future().wait();
+  }
+
+ private:
+  boost::asio::io_context net_{1}, device_{1};
+  boost::asio::executor_work_guard<boost::asio::io_context::executor_type> device_guard_ =
+      boost::asio::make_work_guard(device_);
+  std::shared_ptr<usb::emu::EmulatedStack> stack_;
+  std::optional<daemon::Hub> hub_;
+  std::optional<daemon::Server> server_;
+  std::string address_;
+  std::thread net_thread_, device_thread_;
+};
+
+TEST(DaemonMirror, TamperedBoardMemoryIsCountedAndShownMagentaExactlyWhereItDiffers) {
+  const auto dir = make_temp_dir("mirror-tamper");
+  InProcessMirrorDaemon daemon;
+  std::string why;
+  ASSERT_TRUE(daemon.start(dir, why)) << why;
+  auto board = subscriber(daemon.address(), FrameSource::Board);
+  auto sim = subscriber(daemon.address(), FrameSource::Sim);
+  auto diff = subscriber(daemon.address(), FrameSource::Diff);
+  ASSERT_TRUE(board && sim && diff);
+
+  auto player = client::Client::connect(daemon.address(), 2000ms);
+  ASSERT_TRUE(player);
+  ASSERT_TRUE(player->handshake("player", "", 2000ms));
+  ASSERT_TRUE(player->acquire_lease(protocol::LeaseMode::Wait, 2000ms));
+  auto trace = load_trace(kTrace);
+  ASSERT_TRUE(trace) << trace.error().message;
+  for (const auto& tc : trace->commands) {
+    if (std::holds_alternative<protocol::FenceCmd>(tc.command)) continue;  // fenced once below
+    const auto* frames = std::get_if<protocol::FramesCmd>(&tc.command);
+    ASSERT_NE(frames, nullptr) << "board_triangles.trace is expected to hold register writes only";
+    ASSERT_TRUE(player->write_frames(frames->view(), 2000ms));
+  }
+  ASSERT_TRUE(player->fence(5000ms));
+  // Swap 1: untouched, equal.
+  auto b1 = board->next_frame(5000ms);
+  auto d1 = diff->next_frame(5000ms);
+  ASSERT_TRUE(b1 && d1);
+  auto status = status_of(*player);
+  EXPECT_EQ(status["mirror"]["mismatches"], 0) << status.dump();
+
+  // One pixel of the displayed RGB565 framebuffer at address 0 changes on the board only.
+  const unsigned tx = 37, ty = 21;
+  daemon.poke_board_memory((std::size_t{ty} * 64 + tx) * 2 + 1, 0x5A);
+  protocol::FramesCmd swap;
+  swap.push(protocol::write_frame(protocol::Reg::FB_DISPLAY, 0));
+  ASSERT_TRUE(player->write_frames(swap.view(), 2000ms));
+  ASSERT_TRUE(player->fence(5000ms));
+
+  auto b2 = board->next_frame(5000ms);
+  auto s2 = sim->next_frame(5000ms);
+  auto d2 = diff->next_frame(5000ms);
+  ASSERT_TRUE(b2) << b2.error().message;
+  ASSERT_TRUE(s2) << s2.error().message;
+  ASSERT_TRUE(d2) << d2.error().message;
+  ASSERT_EQ(b2->number, s2->number);
+  ASSERT_EQ(d2->number, b2->number);
+  EXPECT_NE(b2->crc, s2->crc);
+  const Image bi = to_image(*b2), si = to_image(*s2), di = to_image(*d2);
+  ASSERT_EQ(di.width, 64u);
+  ASSERT_EQ(di.height, 48u);
+  // The test's own comparison of the two pictures: exactly the poked pixel differs ...
+  std::vector<std::pair<unsigned, unsigned>> differing;
+  for (unsigned y = 0; y < bi.height; ++y)
+    for (unsigned x = 0; x < bi.width; ++x)
+      if (!std::equal(bi.pixel(x, y), bi.pixel(x, y) + 4, si.pixel(x, y))) differing.emplace_back(x, y);
+  ASSERT_EQ(differing.size(), 1u);
+  EXPECT_EQ(differing[0], std::make_pair(tx, ty));
+  // ... and the diff is magenta there and the dimmed grey of the board pixel everywhere else.
+  for (unsigned y = 0; y < di.height; ++y)
+    for (unsigned x = 0; x < di.width; ++x) {
+      if (x == tx && y == ty)
+        EXPECT_TRUE(is_magenta(di.pixel(x, y))) << x << "," << y;
+      else
+        ASSERT_TRUE(is_dimmed_grey_of(di.pixel(x, y), bi.pixel(x, y))) << x << "," << y;
+    }
+
+  status = status_of(*player);
+  EXPECT_EQ(status["mirror"]["compared"], 2) << status.dump();
+  EXPECT_EQ(status["mirror"]["mismatches"], 1) << status.dump();
+  EXPECT_EQ(status["mirror"]["first_mismatch"], b2->number) << status.dump();
+  std::error_code ec;
+  fs::remove_all(dir, ec);
+}
+
+}  // namespace
+}  // namespace gpubridge::test
+#endif
