@@ -2,6 +2,7 @@
 // processes, before any simulator worker threads exist), then every simulator configuration.
 #include "gpubridge/bench/accuracy_bench.hpp"
 
+#include <algorithm>
 #include <fstream>
 #include <sstream>
 #include <thread>
@@ -63,6 +64,20 @@ Result<Report> run_accuracy_bench(const AccuracyBenchOptions& opt, const std::fu
   auto scenes_r = make_scenes(opt.quick ? 200 : std::max(1u, opt.scale));
   if (!scenes_r) return scenes_r.error();
   rep.scenes = std::move(scenes_r).value();
+  if (!opt.scenes.empty()) {
+    std::vector<Scene> chosen;
+    for (const auto& name : opt.scenes) {
+      auto it = std::find_if(rep.scenes.begin(), rep.scenes.end(), [&](const Scene& s) { return s.name == name; });
+      if (it == rep.scenes.end()) {
+        std::string known;
+        for (const auto& s : rep.scenes) known += (known.empty() ? "" : ", ") + s.name;
+        return make_error("unknown scene '" + name + "' (scenes: " + known + ")");
+      }
+      chosen.push_back(std::move(*it));
+      rep.scenes.erase(it);
+    }
+    rep.scenes = std::move(chosen);
+  }
   const unsigned runs = opt.quick ? 1 : std::max(1u, opt.runs);
 
   progress("reference rasterisation of the error subsets");
@@ -89,7 +104,8 @@ Result<Report> run_accuracy_bench(const AccuracyBenchOptions& opt, const std::fu
     rep.llvmpipe = "not measured (--no-llvmpipe)";
   }
 
-  const auto configs = bench_configs();
+  auto configs = bench_configs();
+  if (opt.exact_only) configs.resize(1);
   rep.scene_pixels.assign(rep.scenes.size(), 0);
   for (std::size_t ci = 0; ci < configs.size(); ++ci) {
     const auto& k = configs[ci];

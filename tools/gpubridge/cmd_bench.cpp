@@ -22,6 +22,8 @@ struct AccuracyArgs {
   unsigned scale = 1;
   bool no_llvmpipe = false;
   std::string out_dir;
+  std::vector<std::string> scenes;
+  bool exact_only = false;
 };
 
 [[maybe_unused]] bool write_file(const std::filesystem::path& p, const std::string& text) {
@@ -42,6 +44,8 @@ int run_accuracy(const GlobalOptions& g, const AccuracyArgs& a) {
   opt.runs = a.runs;
   opt.scale = a.scale;
   opt.llvmpipe = !a.no_llvmpipe;
+  opt.scenes = a.scenes;
+  opt.exact_only = a.exact_only;
   if (!a.out_dir.empty()) {
     std::error_code ec;
     std::filesystem::create_directories(a.out_dir, ec);
@@ -60,6 +64,8 @@ int run_accuracy(const GlobalOptions& g, const AccuracyArgs& a) {
   if (a.quick) command += " --quick";
   if (a.runs != 5) command += " --runs " + std::to_string(a.runs);
   if (a.scale != 1) command += " --scale " + std::to_string(a.scale);
+  for (const auto& name : a.scenes) command += " --scene " + name;
+  if (a.exact_only) command += " --exact-only";
   if (!a.out_dir.empty()) command += " --out-dir " + a.out_dir;
   const std::string md = bench::report_markdown(*report, command);
   const auto json = bench::report_json(*report);
@@ -96,6 +102,10 @@ GPUBRIDGE_COMMAND("bench", 80, [](CLI::App& app, GlobalOptions& g, auto& runners
       ->check(CLI::Range(1u, 1000u))
       ->capture_default_str();
   sub->add_flag("--no-llvmpipe", args->no_llvmpipe, "skip the llvmpipe peer rows");
+  sub->add_option("--scene", args->scenes,
+                  "only this scene (repeatable): tri10-front, tri1k-front, tri50k-front, tri10-random, tri1k-random, "
+                  "tri50k-random, road, cubes, fan, alpha-blend");
+  sub->add_flag("--exact-only", args->exact_only, "only the exact configuration (skip the other accuracy knobs)");
   sub->add_option("--out-dir", args->out_dir, "directory for accuracy-report.md, accuracy-report.json, accuracy-front.svg");
   sub->fallthrough();
   runners.emplace_back(sub, [&g, args] { return run_accuracy(g, *args); });

@@ -33,8 +33,10 @@ struct FifoEntry {
 struct RegisterFacts {
   std::array<std::uint64_t, kRegisterCount> reserved{};
   std::array<bool, kRegisterCount> has_enum{};
+  std::array<const RegisterDesc*, kRegisterCount> desc{};  // null: no register at that index
   RegisterFacts() {
     for (const auto& r : register_table()) {
+      desc[r.index] = &r;
       reserved[r.index] = r.reserved_mask();
       for (const auto& f : r.fields) has_enum[r.index] = has_enum[r.index] || f.kind == FieldKind::Enum;
     }
@@ -56,7 +58,6 @@ struct Device::State {
            (std::uint64_t{kVersionMinor} << 16) | o.variant),
         mem(o.vram_bytes),
         renderer(mem, o.accuracy, o.threads) {
-    crc_buffer.reserve(kCrcBufferBytes);
     reset_registers();
   }
 
@@ -78,7 +79,9 @@ struct Device::State {
   std::uint64_t frame_tick = 0;
   // Link integrity.
   std::uint32_t link_crc = 0;  // zlib-convention running CRC of the frames folded in so far
-  std::vector<std::uint8_t> crc_buffer;  // frames not yet folded into link_crc
+  // Frames not yet folded into link_crc (folded 4 KiB at a time: zlib is fast on long runs).
+  std::array<std::uint8_t, kCrcBufferBytes> crc_buffer{};
+  std::size_t crc_fill = 0;
   std::uint32_t link_frames = 0;
   bool strict = false, discarding = false, group_failed = false;
   std::uint16_t groups_ok = 0, groups_bad = 0;
@@ -99,17 +102,19 @@ struct Device::State {
 
   // --- link CRC ---
   void feed_crc(const Frame& f) {
-    const auto bytes = encode(f);
-    crc_buffer.insert(crc_buffer.end(), bytes.begin(), bytes.end());
-    if (crc_buffer.size() >= kCrcBufferBytes) fold_crc();
+    std::uint8_t* b = crc_buffer.data() + crc_fill;  // the frame's wire bytes (frame.hpp)
+    b[0] = static_cast<std::uint8_t>((f.read ? 0x80 : 0) | f.index);
+    store_be64(b + 1, f.data);
+    crc_fill += kFrameBytes;
+    if (crc_fill >= kCrcBufferBytes) fold_crc();
     link_frames = (link_frames + 1) & 0xFFFFFF;
   }
   void fold_crc() {
-    link_crc = crc32_update(link_crc, crc_buffer);
-    crc_buffer.clear();
+    link_crc = crc32_update(link_crc, std::span<const std::uint8_t>(crc_buffer.data(), crc_fill));
+    crc_fill = 0;
   }
   void restart_link_group() {
-    crc_buffer.clear();
+    crc_fill = 0;
     link_crc = 0;
     link_frames = 0;
     group_failed = false;
@@ -409,7 +414,7 @@ struct Device::State {
   }
 
   void arrive_write(std::uint8_t index, std::uint64_t data) {
-    const RegisterDesc* d = find_register(index);
+    const RegisterDesc* d = facts.desc[index];
     if (!d || d->access == Access::ReadOnly) {
       errors |= ERR_BAD_REGISTER;
       return;
@@ -506,7 +511,9 @@ void Device::write(const protocol::Frame& frame) {
   frame_complete(frame);
 }
 void Device::write(protocol::FrameView frames) {
-  for (std::size_t i = 0; i < frames.size(); ++i) write(frames[i]);
+  const std::uint8_t* b = frames.bytes.data();
+  for (std::size_t i = 0; i < frames.size(); ++i, b += kFrameBytes)
+    write(Frame{(b[0] & 0x80) != 0, static_cast<std::uint8_t>(b[0] & 0x7F), load_be64(b + 1)});
 }
 std::uint64_t Device::read(std::uint8_t index) {
   const std::uint64_t v = s_->read(index & 0x7F);

@@ -34,6 +34,15 @@ class Divider {
     if (a >= kExact || a <= -kExact) return floor_divmod(a, d_);
     std::int64_t q = static_cast<std::int64_t>(static_cast<double>(a) * inv_);
     std::int64_t r = a - q * d_;
+    // One correction each way without branches (the estimate truncates towards zero, so its
+    // direction follows the numerator's sign, which setup cannot predict); the loops are the
+    // exactness guarantee and practically never run.
+    const std::int64_t below = r >> 63;  // −1 when r < 0
+    r += d_ & below;
+    q += below;
+    const std::int64_t above = -static_cast<std::int64_t>(r >= d_);
+    r -= d_ & above;
+    q -= above;
     while (r < 0) { r += d_; --q; }
     while (r >= d_) { r -= d_; ++q; }
     return {q, r};

@@ -61,10 +61,12 @@ void Renderer::draw(const Vertex& a, const Vertex& b, const Vertex& c, const std
     if (st.writes_nothing) return;
     draw_pending();
     pending_ = slot;
-    pending_state_ = state;
+    // The state object is shared with the device: copy the pointer (an atomic count update)
+    // only when it changed, not once per triangle.
+    if (pending_state_ != state) pending_state_ = state;
     return;
   }
-  batch_state_ = state;
+  if (batch_state_ != state) batch_state_ = state;
   if (batch_.size() >= kMaxBatch) flush();
 }
 
@@ -75,8 +77,7 @@ void Renderer::draw_pending() {
   rasterize_rows(t, *pending_state_, ctx, t.y0, t.y1);
   errors_ |= ctx.errors;
   counters_.add(ctx.counters);
-  pending_ = -1;
-  pending_state_.reset();
+  pending_ = -1;  // pending_state_ stays: the next triangle most likely uses it again
 }
 
 // Small triangles are bound by the latency of their first depth and colour reads (random screen
@@ -87,10 +88,16 @@ void Renderer::prefetch_rows(const Vertex& a, const Vertex& b, const Vertex& c, 
   const int y0 = std::clamp((std::min({a.y, b.y, c.y}) >> 4), st.clip.y0, st.clip.y1 - 1);
   const int y1 = std::min(std::clamp((std::max({a.y, b.y, c.y}) >> 4), st.clip.y0, st.clip.y1 - 1), y0 + 7);
   const bool depth = st.z_test || st.z_write;
+  // The row's first 8 pixels (32 bytes at 4 bytes per pixel) may straddle two cache lines.
+  const std::size_t last = std::min<std::size_t>(7, static_cast<std::size_t>(st.clip.x1 - 1 - x));
   for (int y = y0; y <= y1; ++y) {
     const std::size_t pix = static_cast<std::size_t>(y) * st.fb_width + static_cast<std::size_t>(x);
     __builtin_prefetch(mem_.data() + st.fb_draw + pix * st.bpp, 1);
-    if (depth) __builtin_prefetch(mem_.data() + st.fb_z + pix * 4, 1);
+    __builtin_prefetch(mem_.data() + st.fb_draw + (pix + last) * st.bpp, 1);
+    if (depth) {
+      __builtin_prefetch(mem_.data() + st.fb_z + pix * 4, 1);
+      __builtin_prefetch(mem_.data() + st.fb_z + (pix + last) * 4, 1);
+    }
   }
 }
 

@@ -32,8 +32,11 @@ void setup_plane(Plane& p, std::int64_t a0, std::int64_t a1, std::int64_t a2, co
     return;
   }
   p.constant = false;
-  const i128 m0 = 2 * (i128{d1} * b1.e + i128{d2} * b2.e) + D;
-  const DivMod o = den(m0);
+  // |b.e| < 2^35 (12.4 coordinates), so colour and Z deltas (< 2^25) keep M inside 64 bits;
+  // only S/T/Q need the 128-bit product.
+  constexpr std::int64_t kNarrow = std::int64_t{1} << 25;
+  const bool narrow = d1 < kNarrow && d1 > -kNarrow && d2 < kNarrow && d2 > -kNarrow;
+  const DivMod o = narrow ? den(2 * (d1 * b1.e + d2 * b2.e) + D) : den(2 * (i128{d1} * b1.e + i128{d2} * b2.e) + D);
   p.q = a0 + o.q;
   p.r = o.r;
   const DivMod sx = den(2 * (d1 * b1.ex + d2 * b2.ex));

@@ -21,6 +21,8 @@ struct AccuracyBenchOptions {
   unsigned runs = 5;          // timed runs per measurement (best is reported), after 1 warm-up
   bool llvmpipe = true;       // measure the llvmpipe peer (omitted with a reason when unavailable)
   std::vector<unsigned> threads{1, 2};
+  std::vector<std::string> scenes;  // only these scenes (by name); empty = all
+  bool exact_only = false;          // only the exact configuration (no other accuracy knobs)
 };
 
 // Error of one renderer on one scene against the double-precision reference (the leading
