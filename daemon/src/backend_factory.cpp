@@ -29,11 +29,46 @@ std::filesystem::path config_dir_of(const DaemonConfig& cfg) {
   return dir.lexically_normal().parent_path();
 }
 
-Result<std::unique_ptr<backends::Backend>> open_named_board(const std::string& name, bool emulate, const DaemonConfig& cfg) {
+// "emulated:PROFILE?presence=PATH": options after '?' (key=value, '&'-separated) configure the
+// emulation; today only `presence` (the emulated adapter is plugged in while PATH exists).
+struct EmulatedSpec {
+  std::string profile;
+  std::string presence_file;
+};
+
+Result<EmulatedSpec> parse_emulated_spec(const std::string& spec) {
+  EmulatedSpec out;
+  const auto q = spec.find('?');
+  out.profile = spec.substr(0, q);
+  if (out.profile.empty())
+    return make_error("backend \"" + std::string(kEmulatedPrefix) + spec +
+                      "\": expected emulated:PROFILE (a board profile name or .json file), optionally ?presence=PATH");
+  if (q == std::string::npos) return out;
+  std::string rest = spec.substr(q + 1);
+  while (!rest.empty()) {
+    const auto amp = rest.find('&');
+    const std::string item = rest.substr(0, amp);
+    rest = amp == std::string::npos ? "" : rest.substr(amp + 1);
+    const auto eq = item.find('=');
+    const std::string key = item.substr(0, eq);
+    const std::string value = eq == std::string::npos ? "" : item.substr(eq + 1);
+    if (key == "presence" && !value.empty()) {
+      out.presence_file = value;
+    } else {
+      return make_error("backend \"" + std::string(kEmulatedPrefix) + spec + "\": unknown option \"" + item +
+                        "\" (the only option is presence=PATH: the emulated adapter is plugged in while PATH exists)");
+    }
+  }
+  return out;
+}
+
+Result<std::unique_ptr<backends::Backend>> open_named_board(const std::string& name, bool emulate, const DaemonConfig& cfg,
+                                                             const std::string& presence_file = {}) {
   auto profile = usb::find_board_profile(config_dir_of(cfg), name);
   if (!profile) return make_error("backend \"" + std::string(emulate ? kEmulatedPrefix : "") + name + "\": " + profile.error().message);
   usb::BoardOpenOptions opts;
   opts.emulate = emulate;
+  opts.emulated_presence_file = presence_file;
   auto board = usb::open_board(*profile, opts);
   if (!board) {
     std::string msg = "board \"" + profile->name + "\" (" + std::string(usb::to_string(profile->chip)) + ")" +
@@ -106,9 +141,9 @@ Result<std::unique_ptr<backends::Backend>> make_backend(const std::string& name,
     return make_simulator();
   }
   if (name.starts_with(kEmulatedPrefix)) {
-    const std::string profile = name.substr(kEmulatedPrefix.size());
-    if (profile.empty()) return make_error("backend \"" + name + "\": expected emulated:PROFILE (a board profile name or .json file)");
-    return open_named_board(profile, true, cfg);
+    auto spec = parse_emulated_spec(name.substr(kEmulatedPrefix.size()));
+    if (!spec) return spec.error();
+    return open_named_board(spec->profile, true, cfg, spec->presence_file);
   }
   return open_named_board(name, false, cfg);
 #else
@@ -117,6 +152,28 @@ Result<std::unique_ptr<backends::Backend>> make_backend(const std::string& name,
   return make_error("backend \"" + name +
                     "\": board backends need the USB board path (gpubridge_usb), which this gpubridged was built "
                     "without; use \"sim\", \"auto\", \"fake\" or \"discard\"");
+#endif
+}
+
+bool is_board_backend(const std::string& name) {
+  return !(name == "sim" || name == "discard" || name == "fake" || name.starts_with("fake:"));
+}
+
+std::function<Result<std::unique_ptr<backends::Backend>>()> make_reattach_factory(const DaemonConfig& cfg) {
+#ifdef GPUBRIDGE_HAVE_USB
+  if (!is_board_backend(cfg.backend)) return {};
+  const std::string name = cfg.backend;
+  // A copy of the configuration: the factory runs later, on the device thread.
+  return [name, cfg]() -> Result<std::unique_ptr<backends::Backend>> {
+    if (name == "auto") {
+      if (auto board = first_present_board(cfg)) return board;
+      return make_error("auto: no board attached", backends::kDeviceGone);
+    }
+    return make_backend(name, cfg);
+  };
+#else
+  (void)cfg;
+  return {};
 #endif
 }
 

@@ -76,7 +76,7 @@ class Reader {
 Result<DaemonConfig> parse_config(const json& doc, const std::string& source) {
   Reader rd(source);
   if (!doc.is_object()) return rd.fail("(top level)", "expected a JSON object");
-  GPUBRIDGE_TRY(rd.known_keys(doc, "", {"listen", "token", "token_file", "backend", "fallback_to_sim", "boards_dir",
+  GPUBRIDGE_TRY(rd.known_keys(doc, "", {"listen", "token", "token_file", "backend", "fallback_to_sim", "reattach_interval_ms", "boards_dir",
                                         "frames_dir", "record_dir", "log_level", "limits", "mirror", "comment"}));
   DaemonConfig cfg;
   if (doc.contains("listen")) {
@@ -96,6 +96,7 @@ Result<DaemonConfig> parse_config(const json& doc, const std::string& source) {
   if (cfg.backend.empty()) return rd.fail("backend", "expected \"sim\", \"auto\", a board name or \"emulated:BOARD\", got \"\"");
   GPUBRIDGE_TRY(rd.read_bool(doc, "", "fallback_to_sim", cfg.fallback_to_sim));
   GPUBRIDGE_TRY(rd.read_bool(doc, "", "mirror", cfg.mirror));
+  GPUBRIDGE_TRY(rd.read_uint(doc, "", "reattach_interval_ms", 0, kMaxReattachIntervalMs, cfg.reattach_interval_ms));
   GPUBRIDGE_TRY(rd.read_string(doc, "", "boards_dir", cfg.boards_dir));
   GPUBRIDGE_TRY(rd.read_string(doc, "", "frames_dir", cfg.frames_dir));
   GPUBRIDGE_TRY(rd.read_string(doc, "", "record_dir", cfg.record_dir));
@@ -153,6 +154,9 @@ Result<void> finalize_config(DaemonConfig& cfg) {
   if (cfg.limits.max_message_bytes > protocol::kMaxPayload || cfg.limits.max_message_bytes < 4096)
     return make_error("limits.max_message_bytes: expected 4096.." + std::to_string(protocol::kMaxPayload));
   if (cfg.limits.max_clients < 1 || cfg.limits.max_clients > 4096) return make_error("limits.max_clients: expected 1..4096");
+  if (cfg.reattach_interval_ms > kMaxReattachIntervalMs)
+    return make_error("reattach_interval_ms: expected 0.." + std::to_string(kMaxReattachIntervalMs) + " (0 = never), got " +
+                      std::to_string(cfg.reattach_interval_ms));
   return {};
 }
 

@@ -190,6 +190,7 @@ nlohmann::json Hub::status_json() const {
           {"frames", {{"count", frames_seen_}, {"last_number", last_frame_number_},
                       {"pngs_written", frame_pngs_written_.load()}}},
           {"mirror", mirror},
+          {"hotplug", hotplug_json()},
           {"uptime_s", uptime}};
 }
 
@@ -246,18 +247,26 @@ void Hub::compare_mirrored(const backends::ScanoutFrame& frame) {
 }
 
 void Hub::on_device_gone(const Error& e) {
+  // Reported once per disappearance: without a fallback the dead board stays in place and every
+  // later command fails with DEVICE_GONE too (each caller gets that in its error reply).
+  if (device_lost_) return;
+  device_lost_ = true;
   logger("daemon")->error("device gone: {}", e.message);
   nlohmann::json event{{"event", "device_gone"}, {"message", e.message}};
   if (fallback_) {
     if (auto sim = fallback_(); sim) {
-      backend_ = std::move(*sim);
-      backend_->set_scanout_callback([this](std::shared_ptr<const backends::ScanoutFrame> f) { on_scanout(std::move(f)); });
+      install_backend(std::move(*sim));
       event["fallback"] = backend_->info().backend;
       auto info = backend_->info();
       boost::asio::post(net_, [this, info] { info_ = info; });
     }
   }
-  boost::asio::post(net_, [this, event] { broadcast_event(event); });
+  if (reattach_ && hotplug_interval_.count() > 0) event["reattach_interval_ms"] = hotplug_interval_.count();
+  boost::asio::post(net_, [this, event] {
+    ++detaches_;
+    attached_ = false;
+    broadcast_event(event);
+  });
 }
 
 void Hub::broadcast_event(const nlohmann::json& event) {

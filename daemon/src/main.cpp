@@ -63,6 +63,15 @@ int run(daemon::DaemonConfig cfg) {
   int exit_code = 0;
   {
     daemon::Hub hub(net.get_executor(), device.get_executor(), std::move(*backend), opts, fallback);
+    // Board backends: probe presence and re-attach after an unplug (sim/fake/discard: no factory).
+    auto reattach = daemon::make_reattach_factory(cfg);
+    if (reattach && cfg.mirror)  // a board that comes back is mirrored again
+      reattach = [inner = std::move(reattach)]() -> Result<std::unique_ptr<backends::Backend>> {
+        auto board = inner();
+        if (!board) return board;
+        return daemon::make_mirror(std::move(*board));
+      };
+    hub.enable_hotplug(std::move(reattach), std::chrono::milliseconds(cfg.reattach_interval_ms));
     daemon::Server server(net, hub);
     for (const auto& text : cfg.listen) {
       auto addr = client::parse_address(text);
@@ -88,6 +97,7 @@ int run(daemon::DaemonConfig cfg) {
       log->info("signal {}: shutting down", sig);
       notify("STOPPING=1");
       server.stop();  // no new connections; socket and lock removed now
+      hub.stop_hotplug();
       const auto open = hub.shutdown_sessions();
       // Sessions close once their last reply is flushed; never wait longer than 1.5 s in total.
       const auto give_up = std::chrono::steady_clock::now() + std::chrono::milliseconds(open ? 1500 : 0);
@@ -104,8 +114,10 @@ int run(daemon::DaemonConfig cfg) {
     });
     net.run();
     server.stop();
+    // The device thread may still be inside a hub step (a probe or re-attach attempt): let it
+    // finish before the hub it works on is destroyed.
+    join_device();
   }
-  join_device();
   log->info("stopped");
   return exit_code;
 }
@@ -121,6 +133,7 @@ int main(int argc, char** argv) {
   std::optional<unsigned> max_clients, handshake_ms, idle_ms, trickle_ms, min_rate;
   std::optional<std::uint32_t> max_message;
   std::optional<std::uint64_t> queue_bytes;
+  std::optional<unsigned> reattach_ms;
   bool foreground = false;
   bool no_fallback = false;
   bool mirror = false;
@@ -128,11 +141,16 @@ int main(int argc, char** argv) {
   app.add_option("-l,--listen", listen, "unix:PATH or tcp:HOST:PORT (repeatable; replaces the config's list)");
   app.add_option("--token", token, "token TCP clients must present (required for non-loopback TCP)");
   app.add_option("--token-file", token_file, "read the token from the first line of this file");
-  app.add_option("-b,--backend", backend, "sim | auto | BOARD | emulated:BOARD | fake | discard");
+  app.add_option("-b,--backend", backend,
+                 "sim | auto | BOARD | emulated:BOARD[?presence=PATH] | fake | discard "
+                 "(presence: the emulated adapter is plugged in while PATH exists)");
   app.add_flag("--no-fallback", no_fallback, "do not switch to the simulator when a board disappears");
   app.add_flag("--mirror", mirror,
                "board backends: also run the simulator on the same commands and compare every frame "
                "(subscribers may ask for the board, the simulator or a diff image)");
+  app.add_option("--reattach-interval-ms", reattach_ms,
+                 "board backends: probe the board and, after an unplug, look for it again this often "
+                 "(default 1000; 0 = never re-attach)");
   app.add_option("--boards-dir", boards_dir, "directory of board profiles (JSON)");
   app.add_option("--frames-dir", frames_dir, "write every scanned-out frame as frame_NNNNNN.png here");
   app.add_option("--record", record_dir, "write each session's command stream as a binary trace here");
@@ -167,6 +185,7 @@ int main(int argc, char** argv) {
   if (!backend.empty()) cfg.backend = backend;
   if (no_fallback) cfg.fallback_to_sim = false;
   if (mirror) cfg.mirror = true;
+  if (reattach_ms) cfg.reattach_interval_ms = *reattach_ms;
   if (!boards_dir.empty()) cfg.boards_dir = boards_dir;
   if (!frames_dir.empty()) cfg.frames_dir = frames_dir;
   if (!record_dir.empty()) cfg.record_dir = record_dir;

@@ -19,7 +19,9 @@ struct RealLower {
 
 Result<std::unique_ptr<BoardBackend>> open_board(const BoardProfile& profile, const BoardOpenOptions& opts) {
   if (opts.emulate) {
-    auto stack = emu::EmulatedStack::create(profile, emu::EmulationOptions{});
+    emu::EmulationOptions eo;
+    eo.presence_file = opts.emulated_presence_file;
+    auto stack = emu::EmulatedStack::create(profile, eo);
     if (!stack) return stack.error();
     std::shared_ptr<emu::EmulatedStack> s = std::move(*stack);
     s->spi_faults().max_reliable_hz = opts.emulated_max_reliable_hz;

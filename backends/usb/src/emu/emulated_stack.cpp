@@ -1,5 +1,7 @@
 #include "gpubridge/usb/emu/emulated_stack.hpp"
 
+#include <cstdio>
+
 #include "gpubridge/backends/backend.hpp"
 #include "gpubridge/usb/ch341a.hpp"
 #include "gpubridge/usb/cp2130.hpp"
@@ -85,6 +87,17 @@ EmulatedStack::EmulatedStack(std::unique_ptr<Impl> impl) : impl_(std::move(impl)
 EmulatedStack::~EmulatedStack() = default;
 
 Result<std::unique_ptr<EmulatedStack>> EmulatedStack::create(const BoardProfile& profile, EmulationOptions opts) {
+  FaultPlan presence;
+  presence.presence_file = opts.presence_file;
+  if (!presence.present()) {
+    // The wording and code of LibusbContext::open when nothing matches: the same "device gone" case.
+    char id[16];
+    std::snprintf(id, sizeof id, "%04x:%04x", profile.vid, profile.pid);
+    return make_error(std::string("no USB device ") + id + " with serial " + opts.serial +
+                          " is attached (emulated: presence file " + opts.presence_file +
+                          " is absent); create the file to plug the emulated adapter in",
+                      backends::kDeviceGone);
+  }
   auto impl = std::make_unique<Impl>();
   impl->profile = profile;
   impl->opts = opts;
@@ -112,7 +125,9 @@ Result<std::unique_ptr<EmulatedStack>> EmulatedStack::create(const BoardProfile&
     case BridgeChip::MCP2210: impl->mcp2210 = std::make_unique<Mcp2210Model>(impl->slave.get(), opts.serial); break;
     case BridgeChip::CP2130: impl->cp2130 = std::make_unique<Cp2130Model>(impl->slave.get(), opts.serial); break;
   }
-  return std::unique_ptr<EmulatedStack>(new EmulatedStack(std::move(impl)));
+  std::unique_ptr<EmulatedStack> stack(new EmulatedStack(std::move(impl)));
+  stack->usb_faults().presence_file = opts.presence_file;
+  return stack;
 }
 
 UsbDevice* EmulatedStack::usb() {

@@ -2,8 +2,10 @@
 // Builds the daemon's backend from its name: "sim" (the simulator, default), "discard" and
 // "fake" (test_backends.hpp), "auto" (the first board profile whose real bridge opens, else the
 // simulator), a board profile name or .json path (the real board), or "emulated:PROFILE" (that
-// board's bridge-chip model + simulator, same driver code). Boards need the USB board path,
+// board's bridge-chip model + simulator, same driver code; "emulated:PROFILE?presence=PATH" makes
+// the emulated adapter plugged in only while PATH exists). Boards need the USB board path,
 // linked in when gpubridge_usb is built.
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -16,5 +18,12 @@ Result<std::unique_ptr<backends::Backend>> make_backend(const std::string& name,
 // The simulator with default options (fallback when a board disappears).
 Result<std::unique_ptr<backends::Backend>> make_simulator();
 bool simulator_available();
+// True for backends that name a board ("auto", a profile, "emulated:PROFILE"): those can
+// disappear and come back.
+bool is_board_backend(const std::string& name);
+// Re-opens the configured board after it disappeared (the hub calls it on the device thread until
+// it succeeds); "auto" looks for any present board but never settles for the simulator. Empty
+// for backends that cannot disappear (sim, fake, discard) or without the USB board path.
+std::function<Result<std::unique_ptr<backends::Backend>>()> make_reattach_factory(const DaemonConfig& cfg);
 
 }  // namespace gpubridge::daemon

@@ -22,6 +22,8 @@ struct Limits {
   std::uint64_t queue_bytes = 64ull << 20;      // outgoing bytes queued per session before reading pauses
 };
 
+inline constexpr unsigned kMaxReattachIntervalMs = 3600000;  // one hour
+
 struct DaemonConfig {
   std::vector<std::string> listen;  // "unix:PATH" | "tcp:HOST:PORT"; empty = the default Unix socket
   std::string token;                // required from TCP clients when set
@@ -29,6 +31,8 @@ struct DaemonConfig {
   std::string backend = "sim";      // "sim" | "discard" | "fake" | board name | "auto"
   bool fallback_to_sim = true;      // board lost → continue on the simulator
   bool mirror = false;              // board backends: run the simulator alongside and compare (docs/daemon.md)
+  unsigned reattach_interval_ms = 1000;  // board lost → look for it again this often (0 = never);
+                                        // also the interval of the presence probe while attached
   std::string boards_dir;           // board profiles (JSON)
   std::string frames_dir;           // write every scanned-out frame as PNG here
   std::string record_dir;           // write each session's stream as a binary trace here

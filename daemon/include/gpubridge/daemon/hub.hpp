@@ -99,6 +99,14 @@ class Hub {
     });
   }
 
+  // --- hot-plug (hub_hotplug.cpp; docs/daemon.md "Hot-plug") ---
+  // Every `interval` the device thread probes the board (ID read) while it is attached, or calls
+  // `reattach` once it disappeared; a board that comes back replaces the fallback at once and
+  // every session gets a `device_back` event. Call once, before the network loop runs.
+  void enable_hotplug(BackendFactory reattach, std::chrono::milliseconds interval);
+  // Shutdown: cancels the timer; no probe or attempt starts afterwards (network thread).
+  void stop_hotplug();
+
   std::string device_json() const;     // WELCOME's device description
   nlohmann::json status_json() const;  // STATUS_REPLY
   std::uint64_t frames_seen() const { return frames_seen_; }
@@ -113,6 +121,10 @@ class Hub {
   void compare_mirrored(const backends::ScanoutFrame& frame);            // network thread
   void on_device_gone(const Error& e);                                   // device thread
   void broadcast_event(const nlohmann::json& event);                     // network thread
+  void arm_hotplug_timer();                                              // network thread
+  void hotplug_tick();                                                   // device thread
+  void install_backend(std::unique_ptr<backends::Backend> backend);      // device thread
+  nlohmann::json hotplug_json() const;                                   // network thread
   void grant_next();
 
   Executor net_, device_;
@@ -132,6 +144,15 @@ class Hub {
   std::shared_ptr<FrameFanout> newest_fanout_;  // the last swap, for offer_newest_frame
   std::atomic<std::uint64_t> frame_pngs_written_{0};  // incremented on the device thread
   std::chrono::steady_clock::time_point started_ = std::chrono::steady_clock::now();
+
+  // Hot-plug (hub_hotplug.cpp).
+  BackendFactory reattach_;                     // empty: the backend cannot come back (sim, fake)
+  std::chrono::milliseconds hotplug_interval_{0};
+  boost::asio::steady_timer hotplug_timer_{net_};
+  bool hotplug_stopped_ = false;                // network thread
+  bool device_lost_ = false;                    // device thread: gone and not yet re-attached
+  bool attached_ = true;                        // network-thread copy of !device_lost_
+  std::uint64_t detaches_ = 0, reattaches_ = 0;  // network thread
 };
 
 }  // namespace gpubridge::daemon

@@ -2,6 +2,7 @@
 // Opens the board a profile describes: through libusb/hidapi, or fully emulated (chip model +
 // simulator) so the same driver code runs without hardware.
 #include <memory>
+#include <string>
 
 #include "gpubridge/usb/board_backend.hpp"
 #include "gpubridge/usb/board_profile.hpp"
@@ -11,6 +12,7 @@ namespace gpubridge::usb {
 struct BoardOpenOptions {
   bool emulate = false;
   std::uint32_t emulated_max_reliable_hz = 0;  // emulation only: MISO errors above this SCK (0 = none)
+  std::string emulated_presence_file;          // emulation only: plugged in while this file exists ("" = always)
   BoardOptions board;
 };
 

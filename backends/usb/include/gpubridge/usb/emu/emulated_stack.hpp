@@ -22,6 +22,9 @@ struct EmulationOptions {
   unsigned drain_per_frame = 0;  // device slower than the link (flow-control tests); 0 = instant
   bool high_speed = true;        // FTDI: 512-byte packets (false: 64, behind a full-speed hub)
   std::string serial = "EMU00001";
+  // Emulated hot-plug: the board is plugged in only while this file exists (empty = always). An
+  // absent file makes enumeration fail and every transfer return NO_DEVICE, as libusb would.
+  std::string presence_file;
 };
 
 class EmulatedStack {

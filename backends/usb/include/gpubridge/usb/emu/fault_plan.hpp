@@ -4,7 +4,10 @@
 // the index through a whole session (reliability-tests.md section 4).
 #include <cstddef>
 #include <cstdint>
+#include <filesystem>
 #include <optional>
+#include <string>
+#include <system_error>
 
 namespace gpubridge::usb::emu {
 
@@ -20,12 +23,24 @@ struct FaultPlan {
   UsbFault fault = UsbFault::None;
   std::size_t partial_bytes = 0;
 
+  // Unplug from outside the process (emulated hot-plug): when non-empty, the device counts as
+  // plugged in only while this file exists. Once it is found missing the device stays gone (like a
+  // real libusb handle after an unplug); a replug is a new device that must be opened again.
+  std::string presence_file;
+
   std::uint64_t ops = 0;  // operations seen so far
   bool unplugged = false;
+
+  bool present() const {
+    if (presence_file.empty()) return true;
+    std::error_code ec;
+    return std::filesystem::exists(presence_file, ec);
+  }
 
   // Called by a model at the start of every operation; returns the fault to apply now.
   UsbFault next() {
     const std::uint64_t op = ops++;
+    if (!unplugged && !present()) unplugged = true;
     if (unplugged) return UsbFault::NoDevice;
     if (at_op && *at_op == op) {
       if (fault == UsbFault::NoDevice) unplugged = true;
