@@ -22,6 +22,7 @@
 #include "gpubridge/daemon/hub.hpp"
 #include "gpubridge/daemon/mirror_backend.hpp"
 #include "gpubridge/daemon/server.hpp"
+#include "gpubridge/daemon/test_backends.hpp"
 #include "gpubridge/protocol/pixel.hpp"
 
 #if defined(GPUBRIDGE_HAVE_SIM) && defined(GPUBRIDGE_HAVE_USB)
@@ -64,6 +65,57 @@ std::unique_ptr<client::Client> subscriber(const std::string& address, FrameSour
   auto sub = owned->subscribe(protocol::Subscribe{format, 0, source}, 2000ms);
   EXPECT_TRUE(sub) << (sub ? "" : sub.error().message);
   return sub ? std::move(owned) : nullptr;
+}
+
+// The decorator on its own, with two FakeScanoutBackends (a board of 64 KiB, a model of 4 KiB).
+TEST(MirrorBackend, ForwardsToBothAnswersFromTheBoardAndPairsSwaps) {
+  auto board_owned = std::make_unique<daemon::FakeScanoutBackend>(8, 4, 64 * 1024);
+  auto model_owned = std::make_unique<daemon::FakeScanoutBackend>(8, 4, 4 * 1024);
+  auto* board = board_owned.get();
+  auto* model = model_owned.get();
+  daemon::MirrorBackend mirror(std::move(board_owned), std::move(model_owned));
+  std::vector<std::shared_ptr<const backends::ScanoutFrame>> got;
+  mirror.set_scanout_callback([&](std::shared_ptr<const backends::ScanoutFrame> f) { got.push_back(std::move(f)); });
+
+  // Writes reach both sides.
+  protocol::FramesCmd color;
+  color.push(protocol::write_frame(protocol::Reg::CLEAR_COLOR, 0x11223344));
+  ASSERT_TRUE(mirror.write_frames(color.view()));
+  EXPECT_EQ(*board->read_register(protocol::index_of(protocol::Reg::CLEAR_COLOR)), 0x11223344u);
+  EXPECT_EQ(*model->read_register(protocol::index_of(protocol::Reg::CLEAR_COLOR)), 0x11223344u);
+  // Reads are answered by the board: change the board alone, then read through the mirror.
+  protocol::FramesCmd board_only;
+  board_only.push(protocol::write_frame(protocol::Reg::CLEAR_COLOR, 0x55667788));
+  ASSERT_TRUE(board->write_frames(board_only.view()));
+  EXPECT_EQ(*mirror.read_register(protocol::index_of(protocol::Reg::CLEAR_COLOR)), 0x55667788u);
+
+  // An upload the board takes and the model refuses succeeds for the client and is counted.
+  const std::vector<std::uint8_t> bytes(16, 0xAB);
+  EXPECT_TRUE(mirror.upload(32 * 1024, bytes));
+  EXPECT_EQ(mirror.counters().model_errors, 1u);
+  auto back = mirror.readback(32 * 1024, 16);
+  ASSERT_TRUE(back);
+  EXPECT_EQ(*back, bytes);
+
+  // A mirrored swap: one frame, the board's, with the model's frame as reference.
+  protocol::FramesCmd swap;
+  swap.push(protocol::write_frame(protocol::Reg::FB_DISPLAY, 0));
+  ASSERT_TRUE(mirror.write_frames(swap.view()));
+  ASSERT_EQ(got.size(), 1u);
+  ASSERT_NE(got[0]->reference, nullptr);
+  EXPECT_EQ(got[0]->width, 8u);
+  EXPECT_EQ(got[0]->reference->width, 8u);
+
+  // Swaps of one side only never pair up and never pile up: beyond 4 waiting the oldest are dropped.
+  for (int i = 0; i < 6; ++i) ASSERT_TRUE(board->write_frames(swap.view()));
+  ASSERT_TRUE(mirror.flush());
+  EXPECT_EQ(got.size(), 1u);
+  EXPECT_EQ(mirror.counters().unpaired_frames, 2u);
+  // A reset drops the rest and starts pairing afresh.
+  ASSERT_TRUE(mirror.reset());
+  EXPECT_EQ(mirror.counters().unpaired_frames, 6u);
+  ASSERT_TRUE(mirror.write_frames(swap.view()));
+  EXPECT_EQ(got.size(), 2u);
 }
 
 TEST(DaemonMirror, BoardAndSimulatorFramesBothEqualTheInProcessRender) {

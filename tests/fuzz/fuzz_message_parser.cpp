@@ -1,6 +1,7 @@
-// Fuzzes MessageParser with the input fed in pieces whose sizes derive from the input. Properties: no crash/UB, the
-// buffer stays bounded, offsets advance exactly by each message's size, every accepted message
-// re-encodes to the very bytes it was parsed from, and a poisoned parser stays poisoned.
+// Fuzzes MessageParser with the input fed (feed() or prepare/commit) in pieces whose sizes derive
+// from the input. Properties: no crash/UB, the buffer stays bounded, offsets advance exactly by
+// each message's size, every accepted message re-encodes to the very bytes it was parsed from,
+// and a poisoned parser stays poisoned.
 #include <cstring>
 #include <vector>
 
@@ -25,13 +26,24 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   std::size_t fed = 0, parsed_until = 0, step = 1;
   bool failed = false;
   while (fed < stream.size() && !failed) {
+    // Bit 5 of the byte at the split point picks the way in: feed() (a copy) or a direct read
+    // (prepare/commit, as the daemon does), which may offer less room than asked for.
+    const bool direct = stream[fed] & 32;
     step = (step * 7 + (stream[fed] & 31)) % 97 + 1;
-    const std::size_t n = std::min(step, stream.size() - fed);
-    parser.feed(std::span(stream).subspan(fed, n));
+    std::size_t n = std::min(step, stream.size() - fed);
+    if (direct) {
+      const auto space = parser.prepare(step);
+      FUZZ_CHECK(!space.empty() && space.size() <= step);
+      n = std::min(n, space.size());
+      std::memcpy(space.data(), stream.data() + fed, n);
+      parser.commit(n);
+    } else {
+      parser.feed(std::span(stream).subspan(fed, n));
+    }
     fed += n;
-    // Lazy compaction keeps consumed bytes below max(4096, unconsumed), and unconsumed bytes are at
-    // most one partial message plus this feed.
-    FUZZ_CHECK(parser.held_bytes() <= 4096 + 2 * (std::size_t{max_payload} + kHeaderBytes) + n);
+    // Unconsumed bytes are at most one partial message plus this read; the buffer grows by
+    // doubling capped at kHeaderBytes + max_payload + the read size.
+    FUZZ_CHECK(parser.held_bytes() <= 4096 + 2 * (std::size_t{max_payload} + kHeaderBytes) + step);
     for (;;) {
       Message m;
       const auto st = parser.next(m);

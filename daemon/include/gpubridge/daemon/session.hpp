@@ -75,8 +75,8 @@ class Session : public std::enable_shared_from_this<Session> {
   std::unique_ptr<Stream> stream_;
   boost::asio::steady_timer tick_;
   boost::asio::steady_timer frame_timer_;  // releases a rate-limited frame when its interval ends
-  protocol::MessageParser parser_;
-  std::vector<std::uint8_t> read_buf_;
+  protocol::MessageParser parser_;  // socket reads land directly in its buffer
+  std::size_t read_bytes_ = 0;      // largest read: a page before the handshake, 1 MiB after
 
   std::uint32_t id_ = 0;
   std::string name_;

@@ -5,6 +5,7 @@
 //   payload (length bytes, at most the negotiated maximum, never more than kMaxPayload).
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
@@ -95,7 +96,7 @@ struct Header {
 };
 
 // Typed payloads. Byte spans point into the parser's buffer and are valid until the next
-// call to MessageParser::next() or feed(); copy what you keep.
+// call to MessageParser::next(), feed() or prepare(); copy what you keep.
 struct Hello { std::uint16_t version = kSocketVersion; std::string name; std::string token; };
 struct Welcome { std::uint16_t version = kSocketVersion; std::uint32_t max_payload = kMaxPayload; std::uint32_t session_id = 0; std::string json; };
 struct ErrorMsg { ErrorCode code = ErrorCode::Internal; std::uint32_t ref = 0; std::string text; };
@@ -173,10 +174,15 @@ std::optional<DecodeError> decode_header(std::span<const std::uint8_t, kHeaderBy
 // Messages name the field and its payload byte offset; the caller adds the stream position.
 std::optional<DecodeError> decode_payload(const Header& h, std::span<const std::uint8_t> payload, Message& out);
 
-// Incremental parser: feed bytes as they arrive, then call next() until it returns NeedMore.
-// After an Error the parser is poisoned (the stream cannot be resynchronised) and keeps
-// returning the same error. The length field is checked against max_payload before any
-// allocation; the parser's buffer never exceeds max_payload + kHeaderBytes plus one feed() call.
+// Incremental parser. Bytes go in either way:
+//  - feed(bytes) copies them in (tests, fuzzers, small readers);
+//  - prepare(n) returns writable space inside the parser's own buffer, the caller reads into it
+//    (a socket read) and commit(k) appends the first k of those bytes to the stream: no copy
+//    (like Asio's dynamic buffers, but the span may be shorter than n, see prepare()).
+// Then call next() until it returns NeedMore. After an Error the parser is poisoned (the stream
+// cannot be resynchronised) and keeps returning the same error. A header's length field is
+// checked against max_payload before it decides any allocation; the buffer never exceeds
+// kHeaderBytes + max_payload plus one feed() or prepare() size (when next() runs between them).
 class MessageParser {
  public:
   enum class Status { Ok, NeedMore, Error };
@@ -184,18 +190,39 @@ class MessageParser {
   explicit MessageParser(std::uint32_t max_payload = kMaxPayload);
   void set_max_payload(std::uint32_t max_payload);
   void feed(std::span<const std::uint8_t> bytes);
+  // Writable space for at most `max_bytes` incoming bytes (1..max_bytes of them; empty only when
+  // max_bytes is 0 or the parser is poisoned). While the message in progress is a large one
+  // (valid header, kLargeMessageBytes or more in all), the span ends where that message ends: it
+  // then completes at the end of the buffer, which empties, so a stream of large messages is read
+  // without moving bytes to make room. Small messages share reads; their partial tails are moved.
+  // Invalidates earlier spans (from prepare() and from parsed messages).
+  std::span<std::uint8_t> prepare(std::size_t max_bytes);
+  // Appends the first n bytes written into the last prepare() span (n beyond it is clamped).
+  void commit(std::size_t n);
   Status next(Message& out);
   const DecodeError& error() const { return error_; }
   // Bytes buffered but not yet returned as messages (for trickle/idle accounting).
-  std::size_t buffered() const { return buf_.size() - pos_; }
-  // Bytes the parser holds in memory, including consumed bytes not yet compacted away.
-  std::size_t held_bytes() const { return buf_.size(); }
+  std::size_t buffered() const { return end_ - pos_; }
+  // Bytes the parser holds in memory (its buffer's capacity).
+  std::size_t held_bytes() const { return capacity_; }
   // Total stream offset of the first byte of the message being parsed (for error messages).
   std::uint64_t stream_offset() const { return consumed_ + pos_; }
 
+  // prepare() stops at the end of a message in progress of at least this size (header included).
+  static constexpr std::size_t kLargeMessageBytes = 16 * 1024;
+
  private:
-  std::vector<std::uint8_t> buf_;
-  std::size_t pos_ = 0;
+  // Makes room for n more bytes after the unconsumed ones: moves them to the front when that is
+  // enough, otherwise grows (doubling, capped at `ceiling` unless n itself needs more).
+  void make_room(std::size_t n, std::size_t ceiling);
+  // kHeaderBytes + length of the message in progress once its header is buffered and valid.
+  std::optional<std::size_t> current_message_bytes() const;
+
+  std::unique_ptr<std::uint8_t[]> buf_;
+  std::size_t capacity_ = 0;
+  std::size_t pos_ = 0;       // first unconsumed byte
+  std::size_t end_ = 0;       // one past the last stream byte
+  std::size_t prepared_ = 0;  // size of the span the last prepare() returned
   std::uint64_t consumed_ = 0;
   std::uint32_t max_payload_;
   bool failed_ = false;
