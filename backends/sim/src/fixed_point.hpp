@@ -29,7 +29,8 @@ inline DivMod floor_divmod128(i128 a, std::int64_t b) {
 class Divider {
  public:
   explicit Divider(std::int64_t d) : d_(d), inv_(1.0 / static_cast<double>(d)) {}
-  DivMod operator()(std::int64_t a) const {
+  // Always inlined: it sits in per-row loops of the rasteriser and in setup.
+  [[gnu::always_inline]] DivMod operator()(std::int64_t a) const {
     constexpr std::int64_t kExact = std::int64_t{1} << 52;
     if (a >= kExact || a <= -kExact) return floor_divmod(a, d_);
     std::int64_t q = static_cast<std::int64_t>(static_cast<double>(a) * inv_);

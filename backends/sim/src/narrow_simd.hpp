@@ -19,8 +19,10 @@ namespace gpubridge::sim {
 struct NarrowTriangle {
   static constexpr unsigned kPlanes = 5;  // R, G, B, A, Z
   std::int32_t e[3] = {}, ex[3] = {}, ey[3] = {};  // edge values at the first row's box origin, steps
-  std::uint32_t q[kPlanes] = {}, r[kPlanes] = {};  // planes at the first row's box origin (r < den)
-  std::uint32_t qx[kPlanes] = {}, rx[kPlanes] = {}, qy[kPlanes] = {}, ry[kPlanes] = {};  // rx, ry < den
+  // Planes at the first row's box origin (r < den) and their steps (rx, ry < den). Only the
+  // planes the routine uses are filled (R..A when gouraud, Z when depth): no zero fill per triangle.
+  std::uint32_t q[kPlanes], r[kPlanes];
+  std::uint32_t qx[kPlanes], rx[kPlanes], qy[kPlanes], ry[kPlanes];
   std::uint32_t den = 1;
   unsigned width = 0, rows = 0;  // box width (<= 8) and rows to draw
   std::uint32_t flat = 0;        // colour word (memory order R,G,B,A) when !gouraud

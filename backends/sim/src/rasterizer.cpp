@@ -50,7 +50,10 @@ class Kernel {
         edge_div_[i] = Divider(ex < 0 ? -ex : (ex == 0 ? 1 : ex));
       }
     }
-    if (ctx.fast) prepare_fast();
+    if (kTextured && ctx.fast) {
+      fast_scale_u_ = std::ldexp(1.0, 20 + static_cast<int>(st.tex.wl));
+      fast_scale_v_ = std::ldexp(1.0, 20 + static_cast<int>(st.tex.hl));
+    }
     if (kTextured && t.plane[kQ].constant && t.plane[kQ].q != 0) {
       q_const_ = true;  // affine: the reciprocal is the same at every pixel
       const_rc_ = ctx.recip(static_cast<std::uint32_t>(t.plane[kQ].q));
@@ -71,11 +74,6 @@ class Kernel {
     const int w = t_.x1 - t_.x0;
     int row_at = 0;  // narrow rows: x offset of `row` (see narrow_row)
     for (int y = ya; y < yz; ++y) {
-      if (ctx_.fast) {
-        fast_row(y, e, w);
-        for (int i = 0; i < 3; ++i) e[i] += t_.edge[i].ey;
-        continue;
-      }
       if (w >= kSpanSolveWidth) {
         std::int64_t kl = 0, kr = w - 1;
         for (int i = 0; i < 3; ++i) {
@@ -195,54 +193,6 @@ class Kernel {
     }
   }
 
-  // Accuracy knob `fast`: attributes from double-precision planes (value = v00 + x·dx + y·dy,
-  // rounded half up and clamped to the vertex range), texel coordinates from a floating-point
-  // divide. Coverage stays exact. Derived from the exact planes: N/D = q + r/den − 1/2.
-  void prepare_fast() {
-    for (unsigned i = 0; i < kAttrCount; ++i) {
-      if (!((kPlanes >> i) & 1)) continue;
-      const Plane& p = t_.plane[i];
-      const double den = static_cast<double>(t_.den);
-      fv00_[i] = static_cast<double>(p.q) - 0.5 + static_cast<double>(p.r) / den;
-      fdx_[i] = static_cast<double>(p.qx) + static_cast<double>(p.rx) / den;
-      fdy_[i] = static_cast<double>(p.qy) + static_cast<double>(p.ry) / den;
-      std::int64_t lo = INT64_MAX, hi = INT64_MIN;
-      for (const Vertex& v : t_.v) {
-        const std::int64_t a = i < 4 ? v.c[i] : i == kZ ? std::int64_t{v.z} : i == kS ? v.s : i == kT ? v.t : std::int64_t{v.q};
-        lo = std::min(lo, a);
-        hi = std::max(hi, a);
-      }
-      flo_[i] = lo;
-      fhi_[i] = hi;
-    }
-  }
-
-  void fast_row(int y, const std::int64_t* e, int w) {
-    double v[kAttrCount];
-    const double dy = y - t_.y0;
-    for (unsigned i = 0; i < kAttrCount; ++i)
-      if ((kPlanes >> i) & 1) v[i] = fv00_[i] + dy * fdy_[i];
-    std::int64_t e0 = e[0], e1 = e[1], e2 = e[2];
-    Steppers s;
-    for (int kx = 0; kx < w; ++kx) {
-      if ((e0 | e1 | e2) >= 0) {
-        ++ctx_.counters.covered;
-        for (unsigned i = 0; i < kAttrCount; ++i) {
-          if (!((kPlanes >> i) & 1)) continue;
-          const double val = std::floor(v[i] + kx * fdx_[i] + 0.5);
-          s.q[i] = val <= static_cast<double>(flo_[i]) ? flo_[i]
-                   : val >= static_cast<double>(fhi_[i]) ? fhi_[i]
-                                                          : static_cast<std::int64_t>(val);
-        }
-        pixel(t_.x0 + kx, y, s);
-      }
-      e0 += t_.edge[0].ex;
-      e1 += t_.edge[1].ex;
-      e2 += t_.edge[2].ex;
-    }
-    ctx_.counters.scanned += static_cast<std::uint64_t>(w);
-  }
-
   // The vector routine applies to untextured direct RGBA8888 stores with both buffers inside VRAM
   // and values that fit 32-bit lanes (2·den < 2^31 and per-8-pixel steps below 2^30).
   bool simd_ready() {
@@ -348,15 +298,18 @@ class Kernel {
       TexelCoords tc;
       const std::uint32_t q = static_cast<std::uint32_t>(s.q[kQ]);
       if (q != 0 && ctx_.fast) {
-        // Floating-point reciprocal: tu = s/q · 2^8 (texture widths) · W · 4096, clamped so the
-        // conversion is defined for any input.
+        // Accuracy knob `fast`: a floating-point divide instead of the reciprocal table and
+        // Newton-Raphson: tu = s/q · 2^8 (texture widths) · W · 4096, clamped so the conversion
+        // is defined for any input.
         const double inv = 1.0 / static_cast<double>(q);
-        auto conv = [](double value) {
-          const double f = std::floor(value);
-          return f < -0x1p50 ? -(std::int64_t{1} << 50) : f > 0x1p50 ? (std::int64_t{1} << 50) : static_cast<std::int64_t>(f);
+        auto conv = [](double value) {  // floor, without a libm call (baseline x86-64 has no roundsd)
+          if (!(value > -0x1p50)) return -(std::int64_t{1} << 50);
+          if (value > 0x1p50) return std::int64_t{1} << 50;
+          const auto t = static_cast<std::int64_t>(value);
+          return t - (static_cast<double>(t) > value ? 1 : 0);
         };
-        tc.tu = conv(static_cast<double>(static_cast<std::int32_t>(s.q[kS])) * inv * std::ldexp(1.0, 20 + static_cast<int>(st_.tex.wl)));
-        tc.tv = conv(static_cast<double>(static_cast<std::int32_t>(s.q[kT])) * inv * std::ldexp(1.0, 20 + static_cast<int>(st_.tex.hl)));
+        tc.tu = conv(static_cast<double>(static_cast<std::int32_t>(s.q[kS])) * inv * fast_scale_u_);
+        tc.tv = conv(static_cast<double>(static_cast<std::int32_t>(s.q[kT])) * inv * fast_scale_v_);
       } else if (q != 0) {
         const Reciprocal rc = q_const_ ? const_rc_ : ctx_.recip(q);
         tc = texel_coords(static_cast<std::int32_t>(s.q[kS]), static_cast<std::int32_t>(s.q[kT]), rc, st_.tex.wl,
@@ -409,8 +362,7 @@ class Kernel {
   Reciprocal const_rc_;
   Divider edge_div_[3] = {Divider(1), Divider(1), Divider(1)};
   bool simd_ = false, simd_checked_ = false;
-  double fv00_[kAttrCount] = {}, fdx_[kAttrCount] = {}, fdy_[kAttrCount] = {};
-  std::int64_t flo_[kAttrCount] = {}, fhi_[kAttrCount] = {};
+  double fast_scale_u_ = 0, fast_scale_v_ = 0;  // 2^(20 + log2 size): knob `fast`, textured kernels
   SimdSpan simd_tpl_{};
 };
 
@@ -487,7 +439,7 @@ void rasterize_rows(const Triangle& t, const DrawState& st, RasterContext& ctx, 
   for (unsigned ch = 0; ch < 4; ++ch) colours_differ |= !t.plane[kR + ch].constant;
   const bool gouraud = st.gouraud && colours_differ;  // Gouraud only when colours differ
   const bool depth = st.z_test || st.z_write;
-  if (st.simple_color && !st.textured && !ctx.fast && draw_narrow(t, st, ctx, ya, yz, gouraud, depth)) return;
+  if (st.simple_color && !st.textured && draw_narrow(t, st, ctx, ya, yz, gouraud, depth)) return;
   const unsigned key = (gouraud ? 1u : 0u) | (st.textured ? 2u : 0u) | (depth ? 4u : 0u) | (st.simple_color ? 8u : 0u);
   kKernels[key](t, st, ctx, ya, yz);
 }

@@ -30,7 +30,7 @@ struct RasterContext {
   VideoMemory& mem;
   const ReciprocalUnit& recip;
   unsigned z_bits = 24;
-  bool fast = false;         // floating-point attribute evaluation (accuracy knob `fast`)
+  bool fast = false;         // floating-point texel divide (accuracy knob `fast`)
   std::uint16_t errors = 0;  // ERR_MEM_RANGE from out-of-memory accesses
   RasterCounters counters;
 };

@@ -51,24 +51,23 @@ void setup_plane(Plane& p, std::int64_t a0, std::int64_t a1, std::int64_t a2, co
 
 bool setup_triangle(const Vertex& va, const Vertex& vb, const Vertex& vc, const DrawState& state,
                     unsigned subpixel_bits, bool all_attributes, Triangle& t) {
+  // subpixel_bits < 4 truncates the vertex coordinates first.
+  const std::int32_t keep = subpixel_bits < 4 ? ~((std::int32_t{1} << (4 - subpixel_bits)) - 1) : ~std::int32_t{0};
+  const std::int64_t ax = va.x & keep, ay = va.y & keep;
+  std::int64_t D = ((vb.x & keep) - ax) * ((vc.y & keep) - ay) - ((vc.x & keep) - ax) * ((vb.y & keep) - ay);
+  if (D == 0) return false;
+  // The exchange of section 8.1 as a select, not a branch: the winding of consecutive triangles
+  // is as random as their positions.
+  const bool flip = D < 0;
   t.v[0] = va;
-  t.v[1] = vb;
-  t.v[2] = vc;
-  if (subpixel_bits < 4) {
-    const std::int32_t keep = ~((std::int32_t{1} << (4 - subpixel_bits)) - 1);
-    for (auto& v : t.v) {
-      v.x &= keep;
-      v.y &= keep;
-    }
+  t.v[1] = flip ? vc : vb;
+  t.v[2] = flip ? vb : vc;
+  D = flip ? -D : D;
+  for (auto& v : t.v) {
+    v.x &= keep;
+    v.y &= keep;
   }
   std::copy(std::begin(va.c), std::end(va.c), t.flat);
-  const std::int64_t X0 = t.v[0].x, Y0 = t.v[0].y;
-  std::int64_t D = (t.v[1].x - X0) * (t.v[2].y - Y0) - (t.v[2].x - X0) * (t.v[1].y - Y0);
-  if (D == 0) return false;
-  if (D < 0) {
-    std::swap(t.v[1], t.v[2]);
-    D = -D;
-  }
   const auto [mnx, mxx] = std::minmax({t.v[0].x, t.v[1].x, t.v[2].x});
   const auto [mny, mxy] = std::minmax({t.v[0].y, t.v[1].y, t.v[2].y});
   // Pixels whose sample point 16x + 8 lies inside the vertices' extent.
@@ -80,29 +79,32 @@ bool setup_triangle(const Vertex& va, const Vertex& vb, const Vertex& vc, const 
 
   t.den = 2 * D;
   const std::int64_t sx = 16 * std::int64_t{t.x0} + 8, sy = 16 * std::int64_t{t.y0} + 8;
-  const Edge e12 = make_edge(t.v[1], t.v[2], sx, sy);
+  // Raw edge functions (the barycentric weights of the planes) and, in t.edge, the biased ones.
   const Edge e20 = make_edge(t.v[2], t.v[0], sx, sy);
   const Edge e01 = make_edge(t.v[0], t.v[1], sx, sy);
-  t.edge[0] = e12;
+  t.edge[0] = make_edge(t.v[1], t.v[2], sx, sy);
   t.edge[0].e += edge_bias(t.v[1], t.v[2]);
-  t.edge[1] = e20;
-  t.edge[1].e += edge_bias(t.v[2], t.v[0]);
-  t.edge[2] = e01;
-  t.edge[2].e += edge_bias(t.v[0], t.v[1]);
+  t.edge[1] = {e20.e + edge_bias(t.v[2], t.v[0]), e20.ex, e20.ey};
+  t.edge[2] = {e01.e + edge_bias(t.v[0], t.v[1]), e01.ex, e01.ey};
 
   const Vertex* v = t.v;
   const Divider div(t.den);
   const bool colour = all_attributes || state.gouraud;
   const bool depth = all_attributes || state.z_test || state.z_write;
   const bool tex = all_attributes || state.textured;
-  for (unsigned i = 0; i < kAttrCount; ++i) t.plane[i] = Plane{};
+  // Planes not set up read as constant (the kernels never step them).
   if (colour)
     for (unsigned ch = 0; ch < 4; ++ch) setup_plane(t.plane[kR + ch], v[0].c[ch], v[1].c[ch], v[2].c[ch], e20, e01, D, div);
+  else
+    for (unsigned ch = 0; ch < 4; ++ch) t.plane[kR + ch] = Plane{};
   if (depth) setup_plane(t.plane[kZ], v[0].z, v[1].z, v[2].z, e20, e01, D, div);
+  else t.plane[kZ] = Plane{};
   if (tex) {
     setup_plane(t.plane[kS], v[0].s, v[1].s, v[2].s, e20, e01, D, div);
     setup_plane(t.plane[kT], v[0].t, v[1].t, v[2].t, e20, e01, D, div);
     setup_plane(t.plane[kQ], v[0].q, v[1].q, v[2].q, e20, e01, D, div);
+  } else {
+    t.plane[kS] = t.plane[kT] = t.plane[kQ] = Plane{};
   }
   return true;
 }

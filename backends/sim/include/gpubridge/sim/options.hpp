@@ -17,7 +17,7 @@ struct AccuracyKnobs {
   unsigned nr_steps = 1;       // Newton-Raphson steps k, 0..4
   unsigned subpixel_bits = 4;  // honoured vertex subpixel bits, 0..4 (fewer: X/Y truncated toward -inf)
   unsigned z_bits = 24;        // honoured depth bits, 1..24 (fewer: Z truncated before test and store)
-  bool fast = false;           // floating-point attribute evaluation (not bit-exact)
+  bool fast = false;           // texel coordinates from a floating-point divide (not bit-exact when textured)
 
   // True when every knob has its hardware value (the simulator is then the golden model).
   bool exact() const {
