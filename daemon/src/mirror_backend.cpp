@@ -11,10 +11,6 @@
 namespace gpubridge::daemon {
 namespace {
 
-// A swap the other side never matches (board scanout "off", a batch that failed half-way on one
-// side) must not grow a queue without bound: beyond this many waiting frames the oldest is dropped.
-constexpr std::size_t kMaxWaitingFrames = 4;
-
 template <class T>
 Result<void> as_void(const Result<T>& r) {
   if (r) return {};
@@ -26,7 +22,7 @@ Result<void> as_void(const Result<T>& r) {
 MirrorBackend::MirrorBackend(std::unique_ptr<backends::Backend> board, std::unique_ptr<backends::Backend> model)
     : board_(std::move(board)), model_(std::move(model)) {
   // Both callbacks run on the thread that called into the backend (the daemon's device thread);
-  // frames are queued and paired after the forwarded call returns from both sides.
+  // frames are collected and paired when the forwarded call has returned from both sides.
   board_->set_scanout_callback([this](std::shared_ptr<const backends::ScanoutFrame> f) {
     std::lock_guard lock(mu_);
     board_frames_.push_back(std::move(f));
@@ -95,13 +91,7 @@ Result<void> MirrorBackend::flush() {
 Result<void> MirrorBackend::reset() {
   auto b = board_->reset();
   auto m = model_->reset();
-  auto r = decide(std::move(b), m, "a reset");
-  // A reset is the point where both sides are known to agree again: forget half-made pairs.
-  std::lock_guard lock(mu_);
-  counters_.unpaired_frames += board_frames_.size() + model_frames_.size();
-  board_frames_.clear();
-  model_frames_.clear();
-  return r;
+  return decide(std::move(b), m, "a reset");
 }
 
 void MirrorBackend::set_scanout_callback(backends::ScanoutCallback cb) {
@@ -115,23 +105,30 @@ MirrorCounters MirrorBackend::counters() const {
 }
 
 void MirrorBackend::emit_pairs() {
+  // Pairing is per forwarded call. A board reports at most the state after a batch (it reads
+  // FRAME_CRC once the batch is done), while the simulator reports every FB_DISPLAY; so the
+  // board's last frame of a call pairs with the simulator's last, and the simulator's earlier swaps
+  // of the same call are intermediate pictures nobody saw on the board. Frames of one side only
+  // (board scanout "off", a call that failed on one side) pair with nothing and are counted.
   std::vector<std::shared_ptr<const backends::ScanoutFrame>> ready;
   backends::ScanoutCallback cb;
   {
     std::lock_guard lock(mu_);
-    while (!board_frames_.empty() && !model_frames_.empty()) {
-      auto paired = std::make_shared<backends::ScanoutFrame>(*board_frames_.front());
-      paired->reference = std::move(model_frames_.front());
-      board_frames_.pop_front();
-      model_frames_.pop_front();
+    const std::size_t pairs = std::min(board_frames_.size(), model_frames_.size());
+    if (pairs == 0) {
+      counters_.unpaired_frames += board_frames_.size() + model_frames_.size();
+    } else {
+      counters_.unpaired_frames += board_frames_.size() - pairs;  // a board with more swaps than the model
+      counters_.coalesced_swaps += model_frames_.size() - pairs;
+    }
+    for (std::size_t i = 0; i < pairs; ++i) {
+      const auto& board = board_frames_[board_frames_.size() - pairs + i];
+      auto paired = std::make_shared<backends::ScanoutFrame>(*board);
+      paired->reference = model_frames_[model_frames_.size() - pairs + i];
       ready.push_back(std::move(paired));
     }
-    for (auto* q : {&board_frames_, &model_frames_}) {
-      while (q->size() > kMaxWaitingFrames) {
-        q->pop_front();
-        ++counters_.unpaired_frames;
-      }
-    }
+    board_frames_.clear();
+    model_frames_.clear();
     cb = callback_;
   }
   // Outside the lock: the callback may take its time (PNG writing) and must not block the queues.

@@ -3,10 +3,11 @@
 // MirrorBackend sits in front of a board and forwards every command, in order, to the board and
 // to a reference model (the simulator, configured like the board). Results of reads and readbacks
 // come from the board; the model executes them too so its MEM_ADDR and flags stay in step. Every
-// board swap is paired with the model's swap of the same command stream and reported as the
-// board's ScanoutFrame with `reference` set to the model's frame.
+// board swap is paired with the model's swap at the same point of the command stream (the last
+// one of the same call) and reported as the board's ScanoutFrame with `reference` set to the
+// model's frame.
 #include <cstdint>
-#include <deque>
+#include <vector>
 #include <memory>
 #include <mutex>
 
@@ -15,8 +16,9 @@
 namespace gpubridge::daemon {
 
 struct MirrorCounters {
-  std::uint64_t model_errors = 0;    // commands the board accepted but the model refused
-  std::uint64_t unpaired_frames = 0; // swaps dropped because the other side did not swap (desync)
+  std::uint64_t model_errors = 0;     // commands the board accepted but the model refused
+  std::uint64_t unpaired_frames = 0;  // swaps of one side only in a call (board scanout off, a failed call)
+  std::uint64_t coalesced_swaps = 0;  // model swaps before the last one of a call (the board shows the last)
 };
 
 class MirrorBackend final : public backends::Backend {
@@ -42,12 +44,12 @@ class MirrorBackend final : public backends::Backend {
   // device under test, the model must not make it fail).
   template <class T>
   Result<T> decide(Result<T> board_result, const Result<void>& model_result, const char* what);
-  void emit_pairs();  // after each forwarded call: hand out every complete (board, model) pair
+  void emit_pairs();  // after each forwarded call: pair that call's frames and hand them out
 
   std::unique_ptr<backends::Backend> board_;
   std::unique_ptr<backends::Backend> model_;
   mutable std::mutex mu_;  // guards the queues, the callback and the counters
-  std::deque<std::shared_ptr<const backends::ScanoutFrame>> board_frames_, model_frames_;
+  std::vector<std::shared_ptr<const backends::ScanoutFrame>> board_frames_, model_frames_;  // this call's
   backends::ScanoutCallback callback_;
   MirrorCounters counters_;
 };
