@@ -20,10 +20,12 @@
 #include "gpubridge/client/client.hpp"
 #include "gpubridge/common/image.hpp"
 #include "gpubridge/common/trace_files.hpp"
+#include "gpubridge/daemon/frame_diff.hpp"
 #include "gpubridge/daemon/hub.hpp"
 #include "gpubridge/daemon/mirror_backend.hpp"
 #include "gpubridge/daemon/server.hpp"
 #include "gpubridge/daemon/test_backends.hpp"
+#include "gpubridge/protocol/crc32.hpp"
 #include "gpubridge/protocol/pixel.hpp"
 
 #if defined(GPUBRIDGE_HAVE_SIM) && defined(GPUBRIDGE_HAVE_USB)
@@ -66,6 +68,39 @@ std::unique_ptr<client::Client> subscriber(const std::string& address, FrameSour
   auto sub = owned->subscribe(protocol::Subscribe{format, 0, source}, 2000ms);
   EXPECT_TRUE(sub) << (sub ? "" : sub.error().message);
   return sub ? std::move(owned) : nullptr;
+}
+
+backends::ScanoutFrame make_frame(unsigned w, unsigned h, protocol::PixelFormat f, std::vector<std::uint8_t> px) {
+  backends::ScanoutFrame out;
+  out.number = 7;
+  out.width = w;
+  out.height = h;
+  out.format = f;
+  out.pixels = std::move(px);
+  return out;
+}
+
+TEST(FrameDiff, ComparesExpandedPixelsAndMarksEveryDifference) {
+  using protocol::PixelFormat;
+  // 2x1 RGB565 board: pure red, then white. Model in RGBA8888: the same red, a different second pixel.
+  const auto board = make_frame(2, 1, PixelFormat::RGB565, {0xF8, 0x00, 0xFF, 0xFF});
+  const auto model = make_frame(2, 1, PixelFormat::RGBA8888, {255, 0, 0, 255, 255, 255, 254, 255});
+  std::uint64_t differing = 0;
+  auto d = daemon::diff_frame(board, model, &differing);
+  ASSERT_NE(d, nullptr);
+  EXPECT_EQ(d->number, 7u);
+  EXPECT_EQ(d->format, PixelFormat::RGBA8888);
+  EXPECT_EQ(differing, 1u);
+  const unsigned red_grey = (77u * 255 >> 8) / 2;  // 38
+  EXPECT_EQ(d->pixels, (std::vector<std::uint8_t>{std::uint8_t(red_grey), std::uint8_t(red_grey),
+                                                   std::uint8_t(red_grey), 255, 255, 0, 255, 255}));
+  EXPECT_EQ(d->crc, protocol::crc32(d->pixels));
+  // Different sizes differ everywhere; a CRC-only board frame has no diff.
+  const auto bigger = make_frame(3, 1, PixelFormat::RGBA8888, std::vector<std::uint8_t>(12, 0));
+  auto all = daemon::diff_frame(board, bigger, &differing);
+  ASSERT_NE(all, nullptr);
+  EXPECT_EQ(differing, 2u);
+  EXPECT_EQ(daemon::diff_frame(make_frame(2, 1, PixelFormat::RGB565, {}), model), nullptr);
 }
 
 // The decorator on its own, with two FakeScanoutBackends (a board of 64 KiB, a model of 4 KiB).
