@@ -57,13 +57,13 @@ std::shared_ptr<const std::vector<std::uint8_t>> FrameFanout::message(protocol::
     pixels = converted;
   }
   protocol::FrameData d;
-  d.number = f.number;
+  d.number = frame_->number;  // every picture of a swap carries the board's frame number and swap time
   d.width = static_cast<std::uint16_t>(f.width);
   d.height = static_cast<std::uint16_t>(f.height);
   d.format = target;
   d.crc = target == f.format ? f.crc : protocol::crc32(pixels);
   d.swap_ns = static_cast<std::uint64_t>(
-      std::chrono::duration_cast<std::chrono::nanoseconds>(f.swap_time.time_since_epoch()).count());
+      std::chrono::duration_cast<std::chrono::nanoseconds>(frame_->swap_time.time_since_epoch()).count());
   d.pixels = pixels;
   d.source = source;
   auto bytes = std::make_shared<std::vector<std::uint8_t>>();

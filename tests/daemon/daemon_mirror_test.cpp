@@ -235,11 +235,18 @@ TEST(DaemonMirror, SeveralSwapsInOneBatchCompareTheLastSwap) {
                             "--log-level", "warn"}))
       << daemon.error();
   auto sim = subscriber(address, FrameSource::Sim);
-  ASSERT_TRUE(sim);
+  auto board = subscriber(address, FrameSource::Board);
+  ASSERT_TRUE(sim && board);
   const auto play = run_process({GPUBRIDGE_CLI_PATH, "play", trace, "--connect", address});
   ASSERT_EQ(play.exit_code, 0) << play.err << play.out;
   auto s = sim->next_frame(5000ms);
+  auto b = board->next_frame(5000ms);
   ASSERT_TRUE(s) << s.error().message;
+  ASSERT_TRUE(b) << b.error().message;
+  // The simulator counted three swaps, the board one: the pictures carry the board's number.
+  EXPECT_EQ(s->number, b->number);
+  EXPECT_EQ(s->swap_ns, b->swap_ns);
+  EXPECT_EQ(s->crc, b->crc);
   const Image si = to_image(*s);
   EXPECT_EQ(si.pixel(10, 10)[2], 255) << "the simulator picture of the batch is its last swap (blue)";
   EXPECT_EQ(si.pixel(10, 10)[0], 0);
