@@ -1,7 +1,9 @@
 #pragma once
 // Exact integer helpers shared by the stages: floor division, 128-bit intermediates, big-endian
 // memory words. Everything here is exact; no floating point.
+#include <bit>
 #include <cstdint>
+#include <cstring>
 
 namespace gpubridge::sim {
 
@@ -71,12 +73,16 @@ inline void store_be32(std::uint8_t* p, std::uint32_t v) {
   p[2] = static_cast<std::uint8_t>(v >> 8);
   p[3] = static_cast<std::uint8_t>(v);
 }
+// One load/store and a byte swap (the compiler does not merge the byte-wise form here); the
+// frame front end decodes and re-encodes one of these per register write.
 inline std::uint64_t load_be64(const std::uint8_t* p) {
-  return (std::uint64_t{load_be32(p)} << 32) | load_be32(p + 4);
+  std::uint64_t v;
+  std::memcpy(&v, p, 8);
+  return std::endian::native == std::endian::little ? __builtin_bswap64(v) : v;
 }
 inline void store_be64(std::uint8_t* p, std::uint64_t v) {
-  store_be32(p, static_cast<std::uint32_t>(v >> 32));
-  store_be32(p + 4, static_cast<std::uint32_t>(v));
+  if constexpr (std::endian::native == std::endian::little) v = __builtin_bswap64(v);
+  std::memcpy(p, &v, 8);
 }
 
 // div255 of docs/protocol.md section 10.5: round(x / 255) for 0 <= x <= 65025.

@@ -1,5 +1,7 @@
 #include "setup.hpp"
 
+#include "colour_planes.hpp"
+
 #include <algorithm>
 #include <utility>
 
@@ -94,7 +96,7 @@ bool setup_triangle(const Vertex& va, const Vertex& vb, const Vertex& vc, const 
   const bool tex = all_attributes || state.textured;
   // Planes not set up read as constant (the kernels never step them).
   if (colour)
-    for (unsigned ch = 0; ch < 4; ++ch) setup_plane(t.plane[kR + ch], v[0].c[ch], v[1].c[ch], v[2].c[ch], e20, e01, D, div);
+    setup_colour_planes(&t.plane[kR], v, e20, e01, D);
   else
     for (unsigned ch = 0; ch < 4; ++ch) t.plane[kR + ch] = Plane{};
   if (depth) setup_plane(t.plane[kZ], v[0].z, v[1].z, v[2].z, e20, e01, D, div);
