@@ -53,7 +53,7 @@ std::vector<sim::AccuracyKnobs> bench_configs() {
       knobs(10, 1, 2, 24, false),  // 1/4-pixel vertices
       knobs(10, 1, 0, 24, false),  // whole-pixel vertices
       knobs(10, 1, 4, 16, false),  // 16-bit depth
-      knobs(10, 1, 4, 24, true),   // floating-point fast mode
+      knobs(10, 1, 4, 24, true),   // fast: floating-point texel divide, exact planes
   };
 }
 
