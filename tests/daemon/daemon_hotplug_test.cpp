@@ -140,6 +140,9 @@ TEST(DaemonHotplug, UnplugFallsBackToTheSimulatorAndReplugBringsTheBoardBack) {
     EXPECT_EQ(st["hotplug"]["attached"], false);
     EXPECT_EQ(st["hotplug"]["detaches"], 1);
     EXPECT_EQ(st["hotplug"]["reattaches"], 0);
+    const auto cli = run_process({GPUBRIDGE_CLI_PATH, "status", "--connect", "unix:" + d.socket});
+    EXPECT_NE(cli.out.find("hot-plug:  board gone (looking for it), 1 unplug(s), 0 re-attach(es)"), std::string::npos)
+        << cli.out << cli.err;
   }
   // The daemon keeps serving, on the simulator: what is drawn now renders exactly as in-process.
   expect_screenshot_equals_render(*watcher, d.socket, d.dir, trace_path("triangle.trace"), "on-fallback");

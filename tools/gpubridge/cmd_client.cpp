@@ -115,6 +115,15 @@ int run_status(const GlobalOptions& g, const ClientOptions& o) {
   std::printf("frames:    %llu scanned out, last #%u\n",
               static_cast<unsigned long long>(j["frames"].value("count", std::uint64_t{0})),
               j["frames"].value("last_number", 0u));
+  // Board backends only (daemons without hot-plug omit the object or report it disabled).
+  if (j.contains("hotplug") && j["hotplug"].is_object() && j["hotplug"].value("enabled", false)) {
+    const auto& h = j["hotplug"];
+    std::printf("hot-plug:  board %s, %llu unplug(s), %llu re-attach(es), checked every %llu ms\n",
+                h.value("attached", true) ? "attached" : "gone (looking for it)",
+                static_cast<unsigned long long>(h.value("detaches", std::uint64_t{0})),
+                static_cast<unsigned long long>(h.value("reattaches", std::uint64_t{0})),
+                static_cast<unsigned long long>(h.value("interval_ms", std::uint64_t{0})));
+  }
   return 0;
 }
 
