@@ -20,6 +20,7 @@
 #include "gpubridge/client/client.hpp"
 #include "gpubridge/common/image.hpp"
 #include "gpubridge/common/trace_files.hpp"
+#include "gpubridge/daemon/config.hpp"
 #include "gpubridge/daemon/frame_diff.hpp"
 #include "gpubridge/daemon/hub.hpp"
 #include "gpubridge/daemon/mirror_backend.hpp"
@@ -68,6 +69,18 @@ std::unique_ptr<client::Client> subscriber(const std::string& address, FrameSour
   auto sub = owned->subscribe(protocol::Subscribe{format, 0, source}, 2000ms);
   EXPECT_TRUE(sub) << (sub ? "" : sub.error().message);
   return sub ? std::move(owned) : nullptr;
+}
+
+TEST(MirrorConfig, KeyIsABooleanAndOffByDefault) {
+  auto off = daemon::parse_config(nlohmann::json::parse("{}"), "c.json");
+  ASSERT_TRUE(off);
+  EXPECT_FALSE(off->mirror);
+  auto on = daemon::parse_config(nlohmann::json::parse(R"({"backend": "emulated:icebreaker", "mirror": true})"), "c.json");
+  ASSERT_TRUE(on) << on.error().message;
+  EXPECT_TRUE(on->mirror);
+  auto bad = daemon::parse_config(nlohmann::json::parse(R"({"mirror": "yes"})"), "c.json");
+  ASSERT_FALSE(bad);
+  EXPECT_NE(bad.error().message.find("c.json: mirror: expected true or false"), std::string::npos) << bad.error().message;
 }
 
 backends::ScanoutFrame make_frame(unsigned w, unsigned h, protocol::PixelFormat f, std::vector<std::uint8_t> px) {
