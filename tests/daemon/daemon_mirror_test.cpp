@@ -233,6 +233,59 @@ TEST(DaemonMirror, BoardAndSimulatorFramesBothEqualTheInProcessRender) {
   fs::remove_all(dir, ec);
 }
 
+// The CLI side of mirror mode: `gpubridge screenshot --source sim` saves the simulator's picture and
+// `gpubridge status` prints the comparison count.
+TEST(DaemonMirror, CliScreenshotTakesTheSimulatorSourceAndStatusPrintsTheComparison) {
+  const auto dir = make_temp_dir("mirror-cli");
+  const std::string address = "unix:" + (dir / "d.sock").string();
+  Daemon daemon;
+  ASSERT_TRUE(daemon.start({"--listen", address, "--backend", "emulated:icebreaker", "--mirror", "--no-fallback",
+                            "--log-level", "warn"}))
+      << daemon.error();
+  auto watcher = client::Client::connect(address, 2000ms);
+  ASSERT_TRUE(watcher) << watcher.error().message;
+  ASSERT_TRUE(watcher->handshake("watcher", "", 2000ms));
+
+  const std::string shot = (dir / "sim.png").string();
+  auto screenshot = std::async(std::launch::async, [&] {
+    return run_process({GPUBRIDGE_CLI_PATH, "screenshot", "--source", "sim", "--out", shot, "--connect", address,
+                        "--json"});
+  });
+  // Draw only once the screenshot is subscribed, so that it sees this trace's swap.
+  bool subscribed = false;
+  for (int i = 0; i < 200 && !subscribed; ++i) {
+    const auto status = status_of(*watcher);  // named: a temporary would die before the loop body
+    for (const auto& cl : status["clients"]) subscribed = subscribed || cl.value("source", "") == "sim";
+    if (!subscribed) std::this_thread::sleep_for(10ms);
+  }
+  ASSERT_TRUE(subscribed);
+  const auto play = run_process({GPUBRIDGE_CLI_PATH, "play", kTrace, "--connect", address});
+  ASSERT_EQ(play.exit_code, 0) << play.err << play.out;
+  const auto shot_result = screenshot.get();
+  ASSERT_EQ(shot_result.exit_code, 0) << shot_result.err << shot_result.out;
+  EXPECT_EQ(nlohmann::json::parse(shot_result.out).value("source", ""), "sim") << shot_result.out;
+
+  const auto render = run_process({GPUBRIDGE_CLI_PATH, "render", kTrace, "--out", (dir / "ref.png").string()});
+  ASSERT_EQ(render.exit_code, 0) << render.err;
+  auto want = load_png(dir / "ref.png");
+  auto got = load_png(shot);
+  ASSERT_TRUE(want && got);
+  EXPECT_TRUE(got->rgba == want->rgba) << "the simulator screenshot differs from gpubridge render";
+
+  const auto status = run_process({GPUBRIDGE_CLI_PATH, "status", "--connect", address});
+  ASSERT_EQ(status.exit_code, 0) << status.err;
+  EXPECT_NE(status.out.find("mirror:    0 of 1 frame(s) differ from the simulator"), std::string::npos) << status.out;
+
+  const auto bad = run_process({GPUBRIDGE_CLI_PATH, "screenshot", "--source", "model", "--out", shot, "--connect",
+                                address});
+  EXPECT_NE(bad.exit_code, 0);
+  EXPECT_NE(bad.err.find("--source"), std::string::npos) << bad.err;
+  watcher->close();
+  EXPECT_EQ(daemon.terminate(), 0);
+  std::error_code ec;
+  fs::remove_all(dir, ec);
+}
+
 // A board reads FRAME_CRC (and the pixels) once per batch, so of several swaps in one WRITE_FRAMES it
 // reports the last; the simulator reports each. The last ones are compared, not the first.
 TEST(DaemonMirror, SeveralSwapsInOneBatchCompareTheLastSwap) {

@@ -124,6 +124,18 @@ int run_status(const GlobalOptions& g, const ClientOptions& o) {
                 static_cast<unsigned long long>(h.value("reattaches", std::uint64_t{0})),
                 static_cast<unsigned long long>(h.value("interval_ms", std::uint64_t{0})));
   }
+  // Mirror mode (gpubridged --mirror): board frames compared with the simulator's.
+  if (j.contains("mirror") && j["mirror"].is_object() && j["mirror"].value("enabled", false)) {
+    const auto& m = j["mirror"];
+    const auto mismatches = m.value("mismatches", std::uint64_t{0});
+    std::printf("mirror:    %llu of %llu frame(s) differ from the simulator",
+                static_cast<unsigned long long>(mismatches),
+                static_cast<unsigned long long>(m.value("compared", std::uint64_t{0})));
+    if (mismatches && m["first_mismatch"].is_number())
+      std::printf(" (first #%llu; see it with `gpubridge screenshot --source diff`)",
+                  static_cast<unsigned long long>(m["first_mismatch"].get<std::uint64_t>()));
+    std::printf("\n");
+  }
   return 0;
 }
 
@@ -209,11 +221,16 @@ int run_play(const GlobalOptions& g, const ClientOptions& o, const PlayOptions& 
 }
 
 // ------------------------------------------------------------------------------ screenshot
-int run_screenshot(const GlobalOptions& g, const ClientOptions& o, const std::string& out, unsigned skip) {
+int run_screenshot(const GlobalOptions& g, const ClientOptions& o, const std::string& out, unsigned skip,
+                   const std::string& source_name) {
+  const auto source = protocol::parse_frame_source(source_name);
+  if (!source) return fail("screenshot", "--source '" + source_name + "' is not a frame source (use board, sim or diff)");
   auto c = open_client(g, o, "gpubridge screenshot");
   if (!c) return fail("screenshot", c.error().message);
   const client::Timeout timeout{o.timeout_ms};
-  if (auto r = c->subscribe(protocol::FrameFormat::RGBA8888, 0, timeout); !r) return fail("screenshot", r.error().message);
+  protocol::Subscribe request{protocol::FrameFormat::RGBA8888, 0, std::nullopt};
+  if (*source != protocol::FrameSource::Board) request.source = *source;  // old daemons only know board
+  if (auto r = c->subscribe(request, timeout); !r) return fail("screenshot", r.error().message);
   if (!g.json) {
     std::printf("waiting for a frame...\n");
     std::fflush(stdout);
@@ -227,9 +244,11 @@ int run_screenshot(const GlobalOptions& g, const ClientOptions& o, const std::st
   if (auto r = save_png(out, img); !r) return fail("screenshot", r.error().message);
   c->close();
   if (g.json)
-    print_json({{"out", out}, {"frame", f->number}, {"width", f->width}, {"height", f->height}, {"crc", f->crc}});
+    print_json({{"out", out}, {"frame", f->number}, {"width", f->width}, {"height", f->height}, {"crc", f->crc},
+                {"source", protocol::to_string(f->source)}});
   else
-    std::printf("frame #%u (%ux%u) written to %s\n", f->number, f->width, f->height, out.c_str());
+    std::printf("frame #%u (%ux%u, %s) written to %s\n", f->number, f->width, f->height,
+                std::string(protocol::to_string(f->source)).c_str(), out.c_str());
   return 0;
 }
 
@@ -377,8 +396,16 @@ GPUBRIDGE_COMMAND("client", 40, [](CLI::App& app, GlobalOptions& g, auto& runner
   auto* shot = app.add_subcommand("screenshot", "save the next scanned-out frame as a PNG");
   shot->add_option("--out,-o", *out, "PNG file to write")->required();
   shot->add_option("--skip", *skip, "ignore this many frames first");
+  auto source = std::make_shared<std::string>("board");
+  shot->add_option("--source", *source,
+                   "board (what the device scanned out), or with gpubridged --mirror: sim (the simulator's frame "
+                   "for the same swap) or diff (differing pixels magenta)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"board", "sim", "diff"}));
   add_client_options(shot, g, *copts);
-  runners.emplace_back(shot, [&g, copts, out, skip] { return run_screenshot(g, *copts, *out, *skip); });
+  runners.emplace_back(shot, [&g, copts, out, skip, source] {
+    return run_screenshot(g, *copts, *out, *skip, *source);
+  });
 
   auto* reg = app.add_subcommand("reg", "read or write one device register through the daemon");
   reg->require_subcommand(1);
