@@ -1,6 +1,8 @@
 // In-process tests: configuration parsing and the session dispatch over an in-memory stream.
 #include <gtest/gtest.h>
 
+#include <filesystem>
+
 #include <nlohmann/json.hpp>
 
 #include "gpubridge/daemon/config.hpp"
@@ -30,6 +32,16 @@ TEST(DaemonConfig, ParsesEveryKey) {
   EXPECT_EQ(cfg->limits.max_message_bytes, 65536u);
   EXPECT_EQ(cfg->limits.queue_bytes, 2097152u);
   EXPECT_EQ(cfg->limits.idle_timeout_ms, 0u);
+}
+
+// The example shipped in configs/ is what people copy: it must load as it is.
+TEST(DaemonConfig, ShippedExampleLoads) {
+  auto cfg = load_config(std::filesystem::path(GPUBRIDGE_CONFIGS_DIR) / "gpubridged.json");
+  ASSERT_TRUE(cfg) << cfg.error().message;
+  EXPECT_EQ(cfg->backend, "sim");
+  EXPECT_TRUE(cfg->fallback_to_sim);
+  EXPECT_FALSE(cfg->mirror);
+  EXPECT_EQ(cfg->reattach_interval_ms, 1000u);
 }
 
 TEST(DaemonConfig, ErrorsNameTheKeyAndTheProblem) {
