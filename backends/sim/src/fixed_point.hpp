@@ -31,21 +31,14 @@ inline DivMod floor_divmod128(i128 a, std::int64_t b) {
 class Divider {
  public:
   explicit Divider(std::int64_t d) : d_(d), inv_(1.0 / static_cast<double>(d)) {}
-  // Always inlined: it sits in per-row loops of the rasteriser and in setup.
+  // Always inlined: it sits in the rasteriser's per-row loops (a call there costs measurably).
   [[gnu::always_inline]] DivMod operator()(std::int64_t a) const {
     constexpr std::int64_t kExact = std::int64_t{1} << 52;
     if (a >= kExact || a <= -kExact) return floor_divmod(a, d_);
     std::int64_t q = static_cast<std::int64_t>(static_cast<double>(a) * inv_);
     std::int64_t r = a - q * d_;
-    // One correction each way without branches (the estimate truncates towards zero, so its
-    // direction follows the numerator's sign, which setup cannot predict); the loops are the
-    // exactness guarantee and practically never run.
-    const std::int64_t below = r >> 63;  // −1 when r < 0
-    r += d_ & below;
-    q += below;
-    const std::int64_t above = -static_cast<std::int64_t>(r >= d_);
-    r -= d_ & above;
-    q -= above;
+    // Branches, not selects: in the rasteriser's per-row span solving the numerator's sign (and
+    // so the correction) repeats row after row and predicts well; selects cost more there.
     while (r < 0) { r += d_; --q; }
     while (r >= d_) { r -= d_; ++q; }
     return {q, r};
