@@ -72,14 +72,13 @@ void Session::start() {
 // ---------------------------------------------------------------------------------- input
 
 void Session::do_read() {
-  if (reading_ || closing_ || waiting_lease_ || terminated_) return;
+  if (reading_ || closing_ || paused_ || terminated_) return;
   // Backpressure: a client that does not read its replies stops being read.
   if (queued_bytes_ > hub_.options().limits.queue_bytes) return;
-  // Reads land in the parser's buffer. While the device works on a message (paused_), its bytes
-  // (a WRITE_FRAMES batch, UPLOAD data) stay in use there: read ahead only into room that leaves
-  // them alone, so the client keeps streaming while the device executes.
-  const auto space = paused_ ? parser_.prepare_keeping_last(read_bytes_) : parser_.prepare(read_bytes_);
-  if (space.empty()) return;  // no room until the device is done (resume() reads), or poisoned
+  // Safe to hand out parser memory: no message span is live here (device work and lease waits
+  // set paused_), and next() is not called until this read completes.
+  const auto space = parser_.prepare(read_bytes_);
+  if (space.empty()) return;  // poisoned parser: the session is closing anyway
   reading_ = true;
   stream_->async_read_some(asio::buffer(space.data(), space.size()),
                            [self = shared_from_this()](const auto& ec, std::size_t n) { self->on_read(ec, n); });

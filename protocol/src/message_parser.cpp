@@ -5,9 +5,6 @@
 // Room is made only when bytes are added (make_room): an empty buffer restarts at 0, otherwise the
 // unconsumed bytes are moved to the front if that frees enough, else the buffer grows. A move
 // happens at most once per message consumed, so no byte is copied more than once on average.
-// prepare_keeping_last() never moves or frees the last returned message: it reads after the
-// unconsumed bytes, wraps to the front of the buffer when that has more room, or moves to a larger
-// buffer while the old one is kept in retired_ until the message is released.
 #include <algorithm>
 #include <cstring>
 
@@ -18,12 +15,6 @@ namespace gpubridge::protocol {
 MessageParser::MessageParser(std::uint32_t max_payload) : max_payload_(std::min(max_payload, kMaxPayload)) {}
 
 void MessageParser::set_max_payload(std::uint32_t max_payload) { max_payload_ = std::min(max_payload, kMaxPayload); }
-
-void MessageParser::release_last() {
-  last_begin_ = last_end_ = 0;
-  retired_.reset();
-  retired_capacity_ = 0;
-}
 
 void MessageParser::make_room(std::size_t n, std::size_t ceiling) {
   if (pos_ == end_) {
@@ -49,7 +40,6 @@ void MessageParser::make_room(std::size_t n, std::size_t ceiling) {
 
 void MessageParser::feed(std::span<const std::uint8_t> bytes) {
   if (failed_ || bytes.empty()) return;  // a poisoned stream is never parsed again: don't keep its bytes
-  release_last();
   make_room(bytes.size(), kHeaderBytes + std::size_t{max_payload_} + bytes.size());
   std::memcpy(buf_.get() + end_, bytes.data(), bytes.size());
   end_ += bytes.size();
@@ -65,91 +55,36 @@ std::optional<std::size_t> MessageParser::current_message_bytes() const {
   return kHeaderBytes + std::size_t{h.length};
 }
 
-std::size_t MessageParser::read_size(std::size_t max_bytes) const {
-  if (const auto message = current_message_bytes()) {
-    const std::size_t have = end_ - pos_;
-    if (*message >= kLargeMessageBytes && *message > have) return std::min(max_bytes, *message - have);
-  }
-  return max_bytes;
-}
-
 std::span<std::uint8_t> MessageParser::prepare(std::size_t max_bytes) {
   prepared_ = 0;
   if (failed_ || max_bytes == 0) return {};
-  release_last();
-  const std::size_t want = read_size(max_bytes);
+  std::size_t want = max_bytes;
+  if (const auto message = current_message_bytes()) {
+    const std::size_t have = end_ - pos_;
+    if (*message >= kLargeMessageBytes && *message > have) want = std::min(want, *message - have);
+  }
   make_room(want, kHeaderBytes + std::size_t{max_payload_} + max_bytes);
   prepared_ = want;
   return {buf_.get() + end_, want};
 }
 
-std::span<std::uint8_t> MessageParser::prepare_keeping_last(std::size_t max_bytes) {
-  prepared_ = 0;
-  if (failed_ || max_bytes == 0) return {};
-  // One complete message behind the kept one is enough to go on with; reading further would
-  // only fill the buffer with bytes that later have to be moved.
-  if (const auto message = current_message_bytes(); message && *message <= end_ - pos_) return {};
-  std::size_t want = read_size(max_bytes);
-  const bool kept_here = last_end_ > last_begin_;  // else it is in retired_, or there is none
-  if (pos_ == end_) {
-    // Everything after the kept message is consumed: restart at the front of the buffer when the
-    // room there (up to the kept message) is larger than the room at the back.
-    const std::size_t front = kept_here ? last_begin_ : capacity_;
-    if (front > capacity_ - end_) {
-      consumed_ += pos_;
-      pos_ = end_ = 0;
-    }
-  }
-  // Unconsumed bytes in front of the kept message must stop where it starts.
-  const std::size_t limit = kept_here && end_ <= last_begin_ ? last_begin_ : capacity_;
-  if (limit > end_) {
-    want = std::min(want, limit - end_);
-    prepared_ = want;
-    return {buf_.get() + end_, want};
-  }
-  // No free room. Only a buffer holding the kept message is left behind for a larger one, once
-  // per message and never past the size limit, so reading ahead cannot pile up memory.
-  if (!kept_here) return {};
-  const std::size_t live = end_ - pos_;
-  const std::size_t ceiling = kHeaderBytes + std::size_t{max_payload_} + max_bytes;
-  const std::size_t grown = std::min(std::max(live + want, 2 * capacity_), ceiling);
-  if (grown <= capacity_) return {};  // at the limit: wait until the message is released
-  want = std::min(want, grown - live);
-  auto fresh = std::make_unique_for_overwrite<std::uint8_t[]>(grown);
-  if (live > 0) std::memcpy(fresh.get(), buf_.get() + pos_, live);
-  retired_ = std::move(buf_);
-  retired_capacity_ = capacity_;
-  buf_ = std::move(fresh);
-  capacity_ = grown;
-  consumed_ += pos_;
-  pos_ = 0;
-  end_ = live;
-  last_begin_ = last_end_ = 0;  // the kept message now lives in retired_
-  prepared_ = want;
-  return {buf_.get() + end_, want};
-}
-
 void MessageParser::commit(std::size_t n) {
-  if (!failed_) end_ += std::min(n, prepared_);
+  if (failed_) return;
+  end_ += std::min(n, prepared_);
   prepared_ = 0;
 }
 
 MessageParser::Status MessageParser::next(Message& out) {
   if (failed_) return Status::Error;
-  release_last();
   const std::size_t avail = end_ - pos_;
   const std::uint8_t* p = avail > 0 ? buf_.get() + pos_ : nullptr;
   auto fail = [&](DecodeError e) {
     failed_ = true;
     e.message += " (stream offset " + std::to_string(stream_offset()) + ")";
     error_ = std::move(e);
+    buf_.reset();
     consumed_ += pos_;
-    pos_ = end_ = 0;
-    // A read may still be in flight into the span prepare*() handed out: keep its memory then.
-    if (prepared_ == 0) {
-      buf_.reset();
-      capacity_ = 0;
-    }
+    capacity_ = pos_ = end_ = prepared_ = 0;
     return Status::Error;
   };
 
@@ -172,9 +107,7 @@ MessageParser::Status MessageParser::next(Message& out) {
 
   if (auto e = decode_payload(h, std::span<const std::uint8_t>(p + kHeaderBytes, h.length), out))
     return fail(std::move(*e));
-  last_begin_ = pos_;
   pos_ += kHeaderBytes + h.length;
-  last_end_ = pos_;
   return Status::Ok;
 }
 

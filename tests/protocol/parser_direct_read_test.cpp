@@ -1,11 +1,10 @@
 // MessageParser's direct-read API (prepare/commit): the same messages as feed(), reads that stop
-// at the end of a large message so the buffer is reused in place, no allocation sized by a header
-// that fails its checks, and reading ahead (prepare_keeping_last) that leaves the message in use alone.
+// at the end of a large message so the buffer is reused in place, and no allocation sized by a
+// header that fails its checks.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cstring>
-#include <set>
 
 #include "gpubridge/protocol/messages.hpp"
 #include "message_samples.hpp"
@@ -197,77 +196,9 @@ TEST(ParserDirectRead, CommitIsClampedToThePreparedSpan) {
   EXPECT_EQ(p.next(m), MessageParser::Status::NeedMore);
 }
 
-// Reads `stream` like the daemon does while its device is busy: after each message, read ahead
-// with prepare_keeping_last() (up to `reads_ahead` reads), then check the message is unchanged.
-void read_ahead_through(const std::vector<std::uint8_t>& stream, std::size_t read_bytes, int reads_ahead,
-                        std::size_t expect_messages, std::set<const std::uint8_t*>* starts = nullptr) {
-  MessageParser p;
-  std::size_t at = 0, parsed_until = 0, count = 0;
-  auto read_into = [&](std::span<std::uint8_t> space) {
-    const std::size_t n = std::min(space.size(), stream.size() - at);
-    std::memcpy(space.data(), stream.data() + at, n);
-    p.commit(n);
-    at += n;
-  };
-  while (parsed_until < stream.size()) {
-    Message m;
-    const auto st = p.next(m);
-    ASSERT_NE(st, MessageParser::Status::Error) << p.error().message;
-    if (st == MessageParser::Status::NeedMore) {
-      ASSERT_LT(at, stream.size());
-      read_into(p.prepare(read_bytes));
-      continue;
-    }
-    const auto bytes = encode(m);
-    ASSERT_EQ(0, std::memcmp(bytes.data(), stream.data() + parsed_until, bytes.size())) << "message " << count;
-    if (starts) starts->insert(std::get<WriteFrames>(m.payload).frames.bytes.data());
-    for (int r = 0; r < reads_ahead && at < stream.size(); ++r) {
-      const auto space = p.prepare_keeping_last(read_bytes);
-      if (space.empty()) break;
-      EXPECT_LE(space.size(), read_bytes);
-      read_into(space);
-    }
-    // The message is still "in the device": its bytes must be exactly what arrived.
-    EXPECT_EQ(encode(m), bytes) << "message " << count << " changed while reading ahead";
-    parsed_until += bytes.size();
-    ++count;
-  }
-  EXPECT_EQ(count, expect_messages);
-}
-
-TEST(ParserDirectRead, ReadingAheadKeepsTheMessageInUse) {
-  // Batches of varied sizes (small ones share reads, large ones stop reads at their end) and
-  // several read sizes, so reads ahead append, wrap to the front and move to a larger buffer.
-  std::vector<std::uint8_t> stream;
-  std::size_t messages = 0;
-  for (std::size_t frames : {3000, 10, 40000, 2, 25000, 25000, 7, 60000, 1, 1, 30000, 45000}) {
-    const auto one = write_frames_message(frames, static_cast<std::uint32_t>(++messages));
-    stream.insert(stream.end(), one.begin(), one.end());
-  }
-  for (std::size_t read : {std::size_t{100}, std::size_t{4096}, std::size_t{65536}, std::size_t{1} << 20})
-    for (int ahead : {1, 3, 100}) {
-      SCOPED_TRACE("read " + std::to_string(read) + ", " + std::to_string(ahead) + " reads ahead");
-      read_ahead_through(stream, read, ahead, messages);
-    }
-}
-
-TEST(ParserDirectRead, ReadingAheadAlternatesBetweenRegionsWithoutCopying) {
-  // Equal ~1 MiB batches: once the buffer has grown, messages land in a few fixed places of it
-  // (after the message in use, or in front of it) instead of being moved or regrown.
-  std::vector<std::uint8_t> stream;
-  for (std::uint32_t id = 1; id <= 24; ++id) {
-    const auto one = write_frames_message(116508, id);
-    stream.insert(stream.end(), one.begin(), one.end());
-  }
-  std::set<const std::uint8_t*> starts;
-  read_ahead_through(stream, 1u << 20, 100, 24, &starts);
-  EXPECT_LE(starts.size(), 6u);  // a handful of buffer positions over 24 messages
-}
-
 TEST(ParserDirectRead, ZeroSizedPrepareIsEmpty) {
   MessageParser p;
   EXPECT_TRUE(p.prepare(0).empty());
-  EXPECT_TRUE(p.prepare_keeping_last(0).empty());
   EXPECT_EQ(p.held_bytes(), 0u);
 }
 

@@ -2,9 +2,8 @@
 // Session: one client connection. Reads bytes, feeds the MessageParser, dispatches messages,
 // and enforces the per-session limits (handshake deadline, idle and trickle timeouts, message
 // size, outgoing queue). Socket reads land directly in the parser's buffer. Device work pauses
-// message processing until it completes, so a WRITE_FRAMES batch is handed to the backend as a
-// FrameView into the parser buffer (no per-write copy) and a client can never queue unbounded
-// work; meanwhile reading continues only into buffer room that leaves that batch alone.
+// reading until it completes, so a WRITE_FRAMES batch is handed to the backend as a FrameView
+// into that buffer (no per-write copy) and a client can never queue unbounded work.
 // Subscribers hold at most one pending frame (newest wins).
 #include <chrono>
 #include <cstdint>

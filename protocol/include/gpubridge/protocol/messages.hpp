@@ -197,22 +197,14 @@ class MessageParser {
   // without moving bytes to make room. Small messages share reads; their partial tails are moved.
   // Invalidates earlier spans (from prepare() and from parsed messages).
   std::span<std::uint8_t> prepare(std::size_t max_bytes);
-  // Like prepare(), but the message the last next() returned stays valid: its bytes are neither
-  // overwritten, moved nor freed. For reading ahead while that message is still in use (the
-  // daemon reads the next batch while the device executes the current one). Offers only room that
-  // is free as it is: after the unconsumed bytes, or before the kept message once everything after
-  // it is consumed, or a larger buffer (the old one lives on until the next call to next(),
-  // feed() or prepare()). Empty when there is no such room or a complete message is already
-  // buffered behind the kept one: read again after next().
-  std::span<std::uint8_t> prepare_keeping_last(std::size_t max_bytes);
-  // Appends the first n bytes written into the last prepare*() span (n beyond it is clamped).
+  // Appends the first n bytes written into the last prepare() span (n beyond it is clamped).
   void commit(std::size_t n);
   Status next(Message& out);
   const DecodeError& error() const { return error_; }
   // Bytes buffered but not yet returned as messages (for trickle/idle accounting).
   std::size_t buffered() const { return end_ - pos_; }
-  // Bytes the parser holds in memory (its buffer's capacity, plus a buffer kept for a message).
-  std::size_t held_bytes() const { return capacity_ + retired_capacity_; }
+  // Bytes the parser holds in memory (its buffer's capacity).
+  std::size_t held_bytes() const { return capacity_; }
   // Total stream offset of the first byte of the message being parsed (for error messages).
   std::uint64_t stream_offset() const { return consumed_ + pos_; }
 
@@ -225,20 +217,12 @@ class MessageParser {
   void make_room(std::size_t n, std::size_t ceiling);
   // kHeaderBytes + length of the message in progress once its header is buffered and valid.
   std::optional<std::size_t> current_message_bytes() const;
-  // How much a read of at most max_bytes should ask for (stops at the end of a large message).
-  std::size_t read_size(std::size_t max_bytes) const;
-  void release_last();  // the last message's bytes need not stay valid any more
 
   std::unique_ptr<std::uint8_t[]> buf_;
   std::size_t capacity_ = 0;
   std::size_t pos_ = 0;       // first unconsumed byte
   std::size_t end_ = 0;       // one past the last stream byte
-  std::size_t prepared_ = 0;  // size of the span the last prepare*() returned, until commit()
-  // The message the last next() returned: [last_begin_, last_end_) in buf_, or in retired_ (then
-  // the range is empty) when prepare_keeping_last() had to move to a larger buffer.
-  std::size_t last_begin_ = 0, last_end_ = 0;
-  std::unique_ptr<std::uint8_t[]> retired_;
-  std::size_t retired_capacity_ = 0;
+  std::size_t prepared_ = 0;  // size of the span the last prepare() returned
   std::uint64_t consumed_ = 0;
   std::uint32_t max_payload_;
   bool failed_ = false;
