@@ -72,7 +72,6 @@ class Kernel {
       if (k > 0) Plane::advance(row.q[i], row.r[i], t_.plane[i].qy, t_.plane[i].ry, k, t_.den);
     }
     const int w = t_.x1 - t_.x0;
-    int row_at = 0;  // narrow rows: x offset of `row` (see narrow_row)
     for (int y = ya; y < yz; ++y) {
       if (w >= kSpanSolveWidth) {
         std::int64_t kl = 0, kr = w - 1;
@@ -99,7 +98,24 @@ class Kernel {
           ctx_.counters.covered += static_cast<std::uint64_t>(kr - kl + 1);
         }
       } else {
-        narrow_row(y, e, w, row, row_at);
+        // Narrow rows (no span routine): every pixel of the box row is tested and stepped. The
+        // loop count is the same on every row of the triangle, so it predicts; stepping only along
+        // the covered run was tried and lost on tall slivers (its data-dependent loop exits
+        // mispredicted on every row).
+        Steppers s = row;
+        std::int64_t e0 = e[0], e1 = e[1], e2 = e[2];
+        const std::int64_t x0 = t_.edge[0].ex, x1 = t_.edge[1].ex, x2 = t_.edge[2].ex;
+        for (int kx = 0; kx < w; ++kx) {
+          if ((e0 | e1 | e2) >= 0) {
+            ++ctx_.counters.covered;
+            pixel(t_.x0 + kx, y, s);
+          }
+          e0 += x0;
+          e1 += x1;
+          e2 += x2;
+          step_x(s);
+        }
+        ctx_.counters.scanned += static_cast<std::uint64_t>(w);
       }
       for (int i = 0; i < 3; ++i) e[i] += t_.edge[i].ey;
       step_y(row);
@@ -107,57 +123,6 @@ class Kernel {
   }
 
  private:
-  // A row of a narrow box (w < kSpanSolveWidth): the edges are tested at every pixel (cheap),
-  // but the planes are stepped only to and along the covered run. `s` follows the run's first
-  // pixel from row to row (x offset `at`): one y step plus the small shift of the run start, so
-  // no plane work is spent on the uncovered part of the box. Exact: (q, r) is the floor-divmod
-  // of a linear numerator, so any path of steps to a pixel gives the same pair.
-  void narrow_row(int y, const std::int64_t* e, int w, Steppers& s, int& at) {
-    std::int64_t e0 = e[0], e1 = e[1], e2 = e[2];
-    const std::int64_t x0 = t_.edge[0].ex, x1 = t_.edge[1].ex, x2 = t_.edge[2].ex;
-    int kx = 0;
-    while (kx < w && (e0 | e1 | e2) < 0) {
-      e0 += x0;
-      e1 += x1;
-      e2 += x2;
-      ++kx;
-    }
-    ctx_.counters.scanned += static_cast<std::uint64_t>(w);
-    if (kx == w) return;
-    const int kl = kx;
-    // A row of a triangle is covered in one run (each edge test is monotonic along the row).
-    do {
-      e0 += x0;
-      e1 += x1;
-      e2 += x2;
-      ++kx;
-    } while (kx < w && (e0 | e1 | e2) >= 0);
-    const int n = kx - kl;
-    for (; at < kl; ++at) step_x(s);
-    for (; at > kl; --at) unstep_x(s);
-    ctx_.counters.covered += static_cast<std::uint64_t>(n);
-    if (n == 1) {
-      pixel(t_.x0 + kl, y, s);
-      return;
-    }
-    Steppers p = s;
-    for (int k = 0;; ++k) {
-      pixel(t_.x0 + kl + k, y, p);
-      if (k + 1 == n) break;
-      step_x(p);
-    }
-  }
-
-  void unstep_x(Steppers& s) const {
-    for (unsigned i = 0; i < kAttrCount; ++i) {
-      if (!((kPlanes >> i) & 1)) continue;
-      s.q[i] -= t_.plane[i].qx;
-      s.r[i] -= t_.plane[i].rx;
-      const bool borrow = s.r[i] < 0;
-      s.r[i] += borrow ? t_.den : 0;
-      s.q[i] -= borrow;
-    }
-  }
   void step_x(Steppers& s) const {
     for (unsigned i = 0; i < kAttrCount; ++i) {
       if (!((kPlanes >> i) & 1)) continue;
