@@ -8,10 +8,8 @@ namespace gpubridge::daemon {
 namespace {
 
 Result<void> check_writes(protocol::FrameView frames) {
-  for (std::size_t i = 0; i < frames.bytes.size(); i += protocol::kFrameBytes)
-    if (frames.bytes[i] & 0x80)
-      return make_error("frame " + std::to_string(i / protocol::kFrameBytes) + " of the batch is a read frame",
-                        backends::kBadRequest);
+  if (const std::size_t i = protocol::first_read_frame(frames); i < frames.size())
+    return make_error("frame " + std::to_string(i) + " of the batch is a read frame", backends::kBadRequest);
   return {};
 }
 

@@ -62,9 +62,8 @@ std::string command_problem(const Command& c) {
             if (f.size() > kMaxFramesPerBatch)
               return "frame batch of " + std::to_string(f.size()) + " frames exceeds " +
                      std::to_string(kMaxFramesPerBatch) + "; split it";
-            for (std::size_t i = 0; i < f.bytes.size(); i += kFrameBytes)
-              if (f.bytes[i] & 0x80)
-                return "frame " + std::to_string(i / kFrameBytes) + " has the read bit set; use a register read";
+            if (const std::size_t i = first_read_frame(FrameView{f.bytes}); i < f.size())
+              return "frame " + std::to_string(i) + " has the read bit set; use a register read";
             return {};
           },
           [](const UploadCmd& u) -> std::string {

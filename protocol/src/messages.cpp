@@ -123,33 +123,6 @@ bool valid_utf8(std::string_view s) {
   return true;
 }
 
-// Index of the first frame whose R/W bit (bit 7 of its byte 0) is set; frame count if none. Every
-// WRITE_FRAMES byte passes here, so it tests 8 frames (72 bytes) per step: on a little-endian host
-// byte 9i of such a block is byte i of its 64-bit word i, so one masked OR per word covers it.
-template <std::size_t... W>
-std::uint64_t read_bits_of_block(const std::uint8_t* block, std::index_sequence<W...>) {
-  const auto word = [block](std::size_t w) {
-    std::uint64_t v;
-    std::memcpy(&v, block + 8 * w, sizeof v);
-    return v;
-  };
-  return ((word(W) & (std::uint64_t{0x80} << (8 * W))) | ...);  // unrolled: constant masks
-}
-
-std::size_t first_read_frame(std::span<const std::uint8_t> bytes) {
-  const std::size_t n = bytes.size() / kFrameBytes;
-  std::size_t i = 0;
-  if constexpr (std::endian::native == std::endian::little) {
-    constexpr std::size_t kBlock = 8;
-    for (; i + kBlock <= n; i += kBlock)
-      if (read_bits_of_block(bytes.data() + i * kFrameBytes, std::make_index_sequence<kBlock>{}) != 0)
-        break;  // the exact frame is found below
-  }
-  for (; i < n; ++i)
-    if (bytes[i * kFrameBytes] & 0x80) return i;
-  return n;
-}
-
 void read_text(PayloadReader& r, const char* field, std::string& out) {
   const std::size_t at = r.pos();
   out = as_string(r.rest());
@@ -213,7 +186,7 @@ void decode_into(const Header& h, PayloadReader& r, Payload& out) {
       } else if (data.size() % kFrameBytes != 0) {
         r.fail(ErrorCode::Malformed, "payload of " + std::to_string(data.size()) + " bytes is not a multiple of 9");
       } else {
-        if (const std::size_t f = first_read_frame(data); f * kFrameBytes < data.size())
+        if (const std::size_t f = first_read_frame(FrameView{data}); f * kFrameBytes < data.size())
           r.fail(ErrorCode::BadFrame, "frame " + std::to_string(f) + " (payload byte " +
                                           std::to_string(f * kFrameBytes) + ") has the read bit set; use READ_REG");
       }

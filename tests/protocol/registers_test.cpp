@@ -68,6 +68,23 @@ TEST(Registers, ReadFramesRoundTrip) {
   }
 }
 
+// The 8-frames-at-a-time scan must find the first read frame wherever it sits: in a whole block, in
+// the tail, with other reads after it, and in batches with no read at all. Data bytes with bit 7 set
+// (every data byte is 0xFF here) must never count.
+TEST(Registers, FirstReadFrameFindsTheFirstReadBitAtEveryPosition) {
+  for (std::size_t n = 0; n <= 40; ++n) {
+    std::vector<std::uint8_t> bytes;
+    for (std::size_t i = 0; i < n; ++i) append(bytes, Frame{false, 0x02, ~std::uint64_t{0}});
+    EXPECT_EQ(first_read_frame(FrameView{bytes}), n) << "no read frame in " << n;
+    for (std::size_t at = 0; at < n; ++at) {
+      auto with_read = bytes;
+      with_read[at * kFrameBytes] |= 0x80;
+      if (at + 3 < n) with_read[(at + 3) * kFrameBytes] |= 0x80;  // a later read does not hide the first
+      EXPECT_EQ(first_read_frame(FrameView{with_read}), at) << "batch of " << n << ", read at " << at;
+    }
+  }
+}
+
 TEST(Registers, FixedPointFieldsInText) {
   auto v = parse_register_line("VERTEX X=-2048 Y=2047.9375 Z=16777215");
   ASSERT_TRUE(v.ok()) << v.error().message;

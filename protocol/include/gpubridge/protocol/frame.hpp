@@ -55,4 +55,8 @@ struct FrameView {
   }
 };
 
+// Index of the first frame whose R/W̄ bit (bit 7 of byte 0) is set; frames.size() when none is.
+// Write batches must not contain reads: every consumer checks with this one routine.
+std::size_t first_read_frame(FrameView frames);
+
 }  // namespace gpubridge::protocol
