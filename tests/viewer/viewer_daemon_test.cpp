@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "gpubridge/common/image.hpp"
+#include "daemon_fixture.hpp"
 #include "process.hpp"
 
 namespace gpubridge::viewer::test {
@@ -62,37 +63,10 @@ class ViewerDaemon : public ::testing::Test {
   }
 
   std::unique_ptr<BackgroundProcess> start_daemon(const std::string& name) {
-    auto d = std::make_unique<BackgroundProcess>(
-        std::vector<std::string>{kDaemon, "--backend", "sim", "--listen", socket_, "--foreground"},
-        std::vector<std::string>{}, dir_.path(), name);
-    for (int i = 0; i < 200; ++i) {  // up to 10 s for the socket to accept
-      if (run_process({kCli, "status", "--connect", socket_}).exit_code == 0) return d;
-      if (!d->running()) break;
-      std::this_thread::sleep_for(50ms);
-    }
-    ADD_FAILURE() << "gpubridged did not come up: " << d->log();
-    return d;
+    return test::start_daemon(socket_, {"--backend", "sim"}, dir_.path(), name);
   }
 
-  // True once the daemon lists a subscribed gpubridge-view session.
-  bool viewer_subscribed() {
-    const auto r = run_process({kCli, "--json", "status", "--connect", socket_});
-    if (r.exit_code != 0) return false;
-    const auto j = nlohmann::json::parse(r.out, nullptr, false);
-    if (j.is_discarded() || !j.contains("clients")) return false;
-    for (const auto& c : j["clients"])
-      if (c.value("name", "") == "gpubridge-view" && c.value("subscribed", false)) return true;
-    return false;
-  }
-
-  ::testing::AssertionResult wait_subscribed(BackgroundProcess& viewer) {
-    for (int i = 0; i < 300; ++i) {  // up to 15 s
-      if (viewer_subscribed()) return ::testing::AssertionSuccess();
-      if (!viewer.running()) return ::testing::AssertionFailure() << "viewer exited: " << viewer.log();
-      std::this_thread::sleep_for(50ms);
-    }
-    return ::testing::AssertionFailure() << "viewer never subscribed: " << viewer.log();
-  }
+  ::testing::AssertionResult wait_subscribed(BackgroundProcess& viewer) { return test::wait_subscribed(viewer, socket_); }
 
   void play(const std::string& trace) {
     const auto r = run_process({kCli, "play", trace, "--connect", socket_});

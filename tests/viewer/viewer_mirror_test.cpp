@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "gpubridge/common/image.hpp"
+#include "daemon_fixture.hpp"
 #include "process.hpp"
 
 namespace gpubridge::viewer::test {
@@ -23,7 +24,6 @@ namespace {
 using namespace std::chrono_literals;
 
 const std::string kViewer = GPUBRIDGE_VIEW_PATH;
-const std::string kDaemon = GPUBRIDGED_PATH;
 const std::string kCli = GPUBRIDGE_CLI_PATH;
 
 // 160x120 RGB565 (fits the iCEBreaker profile's 320x240 / 128 KiB): a clear and one flat triangle.
@@ -60,35 +60,11 @@ class ViewerMirror : public ::testing::Test {
   }
 
   std::unique_ptr<BackgroundProcess> start_daemon(std::vector<std::string> extra) {
-    std::vector<std::string> argv{kDaemon, "--listen", socket_, "--foreground", "--no-fallback"};
-    argv.insert(argv.end(), extra.begin(), extra.end());
-    auto d = std::make_unique<BackgroundProcess>(argv, std::vector<std::string>{}, dir_.path(), "daemon");
-    for (int i = 0; i < 200; ++i) {  // up to 10 s for the socket to accept
-      if (run_process({kCli, "status", "--connect", socket_}).exit_code == 0) return d;
-      if (!d->running()) break;
-      std::this_thread::sleep_for(50ms);
-    }
-    ADD_FAILURE() << "gpubridged did not come up: " << d->log();
-    return d;
+    extra.push_back("--no-fallback");
+    return test::start_daemon(socket_, extra, dir_.path(), "daemon");
   }
 
-  bool viewer_subscribed() {
-    const auto r = run_process({kCli, "--json", "status", "--connect", socket_});
-    const auto j = nlohmann::json::parse(r.out, nullptr, false);
-    if (r.exit_code != 0 || j.is_discarded() || !j.contains("clients")) return false;
-    for (const auto& c : j["clients"])
-      if (c.value("name", "") == "gpubridge-view" && c.value("subscribed", false)) return true;
-    return false;
-  }
-
-  ::testing::AssertionResult wait_subscribed(BackgroundProcess& viewer) {
-    for (int i = 0; i < 300; ++i) {
-      if (viewer_subscribed()) return ::testing::AssertionSuccess();
-      if (!viewer.running()) return ::testing::AssertionFailure() << "viewer exited: " << viewer.log();
-      std::this_thread::sleep_for(50ms);
-    }
-    return ::testing::AssertionFailure() << "viewer never subscribed: " << viewer.log();
-  }
+  ::testing::AssertionResult wait_subscribed(BackgroundProcess& viewer) { return test::wait_subscribed(viewer, socket_); }
 
   std::unique_ptr<BackgroundProcess> start_viewer(std::vector<std::string> args) {
     args.insert(args.begin(), {kViewer, "--connect", socket_, "--offscreen", "--json", "--timeout", "60"});
