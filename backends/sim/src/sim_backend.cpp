@@ -28,10 +28,9 @@ Result<void> SimBackend::write_frames(protocol::FrameView frames) {
     return make_error("write_frames: " + std::to_string(frames.bytes.size()) + " bytes is not a whole number of " +
                           "9-byte frames",
                       backends::kBadRequest);
-  for (std::size_t i = 0; i < frames.size(); ++i)
-    if (frames.bytes[i * protocol::kFrameBytes] & 0x80)
-      return make_error("write_frames: frame " + std::to_string(i) + " is a read frame; use read_register",
-                        backends::kBadRequest);
+  if (const std::size_t i = protocol::first_read_frame(frames); i < frames.size())
+    return make_error("write_frames: frame " + std::to_string(i) + " is a read frame; use read_register",
+                      backends::kBadRequest);
   device_->write(frames);
   return {};
 }
