@@ -9,6 +9,8 @@
 // - after a disappearance: one call of the re-attach factory (libusb/hidapi open + attach, or the
 //   emulated stack). On success the board is reset to the defined state and replaces the current
 //   backend at once, between two device operations.
+// - `auto` that found no board at start (it runs the simulator): the same factory call, so a board
+//   plugged in after the daemon started replaces the simulator exactly as a board coming back does.
 //
 // Why "at once" even while a client holds the lease: the board lost all device state when it was
 // unplugged and the fallback simulator holds state the board never saw, so nothing the holder drew
@@ -24,6 +26,12 @@ void Hub::enable_hotplug(BackendFactory reattach, std::chrono::milliseconds inte
   reattach_ = std::move(reattach);
   hotplug_interval_ = interval;
   if (!reattach_ || interval.count() <= 0) return;
+  // A re-attach factory exists only for board configurations; serving anything but a board now
+  // means `auto` found none at start and fell back to the simulator. Set before the loops run,
+  // so the device thread sees it through the post below.
+  awaiting_first_board_ = info_.backend != "board";
+  first_board_pending_ = awaiting_first_board_;
+  attached_ = !awaiting_first_board_;
   boost::asio::post(net_, [this] { arm_hotplug_timer(); });
 }
 
@@ -52,16 +60,17 @@ void Hub::install_backend(std::unique_ptr<backends::Backend> backend) {
 
 void Hub::hotplug_tick() {
   auto log = logger("daemon");
-  if (!device_lost_) {
-    // Only boards can vanish; "auto" that found no board at start runs the simulator: nothing to probe.
+  if (!device_lost_ && !awaiting_first_board_) {
+    // Only boards can vanish (a fallback simulator is only ever in place while device_lost_).
     if (backend_->info().backend != "board") return;
     auto r = backend_->read_register(protocol::index_of(protocol::Reg::ID));
     if (!r && r.error().code == backends::kDeviceGone) on_device_gone(r.error());
     return;
   }
+  const bool first = awaiting_first_board_;
   auto board = reattach_();
   if (!board) {
-    log->debug("re-attach: not back yet: {}", board.error().message);
+    log->debug("{}: {}", first ? "auto: still no board" : "re-attach: not back yet", board.error().message);
     return;
   }
   // attach() checked ID/CAPS and wrote HOST_TAG; RESET puts registers, FIFO and flags into their
@@ -73,17 +82,28 @@ void Hub::hotplug_tick() {
   const auto info = (*board)->info();
   install_backend(std::move(*board));
   device_lost_ = false;
-  log->info("re-attach: board {} ({}) is back and reset; it replaces the fallback", info.board, info.bridge);
+  awaiting_first_board_ = false;
+  if (first)
+    log->info("auto: board {} ({}) plugged in; reset, it replaces the simulator", info.board, info.bridge);
+  else
+    log->info("re-attach: board {} ({}) is back and reset; it replaces the fallback", info.board, info.bridge);
+  // A first board uses the same event as a returning one: for every client the consequence is the
+  // same (another device in its reset state serves from now on; redraw), and clients that already
+  // redraw on device_back need no change. `first_attach` tells the two apart.
+  const std::string what = first ? "board '" + info.board + "' was plugged in and replaces the simulator"
+                                 : "board '" + info.board + "' is back";
   const nlohmann::json event{{"event", "device_back"},
                              {"backend", info.backend},
                              {"board", info.board},
                              {"bridge", info.bridge},
                              {"state", "reset"},
-                             {"message", "board '" + info.board + "' is back: registers, FIFO and memory are in their "
-                                         "power-on/reset state; the lease holder keeps the lease and should redraw"}};
-  boost::asio::post(net_, [this, info, event] {
+                             {"first_attach", first},
+                             {"message", what + ": registers, FIFO and memory are in their power-on/reset state; "
+                                                "the lease holder keeps the lease and should redraw"}};
+  boost::asio::post(net_, [this, info, event, first] {
     info_ = info;
-    ++reattaches_;
+    if (first) first_board_pending_ = false;
+    else ++reattaches_;
     attached_ = true;
     broadcast_event(event);
   });
@@ -93,6 +113,9 @@ nlohmann::json Hub::hotplug_json() const {
   return {{"enabled", static_cast<bool>(reattach_) && hotplug_interval_.count() > 0},
           {"interval_ms", hotplug_interval_.count()},
           {"attached", attached_},
+          // `auto` started on the simulator and no board was plugged in yet (attached is false, but
+          // nothing was ever detached).
+          {"awaiting_first_board", first_board_pending_},
           {"detaches", detaches_},
           {"reattaches", reattaches_}};
 }

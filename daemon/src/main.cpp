@@ -63,7 +63,8 @@ int run(daemon::DaemonConfig cfg) {
   int exit_code = 0;
   {
     daemon::Hub hub(net.get_executor(), device.get_executor(), std::move(*backend), opts, fallback);
-    // Board backends: probe presence and re-attach after an unplug (sim/fake/discard: no factory).
+    // Board backends: probe presence and re-attach after an unplug; `auto` that started on the
+    // simulator keeps looking for a first board the same way (sim/fake/discard: no factory).
     auto reattach = daemon::make_reattach_factory(cfg);
     if (reattach && cfg.mirror)  // a board that comes back is mirrored again
       reattach = [inner = std::move(reattach)]() -> Result<std::unique_ptr<backends::Backend>> {

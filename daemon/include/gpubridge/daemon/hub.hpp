@@ -102,7 +102,10 @@ class Hub {
   // --- hot-plug (hub_hotplug.cpp; docs/daemon.md "Hot-plug") ---
   // Every `interval` the device thread probes the board (ID read) while it is attached, or calls
   // `reattach` once it disappeared; a board that comes back replaces the fallback at once and
-  // every session gets a `device_back` event. Call once, before the network loop runs.
+  // every session gets a `device_back` event. When the hub serves a non-board backend at this
+  // point (`auto` found no board at start) `reattach` is called from the first interval on, and
+  // the first board it returns replaces the simulator the same way (`device_back` with
+  // `first_attach`). Call once, before the network loop runs.
   void enable_hotplug(BackendFactory reattach, std::chrono::milliseconds interval);
   // Shutdown: cancels the timer; no probe or attempt starts afterwards (network thread).
   void stop_hotplug();
@@ -151,7 +154,9 @@ class Hub {
   boost::asio::steady_timer hotplug_timer_{net_};
   bool hotplug_stopped_ = false;                // network thread
   bool device_lost_ = false;                    // device thread: gone and not yet re-attached
-  bool attached_ = true;                        // network-thread copy of !device_lost_
+  bool awaiting_first_board_ = false;           // device thread: `auto` on the simulator, no board yet
+  bool attached_ = true;                        // network-thread copy of !device_lost_ && !awaiting_first_board_
+  bool first_board_pending_ = false;            // network-thread copy of awaiting_first_board_
   std::uint64_t detaches_ = 0, reattaches_ = 0;  // network thread
 };
 

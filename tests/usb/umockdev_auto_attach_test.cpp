@@ -1,0 +1,171 @@
+// `gpubridged --backend auto` started with no board picks up a board plugged in later (issue 4,
+// docs/daemon.md "Hot-plug"): the daemon's Hub and Server in-process on the simulator, with the
+// real auto re-attach factory (board profiles → libusb enumeration/open → FTDI MPSSE driver →
+// attach) running against a umockdev testbed that is empty at first and then gets an FT232H
+// whose usbfs ioctls are answered by the byte-exact MPSSE model.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <filesystem>
+#include <optional>
+#include <random>
+#include <thread>
+
+#include <nlohmann/json.hpp>
+
+#include "gpubridge/client/client.hpp"
+#include "gpubridge/daemon/backend_factory.hpp"
+#include "gpubridge/daemon/config.hpp"
+#include "gpubridge/daemon/hub.hpp"
+#include "gpubridge/daemon/server.hpp"
+#include "gpubridge/protocol/registers.hpp"
+#include "umockdev_bed.hpp"
+
+namespace gpubridge {
+namespace {
+
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+using namespace std::chrono_literals;
+
+fs::path make_temp_dir() {
+  std::random_device rd;
+  fs::path dir = fs::temp_directory_path() / ("gb-autoattach-" + std::to_string(rd() % 1000000));
+  fs::create_directories(dir / "boards");
+  return dir;
+}
+
+json status_of(client::Client& c) {
+  auto s = c.status(2000ms);
+  EXPECT_TRUE(s) << (s ? "" : s.error().message);
+  return s ? json::parse(*s) : json::object();
+}
+
+// Events named `name` that arrived within `timeout` (PING keeps the connection read).
+std::optional<json> wait_event(client::Client& c, const std::string& name, std::chrono::milliseconds timeout) {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  while (std::chrono::steady_clock::now() < deadline) {
+    for (const auto& text : c.take_device_events()) {
+      auto j = json::parse(text);
+      if (j.value("event", "") == name) return j;
+    }
+    if (!c.ping(1000ms)) return std::nullopt;
+    std::this_thread::sleep_for(10ms);
+  }
+  return std::nullopt;
+}
+
+// gpubridged's wiring (main.cpp) for `--backend auto`, in-process: network and device threads,
+// the simulator fallback and the auto re-attach factory.
+class InProcessAutoDaemon {
+ public:
+  ~InProcessAutoDaemon() {
+    if (server_) boost::asio::post(net_, [this] { hub_->stop_hotplug(); server_->stop(); hub_->shutdown_sessions(); });
+    std::this_thread::sleep_for(50ms);
+    net_.stop();
+    if (net_thread_.joinable()) net_thread_.join();
+    device_guard_.reset();
+    device_.stop();
+    if (device_thread_.joinable()) device_thread_.join();
+    server_.reset();
+    hub_.reset();
+  }
+
+  // Starts like gpubridged: make_backend("auto") first (with the testbed as it is now).
+  bool start(const daemon::DaemonConfig& cfg, const fs::path& socket_dir, std::string& started_on, std::string& why) {
+    auto backend = daemon::make_backend(cfg.backend, cfg);
+    if (!backend) return (why = backend.error().message, false);
+    started_on = (*backend)->info().backend;
+    hub_.emplace(net_.get_executor(), device_.get_executor(), std::move(*backend), daemon::HubOptions{},
+                 daemon::make_simulator);
+    hub_->enable_hotplug(daemon::make_reattach_factory(cfg), std::chrono::milliseconds(cfg.reattach_interval_ms));
+    server_.emplace(net_, *hub_);
+    auto a = client::parse_address("unix:" + (socket_dir / "d.sock").string());
+    if (!a) return (why = a.error().message, false);
+    auto bound = server_->listen(*a);
+    if (!bound) return (why = bound.error().message, false);
+    address_ = bound->to_string();
+    device_thread_ = std::thread([this] { device_.run(); });
+    net_thread_ = std::thread([this] { net_.run(); });
+    return true;
+  }
+  const std::string& address() const { return address_; }
+
+ private:
+  boost::asio::io_context net_{1}, device_{1};
+  boost::asio::executor_work_guard<boost::asio::io_context::executor_type> device_guard_ =
+      boost::asio::make_work_guard(device_);
+  std::optional<daemon::Hub> hub_;
+  std::optional<daemon::Server> server_;
+  std::string address_;
+  std::thread net_thread_, device_thread_;
+};
+
+TEST(AutoAttach, BoardPluggedInAfterStartReplacesTheSimulator) {
+  usb::testing::Bed bed(/*plugged=*/false);
+  const fs::path dir = make_temp_dir();
+  // Only the profile that matches the testbed's FT232H, so every attempt is this board's open.
+  fs::copy_file(fs::path(GPUBRIDGE_TEST_CONFIG_DIR) / "boards" / "ft232h-generic.json", dir / "boards" / "ft232h-generic.json");
+
+  daemon::DaemonConfig cfg;
+  cfg.backend = "auto";
+  cfg.boards_dir = dir.string();
+  cfg.reattach_interval_ms = 50;
+
+  std::string started_on, why;
+  {
+    InProcessAutoDaemon d;
+    ASSERT_TRUE(d.start(cfg, dir, started_on, why)) << why;
+    ASSERT_EQ(started_on, "sim") << "auto found a board in an empty testbed";
+
+    auto c = client::Client::connect(d.address(), 2000ms);
+    ASSERT_TRUE(c) << c.error().message;
+    ASSERT_TRUE(c->handshake("watcher", "", 2000ms));
+
+    // No board: it keeps serving the simulator, and status claims no attach or detach.
+    std::this_thread::sleep_for(300ms);  // several 50 ms attempts, all finding nothing
+    {
+      const auto st = status_of(*c);
+      EXPECT_EQ(st["backend"], "sim") << st.dump();
+      EXPECT_EQ(st["hotplug"]["enabled"], true) << st.dump();
+      EXPECT_EQ(st["hotplug"]["attached"], false) << st.dump();
+      EXPECT_EQ(st["hotplug"]["awaiting_first_board"], true) << st.dump();
+      EXPECT_EQ(st["hotplug"]["detaches"], 0) << st.dump();
+      EXPECT_EQ(st["hotplug"]["reattaches"], 0) << st.dump();
+    }
+    EXPECT_TRUE(c->take_device_events().empty()) << "an event without any board";
+    EXPECT_EQ(bed.bulk_urbs.load(), 0u) << "no device, yet bulk transfers happened";
+
+    bed.plug();
+    const auto back = wait_event(*c, "device_back", 5000ms);
+    ASSERT_TRUE(back) << "no device_back event after the board was plugged in";
+    EXPECT_EQ((*back)["backend"], "board") << back->dump();
+    EXPECT_EQ((*back)["board"], "ft232h-generic") << back->dump();
+    EXPECT_EQ((*back)["state"], "reset") << back->dump();
+    EXPECT_EQ((*back)["first_attach"], true) << back->dump();
+    {
+      const auto st = status_of(*c);
+      EXPECT_EQ(st["backend"], "board") << st.dump();
+      EXPECT_EQ(st["board"], "ft232h-generic") << st.dump();
+      EXPECT_EQ(st["hotplug"]["attached"], true) << st.dump();
+      EXPECT_EQ(st["hotplug"]["awaiting_first_board"], false) << st.dump();
+      EXPECT_EQ(st["hotplug"]["detaches"], 0) << st.dump();
+      EXPECT_EQ(st["hotplug"]["reattaches"], 0) << "a first attach is not a re-attach: " << st.dump();
+    }
+
+    // Commands now go through libusb to the model: an ID read costs bulk URBs and returns the
+    // reference target's ID.
+    ASSERT_TRUE(c->acquire_lease(protocol::LeaseMode::Wait, 2000ms));
+    const unsigned urbs_before = bed.bulk_urbs.load();
+    auto id = c->read_register(protocol::index_of(protocol::Reg::ID), 2000ms);
+    ASSERT_TRUE(id) << id.error().message;
+    EXPECT_EQ(*id >> 56, 0x53u);
+    EXPECT_GT(bed.bulk_urbs.load(), urbs_before) << "the ID read did not reach the USB device";
+    EXPECT_TRUE(bed.model.violations().empty()) << bed.model.violations()[0];
+  }
+  std::error_code ec;
+  fs::remove_all(dir, ec);
+}
+
+}  // namespace
+}  // namespace gpubridge
