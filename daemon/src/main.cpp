@@ -150,7 +150,8 @@ int main(int argc, char** argv) {
                "board backends: also run the simulator on the same commands and compare every frame "
                "(subscribers may ask for the board, the simulator or a diff image)");
   app.add_option("--reattach-interval-ms", reattach_ms,
-                 "board backends: probe the board and, after an unplug, look for it again this often "
+                 "board backends: probe the board and, after an unplug, look for it again this often; "
+                 "auto without a board at start keeps looking for one at this interval "
                  "(default 1000; 0 = never re-attach)");
   app.add_option("--boards-dir", boards_dir, "directory of board profiles (JSON)");
   app.add_option("--frames-dir", frames_dir, "write every scanned-out frame as frame_NNNNNN.png here");

@@ -1,8 +1,8 @@
 #pragma once
 // A umockdev testbed holding one FT232H whose usbfs ioctls are answered by the byte-exact MPSSE
 // model (driving the reference SPI target), so the real LibusbContext/LibusbDevice code path runs
-// against it. Optionally created unplugged (plug() adds the device later). Same model as the one
-// in umockdev_test.cpp (which still carries its own copy); template: libusb tests/umockdev.c.
+// against it. Optionally created unplugged (plug() adds the device later). Used by umockdev_test.cpp
+// and umockdev_auto_attach_test.cpp; template: libusb tests/umockdev.c.
 #include <atomic>
 #include <cerrno>
 #include <cstring>

@@ -119,7 +119,9 @@ int run_status(const GlobalOptions& g, const ClientOptions& o) {
   if (j.contains("hotplug") && j["hotplug"].is_object() && j["hotplug"].value("enabled", false)) {
     const auto& h = j["hotplug"];
     std::printf("hot-plug:  board %s, %llu unplug(s), %llu re-attach(es), checked every %llu ms\n",
-                h.value("attached", true) ? "attached" : "gone (looking for it)",
+                h.value("awaiting_first_board", false) ? "none yet (auto: looking for one)"
+                : h.value("attached", true)            ? "attached"
+                                                       : "gone (looking for it)",
                 static_cast<unsigned long long>(h.value("detaches", std::uint64_t{0})),
                 static_cast<unsigned long long>(h.value("reattaches", std::uint64_t{0})),
                 static_cast<unsigned long long>(h.value("interval_ms", std::uint64_t{0})));
