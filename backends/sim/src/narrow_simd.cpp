@@ -1,18 +1,12 @@
 #include "narrow_simd.hpp"
 
-#include <cstring>
+#include "simd_lanes.hpp"
 
 namespace gpubridge::sim {
 namespace {
 
-typedef std::uint32_t u32x8 __attribute__((vector_size(32)));
-typedef std::int32_t i32x8 __attribute__((vector_size(32)));
-
-// Macros, not functions, so they inline into every target clone (see span_simd.cpp).
-#define GB_LOAD8(dst, p) std::memcpy(&(dst), (p), sizeof(u32x8))
-#define GB_STORE8(p, src) std::memcpy((p), &(src), sizeof(u32x8))
-#define GB_BSWAP(w) (((w) >> 24) | (((w) >> 8) & 0xFF00u) | (((w) << 8) & 0xFF0000u) | ((w) << 24))
-#define GB_MASK(m) ((u32x8)(m))
+using simd::i32x8;
+using simd::u32x8;
 // r < den after one carry: r may reach 2·den − 2 < 2^31, so the signed compare is exact.
 #define GB_CARRY(q, r, den)                               \
   do {                                                    \
@@ -58,16 +52,7 @@ __attribute__((target_clones("avx2", "default"))) NarrowCounts shade_narrow_simd
       const u32x8 z = q[4] & t.zmask;
       if (t.z_test) {
         const i32x8 zi = (i32x8)z, di = (i32x8)(GB_BSWAP(old) & 0xFFFFFFu);  // both < 2^24
-        switch (t.z_func) {
-          case 1: pass &= GB_MASK(zi < di); break;
-          case 2: pass &= GB_MASK(zi == di); break;
-          case 3: pass &= GB_MASK(zi <= di); break;
-          case 4: pass &= GB_MASK(zi > di); break;
-          case 5: pass &= GB_MASK(zi != di); break;
-          case 6: pass &= GB_MASK(zi >= di); break;
-          case 7: break;
-          default: pass = u32x8{}; break;
-        }
+        GB_DEPTH_TEST(pass, zi, di, t.z_func);
       }
       if (t.z_write) {
         const u32x8 out = (GB_BSWAP(z) & pass) | (old & ~pass);

@@ -1,18 +1,12 @@
 #include "span_simd.hpp"
 
-#include <cstring>
+#include "simd_lanes.hpp"
 
 namespace gpubridge::sim {
 namespace {
 
-typedef std::uint32_t u32x8 __attribute__((vector_size(32)));
-typedef std::int32_t i32x8 __attribute__((vector_size(32)));
-
-// Helpers are macros so they inline into every target clone (a plain inline function compiled
-// for the default target would not inline into the AVX2 clone).
-#define GB_LOAD8(dst, p) std::memcpy(&(dst), (p), sizeof(u32x8))
-#define GB_BSWAP(w) (((w) >> 24) | (((w) >> 8) & 0xFF00u) | (((w) << 8) & 0xFF0000u) | ((w) << 24))
-#define GB_MASK(m) ((u32x8)(m))
+using simd::i32x8;
+using simd::u32x8;
 // Full chunks copy a constant 32 bytes (inlined); only the tail copies n words.
 #define GB_COPY(dst, src, n) ((n) == 8 ? std::memcpy((dst), (src), 32) : std::memcpy((dst), (src), (n) * 4))
 
@@ -49,16 +43,7 @@ __attribute__((target_clones("avx2", "default"))) std::uint64_t shade_span_simd(
       GB_LOAD8(old, zbuf);
       if (s.z_test) {
         const i32x8 zi = (i32x8)z, di = (i32x8)(GB_BSWAP(old) & 0xFFFFFFu);  // both < 2^24
-        switch (s.z_func) {
-          case 1: pass &= GB_MASK(zi < di); break;
-          case 2: pass &= GB_MASK(zi == di); break;
-          case 3: pass &= GB_MASK(zi <= di); break;
-          case 4: pass &= GB_MASK(zi > di); break;
-          case 5: pass &= GB_MASK(zi != di); break;
-          case 6: pass &= GB_MASK(zi >= di); break;
-          case 7: break;
-          default: pass = u32x8{}; break;
-        }
+        GB_DEPTH_TEST(pass, zi, di, s.z_func);
       }
       std::uint64_t m[4];
       std::memcpy(m, &pass, sizeof m);

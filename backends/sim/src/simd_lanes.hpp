@@ -1,0 +1,32 @@
+#pragma once
+// 8-lane GCC/Clang vector types and the helpers both SIMD routines (span_simd.cpp, narrow_simd.cpp)
+// share. The helpers are macros, not functions, so that they inline into every target clone (a
+// plain inline function compiled for the default target would not inline into the AVX2 clone).
+#include <cstdint>
+#include <cstring>
+
+namespace gpubridge::sim::simd {
+typedef std::uint32_t u32x8 __attribute__((vector_size(32)));
+typedef std::int32_t i32x8 __attribute__((vector_size(32)));
+}  // namespace gpubridge::sim::simd
+
+#define GB_LOAD8(dst, p) std::memcpy(&(dst), (p), sizeof(u32x8))
+#define GB_STORE8(p, src) std::memcpy((p), &(src), sizeof(u32x8))
+// Z is stored big-endian in video memory (docs/protocol.md): byte-swap each lane.
+#define GB_BSWAP(w) (((w) >> 24) | (((w) >> 8) & 0xFF00u) | (((w) << 8) & 0xFF0000u) | ((w) << 24))
+#define GB_MASK(m) ((u32x8)(m))
+// pass &= the depth test `func` (TRI_MODE.Z_FUNC: 0 NEVER, 1 LESS, 2 EQUAL, 3 LEQUAL, 4 GREATER,
+// 5 NOTEQUAL, 6 GEQUAL, 7 ALWAYS) of new depth zi against stored di, both < 2^24 in signed lanes.
+#define GB_DEPTH_TEST(pass, zi, di, func)           \
+  do {                                              \
+    switch (func) {                                 \
+      case 1: (pass) &= GB_MASK((zi) < (di)); break;  \
+      case 2: (pass) &= GB_MASK((zi) == (di)); break; \
+      case 3: (pass) &= GB_MASK((zi) <= (di)); break; \
+      case 4: (pass) &= GB_MASK((zi) > (di)); break;  \
+      case 5: (pass) &= GB_MASK((zi) != (di)); break; \
+      case 6: (pass) &= GB_MASK((zi) >= (di)); break; \
+      case 7: break;                                \
+      default: (pass) = u32x8{}; break;             \
+    }                                               \
+  } while (0)
