@@ -144,13 +144,14 @@ Result<std::unique_ptr<backends::Backend>> make_mirror(std::unique_ptr<backends:
 #ifdef GPUBRIDGE_HAVE_SIM
   sim::DeviceOptions o;
   // The model gets the board's memory and limits, so a command that does not fit the board does
-  // not fit the model either. CAPS layout: docs/protocol.md, CAPS.
+  // not fit the model either (CAPS fields from the register table).
   o.vram_bytes = std::clamp<std::uint64_t>(info.vram_bytes / 1024 * 1024, 64 * 1024, sim::kMaxVramBytes);
   o.max_width = std::clamp(info.max_width, 1u, protocol::kMaxFramebufferDim);
   o.max_height = std::clamp(info.max_height, 1u, protocol::kMaxFramebufferDim);
   if (info.caps != 0) {
-    o.fifo_depth = std::clamp(static_cast<unsigned>((info.caps >> 46) & 0x3FF), 64u, 1023u);
-    o.features = static_cast<std::uint8_t>((info.caps >> 56) & sim::kAllFeatures);
+    const auto& caps = protocol::describe(protocol::Reg::CAPS);
+    o.fifo_depth = std::clamp(static_cast<unsigned>(caps.field("FIFO_DEPTH")->get(info.caps)), 64u, 1023u);
+    o.features = static_cast<std::uint8_t>(caps.field("FEATURES")->get(info.caps) & sim::kAllFeatures);
   }
   auto model = sim::SimBackend::create(o);
   if (!model) return make_error("mirror: cannot create the simulator for board \"" + info.board + "\": " + model.error().message);

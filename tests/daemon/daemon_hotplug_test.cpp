@@ -7,6 +7,7 @@
 #include <future>
 #include <nlohmann/json.hpp>
 
+#include "client_checks.hpp"
 #include "daemon_process.hpp"
 #include "gpubridge/client/client.hpp"
 #include "gpubridge/common/image.hpp"
@@ -27,25 +28,7 @@ std::string trace_path(const char* name) { return std::string(GPUBRIDGE_TEST_DAT
 void plug(const fs::path& presence) { std::ofstream(presence) << "plugged\n"; }
 void unplug(const fs::path& presence) { fs::remove(presence); }
 
-json status_of(client::Client& c) {
-  auto s = c.status(2000ms);
-  if (!s) return json{{"error", s.error().message}};
-  return json::parse(*s);
-}
 
-// Waits for DEVICE_EVENT `name` on `c` (pinging so the client reads what arrived).
-std::optional<json> wait_event(client::Client& c, const std::string& name, std::chrono::milliseconds timeout) {
-  const auto deadline = std::chrono::steady_clock::now() + timeout;
-  while (std::chrono::steady_clock::now() < deadline) {
-    for (const auto& text : c.take_device_events()) {
-      auto j = json::parse(text);
-      if (j.value("event", "") == name) return j;
-    }
-    if (!c.ping(1000ms)) return std::nullopt;
-    std::this_thread::sleep_for(10ms);
-  }
-  return std::nullopt;
-}
 
 // Plays `trace` with `gpubridge play` while `gpubridge screenshot` waits for the frame, renders the
 // same trace in-process with `gpubridge render`, and compares the two pictures pixel for pixel.

@@ -16,6 +16,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "client_checks.hpp"
 #include "daemon_process.hpp"
 #include "gpubridge/client/client.hpp"
 #include "gpubridge/common/image.hpp"
@@ -54,11 +55,6 @@ bool is_dimmed_grey_of(const std::uint8_t* diff, const std::uint8_t* board_rgba)
 
 Image to_image(const client::ReceivedFrame& f) { return image_from_device(f.format, f.width, f.height, f.pixels); }
 
-nlohmann::json status_of(client::Client& c) {
-  auto s = c.status(2000ms);
-  EXPECT_TRUE(s) << (s ? "" : s.error().message);
-  return s ? nlohmann::json::parse(*s) : nlohmann::json::object();
-}
 
 std::unique_ptr<client::Client> subscriber(const std::string& address, FrameSource source,
                                            FrameFormat format = FrameFormat::Native) {

@@ -19,6 +19,7 @@
 #include "gpubridge/daemon/hub.hpp"
 #include "gpubridge/daemon/server.hpp"
 #include "gpubridge/protocol/registers.hpp"
+#include "client_checks.hpp"
 #include "umockdev_bed.hpp"
 
 namespace gpubridge {
@@ -27,6 +28,8 @@ namespace {
 namespace fs = std::filesystem;
 using json = nlohmann::json;
 using namespace std::chrono_literals;
+using test::status_of;
+using test::wait_event;
 
 fs::path make_temp_dir() {
   std::random_device rd;
@@ -35,25 +38,7 @@ fs::path make_temp_dir() {
   return dir;
 }
 
-json status_of(client::Client& c) {
-  auto s = c.status(2000ms);
-  EXPECT_TRUE(s) << (s ? "" : s.error().message);
-  return s ? json::parse(*s) : json::object();
-}
 
-// Events named `name` that arrived within `timeout` (PING keeps the connection read).
-std::optional<json> wait_event(client::Client& c, const std::string& name, std::chrono::milliseconds timeout) {
-  const auto deadline = std::chrono::steady_clock::now() + timeout;
-  while (std::chrono::steady_clock::now() < deadline) {
-    for (const auto& text : c.take_device_events()) {
-      auto j = json::parse(text);
-      if (j.value("event", "") == name) return j;
-    }
-    if (!c.ping(1000ms)) return std::nullopt;
-    std::this_thread::sleep_for(10ms);
-  }
-  return std::nullopt;
-}
 
 // gpubridged's wiring (main.cpp) for `--backend auto`, in-process: network and device threads,
 // the simulator fallback and the auto re-attach factory.
