@@ -201,8 +201,11 @@ Result<void> Client::pump(Clock::time_point deadline, bool block) {
   const int rc = ::poll(&p, 1, block ? remaining_ms(deadline) : 0);
   if (rc < 0 && errno != EINTR) return io_error("poll: " + errno_text(errno));
   if (rc <= 0) return {};
-  std::uint8_t buf[64 * 1024];
-  const ssize_t n = ::recv(fd_, buf, sizeof buf, 0);
+  // Read straight into the parser's buffer (no copy per read; frames can be 4 MiB). The span is
+  // empty only once the stream has failed to parse, which was already reported.
+  const auto room = parser_->prepare(256 * 1024);
+  if (room.empty()) return io_error("bad data from daemon: " + parser_->error().message);
+  const ssize_t n = ::recv(fd_, room.data(), room.size(), 0);
   if (n == 0) {
     // Report the daemon's last words (e.g. SERVER_FULL, SHUTTING_DOWN) if it sent any.
     for (auto& m : inbox_)
@@ -213,7 +216,7 @@ Result<void> Client::pump(Clock::time_point deadline, bool block) {
     if (errno == EAGAIN || errno == EINTR) return {};
     return io_error("lost connection to " + address_.to_string() + ": " + errno_text(errno));
   }
-  parser_->feed({buf, static_cast<std::size_t>(n)});
+  parser_->commit(static_cast<std::size_t>(n));
   for (;;) {
     Message m;
     const auto st = parser_->next(m);
