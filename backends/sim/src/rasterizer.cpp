@@ -158,7 +158,8 @@ class Kernel {
     }
   }
 
-  // The vector routine applies to untextured direct RGBA8888 stores with both buffers inside VRAM
+  // The vector routine applies to untextured RGBA8888 stores (blend and write mask included) with
+  // both buffers inside VRAM and disjoint (it tests eight depths before it writes eight colours),
   // and values that fit 32-bit lanes (2·den < 2^31 and per-8-pixel steps below 2^30).
   bool simd_ready() {
     if (!simd_checked_) {
@@ -168,10 +169,11 @@ class Kernel {
     return simd_;
   }
   void prepare_simd() {
-    if constexpr (kTextured || !kSimple) {
+    if constexpr (kTextured) {
       return;
     } else {
-      if (!st_.color_in_vram || (kDepth && !st_.z_in_vram) || skip_colour_) return;
+      if (st_.fb_format != protocol::PixelFormat::RGBA8888 || !st_.color_in_vram || skip_colour_) return;
+      if (kDepth && (!st_.z_in_vram || !st_.buffers_disjoint)) return;
       if (t_.den >= (std::int64_t{1} << 30)) return;
       simd_tpl_.den = static_cast<std::uint32_t>(t_.den);
       for (unsigned p = 0; p < SimdSpan::kPlanes; ++p) {
@@ -206,6 +208,10 @@ class Kernel {
       simd_tpl_.z_test = kDepth && st_.z_test;
       simd_tpl_.z_write = kDepth && st_.z_write;
       simd_tpl_.z_func = static_cast<unsigned>(st_.z_func);
+      simd_tpl_.blend = static_cast<unsigned>(st_.blend);
+      simd_tpl_.keep = 0;
+      for (unsigned c = 0; c < 4; ++c)
+        if (st_.keep_mask & (1u << c)) simd_tpl_.keep |= 0xFFu << (8 * c);
       simd_ = true;
     }
   }
@@ -230,7 +236,9 @@ class Kernel {
     sp.colour = color_ + pix * 4;
     sp.depth = kDepth ? zbuf_ + pix * 4 : nullptr;
     sp.count = count;
-    ctx_.counters.passed += shade_span_simd(sp);
+    const std::uint64_t passed = shade_span_simd(sp);
+    ctx_.counters.passed += passed;
+    if (st_.blend != protocol::BlendMode::Off) ctx_.counters.blended += passed;
   }
 
   void pixel(int x, int y, const Steppers& s) {

@@ -10,6 +10,33 @@ using simd::u32x8;
 // Full chunks copy a constant 32 bytes (inlined); only the tail copies n words.
 #define GB_COPY(dst, src, n) ((n) == 8 ? std::memcpy((dst), (src), 32) : std::memcpy((dst), (src), (n) * 4))
 
+// Section 11's blend of eight source words with the eight stored ones (byte c of a word is channel
+// c: R, G, B, A), channel by channel in 32-bit lanes; div255 as in fixed_point.hpp. Macros so they
+// inline into each target clone.
+#define GB_DIV255(x) (((x) + 128u + (((x) + 128u) >> 8)) >> 8)
+#define GB_BLEND8(mode, src, dst)                                                    \
+  ({                                                                                 \
+    const u32x8 bl_a = (src) >> 24, bl_inv = 255u - bl_a;                            \
+    u32x8 bl_out = {};                                                               \
+    for (unsigned bl_c = 0; bl_c < 32; bl_c += 8) {                                  \
+      const u32x8 bl_s = ((src) >> bl_c) & 255u, bl_d = ((dst) >> bl_c) & 255u;      \
+      u32x8 bl_v;                                                                    \
+      if ((mode) == 1) {                                                             \
+        bl_v = bl_s * bl_a + bl_d * bl_inv;                                          \
+        bl_v = GB_DIV255(bl_v);                                                      \
+      } else if ((mode) == 2) {                                                      \
+        bl_v = bl_s + bl_d;                                                          \
+        const u32x8 bl_over = GB_MASK((i32x8)bl_v > 255);                            \
+        bl_v = (bl_v & ~bl_over) | (255u & bl_over);                                 \
+      } else {                                                                       \
+        bl_v = bl_s * bl_d;                                                          \
+        bl_v = GB_DIV255(bl_v);                                                      \
+      }                                                                              \
+      bl_out |= bl_v << bl_c;                                                        \
+    }                                                                                \
+    bl_out;                                                                          \
+  })
+
 }  // namespace
 
 __attribute__((target_clones("avx2", "default"))) std::uint64_t shade_span_simd(const SimdSpan& s) {
@@ -28,6 +55,7 @@ __attribute__((target_clones("avx2", "default"))) std::uint64_t shade_span_simd(
   }
   const u32x8 lane = {0, 1, 2, 3, 4, 5, 6, 7};
   const bool depth = s.z_test || s.z_write;
+  const bool reads_colour = s.blend != 0 || s.keep != 0;
   u32x8 passed = {};
   for (unsigned i = 0; i < s.count; i += 8) {
     const unsigned n = s.count - i < 8 ? s.count - i : 8;
@@ -59,15 +87,17 @@ __attribute__((target_clones("avx2", "default"))) std::uint64_t shade_span_simd(
     if (!none) {
       u32x8 word = u32x8{} + s.flat;
       if (s.gouraud) word = (q[0] & 255u) | ((q[1] & 255u) << 8) | ((q[2] & 255u) << 16) | (q[3] << 24);
-      if (all) {
-        std::memcpy(cp, &word, 32);
-      } else {
+      if (reads_colour || !all) {
         std::uint32_t cbuf[8] = {};
         GB_COPY(cbuf, cp, n);
         u32x8 cold;
         GB_LOAD8(cold, cbuf);
+        if (s.blend != 0) word = GB_BLEND8(s.blend, word, cold);
+        word = (word & ~s.keep) | (cold & s.keep);
         const u32x8 out = (word & pass) | (cold & ~pass);
         GB_COPY(cp, &out, n);
+      } else {
+        std::memcpy(cp, &word, 32);  // fully passing chunk of a plain store: no read
       }
       passed -= pass;  // pass lanes are all ones (−1)
     }

@@ -1,6 +1,7 @@
 #pragma once
-// The vectorised span routine for the commonest draw: untextured, RGBA8888 store without blend or
-// mask, optional depth test/write, both buffers inside VRAM. Eight pixels per step: lanes k = 0..7
+// The vectorised span routine for untextured draws into an RGBA8888 buffer: optional depth
+// test/write, optional blend (ALPHA, ADD, MULTIPLY) and write mask, both buffers inside VRAM and
+// disjoint. Eight pixels per step: lanes k = 0..7
 // hold (q, r) of each attribute plane for x + k and advance by (Q8, R8) = divmod(8·step) with
 // add, add, compare, and, subtract, subtract — no division per pixel, and integer-exact, so the
 // output equals the scalar routine's byte for byte (tests compare them).
@@ -20,6 +21,8 @@ struct SimdSpan {
   std::uint8_t* depth = nullptr;           // first depth word of the span (when z_test or z_write)
   unsigned count = 0;                      // pixels in the span
   unsigned z_func = 0;                     // protocol::DepthFunc
+  unsigned blend = 0;                      // protocol::BlendMode (0 = off)
+  std::uint32_t keep = 0;                  // bytes of the colour word the write mask keeps
   bool gouraud = false, z_test = false, z_write = false;
 };
 
