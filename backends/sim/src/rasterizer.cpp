@@ -120,6 +120,10 @@ class Kernel {
       for (int i = 0; i < 3; ++i) e[i] += t_.edge[i].ey;
       step_y(row);
     }
+    if constexpr (kTextured) {
+      ctx_.counters.textured += textured_;
+      ctx_.counters.texel_bytes += textured_ * (st_.tex.bilinear ? 4u : 1u) * protocol::bytes_per_pixel(st_.tex.format);
+    }
   }
 
  private:
@@ -241,7 +245,7 @@ class Kernel {
     if (st_.blend != protocol::BlendMode::Off) ctx_.counters.blended += passed;
   }
 
-  void pixel(int x, int y, const Steppers& s) {
+  [[gnu::always_inline]] void pixel(int x, int y, const Steppers& s) {
     const std::size_t pix = static_cast<std::size_t>(y) * width_ + static_cast<std::size_t>(x);
     if constexpr (kDepth) {
       const std::uint32_t z = static_cast<std::uint32_t>(s.q[kZ]) & zmask_;
@@ -266,8 +270,7 @@ class Kernel {
            static_cast<std::uint8_t>(s.q[kA])};
     }
     if constexpr (kTextured) {
-      ++ctx_.counters.textured;
-      ctx_.counters.texel_bytes += (st_.tex.bilinear ? 4u : 1u) * protocol::bytes_per_pixel(st_.tex.format);
+      ++textured_;  // counted here, added to the context once per run (no per-pixel store through ctx_)
       TexelCoords tc;
       const std::uint32_t q = static_cast<std::uint32_t>(s.q[kQ]);
       if (q != 0 && ctx_.fast) {
@@ -337,6 +340,7 @@ class Kernel {
   bool simd_ = false, simd_checked_ = false;
   double fast_scale_u_ = 0, fast_scale_v_ = 0;  // 2^(20 + log2 size): knob `fast`, textured kernels
   SimdSpan simd_tpl_{};
+  std::uint64_t textured_ = 0;  // texture-unit pixels of this run
 };
 
 template <bool G, bool T, bool Z, bool S>

@@ -17,7 +17,7 @@ class ReciprocalUnit {
  public:
   ReciprocalUnit(unsigned table_bits, unsigned nr_steps);
   // q must be non-zero.
-  Reciprocal operator()(std::uint32_t q) const {
+  [[gnu::always_inline]] Reciprocal operator()(std::uint32_t q) const {
     const unsigned n = static_cast<unsigned>(std::countl_zero(q));
     const std::uint64_t m = std::uint64_t{q} << n;  // 2^31 <= m < 2^32
     std::uint64_t y = table_[(m >> (31 - bits_)) & mask_];

@@ -22,7 +22,7 @@ inline TexelCoords texel_coords(std::int32_t s, std::int32_t t, Reciprocal rc, u
 }
 
 // Section 10.3: the index a wrap mode uses for integer texel index i of a size-2^log2 axis.
-inline std::int64_t address(std::int64_t i, protocol::Wrap mode, unsigned log2) {
+[[gnu::always_inline]] inline std::int64_t address(std::int64_t i, protocol::Wrap mode, unsigned log2) {
   const std::int64_t size = std::int64_t{1} << log2;
   switch (mode) {
     case protocol::Wrap::Clamp: return i < 0 ? 0 : i >= size ? size - 1 : i;
@@ -34,18 +34,33 @@ inline std::int64_t address(std::int64_t i, protocol::Wrap mode, unsigned log2) 
   }
 }
 
+// Holds the draw's texture state by value (with the base pointer resolved once), so the per-pixel
+// path reads no state through references that the framebuffer's byte stores could alias.
 class TextureUnit {
  public:
-  TextureUnit(const TextureState& tex, const VideoMemory& mem) : tex_(tex), mem_(mem) {}
+  TextureUnit(const TextureState& tex, const VideoMemory& mem)
+      : mem_(mem),
+        base_(tex.base),
+        direct_(tex.in_vram ? mem.data() + tex.base : nullptr),
+        wl_(tex.wl),
+        hl_(tex.hl),
+        bpp_(protocol::bytes_per_pixel(tex.format)),
+        format_(tex.format),
+        wrap_s_(tex.wrap_s),
+        wrap_t_(tex.wrap_t),
+        bilinear_(tex.bilinear) {}
 
   // Filtered texel at texel coordinates (tu, tv); sets ERR_MEM_RANGE in errors for fetches beyond VRAM.
-  protocol::Rgba8 sample(TexelCoords c, std::uint16_t& errors) const {
-    if (!tex_.bilinear) return fetch(c.tu >> 12, c.tv >> 12, errors);
+  [[gnu::always_inline]] protocol::Rgba8 sample(TexelCoords c, std::uint16_t& errors) const {
+    if (!bilinear_) return fetch(address(c.tu >> 12, wrap_s_, wl_), address(c.tv >> 12, wrap_t_, hl_), errors);
     const std::int64_t u = c.tu - 2048, v = c.tv - 2048;
     const std::int64_t i0 = u >> 12, j0 = v >> 12;
     const unsigned fu = static_cast<unsigned>((u >> 4) & 255), fv = static_cast<unsigned>((v >> 4) & 255);
-    const protocol::Rgba8 c00 = fetch(i0, j0, errors), c10 = fetch(i0 + 1, j0, errors);
-    const protocol::Rgba8 c01 = fetch(i0, j0 + 1, errors), c11 = fetch(i0 + 1, j0 + 1, errors);
+    // Each axis is addressed once per neighbour, not once per texel.
+    const std::int64_t a0 = address(i0, wrap_s_, wl_), a1 = address(i0 + 1, wrap_s_, wl_);
+    const std::int64_t b0 = address(j0, wrap_t_, hl_), b1 = address(j0 + 1, wrap_t_, hl_);
+    const protocol::Rgba8 c00 = fetch(a0, b0, errors), c10 = fetch(a1, b0, errors);
+    const protocol::Rgba8 c01 = fetch(a0, b1, errors), c11 = fetch(a1, b1, errors);
     const unsigned w00 = (256 - fu) * (256 - fv), w10 = fu * (256 - fv), w01 = (256 - fu) * fv, w11 = fu * fv;
     auto mix = [&](std::uint8_t a, std::uint8_t b, std::uint8_t cc, std::uint8_t d) {
       return static_cast<std::uint8_t>((a * w00 + b * w10 + cc * w01 + d * w11 + 32768) >> 16);
@@ -54,21 +69,23 @@ class TextureUnit {
             mix(c00.a, c10.a, c01.a, c11.a)};
   }
 
-  // Texel (i, j) after addressing, expanded to 8 bits per channel.
-  protocol::Rgba8 fetch(std::int64_t i, std::int64_t j, std::uint16_t& errors) const {
-    const std::uint64_t ai = static_cast<std::uint64_t>(address(i, tex_.wrap_s, tex_.wl));
-    const std::uint64_t aj = static_cast<std::uint64_t>(address(j, tex_.wrap_t, tex_.hl));
-    const unsigned bpp = protocol::bytes_per_pixel(tex_.format);
-    const std::uint64_t at = tex_.base + ((aj << tex_.wl) + ai) * bpp;
-    if (tex_.in_vram) return protocol::load_pixel(tex_.format, mem_.data() + at);
+  // Texel (i, j) of an addressed (in-range) index pair, expanded to 8 bits per channel.
+  [[gnu::always_inline]] protocol::Rgba8 fetch(std::int64_t i, std::int64_t j, std::uint16_t& errors) const {
+    const std::uint64_t offset = ((static_cast<std::uint64_t>(j) << wl_) + static_cast<std::uint64_t>(i)) * bpp_;
+    if (direct_) return protocol::load_pixel(format_, direct_ + offset);
     std::uint8_t buf[4];
-    if (!mem_.read(at, buf, bpp)) errors |= protocol::ERR_MEM_RANGE;
-    return protocol::load_pixel(tex_.format, buf);
+    if (!mem_.read(std::uint64_t{base_} + offset, buf, bpp_)) errors |= protocol::ERR_MEM_RANGE;
+    return protocol::load_pixel(format_, buf);
   }
 
  private:
-  const TextureState& tex_;
   const VideoMemory& mem_;
+  std::uint32_t base_;
+  const std::uint8_t* direct_;  // the texture's first byte when it lies wholly inside VRAM
+  unsigned wl_, hl_, bpp_;
+  protocol::PixelFormat format_;
+  protocol::Wrap wrap_s_, wrap_t_;
+  bool bilinear_;
 };
 
 // Section 10.5.
