@@ -1,5 +1,7 @@
 #include "gpubridge/geometry/clip.hpp"
 
+#include <algorithm>
+
 namespace gpubridge::geometry {
 
 Vertex interpolate(const Vertex& a, const Vertex& b, double t) {
@@ -24,28 +26,38 @@ Polygon polygon_from(const Triangle& tri) {
   return p;
 }
 
-Polygon clip_polygon(const Polygon& in, Vec4 plane, double offset) {
-  Polygon out;
-  if (in.count < 3) return out;
-  std::array<double, Polygon::kCapacity> d{};
+PolygonView clip_polygon_view(PolygonView in, Vec4 plane, double offset, ClipBuffer& out) {
+  if (in.count < 3) return {out.v, 0};
+  std::array<double, Polygon::kCapacity> d;
+  const std::size_t n = std::min(in.count, Polygon::kCapacity);
   bool any_strictly_inside = false, any_outside = false;
-  for (std::size_t i = 0; i < in.count; ++i) {
+  for (std::size_t i = 0; i < n; ++i) {
     d[i] = dot(plane, in.v[i].pos) + offset;
     any_strictly_inside |= d[i] > 0;
     any_outside |= d[i] < 0;
   }
-  if (!any_strictly_inside && any_outside) return out;  // touches the plane at most: no area left
-  if (!any_outside) return in;                            // fully kept (NaN distances count as kept)
-  for (std::size_t i = 0; i < in.count; ++i) {
-    const std::size_t j = (i + 1) % in.count;
+  if (!any_strictly_inside && any_outside) return {out.v, 0};  // touches the plane at most: no area left
+  if (!any_outside) return in;                                   // fully kept (NaN distances count as kept)
+  std::size_t count = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t j = i + 1 == n ? 0 : i + 1;
     const Vertex& a = in.v[i];
     const Vertex& b = in.v[j];
-    if (d[i] >= 0 && out.count < Polygon::kCapacity) out.v[out.count++] = a;
+    if (d[i] >= 0 && count < Polygon::kCapacity) out.v[count++] = a;
     // A new vertex only where the edge strictly crosses the plane; on-plane vertices are kept.
-    if ((d[i] > 0 && d[j] < 0) && out.count < Polygon::kCapacity) out.v[out.count++] = intersect(a, d[i], b, d[j]);
-    if ((d[i] < 0 && d[j] > 0) && out.count < Polygon::kCapacity) out.v[out.count++] = intersect(b, d[j], a, d[i]);
+    if ((d[i] > 0 && d[j] < 0) && count < Polygon::kCapacity) out.v[count++] = intersect(a, d[i], b, d[j]);
+    if ((d[i] < 0 && d[j] > 0) && count < Polygon::kCapacity) out.v[count++] = intersect(b, d[j], a, d[i]);
   }
-  if (out.count < 3) out.count = 0;
+  return {out.v, count < 3 ? 0 : count};
+}
+
+Polygon clip_polygon(const Polygon& in, Vec4 plane, double offset) {
+  ClipBuffer buffer;
+  const PolygonView r = clip_polygon_view({in.v.data(), in.count}, plane, offset, buffer);
+  if (r.v == in.v.data()) return in;
+  Polygon out;
+  std::copy(r.v, r.v + r.count, out.v.begin());
+  out.count = r.count;
   return out;
 }
 

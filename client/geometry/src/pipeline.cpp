@@ -130,6 +130,34 @@ ScreenVertex to_screen(const Vertex& v) {
   return ScreenVertex{v.pos.x * inv, v.pos.y * inv, v.pos.z * inv, v.pos.w, v.color, v.uv};
 }
 
+ClippedPolygon clip_for_pipeline(const Triangle& tri, const PipelineOptions& opt, ClipBuffers& buffers) {
+  // Planes in the order the seeds' pipeline applies them: the near plane first (Foenix), then
+  // the ones that only matter for unusual input. The polygon lives in the input triangle until a
+  // plane cuts it, then alternates between the two buffers: no pass copies a whole polygon.
+  ClippedPolygon r{{tri.data(), tri.size()}, false};
+  auto clip = [&](Vec4 plane, double offset = 0.0) {
+    ClipBuffer& target = r.polygon.v == buffers.a.v ? buffers.b : buffers.a;
+    const PolygonView next = clip_polygon_view(r.polygon, plane, offset, target);
+    r.clipped |= next.v != r.polygon.v;
+    r.polygon = next;
+  };
+  clip(kNearPlane);
+  if (opt.clip_far && r.polygon.count) clip(kFarPlane);
+  if (r.polygon.count) clip(Vec4{0, 0, 0, 1}, -opt.min_w);  // W - min_w >= 0
+  if (r.polygon.count) {
+    bool inside = true;
+    for (std::size_t i = 0; i < r.polygon.count && inside; ++i) {
+      const Vec4& p = r.polygon.v[i].pos;
+      const double x = p.x / p.w, y = p.y / p.w;
+      inside = x >= opt.guard_band.min && x <= opt.guard_band.max && y >= opt.guard_band.min && y <= opt.guard_band.max;
+    }
+    if (!inside)
+      for (const Vec4& plane : guard_band_planes(opt.guard_band))
+        if (r.polygon.count) clip(plane);
+  }
+  return r;
+}
+
 Result<void> process_triangle(const Triangle& tri, const PipelineOptions& opt, std::vector<DeviceTriangle>& out,
                               PipelineStats* stats) {
   PipelineStats local;
@@ -151,35 +179,14 @@ Result<void> process_triangle(const Triangle& tri, const PipelineOptions& opt, s
   }
   if (all_inside) return emitter.subdivide(tri, 0);
 
-  // Planes in the order the seeds' pipeline applies them: the near plane first (Foenix), then
-  // the ones that only matter for unusual input.
-  Polygon poly = polygon_from(tri);
-  bool clipped = false;
-  auto clip = [&](Vec4 plane, double offset = 0.0) {
-    bool outside = false;
-    for (std::size_t i = 0; i < poly.count && !outside; ++i) outside = dot(plane, poly.v[i].pos) + offset < 0;
-    if (!outside) return;  // nothing to cut: skip the copy
-    clipped = true;
-    poly = clip_polygon(poly, plane, offset);
-  };
-  clip(kNearPlane);
-  if (opt.clip_far && poly.count) clip(kFarPlane);
-  if (poly.count) clip(Vec4{0, 0, 0, 1}, -opt.min_w);  // W - min_w >= 0
-  if (poly.count) {
-    bool inside = true;
-    for (std::size_t i = 0; i < poly.count && inside; ++i) {
-      const double x = poly.v[i].pos.x / poly.v[i].pos.w, y = poly.v[i].pos.y / poly.v[i].pos.w;
-      inside = x >= opt.guard_band.min && x <= opt.guard_band.max && y >= opt.guard_band.min && y <= opt.guard_band.max;
-    }
-    if (!inside)
-      for (const Vec4& plane : guard_band_planes(opt.guard_band))
-        if (poly.count) clip(plane);
-  }
+  ClipBuffers buffers;
+  const ClippedPolygon c = clip_for_pipeline(tri, opt, buffers);
+  const PolygonView poly = c.polygon;
   if (poly.count == 0) {
     ++st.clipped_away;
     return {};
   }
-  if (clipped) ++st.clipped;
+  if (c.clipped) ++st.clipped;
 
   for (std::size_t i = 1; i + 1 < poly.count; ++i)
     if (auto r = emitter.subdivide(Triangle{poly.v[0], poly.v[i], poly.v[i + 1]}, 0); !r) return r;

@@ -53,6 +53,25 @@ Polygon polygon_from(const Triangle& tri);
 // affine half-spaces such as W >= min_w). Polygons with fewer than 3 vertices become empty.
 Polygon clip_polygon(const Polygon& in, Vec4 plane, double offset = 0.0);
 
+// The same clipper without copying whole polygons (what the pipeline uses: a Polygon is
+// 11 × 80 bytes, and copying it per plane cost more than the clipping itself).
+struct PolygonView {
+  const Vertex* v = nullptr;
+  std::size_t count = 0;
+};
+// Room for one clipped polygon, deliberately left uninitialised: the clipper writes every vertex
+// before anything reads it.
+struct ClipBuffer {
+  union {
+    Vertex v[Polygon::kCapacity];
+  };
+  ClipBuffer() {}  // NOLINT: no initialisation on purpose
+};
+// Same rules and bit-identical vertices as clip_polygon. Returns `in` itself when no vertex lies
+// outside the plane; otherwise the clipped polygon, written into `out` (which must not overlap
+// `in`), count 0 when no area is left.
+PolygonView clip_polygon_view(PolygonView in, Vec4 plane, double offset, ClipBuffer& out);
+
 // The 2D guard band, in pixels: every emitted vertex lies inside [min, max] on both axes.
 // The default keeps a 1-pixel margin inside the 12.4 register range [-2048, 2047.9375] so that
 // floating-point error after the divide can never push a snapped vertex out of range.

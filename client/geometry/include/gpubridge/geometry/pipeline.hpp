@@ -62,6 +62,18 @@ struct PipelineStats {
 // on screen.
 std::int64_t signed_area2(const DeviceTriangle& t);
 
+// The clipping stage of process_triangle (near, far, W >= min_w, then the guard band when a
+// vertex lies outside it). The polygon points into `tri` when no plane cut it, else into
+// `buffers`; count 0 when nothing is left. `clipped` says whether any plane cut it.
+struct ClipBuffers {
+  ClipBuffer a, b;
+};
+struct ClippedPolygon {
+  PolygonView polygon;
+  bool clipped = false;
+};
+ClippedPolygon clip_for_pipeline(const Triangle& tri, const PipelineOptions& opt, ClipBuffers& buffers);
+
 // Runs one window-homogeneous triangle through the pipeline, appending device triangles.
 // Errors: non-finite input (NaN/Inf in any position, colour or texture coordinate), or a texture
 // coordinate range that S/T cannot hold even after subdivision.
