@@ -57,7 +57,7 @@ struct Device::State {
         id((std::uint64_t{kIdMagic} << 32) | (std::uint64_t{kVersionMajor} << 24) |
            (std::uint64_t{kVersionMinor} << 16) | o.variant),
         mem(o.vram_bytes),
-        renderer(mem, o.accuracy, o.threads) {
+        renderer(mem, o.accuracy, o.threads, o.vector_routines) {
     reset_registers();
   }
 

@@ -168,7 +168,7 @@ class Kernel {
   bool simd_ready() {
     if (!simd_checked_) {
       simd_checked_ = true;
-      prepare_simd();
+      if (ctx_.vector) prepare_simd();
     }
     return simd_;
   }
@@ -416,7 +416,7 @@ void rasterize_rows(const Triangle& t, const DrawState& st, RasterContext& ctx, 
   for (unsigned ch = 0; ch < 4; ++ch) colours_differ |= !t.plane[kR + ch].constant;
   const bool gouraud = st.gouraud && colours_differ;  // Gouraud only when colours differ
   const bool depth = st.z_test || st.z_write;
-  if (st.simple_color && !st.textured && draw_narrow(t, st, ctx, ya, yz, gouraud, depth)) return;
+  if (ctx.vector && st.simple_color && !st.textured && draw_narrow(t, st, ctx, ya, yz, gouraud, depth)) return;
   const unsigned key = (gouraud ? 1u : 0u) | (st.textured ? 2u : 0u) | (depth ? 4u : 0u) | (st.simple_color ? 8u : 0u);
   kKernels[key](t, st, ctx, ya, yz);
 }

@@ -33,6 +33,7 @@ struct RasterContext {
   bool fast = false;         // floating-point texel divide (accuracy knob `fast`)
   std::uint16_t errors = 0;  // ERR_MEM_RANGE from out-of-memory accesses
   RasterCounters counters;
+  bool vector = true;  // vector routines allowed (DeviceOptions::vector_routines)
 };
 
 // Draws the rows [row_begin, row_end) of t (clipped to its bounding box) with state st.

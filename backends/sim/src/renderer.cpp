@@ -11,8 +11,8 @@ bool overlaps(std::uint64_t a, std::uint64_t alen, std::uint64_t b, std::uint64_
 
 }  // namespace
 
-Renderer::Renderer(VideoMemory& mem, const AccuracyKnobs& knobs, unsigned threads)
-    : mem_(mem), knobs_(knobs), recip_(knobs.recip_bits, knobs.nr_steps), pool_(threads) {
+Renderer::Renderer(VideoMemory& mem, const AccuracyKnobs& knobs, unsigned threads, bool vector_routines)
+    : mem_(mem), knobs_(knobs), vector_(vector_routines), recip_(knobs.recip_bits, knobs.nr_steps), pool_(threads) {
   if (pool_.workers() > 1) batch_.reserve(kMaxBatch);
 }
 
@@ -73,7 +73,7 @@ void Renderer::draw(const Vertex& a, const Vertex& b, const Vertex& c, const std
 void Renderer::draw_pending() {
   if (pending_ < 0) return;
   const Triangle& t = slots_[pending_];
-  RasterContext ctx{mem_, recip_, knobs_.z_bits, knobs_.fast, 0, {}};
+  RasterContext ctx{mem_, recip_, knobs_.z_bits, knobs_.fast, 0, {}, vector_};
   rasterize_rows(t, *pending_state_, ctx, t.y0, t.y1);
   errors_ |= ctx.errors;
   counters_.add(ctx.counters);
@@ -111,7 +111,7 @@ void Renderer::flush() {
   const unsigned n = pool_.workers();
   std::vector<RasterContext> ctx;
   ctx.reserve(n);
-  for (unsigned w = 0; w < n; ++w) ctx.push_back(RasterContext{mem_, recip_, knobs_.z_bits, knobs_.fast, 0, {}});
+  for (unsigned w = 0; w < n; ++w) ctx.push_back(RasterContext{mem_, recip_, knobs_.z_bits, knobs_.fast, 0, {}, vector_});
   pool_.run([&](unsigned w) {
     RasterContext& c = ctx[w];
     for (const Triangle& t : batch_) {

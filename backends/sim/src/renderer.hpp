@@ -19,7 +19,7 @@ namespace gpubridge::sim {
 
 class Renderer {
  public:
-  Renderer(VideoMemory& mem, const AccuracyKnobs& knobs, unsigned threads);
+  Renderer(VideoMemory& mem, const AccuracyKnobs& knobs, unsigned threads, bool vector_routines);
 
   void set_observer(PixelObserver observer) { observer_ = std::move(observer); }
   // Draws (or queues) one triangle. A state object different from the batch's flushes the batch.
@@ -48,6 +48,7 @@ class Renderer {
 
   VideoMemory& mem_;
   AccuracyKnobs knobs_;
+  bool vector_;
   ReciprocalUnit recip_;
   BandPool pool_;
   PixelObserver observer_;

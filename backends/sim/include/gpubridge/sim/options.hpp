@@ -63,6 +63,9 @@ struct DeviceOptions {
   // frame (1..1024), so N = 1, interval = 4 models a device four times slower than the link.
   unsigned fifo_drain_interval = 1;
   unsigned threads = 1;  // rasteriser worker threads (1 = no pool), 1..kMaxThreads
+  // false: every pixel goes through the scalar routines instead of the vector ones. The output is
+  // identical by design; tests render both ways and compare bytes.
+  bool vector_routines = true;
   AccuracyKnobs accuracy;
 
   // Empty when valid, otherwise what is wrong and the accepted range.
