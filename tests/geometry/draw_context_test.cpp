@@ -119,7 +119,7 @@ TEST(DrawContext, VideoMemoryIsBounded) {
   big.rgba.assign(256 * 256 * 4, 0);
   auto t = ctx->create_texture(big);
   ASSERT_FALSE(t);
-  EXPECT_NE(t.error().message.find("not enough video memory for the texture"), std::string::npos);
+  EXPECT_NE(t.error().message.find("video memory full: 262144 bytes requested"), std::string::npos) << t.error().message;
 }
 
 #if GPUBRIDGE_DRAW_HAS_SIM

@@ -8,19 +8,25 @@ namespace gpubridge::draw {
 namespace {
 
 using protocol::Reg;
-constexpr std::uint64_t kAlignment = 256;
+
+Result<void> check_image_data(const Image& image, const char* what) {
+  if (image.rgba.size() != std::size_t{image.width} * image.height * 4)
+    return make_error(fmt::format("{} image data holds {} bytes, not {}x{}x4", what, image.rgba.size(), image.width,
+                                  image.height));
+  return {};
+}
 
 }  // namespace
 
 Result<std::uint32_t> Context::allocate(std::uint64_t bytes, const char* what) {
-  const std::uint64_t at = next_free_;
-  const std::uint64_t end = (at + bytes + kAlignment - 1) / kAlignment * kAlignment;
-  const std::uint64_t vram = sink_->vram_bytes();
-  if (end > vram)
-    return make_error(fmt::format("not enough video memory for the {} ({} bytes at 0x{:x}; the device has {} bytes)", what,
-                                  bytes, at, vram));
-  next_free_ = end;
-  return static_cast<std::uint32_t>(at);
+  auto a = vram_.allocate(bytes);
+  if (!a) return make_error(fmt::format("not enough video memory for the {}: {}", what, a.error().message));
+  return *a;
+}
+
+bool Context::live(const Texture& texture) const {
+  const auto it = textures_.find(texture.id);
+  return it != textures_.end() && it->second == texture.address;
 }
 
 Result<Context> Context::create(CommandSink& sink, const ContextOptions& options) {
@@ -81,15 +87,48 @@ Result<Texture> Context::create_texture(const Image& image, const TextureOptions
   Texture t;
   t.format = geometry::TextureFormat{image.width, image.height, o.format, o.wrap_s, o.wrap_t, o.bilinear};
   if (auto w = geometry::tex_fmt_word(t.format); !w) return w.error();
-  if (image.rgba.size() != std::size_t{image.width} * image.height * 4)
-    return make_error(fmt::format("texture image data holds {} bytes, not {}x{}x4", image.rgba.size(), image.width, image.height));
-  auto a = allocate(std::uint64_t{image.width} * image.height * protocol::bytes_per_pixel(o.format), "texture");
-  if (!a) return a.error();
+  if (auto r = check_image_data(image, "texture"); !r) return r.error();
+  // The allocator's message already says "video memory full: N bytes requested, largest free
+  // block M; release textures or use a smaller format".
+  auto a = vram_.allocate(std::uint64_t{image.width} * image.height * protocol::bytes_per_pixel(o.format));
+  if (!a) return make_error(fmt::format("texture {}x{}: {}", image.width, image.height, a.error().message));
   t.address = *a;
-  if (auto r = send_pending(); !r) return r.error();  // keep uploads ordered with register writes
+  if (auto r = send_pending(); !r) {  // keep uploads ordered with register writes
+    vram_.release(t.address);
+    return r.error();
+  }
   const auto bytes = device_from_image(o.format, image);
-  if (auto r = sink_->upload(t.address, bytes); !r) return r.error();
+  if (auto r = sink_->upload(t.address, bytes); !r) {
+    vram_.release(t.address);
+    return r.error();
+  }
+  t.id = next_texture_id_++;
+  textures_.emplace(t.id, t.address);
   return t;
+}
+
+Result<void> Context::update_texture(const Texture& texture, const Image& image) {
+  if (!live(texture))
+    return make_error(fmt::format("update_texture: texture {} was released or never created by this context "
+                                  "(create_texture gives a live handle)", texture.id));
+  if (image.width != texture.format.width || image.height != texture.format.height)
+    return make_error(fmt::format("update_texture: the image is {}x{} but the texture is {}x{} (updates keep the size; "
+                                  "create a new texture for another size)",
+                                  image.width, image.height, texture.format.width, texture.format.height));
+  if (auto r = check_image_data(image, "update_texture:"); !r) return r;
+  if (auto r = send_pending(); !r) return r;  // draws issued so far sample the old contents
+  return sink_->upload(texture.address, device_from_image(texture.format.format, image));
+}
+
+bool Context::release_texture(Texture& texture) {
+  const bool was_live = live(texture);
+  if (was_live) {
+    if (texture_ && texture_->id == texture.id) texture_.reset();
+    textures_.erase(texture.id);
+    vram_.release(texture.address);
+  }
+  texture = Texture{};
+  return was_live;
 }
 
 Result<Texture> Context::load_texture(const std::filesystem::path& png, const TextureOptions& options) {
@@ -127,6 +166,9 @@ Result<void> Context::clear_depth(double z) {
 Result<void> Context::apply_state(geometry::PipelineOptions& opt) {
   if ((state_.z_test || state_.z_write) && !depth_)
     return make_error("depth test/write requested but this context has no depth buffer (ContextOptions::depth_buffer)");
+  if (texture_ && !live(*texture_))
+    return make_error(fmt::format("the bound texture (id {}, address 0x{:x}) was released; bind a live texture or nullptr",
+                                  texture_->id, texture_->address));
   geometry::RenderState s = state_;
   s.textured = texture_.has_value();
   const std::uint64_t mode = geometry::tri_mode_word(s);

@@ -12,12 +12,26 @@
 //   ctx->bind_texture(&*tex);
 //   ctx->draw_indexed(cube_vertices, cube_indices);
 //   ctx->swap();
+//   ctx->release_texture(*tex);  // when no longer needed (see below)
 //
-// Video memory is allocated from address 0 upwards (256-byte aligned): the colour buffers (two
-// when double-buffered), the depth buffer, then textures in creation order. Textures live until
-// the Context is destroyed.
+// Video memory (vram_allocator.hpp: address-ordered first-fit, 256-byte aligned) holds the
+// colour buffers (two when double-buffered) and the depth buffer from address 0 up, for the
+// Context's lifetime, then the textures. A texture lives until release_texture() or the end of
+// the Context; its block is then reused, so a long-running client can stream frames or load
+// levels without running out. With no releases the layout is the same as the original bump
+// allocator's (buffers, then textures in creation order).
+//
+// Texture handles are plain values (copy them freely); each carries an id that the Context
+// checks. Releasing one:
+//   - frees its block at once: commands already issued that use it are sent before any later
+//     upload can overwrite that memory (uploads and register writes stay in order);
+//   - unbinds it if it is the bound texture (later draws are untextured until the next bind);
+//   - makes every copy of the handle stale: binding a stale handle makes the next draw fail
+//     ("the bound texture was released"), update_texture() rejects it, and releasing it again
+//     does nothing (returns false).
 #include <cstdint>
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <span>
 #include <vector>
@@ -25,6 +39,7 @@
 #include "gpubridge/common/image.hpp"
 #include "gpubridge/common/result.hpp"
 #include "gpubridge/draw/sink.hpp"
+#include "gpubridge/draw/vram_allocator.hpp"
 #include "gpubridge/geometry/encode.hpp"
 #include "gpubridge/geometry/math.hpp"
 #include "gpubridge/geometry/pipeline.hpp"
@@ -59,6 +74,7 @@ struct TextureOptions {
 struct Texture {
   std::uint32_t address = 0;
   geometry::TextureFormat format;
+  std::uint64_t id = 0;  // assigned by create_texture (never reused); 0 = no texture
 };
 
 class Context {
@@ -82,7 +98,13 @@ class Context {
   // Converts the image to the board format and uploads it. Sizes: powers of two 8..1024.
   Result<Texture> create_texture(const Image& image, const TextureOptions& options = {});
   Result<Texture> load_texture(const std::filesystem::path& png, const TextureOptions& options = {});
-  // nullptr unbinds (untextured drawing).
+  // Re-uploads a texture's contents in place (same size; converted to the texture's format),
+  // e.g. one video frame after another. Draws issued before the call sample the old contents.
+  Result<void> update_texture(const Texture& texture, const Image& image);
+  // Frees the texture's video memory and clears the handle (see the top of this file). Returns
+  // false when the handle was already released (or empty): nothing happens then.
+  bool release_texture(Texture& texture);
+  // nullptr unbinds (untextured drawing). A released handle makes the next draw fail.
   void bind_texture(const Texture* texture);
 
   // --- drawing ---
@@ -100,14 +122,19 @@ class Context {
   Result<Image> read_display();
 
   const geometry::PipelineStats& stats() const { return stats_; }
+  // Video memory use (buffers and live textures), e.g. to show how much room is left.
+  const VramAllocator& video_memory() const { return vram_; }
+  std::size_t live_textures() const { return textures_.size(); }
   unsigned width() const { return options_.width; }
   unsigned height() const { return options_.height; }
   std::uint32_t back_buffer() const { return color_[back_]; }
   std::uint32_t front_buffer() const { return color_[1 - back_]; }
 
  private:
-  Context(CommandSink& sink, const ContextOptions& options) : sink_(&sink), options_(options) {}
+  Context(CommandSink& sink, const ContextOptions& options)
+      : sink_(&sink), options_(options), vram_(sink.vram_bytes()) {}
   Result<std::uint32_t> allocate(std::uint64_t bytes, const char* what);
+  bool live(const Texture& texture) const;
   void write(protocol::Reg reg, std::uint64_t data);
   Result<void> send_pending();
   Result<void> apply_state(geometry::PipelineOptions& opt);
@@ -115,7 +142,9 @@ class Context {
 
   CommandSink* sink_;
   ContextOptions options_;
-  std::uint64_t next_free_ = 0;
+  VramAllocator vram_;
+  std::map<std::uint64_t, std::uint32_t> textures_;  // live texture id → address
+  std::uint64_t next_texture_id_ = 1;
   std::uint32_t color_[2] = {0, 0};
   int back_ = 0;
   std::optional<std::uint32_t> depth_;
