@@ -162,9 +162,12 @@ class Kernel {
     }
   }
 
-  // The vector routine applies to untextured RGBA8888 stores (blend and write mask included) with
-  // both buffers inside VRAM and disjoint (it tests eight depths before it writes eight colours),
-  // and values that fit 32-bit lanes (2·den < 2^31 and per-8-pixel steps below 2^30).
+  // The vector routine applies to RGBA8888 stores (blend and write mask included) with both
+  // buffers inside VRAM and disjoint (it tests eight depths before it writes eight colours), a
+  // texture inside VRAM and disjoint from both (it samples eight texels before it writes), the
+  // exact texel arithmetic (not the `fast` knob), and 2·den < 2^31 so remainders fit signed
+  // 32-bit lanes. Quotients are kept modulo 2^32, which is all any consumer reads (the low 32
+  // bits of S, T, Q; 8 of a colour; 24 of Z).
   bool simd_ready() {
     if (!simd_checked_) {
       simd_checked_ = true;
@@ -173,24 +176,22 @@ class Kernel {
     return simd_;
   }
   void prepare_simd() {
-    if constexpr (kTextured) {
-      return;
-    } else {
+    {
       if (st_.fb_format != protocol::PixelFormat::RGBA8888 || !st_.color_in_vram || skip_colour_) return;
       if (kDepth && (!st_.z_in_vram || !st_.buffers_disjoint)) return;
+      if (kTextured && (ctx_.fast || !tex_.direct() || !texture_disjoint())) return;
       if (t_.den >= (std::int64_t{1} << 30)) return;
       simd_tpl_.den = static_cast<std::uint32_t>(t_.den);
+      simd_tpl_.planes = kTextured ? 8 : 5;
       for (unsigned p = 0; p < SimdSpan::kPlanes; ++p) {
         const Plane& pl = t_.plane[kR + p];
-        const bool used = p < 4 ? kGouraud : kDepth;
-        if (!used) {
+        if (!simd_plane_used(p)) {
           simd_tpl_.q8[p] = simd_tpl_.r8[p] = 0;
           for (unsigned k = 0; k < 8; ++k) simd_tpl_.qk[p][k] = simd_tpl_.rk[p][k] = 0;
           continue;
         }
         const DivMod d = floor_divmod(8 * pl.rx, t_.den);
         const std::int64_t q8 = 8 * pl.qx + d.q;
-        if (q8 >= (std::int64_t{1} << 30) || q8 <= -(std::int64_t{1} << 30)) return;
         simd_tpl_.q8[p] = static_cast<std::uint32_t>(q8);
         simd_tpl_.r8[p] = static_cast<std::uint32_t>(d.r);
         std::int64_t qk = 0, rk = 0;  // lane k's offset: k steps from (0, 0)
@@ -216,8 +217,25 @@ class Kernel {
       simd_tpl_.keep = 0;
       for (unsigned c = 0; c < 4; ++c)
         if (st_.keep_mask & (1u << c)) simd_tpl_.keep |= 0xFFu << (8 * c);
+      if (kTextured) {
+        simd_tpl_.tex = &tex_;
+        simd_tpl_.recip = &ctx_.recip;
+        simd_tpl_.q_const = q_const_;
+        simd_tpl_.const_rc = const_rc_;
+        simd_tpl_.wl = st_.tex.wl;
+        simd_tpl_.hl = st_.tex.hl;
+        simd_tpl_.decal = st_.decal;
+      }
       simd_ = true;
     }
+  }
+  static constexpr bool simd_plane_used(unsigned p) { return p < 4 ? kGouraud : p == 4 ? kDepth : kTextured; }
+  // No texel the draw samples lies in a buffer it writes.
+  bool texture_disjoint() const {
+    const std::uint64_t tlen = (std::uint64_t{1} << (st_.tex.wl + st_.tex.hl)) * protocol::bytes_per_pixel(st_.tex.format);
+    const std::uint64_t pixels = std::uint64_t{st_.fb_width} * st_.fb_height;
+    auto apart = [&](std::uint64_t base, std::uint64_t len) { return st_.tex.base + tlen <= base || base + len <= st_.tex.base; };
+    return apart(st_.fb_draw, pixels * 4) && (!kDepth || apart(st_.fb_z, pixels * 4));
   }
 
   // Rows two ahead are fetched while this one is drawn (random triangles miss the caches).
@@ -232,7 +250,7 @@ class Kernel {
   void simd_span(const Steppers& s, int x, int y, unsigned count) {
     SimdSpan& sp = simd_tpl_;
     for (unsigned p = 0; p < SimdSpan::kPlanes; ++p) {
-      const bool used = p < 4 ? kGouraud : kDepth;
+      const bool used = simd_plane_used(p);
       sp.q0[p] = used ? static_cast<std::uint32_t>(s.q[kR + p]) : 0;
       sp.r0[p] = used ? static_cast<std::uint32_t>(s.r[kR + p]) : 0;
     }
@@ -243,6 +261,7 @@ class Kernel {
     const std::uint64_t passed = shade_span_simd(sp);
     ctx_.counters.passed += passed;
     if (st_.blend != protocol::BlendMode::Off) ctx_.counters.blended += passed;
+    if (kTextured) textured_ += passed;
   }
 
   [[gnu::always_inline]] void pixel(int x, int y, const Steppers& s) {

@@ -2,8 +2,13 @@
 // 8-lane GCC/Clang vector types and the helpers both SIMD routines (span_simd.cpp, narrow_simd.cpp)
 // share. The helpers are macros, not functions, so that they inline into every target clone (a
 // plain inline function compiled for the default target would not inline into the AVX2 clone).
+#include <bit>
 #include <cstdint>
 #include <cstring>
+
+// Colour words hold channel c in byte c (R lowest), which is memory order R, G, B, A only on a
+// little-endian host.
+static_assert(std::endian::native == std::endian::little, "the vector routines assume a little-endian host");
 
 namespace gpubridge::sim::simd {
 typedef std::uint32_t u32x8 __attribute__((vector_size(32)));

@@ -1,16 +1,22 @@
 #pragma once
-// The vectorised span routine for untextured draws into an RGBA8888 buffer: optional depth
-// test/write, optional blend (ALPHA, ADD, MULTIPLY) and write mask, both buffers inside VRAM and
-// disjoint. Eight pixels per step: lanes k = 0..7
+// The vectorised span routine for draws into an RGBA8888 buffer: optional depth test/write,
+// optional texture (any format inside VRAM, nearest or bilinear, modulate or decal; the texture
+// disjoint from both buffers), optional blend (ALPHA, ADD, MULTIPLY) and write mask, both buffers
+// inside VRAM and disjoint. Eight pixels per step: lanes k = 0..7
 // hold (q, r) of each attribute plane for x + k and advance by (Q8, R8) = divmod(8·step) with
 // add, add, compare, and, subtract, subtract — no division per pixel, and integer-exact, so the
 // output equals the scalar routine's byte for byte (tests compare them).
 #include <cstdint>
 
+#include "reciprocal.hpp"
+
 namespace gpubridge::sim {
 
+class TextureUnit;
+
 struct SimdSpan {
-  static constexpr unsigned kPlanes = 5;  // R, G, B, A, Z
+  static constexpr unsigned kPlanes = 8;  // R, G, B, A, Z, S, T, Q (setup.hpp's attribute order)
+  unsigned planes = 5;                    // planes stepped: 5 untextured, 8 textured
   std::uint32_t q0[kPlanes], r0[kPlanes];      // (q, r) at the span's first pixel
   std::uint32_t qk[kPlanes][8], rk[kPlanes][8];  // offsets of lane k: divmod(k·step), rk < den
   std::uint32_t q8[kPlanes], r8[kPlanes];  // advance per 8 pixels (r8 < den)
@@ -24,6 +30,14 @@ struct SimdSpan {
   unsigned blend = 0;                      // protocol::BlendMode (0 = off)
   std::uint32_t keep = 0;                  // bytes of the colour word the write mask keeps
   bool gouraud = false, z_test = false, z_write = false;
+  // Texture stage (tex == nullptr: untextured). Texels are fetched lane by lane (the texel
+  // coordinates need 64-bit products and a table lookup); filter and combine run in lanes.
+  const TextureUnit* tex = nullptr;
+  const ReciprocalUnit* recip = nullptr;
+  bool q_const = false;  // Q constant over the triangle: const_rc is every pixel's reciprocal
+  Reciprocal const_rc;
+  unsigned wl = 3, hl = 3;
+  bool decal = false;
 };
 
 // Returns the number of pixels that passed the depth test (all of them without a test).

@@ -2,6 +2,7 @@
 // The texture unit (docs/protocol.md section 10): texel coordinates from (s, t, q) through the
 // reciprocal unit, addressing, nearest / bilinear filtering, and the colour combine.
 #include <cstdint>
+#include <cstring>
 
 #include "draw_state.hpp"
 #include "fixed_point.hpp"
@@ -16,7 +17,7 @@ struct TexelCoords {
 };
 
 // Section 10.2 for one (s, t, q), given the reciprocal of q (q != 0).
-inline TexelCoords texel_coords(std::int32_t s, std::int32_t t, Reciprocal rc, unsigned wl, unsigned hl) {
+[[gnu::always_inline]] inline TexelCoords texel_coords(std::int32_t s, std::int32_t t, Reciprocal rc, unsigned wl, unsigned hl) {
   const std::int64_t y = rc.y;
   return {(std::int64_t{s} * y) >> (43 - rc.n - wl), (std::int64_t{t} * y) >> (43 - rc.n - hl)};
 }
@@ -69,6 +70,30 @@ class TextureUnit {
             mix(c00.a, c10.a, c01.a, c11.a)};
   }
 
+  // The texels sample() filters, for the vector span routine: the four neighbours as colour words
+  // (byte c = channel c: R, G, B, A, as the framebuffer stores them) and the bilinear weights
+  // (nearest: c00 only, fu = fv = 0). The texture must lie inside VRAM (direct_).
+  [[gnu::always_inline]] void quad(TexelCoords c, std::uint32_t& c00, std::uint32_t& c10, std::uint32_t& c01,
+                                   std::uint32_t& c11, std::uint32_t& fu, std::uint32_t& fv) const {
+    if (!bilinear_) {
+      c00 = word(address(c.tu >> 12, wrap_s_, wl_), address(c.tv >> 12, wrap_t_, hl_));
+      c10 = c01 = c11 = fu = fv = 0;
+      return;
+    }
+    const std::int64_t u = c.tu - 2048, v = c.tv - 2048;
+    const std::int64_t i0 = u >> 12, j0 = v >> 12;
+    fu = static_cast<std::uint32_t>((u >> 4) & 255);
+    fv = static_cast<std::uint32_t>((v >> 4) & 255);
+    const std::int64_t a0 = address(i0, wrap_s_, wl_), a1 = address(i0 + 1, wrap_s_, wl_);
+    const std::int64_t b0 = address(j0, wrap_t_, hl_), b1 = address(j0 + 1, wrap_t_, hl_);
+    c00 = word(a0, b0);
+    c10 = word(a1, b0);
+    c01 = word(a0, b1);
+    c11 = word(a1, b1);
+  }
+  bool direct() const { return direct_ != nullptr; }
+  bool bilinear() const { return bilinear_; }
+
   // Texel (i, j) of an addressed (in-range) index pair, expanded to 8 bits per channel.
   [[gnu::always_inline]] protocol::Rgba8 fetch(std::int64_t i, std::int64_t j, std::uint16_t& errors) const {
     const std::uint64_t offset = ((static_cast<std::uint64_t>(j) << wl_) + static_cast<std::uint64_t>(i)) * bpp_;
@@ -79,6 +104,18 @@ class TextureUnit {
   }
 
  private:
+  // Texel (i, j) as a colour word (byte c = channel c), from a texture inside VRAM.
+  [[gnu::always_inline]] std::uint32_t word(std::int64_t i, std::int64_t j) const {
+    const std::uint8_t* p = direct_ + ((static_cast<std::uint64_t>(j) << wl_) + static_cast<std::uint64_t>(i)) * bpp_;
+    if (format_ == protocol::PixelFormat::RGBA8888) {  // memory order R, G, B, A is already the word's byte order
+      std::uint32_t w;
+      std::memcpy(&w, p, 4);
+      return w;
+    }
+    const protocol::Rgba8 c = protocol::load_pixel(format_, p);
+    return std::uint32_t{c.r} | (std::uint32_t{c.g} << 8) | (std::uint32_t{c.b} << 16) | (std::uint32_t{c.a} << 24);
+  }
+
   const VideoMemory& mem_;
   std::uint32_t base_;
   const std::uint8_t* direct_;  // the texture's first byte when it lies wholly inside VRAM
