@@ -61,7 +61,76 @@ double texture_offset(double min_coord, protocol::Wrap wrap) {
   }
 }
 
-Result<DeviceTriangle> convert_triangle(const std::array<ScreenVertex, 3>& tri, const TexAddressing& tex) {
+namespace {
+
+// Exact floor and round-half-away-from-zero for finite doubles, inline: the libm calls (the
+// baseline x86-64 target has no rounding instruction) cost more than the rest of a conversion.
+// Below 2^52 the truncation fits an int64 and x − trunc(x) is exact; from 2^52 up every double
+// is an integer. Only the sign of a zero result can differ from std::floor / std::round, and
+// every use below converts the result to an integer, where −0 and +0 are the same.
+constexpr double kTwoPow52 = 4503599627370496.0;
+
+inline double floor_exact(double x) {
+  if (!(std::fabs(x) < kTwoPow52)) return x;
+  const double t = static_cast<double>(static_cast<std::int64_t>(x));
+  return t > x ? t - 1.0 : t;
+}
+
+inline double round_exact(double x) {
+  if (!(std::fabs(x) < kTwoPow52)) return x;
+  const double t = static_cast<double>(static_cast<std::int64_t>(x));
+  const double frac = x - t;
+  return frac >= 0.5 ? t + 1.0 : (frac <= -0.5 ? t - 1.0 : t);
+}
+
+// The conversion of convert_triangle_checked for input that needs no error message: the same
+// expressions, without Result values and error names per value. Returns false on anything that
+// would be an error; convert_triangle then runs the checked version, which names the problem.
+bool convert_triangle_fast(const std::array<ScreenVertex, 3>& tri, const TexAddressing& tex, DeviceTriangle& out) {
+  double qmax = 0;
+  std::array<double, 3> q{};
+  for (int i = 0; i < 3; ++i) {
+    const auto& v = tri[i];
+    if (!std::isfinite(v.w) || !std::isfinite(v.uv.x) || !std::isfinite(v.uv.y) || !(v.w > 0)) return false;
+    if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z)) return false;
+    double snapped[2];
+    for (int k = 0; k < 2; ++k) {
+      const double sixteen_x = 16.0 * (k == 0 ? v.x : v.y);  // as snap_12_4
+      const double whole = floor_exact(sixteen_x);
+      snapped[k] = whole + (sixteen_x - whole >= 0.5 ? 1.0 : 0.0);
+      if (snapped[k] < -32768.0 || snapped[k] > 32767.0) return false;
+    }
+    if (v.z < -1e-9) return false;  // as depth_to_z24
+    const double zs = floor_exact(std::clamp(v.z, 0.0, 1.0) * 16777215.0 + 0.5);
+    const double ch[4] = {v.color.x, v.color.y, v.color.z, v.color.w};
+    std::uint32_t rgba = 0;
+    for (double c : ch) {  // as unit_to_u8 / color_to_rgba8
+      if (!std::isfinite(c)) return false;
+      rgba = (rgba << 8) | static_cast<std::uint8_t>(std::clamp(round_exact(c * 255.0), 0.0, 255.0));
+    }
+    out[i].x = static_cast<std::int16_t>(snapped[0]);
+    out[i].y = static_cast<std::int16_t>(snapped[1]);
+    out[i].z = static_cast<std::uint32_t>(std::min(zs, 16777215.0));
+    out[i].rgba = rgba;
+    q[i] = 1.0 / v.w;
+    if (!std::isfinite(q[i])) return false;
+    qmax = std::max(qmax, q[i]);
+  }
+  const double u_off = texture_offset(std::min({tri[0].uv.x, tri[1].uv.x, tri[2].uv.x}), tex.wrap_s);
+  const double v_off = texture_offset(std::min({tri[0].uv.y, tri[1].uv.y, tri[2].uv.y}), tex.wrap_t);
+  for (int i = 0; i < 3; ++i) {
+    const double qn = round_exact(q[i] / qmax * 4294967295.0);
+    out[i].q = static_cast<std::uint32_t>(qn);
+    const double du = tri[i].uv.x - u_off, dv = tri[i].uv.y - v_off;
+    if (!(std::fabs(du) < kMaxTexOffset) || !(std::fabs(dv) < kMaxTexOffset)) return false;
+    out[i].s = static_cast<std::int32_t>(std::clamp(round_exact(du * qn / 256.0), -2147483648.0, 2147483647.0));
+    out[i].t = static_cast<std::int32_t>(std::clamp(round_exact(dv * qn / 256.0), -2147483648.0, 2147483647.0));
+  }
+  return true;
+}
+
+// Every check with its own message; also the reference the fast path must match bit for bit.
+Result<DeviceTriangle> convert_triangle_checked(const std::array<ScreenVertex, 3>& tri, const TexAddressing& tex) {
   DeviceTriangle out;
   // Names are constants: formatting them per vertex would dominate the cost of a conversion.
   static constexpr std::string_view vnames[3] = {"vertex 0", "vertex 1", "vertex 2"};
@@ -106,6 +175,14 @@ Result<DeviceTriangle> convert_triangle(const std::array<ScreenVertex, 3>& tri, 
     out[i].t = static_cast<std::int32_t>(std::clamp(std::round(dv * qn / 256.0), -2147483648.0, 2147483647.0));
   }
   return out;
+}
+
+}  // namespace
+
+Result<DeviceTriangle> convert_triangle(const std::array<ScreenVertex, 3>& tri, const TexAddressing& tex) {
+  DeviceTriangle out;
+  if (convert_triangle_fast(tri, tex, out)) return out;
+  return convert_triangle_checked(tri, tex);
 }
 
 }  // namespace gpubridge::geometry
