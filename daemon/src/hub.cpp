@@ -174,11 +174,18 @@ nlohmann::json Hub::status_json() const {
   if (lease_holder_) lease = {{"session", lease_holder_}, {"name", holder_name}};
   const auto uptime = std::chrono::duration<double>(std::chrono::steady_clock::now() - started_).count();
   const auto frame_or_null = [](const std::optional<std::uint32_t>& n) { return n ? nlohmann::json(*n) : nlohmann::json(); };
+  const MirrorCounters decorator = mirror_counters();
   const nlohmann::json mirror{{"enabled", options_.mirror},
                               {"compared", mirror_.compared},
                               {"mismatches", mirror_.mismatches},
                               {"first_mismatch", frame_or_null(mirror_.first_mismatch)},
-                              {"last_mismatch", frame_or_null(mirror_.last_mismatch)}};
+                              {"first_mismatch_pixels", mirror_.first_mismatch_pixels
+                                                            ? nlohmann::json(*mirror_.first_mismatch_pixels)
+                                                            : nlohmann::json()},
+                              {"last_mismatch", frame_or_null(mirror_.last_mismatch)},
+                              {"model_errors", decorator.model_errors},
+                              {"unpaired_frames", decorator.unpaired_frames},
+                              {"coalesced_swaps", decorator.coalesced_swaps}};
   return {{"daemon_version", kVersion},
           {"backend", info_.backend},
           {"board", info_.board},
@@ -192,6 +199,13 @@ nlohmann::json Hub::status_json() const {
           {"mirror", mirror},
           {"hotplug", hotplug_json()},
           {"uptime_s", uptime}};
+}
+
+MirrorCounters Hub::mirror_counters() const {
+  std::lock_guard lock(backend_swap_mu_);
+  MirrorCounters total = retired_mirror_counters_;
+  if (const auto* mirror = dynamic_cast<const MirrorBackend*>(backend_.get())) total += mirror->counters();
+  return total;
 }
 
 void Hub::on_scanout(std::shared_ptr<const backends::ScanoutFrame> frame) {
@@ -239,7 +253,10 @@ void Hub::compare_mirrored(const backends::ScanoutFrame& frame) {
   std::string where;
   if (!frame.pixels.empty()) {
     std::uint64_t differing = 0;
-    if (diff_frame(frame, *frame.reference, &differing)) where = ", " + std::to_string(differing) + " pixels differ";
+    if (diff_frame(frame, *frame.reference, &differing)) {
+      mirror_.first_mismatch_pixels = differing;
+      where = ", " + std::to_string(differing) + " pixels differ";
+    }
   }
   logger("daemon")->warn("mirror: frame {} differs from the simulator (board CRC 0x{:08X}, simulator CRC 0x{:08X}{}); "
                          "first mismatch, later ones are counted in status (mirror.mismatches)",

@@ -17,6 +17,8 @@
 // survives either way. Waiting for the lease to be released could postpone the board forever. The
 // holder keeps its lease and learns from the device_back event ("state": "reset") that it must
 // redraw; any other client sees the same event.
+#include <utility>
+
 #include "gpubridge/common/log.hpp"
 #include "gpubridge/daemon/hub.hpp"
 
@@ -54,7 +56,16 @@ void Hub::arm_hotplug_timer() {
 
 void Hub::install_backend(std::unique_ptr<backends::Backend> backend) {
   if (backend_) backend_->set_scanout_callback({});
-  backend_ = std::move(backend);
+  std::unique_ptr<backends::Backend> old;
+  {
+    // STATUS reads the mirror's counters from the network thread: swap under the lock and keep
+    // what the outgoing mirror counted, so the totals survive an unplug.
+    std::lock_guard lock(backend_swap_mu_);
+    if (const auto* mirror = dynamic_cast<const MirrorBackend*>(backend_.get()))
+      retired_mirror_counters_ += mirror->counters();
+    old = std::exchange(backend_, std::move(backend));
+  }
+  old.reset();  // closing a board may take a while: outside the lock
   backend_->set_scanout_callback([this](std::shared_ptr<const backends::ScanoutFrame> f) { on_scanout(std::move(f)); });
 }
 

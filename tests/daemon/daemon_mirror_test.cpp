@@ -8,6 +8,9 @@
 //   board's VRAM, as a stuck bit or a stray write would) gives a CRC mismatch, and the diff frame
 //   is magenta exactly at that pixel.
 // - Without --mirror, SUBSCRIBE source sim/diff is refused with UNAVAILABLE.
+// - STATUS and `gpubridge status` report the decorator's own counters as they change: commands the
+//   simulator refused but the board accepted (a model with less memory than the board), swaps
+//   without a partner (a board with scanout "off"), intermediate simulator swaps of one batch.
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -32,6 +35,7 @@
 
 #if defined(GPUBRIDGE_HAVE_SIM) && defined(GPUBRIDGE_HAVE_USB)
 #include "gpubridge/sim/device.hpp"
+#include "gpubridge/sim/sim_backend.hpp"
 #include "gpubridge/usb/board_profile.hpp"
 #include "gpubridge/usb/emu/emulated_stack.hpp"
 
@@ -315,6 +319,50 @@ TEST(DaemonMirror, SeveralSwapsInOneBatchCompareTheLastSwap) {
   const auto status = status_of(*sim);
   EXPECT_EQ(status["mirror"]["mismatches"], 0) << status.dump();
   EXPECT_GE(status["mirror"]["compared"].get<int>(), 1) << status.dump();
+  // The simulator's first two swaps of the batch had no board counterpart: skipped, not unpaired.
+  EXPECT_EQ(status["mirror"]["coalesced_swaps"], 2) << status.dump();
+  EXPECT_EQ(status["mirror"]["unpaired_frames"], 0) << status.dump();
+  EXPECT_EQ(status["mirror"]["model_errors"], 0) << status.dump();
+  EXPECT_EQ(daemon.terminate(), 0);
+  std::error_code ec;
+  fs::remove_all(dir, ec);
+}
+
+// A board that is unplugged and comes back gets a new mirror decorator; STATUS keeps adding up
+// (real gpubridged; the emulated FT232H is present only while the presence file exists).
+TEST(DaemonMirror, CountersAddUpAcrossAnUnplugAndReattach) {
+  const auto dir = make_temp_dir("mirror-hotplug");
+  const auto presence = dir / "present";
+  const std::string address = "unix:" + (dir / "d.sock").string();
+  const auto trace = (dir / "two.trace").string();
+  std::ofstream(trace) << "FB_FORMAT FORMAT=RGB565 WIDTH=64 HEIGHT=48\n"
+                          "CLEAR_COLOR R=255 A=255\nCLEAR\nFB_DISPLAY 0\n"
+                          "CLEAR_COLOR G=255 A=255\nCLEAR\nFB_DISPLAY 0\n";
+  std::ofstream(presence) << "plugged\n";
+  Daemon daemon;
+  ASSERT_TRUE(daemon.start({"--listen", address, "--backend", "emulated:ft232h-generic?presence=" + presence.string(),
+                            "--mirror", "--reattach-interval-ms", "50", "--log-level", "warn"}))
+      << daemon.error();
+  auto watcher = client::Client::connect(address, 2000ms);
+  ASSERT_TRUE(watcher);
+  ASSERT_TRUE(watcher->handshake("watcher", "", 2000ms));
+  const auto coalesced = [&] { return status_of(*watcher)["mirror"]["coalesced_swaps"]; };
+
+  auto play = run_process({GPUBRIDGE_CLI_PATH, "play", trace, "--connect", address});
+  ASSERT_EQ(play.exit_code, 0) << play.err << play.out;
+  EXPECT_EQ(coalesced(), 1);
+
+  fs::remove(presence);
+  ASSERT_TRUE(wait_event(*watcher, "device_gone", 5000ms)) << "no device_gone event after the unplug";
+  EXPECT_EQ(coalesced(), 1) << "the unplugged board's mirror counted one skipped swap";
+  std::ofstream(presence) << "plugged\n";
+  ASSERT_TRUE(wait_event(*watcher, "device_back", 5000ms)) << "no device_back event after the replug";
+  EXPECT_EQ(status_of(*watcher)["hotplug"]["reattaches"], 1);
+
+  play = run_process({GPUBRIDGE_CLI_PATH, "play", trace, "--connect", address});
+  ASSERT_EQ(play.exit_code, 0) << play.err << play.out;
+  EXPECT_EQ(coalesced(), 2) << "one from the first board's mirror, one from the re-attached board's";
+  watcher->close();
   EXPECT_EQ(daemon.terminate(), 0);
   std::error_code ec;
   fs::remove_all(dir, ec);
@@ -384,20 +432,37 @@ TEST(DaemonMirror, MirrorNeedsABoardBackend) {
 
 // The tampered board: the hub, sessions and sockets are the daemon's own code, run in-process so
 // the test can reach the emulated board's video memory below the USB driver.
+// How the in-process mirror differs from what `gpubridged --mirror` builds (defaults: not at all).
+struct MirrorSetup {
+  usb::ScanoutMode scanout = usb::ScanoutMode::Readback;  // the emulated icebreaker's profile value
+  std::uint64_t model_vram_bytes = 0;  // > 0: a simulator with this much memory instead of the board's
+};
+
 class InProcessMirrorDaemon {
  public:
-  bool start(const fs::path& dir, std::string& why) {
+  bool start(const fs::path& dir, std::string& why, const MirrorSetup& setup = {}) {
     auto profile = usb::find_board_profile(fs::path(GPUBRIDGE_BOARDS_DIR).parent_path(), "icebreaker");
     if (!profile) return (why = profile.error().message, false);
+    profile->scanout = setup.scanout;
     auto emulated = usb::emu::open_emulated_board(*profile);
     if (!emulated) return (why = emulated.error().message, false);
     stack_ = emulated->stack;
     if (!stack_->target_is_simulator()) return (why = "emulated board without the simulator's device model", false);
-    auto mirror = daemon::make_mirror(std::move(emulated->backend));
-    if (!mirror) return (why = mirror.error().message, false);
+    std::unique_ptr<backends::Backend> mirror;
+    if (setup.model_vram_bytes == 0) {
+      auto made = daemon::make_mirror(std::move(emulated->backend));
+      if (!made) return (why = made.error().message, false);
+      mirror = std::move(*made);
+    } else {
+      sim::DeviceOptions o;
+      o.vram_bytes = setup.model_vram_bytes;
+      auto model = sim::SimBackend::create(o);
+      if (!model) return (why = model.error().message, false);
+      mirror = std::make_unique<daemon::MirrorBackend>(std::move(emulated->backend), std::move(*model));
+    }
     daemon::HubOptions opts;
     opts.mirror = true;
-    hub_.emplace(net_.get_executor(), device_.get_executor(), std::move(*mirror), opts);
+    hub_.emplace(net_.get_executor(), device_.get_executor(), std::move(mirror), opts);
     server_.emplace(net_, *hub_);
     auto a = client::parse_address("unix:" + (dir / "d.sock").string());
     auto bound = server_->listen(*a);
@@ -442,6 +507,20 @@ class InProcessMirrorDaemon {
   std::thread net_thread_, device_thread_;
 };
 
+// Sends board_triangles.trace's register writes (one swap of the 64x48 RGB565 framebuffer at
+// address 0) through a client holding the lease, then fences.
+void play_triangles(client::Client& player) {
+  auto trace = load_trace(kTrace);
+  ASSERT_TRUE(trace) << trace.error().message;
+  for (const auto& tc : trace->commands) {
+    if (std::holds_alternative<protocol::FenceCmd>(tc.command)) continue;  // fenced once below
+    const auto* frames = std::get_if<protocol::FramesCmd>(&tc.command);
+    ASSERT_NE(frames, nullptr) << "board_triangles.trace is expected to hold register writes only";
+    ASSERT_TRUE(player.write_frames(frames->view(), 2000ms));
+  }
+  ASSERT_TRUE(player.fence(5000ms));
+}
+
 TEST(DaemonMirror, TamperedBoardMemoryIsCountedAndShownMagentaExactlyWhereItDiffers) {
   const auto dir = make_temp_dir("mirror-tamper");
   InProcessMirrorDaemon daemon;
@@ -456,21 +535,14 @@ TEST(DaemonMirror, TamperedBoardMemoryIsCountedAndShownMagentaExactlyWhereItDiff
   ASSERT_TRUE(player);
   ASSERT_TRUE(player->handshake("player", "", 2000ms));
   ASSERT_TRUE(player->acquire_lease(protocol::LeaseMode::Wait, 2000ms));
-  auto trace = load_trace(kTrace);
-  ASSERT_TRUE(trace) << trace.error().message;
-  for (const auto& tc : trace->commands) {
-    if (std::holds_alternative<protocol::FenceCmd>(tc.command)) continue;  // fenced once below
-    const auto* frames = std::get_if<protocol::FramesCmd>(&tc.command);
-    ASSERT_NE(frames, nullptr) << "board_triangles.trace is expected to hold register writes only";
-    ASSERT_TRUE(player->write_frames(frames->view(), 2000ms));
-  }
-  ASSERT_TRUE(player->fence(5000ms));
+  ASSERT_NO_FATAL_FAILURE(play_triangles(*player));
   // Swap 1: untouched, equal.
   auto b1 = board->next_frame(5000ms);
   auto d1 = diff->next_frame(5000ms);
   ASSERT_TRUE(b1 && d1);
   auto status = status_of(*player);
   EXPECT_EQ(status["mirror"]["mismatches"], 0) << status.dump();
+  EXPECT_TRUE(status["mirror"]["first_mismatch_pixels"].is_null()) << status.dump();
 
   // One pixel of the displayed RGB565 framebuffer at address 0 changes on the board only.
   const unsigned tx = 37, ty = 21;
@@ -512,6 +584,129 @@ TEST(DaemonMirror, TamperedBoardMemoryIsCountedAndShownMagentaExactlyWhereItDiff
   EXPECT_EQ(status["mirror"]["compared"], 2) << status.dump();
   EXPECT_EQ(status["mirror"]["mismatches"], 1) << status.dump();
   EXPECT_EQ(status["mirror"]["first_mismatch"], b2->number) << status.dump();
+  EXPECT_EQ(status["mirror"]["first_mismatch_pixels"], differing.size()) << status.dump();
+  std::error_code ec;
+  fs::remove_all(dir, ec);
+}
+
+// The counters of STATUS's `mirror` object that a test reads as one line.
+struct Counted {
+  std::uint64_t model_errors, unpaired, coalesced, compared, mismatches;
+  bool operator==(const Counted&) const = default;
+};
+std::ostream& operator<<(std::ostream& os, const Counted& c) {
+  return os << "{model_errors " << c.model_errors << ", unpaired " << c.unpaired << ", coalesced " << c.coalesced
+            << ", compared " << c.compared << ", mismatches " << c.mismatches << "}";
+}
+Counted counted(const nlohmann::json& status) {
+  const auto& m = status.at("mirror");
+  return {m.at("model_errors").get<std::uint64_t>(), m.at("unpaired_frames").get<std::uint64_t>(),
+          m.at("coalesced_swaps").get<std::uint64_t>(), m.at("compared").get<std::uint64_t>(),
+          m.at("mismatches").get<std::uint64_t>()};
+}
+
+// The board (emulated icebreaker, 128 KiB) is mirrored by a simulator with only 64 KiB, so the
+// upper half of the board's memory is where the model refuses what the board accepts.
+TEST(DaemonMirror, StatusAndCliReportTheMirrorsOwnCountersAsTheyChange) {
+  const auto dir = make_temp_dir("mirror-counters");
+  InProcessMirrorDaemon daemon;
+  std::string why;
+  ASSERT_TRUE(daemon.start(dir, why, MirrorSetup{.model_vram_bytes = 64 * 1024})) << why;
+  auto board = subscriber(daemon.address(), FrameSource::Board);
+  auto sim = subscriber(daemon.address(), FrameSource::Sim);
+  ASSERT_TRUE(board && sim);
+  auto player = client::Client::connect(daemon.address(), 2000ms);
+  ASSERT_TRUE(player);
+  ASSERT_TRUE(player->handshake("player", "", 2000ms));
+  ASSERT_TRUE(player->acquire_lease(protocol::LeaseMode::Wait, 2000ms));
+  EXPECT_EQ(counted(status_of(*player)), (Counted{0, 0, 0, 0, 0}));
+
+  // Upload and readback in the board's upper half: the client gets the board's success and data,
+  // each refusal of the 64 KiB simulator is counted.
+  const std::uint32_t high = 96 * 1024;
+  const std::vector<std::uint8_t> bytes(64, 0xA5);
+  ASSERT_TRUE(player->upload(high, bytes, {}, 2000ms));
+  EXPECT_EQ(counted(status_of(*player)), (Counted{1, 0, 0, 0, 0}));
+  auto back = player->readback(high, 64, {}, 2000ms);
+  ASSERT_TRUE(back) << back.error().message;
+  EXPECT_EQ(*back, bytes);
+  EXPECT_EQ(counted(status_of(*player)), (Counted{2, 0, 0, 0, 0}));
+
+  // A swap inside both memories is compared, and equal.
+  ASSERT_NO_FATAL_FAILURE(play_triangles(*player));
+  ASSERT_TRUE(board->next_frame(5000ms));
+  EXPECT_EQ(counted(status_of(*player)), (Counted{2, 0, 0, 1, 0}));
+
+  // Two swaps in one batch: the board reports the last, the simulator's first is skipped.
+  protocol::FramesCmd twice;
+  twice.push(protocol::write_frame(protocol::Reg::FB_DISPLAY, 0));
+  twice.push(protocol::write_frame(protocol::Reg::FB_DISPLAY, 0));
+  ASSERT_TRUE(player->write_frames(twice.view(), 2000ms));
+  ASSERT_TRUE(player->fence(5000ms));
+  ASSERT_TRUE(board->next_frame(5000ms));
+  EXPECT_EQ(counted(status_of(*player)), (Counted{2, 0, 1, 2, 0}));
+  EXPECT_TRUE(status_of(*player)["mirror"]["first_mismatch_pixels"].is_null());
+
+  // Showing the upper half: the board has the uploaded bytes there, the simulator has no memory
+  // there (its scanout reads zeros), so the pictures differ; the test counts where.
+  protocol::FramesCmd high_swap;
+  high_swap.push(protocol::write_frame(protocol::Reg::FB_DISPLAY, high));
+  ASSERT_TRUE(player->write_frames(high_swap.view(), 2000ms));
+  ASSERT_TRUE(player->fence(5000ms));
+  auto b = board->next_frame(5000ms);
+  ASSERT_TRUE(b) << b.error().message;
+  std::optional<client::ReceivedFrame> s;
+  for (int i = 0; i < 3 && (!s || s->number != b->number); ++i) {  // the sim subscriber also has the earlier swaps
+    auto next = sim->next_frame(5000ms);
+    ASSERT_TRUE(next) << next.error().message;
+    s = std::move(*next);
+  }
+  ASSERT_EQ(s->number, b->number);
+  const Image bi = to_image(*b), si = to_image(*s);
+  ASSERT_EQ(bi.rgba.size(), si.rgba.size());
+  std::uint64_t differing = 0;
+  for (unsigned y = 0; y < bi.height; ++y)
+    for (unsigned x = 0; x < bi.width; ++x) differing += !std::equal(bi.pixel(x, y), bi.pixel(x, y) + 4, si.pixel(x, y));
+  EXPECT_GE(differing, 32u) << "the 64 uploaded bytes are 32 RGB565 pixels the simulator does not have";
+  auto status = status_of(*player);
+  EXPECT_EQ(counted(status), (Counted{2, 0, 1, 3, 1}));
+  EXPECT_EQ(status["mirror"]["first_mismatch"], b->number) << status.dump();
+  EXPECT_EQ(status["mirror"]["first_mismatch_pixels"], differing) << status.dump();
+
+  // `gpubridge status`: the same numbers in --json and in the text.
+  const auto json = run_process({GPUBRIDGE_CLI_PATH, "status", "--connect", daemon.address(), "--json"});
+  ASSERT_EQ(json.exit_code, 0) << json.err;
+  const auto cli = nlohmann::json::parse(json.out);
+  EXPECT_EQ(counted(cli), (Counted{2, 0, 1, 3, 1})) << json.out;
+  EXPECT_EQ(cli["mirror"]["first_mismatch_pixels"], differing) << json.out;
+  const auto text = run_process({GPUBRIDGE_CLI_PATH, "status", "--connect", daemon.address()});
+  ASSERT_EQ(text.exit_code, 0) << text.err;
+  EXPECT_NE(text.out.find("mirror:    1 of 3 frame(s) differ from the simulator (first #" + std::to_string(b->number) +
+                          ", " + std::to_string(differing) + " pixel(s) differ;"),
+            std::string::npos)
+      << text.out;
+  EXPECT_NE(text.out.find("2 command(s) the board accepted were refused by the simulator, 0 swap(s) without a "
+                          "partner, 1 intermediate simulator swap(s) skipped"),
+            std::string::npos)
+      << text.out;
+  std::error_code ec;
+  fs::remove_all(dir, ec);
+}
+
+// A board whose profile says "scanout": "off" reports no swaps: every simulator swap is unpaired.
+TEST(DaemonMirror, SwapsOfABoardWithoutScanoutAreCountedAsUnpaired) {
+  const auto dir = make_temp_dir("mirror-unpaired");
+  InProcessMirrorDaemon daemon;
+  std::string why;
+  ASSERT_TRUE(daemon.start(dir, why, MirrorSetup{.scanout = usb::ScanoutMode::Off})) << why;
+  auto player = client::Client::connect(daemon.address(), 2000ms);
+  ASSERT_TRUE(player);
+  ASSERT_TRUE(player->handshake("player", "", 2000ms));
+  ASSERT_TRUE(player->acquire_lease(protocol::LeaseMode::Wait, 2000ms));
+  ASSERT_NO_FATAL_FAILURE(play_triangles(*player));
+  EXPECT_EQ(counted(status_of(*player)), (Counted{0, 1, 0, 0, 0}));
+  ASSERT_NO_FATAL_FAILURE(play_triangles(*player));
+  EXPECT_EQ(counted(status_of(*player)), (Counted{0, 2, 0, 0, 0}));
   std::error_code ec;
   fs::remove_all(dir, ec);
 }

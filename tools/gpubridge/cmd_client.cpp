@@ -133,10 +133,21 @@ int run_status(const GlobalOptions& g, const ClientOptions& o) {
     std::printf("mirror:    %llu of %llu frame(s) differ from the simulator",
                 static_cast<unsigned long long>(mismatches),
                 static_cast<unsigned long long>(m.value("compared", std::uint64_t{0})));
-    if (mismatches && m["first_mismatch"].is_number())
-      std::printf(" (first #%llu; see it with `gpubridge screenshot --source diff`)",
-                  static_cast<unsigned long long>(m["first_mismatch"].get<std::uint64_t>()));
+    if (mismatches && m.contains("first_mismatch") && m["first_mismatch"].is_number()) {
+      std::printf(" (first #%llu", static_cast<unsigned long long>(m["first_mismatch"].get<std::uint64_t>()));
+      if (m.contains("first_mismatch_pixels") && m["first_mismatch_pixels"].is_number())
+        std::printf(", %llu pixel(s) differ",
+                    static_cast<unsigned long long>(m["first_mismatch_pixels"].get<std::uint64_t>()));
+      std::printf("; see the differences with `gpubridge screenshot --source diff`)");
+    }
     std::printf("\n");
+    // The decorator's own counters (daemons before they were reported omit them).
+    if (m.contains("model_errors"))
+      std::printf("           %llu command(s) the board accepted were refused by the simulator, "
+                  "%llu swap(s) without a partner, %llu intermediate simulator swap(s) skipped\n",
+                  static_cast<unsigned long long>(m.value("model_errors", std::uint64_t{0})),
+                  static_cast<unsigned long long>(m.value("unpaired_frames", std::uint64_t{0})),
+                  static_cast<unsigned long long>(m.value("coalesced_swaps", std::uint64_t{0})));
   }
   return 0;
 }
@@ -379,7 +390,8 @@ int run_readback(const GlobalOptions& g, const ClientOptions& o, const std::stri
 GPUBRIDGE_COMMAND("client", 40, [](CLI::App& app, GlobalOptions& g, auto& runners) {
   auto copts = std::make_shared<ClientOptions>();
 
-  auto* status = app.add_subcommand("status", "show the daemon's backend, lease holder, clients and frame counter");
+  auto* status = app.add_subcommand(
+      "status", "show the daemon's backend, lease holder, clients, frame counter and its hot-plug and mirror counters");
   add_client_options(status, g, *copts);
   runners.emplace_back(status, [&g, copts] { return run_status(g, *copts); });
 

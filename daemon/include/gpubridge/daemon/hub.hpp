@@ -9,6 +9,7 @@
 #include <deque>
 #include <map>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 
@@ -18,6 +19,7 @@
 
 #include "gpubridge/backends/backend.hpp"
 #include "gpubridge/daemon/config.hpp"
+#include "gpubridge/daemon/mirror_backend.hpp"
 #include "gpubridge/protocol/messages.hpp"
 
 namespace gpubridge::daemon {
@@ -36,6 +38,7 @@ struct HubOptions {
 struct MirrorStats {
   std::uint64_t compared = 0, mismatches = 0;
   std::optional<std::uint32_t> first_mismatch, last_mismatch;  // frame numbers
+  std::optional<std::uint64_t> first_mismatch_pixels;           // differing pixels; none for CRC-only boards
 };
 
 // A scanned-out frame encoded once per requested source and format and shared by every subscriber.
@@ -114,6 +117,9 @@ class Hub {
   nlohmann::json status_json() const;  // STATUS_REPLY
   std::uint64_t frames_seen() const { return frames_seen_; }
   const MirrorStats& mirror_stats() const { return mirror_; }
+  // The mirror decorator's own counters (model refusals, unpaired and coalesced swaps), summed over
+  // every MirrorBackend this hub served; zero without mirror mode. Any thread.
+  MirrorCounters mirror_counters() const;
   // A subscriber switched pictures (SUBSCRIBE with another source): offers it the newest swap
   // again, so a still scene shows the new picture at once (network thread).
   void offer_newest_frame(Session& s);
@@ -131,7 +137,12 @@ class Hub {
   void grant_next();
 
   Executor net_, device_;
-  std::unique_ptr<backends::Backend> backend_;  // touched only on the device executor
+  std::unique_ptr<backends::Backend> backend_;  // used only on the device executor (see backend_swap_mu_)
+  // STATUS (network thread) reads the mirror's counters while the device thread works; the mirror
+  // guards them itself. This mutex only keeps backend_ alive and in place meanwhile: the device
+  // thread holds it to replace backend_ (hot-plug), the network thread to read the counters.
+  mutable std::mutex backend_swap_mu_;
+  MirrorCounters retired_mirror_counters_;  // of mirrors replaced by hot-plug; under backend_swap_mu_
   backends::DeviceInfo info_;                   // network-thread copy of backend_->info()
   HubOptions options_;
   BackendFactory fallback_;

@@ -19,6 +19,15 @@ struct MirrorCounters {
   std::uint64_t model_errors = 0;     // commands the board accepted but the model refused
   std::uint64_t unpaired_frames = 0;  // swaps of one side only in a call (board scanout off, a failed call)
   std::uint64_t coalesced_swaps = 0;  // model swaps before the last one of a call (the board shows the last)
+
+  // The daemon's STATUS adds up the counters of every mirror it served (a board that comes back
+  // after an unplug gets a new MirrorBackend).
+  MirrorCounters& operator+=(const MirrorCounters& o) {
+    model_errors += o.model_errors;
+    unpaired_frames += o.unpaired_frames;
+    coalesced_swaps += o.coalesced_swaps;
+    return *this;
+  }
 };
 
 class MirrorBackend final : public backends::Backend {
@@ -35,7 +44,7 @@ class MirrorBackend final : public backends::Backend {
   Result<void> reset() override;
   void set_scanout_callback(backends::ScanoutCallback cb) override;
 
-  MirrorCounters counters() const;
+  MirrorCounters counters() const;  // safe from any thread (STATUS reads it on the network thread)
   backends::Backend& board() { return *board_; }
   backends::Backend& model() { return *model_; }
 
