@@ -182,7 +182,6 @@ class Kernel {
       if (kTextured && (ctx_.fast || !tex_.direct() || !texture_disjoint())) return;
       if (t_.den >= (std::int64_t{1} << 30)) return;
       simd_tpl_.den = static_cast<std::uint32_t>(t_.den);
-      simd_tpl_.planes = kTextured ? 8 : 5;
       for (unsigned p = 0; p < SimdSpan::kPlanes; ++p) {
         const Plane& pl = t_.plane[kR + p];
         if (!simd_plane_used(p)) {

@@ -88,11 +88,15 @@ using simd::u32x8;
 
 }  // namespace
 
-__attribute__((target_clones("avx2", "default"))) std::uint64_t shade_span_simd(const SimdSpan& s) {
-  u32x8 q[SimdSpan::kPlanes], r[SimdSpan::kPlanes];
+// One instance per plane count, so the plane loops have constant bounds and the lanes stay in
+// registers (a run-time bound cost the untextured spans 5-15%).
+template <bool kTextured>
+[[gnu::always_inline]] inline std::uint64_t shade_span(const SimdSpan& s) {
+  constexpr unsigned kUsed = kTextured ? 8 : 5;
+  u32x8 q[kUsed], r[kUsed];
   const unsigned first = s.gouraud ? 0 : 4;
   const u32x8 den = u32x8{} + s.den;
-  for (unsigned p = first; p < s.planes; ++p) {
+  for (unsigned p = first; p < kUsed; ++p) {
     u32x8 qk, rk;
     GB_LOAD8(qk, s.qk[p]);
     GB_LOAD8(rk, s.rk[p]);
@@ -136,7 +140,7 @@ __attribute__((target_clones("avx2", "default"))) std::uint64_t shade_span_simd(
     if (!none) {
       u32x8 word = u32x8{} + s.flat;
       if (s.gouraud) word = (q[0] & 255u) | ((q[1] & 255u) << 8) | ((q[2] & 255u) << 16) | (q[3] << 24);
-      if (s.tex) word = texture8(s, q[5], q[6], q[7], pass, n, word);
+      if constexpr (kTextured) word = texture8(s, q[5], q[6], q[7], pass, n, word);
       if (reads_colour || !all) {
         std::uint32_t cbuf[8] = {};
         GB_COPY(cbuf, cp, n);
@@ -151,7 +155,7 @@ __attribute__((target_clones("avx2", "default"))) std::uint64_t shade_span_simd(
       }
       passed -= pass;  // pass lanes are all ones (−1)
     }
-    for (unsigned p = first; p < s.planes; ++p) {
+    for (unsigned p = first; p < kUsed; ++p) {
       q[p] += s.q8[p];
       r[p] += s.r8[p];
       const u32x8 carry = GB_MASK((i32x8)r[p] >= (i32x8)den);
@@ -162,6 +166,10 @@ __attribute__((target_clones("avx2", "default"))) std::uint64_t shade_span_simd(
   std::uint64_t total = 0;
   for (unsigned k = 0; k < 8; ++k) total += passed[k];
   return total;
+}
+
+__attribute__((target_clones("avx2", "default"))) std::uint64_t shade_span_simd(const SimdSpan& s) {
+  return s.tex ? shade_span<true>(s) : shade_span<false>(s);
 }
 
 }  // namespace gpubridge::sim

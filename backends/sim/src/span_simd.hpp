@@ -16,7 +16,6 @@ class TextureUnit;
 
 struct SimdSpan {
   static constexpr unsigned kPlanes = 8;  // R, G, B, A, Z, S, T, Q (setup.hpp's attribute order)
-  unsigned planes = 5;                    // planes stepped: 5 untextured, 8 textured
   std::uint32_t q0[kPlanes], r0[kPlanes];      // (q, r) at the span's first pixel
   std::uint32_t qk[kPlanes][8], rk[kPlanes][8];  // offsets of lane k: divmod(k·step), rk < den
   std::uint32_t q8[kPlanes], r8[kPlanes];  // advance per 8 pixels (r8 < den)
