@@ -110,7 +110,11 @@ TEST(DrawContext, BadInputIsAnError) {
 
 TEST(DrawContext, VideoMemoryIsBounded) {
   RecordingSink sink(64 * 1024);
-  EXPECT_FALSE(Context::create(sink, {.width = 256, .height = 256}));
+  auto too_big = Context::create(sink, {.width = 256, .height = 256});
+  ASSERT_FALSE(too_big);
+  EXPECT_NE(too_big.error().message.find("not enough video memory for the colour buffer (262144 bytes, 65536 bytes left"),
+            std::string::npos)
+      << too_big.error().message;
   RecordingSink small(64 * 1024);
   auto ctx = Context::create(small, {.width = 64, .height = 64, .depth_buffer = false, .double_buffer = false});
   ASSERT_TRUE(ctx);

@@ -18,9 +18,13 @@ Result<void> check_image_data(const Image& image, const char* what) {
 
 }  // namespace
 
+// The buffers, at creation (no textures yet, so the allocator's advice to release some does not apply).
 Result<std::uint32_t> Context::allocate(std::uint64_t bytes, const char* what) {
   auto a = vram_.allocate(bytes);
-  if (!a) return make_error(fmt::format("not enough video memory for the {}: {}", what, a.error().message));
+  if (!a)
+    return make_error(fmt::format("not enough video memory for the {} ({} bytes, {} bytes left; the device has {} bytes): "
+                                  "use a smaller framebuffer or format, or no depth buffer / double buffering",
+                                  what, bytes, vram_.largest_free_block(), sink_->vram_bytes()));
   return *a;
 }
 
