@@ -55,6 +55,48 @@ TEST(SimEquivalence, ThreadCountDoesNotChangeBytes) {
   }
 }
 
+// Several batches in flight one after another (more than Renderer::kMaxBatch triangles), render
+// state changes between them, and video memory written and read back in the middle of the stream:
+// the front end prepares the next batch while the workers draw, and the bytes must not depend on it.
+TEST(SimEquivalence, PipelinedBatchesMatchOneThread) {
+  auto run = [](unsigned threads) {
+    DeviceOptions o;
+    o.threads = threads;
+    Canvas c(160, 120, 0, o);
+    w(*c.dev, Reg::CLEAR_DEPTH, 0xFFFFFF);
+    w(*c.dev, Reg::CLEAR_Z, 0);
+    std::mt19937 rng(77);
+    std::uniform_int_distribution<int> px(0, 160 * 16), py(0, 120 * 16), d(-12 * 16, 12 * 16);
+    std::vector<std::uint64_t> readback;
+    for (int i = 0; i < 11000; ++i) {
+      if (i % 3000 == 0) w(*c.dev, Reg::TRI_MODE, 1 | 4 | (1u << 3) | (1u << 6) | ((i / 3000 % 2) << 7));
+      if (i == 5000) {  // a memory write and a prefetching read between batches
+        w(*c.dev, Reg::MEM_ADDR, 8 * 160 * 4);
+        w(*c.dev, Reg::MEM_DATA, 0x0123456789ABCDEFull);
+        w(*c.dev, Reg::MEM_ADDR, 40 * 160 * 4);
+        readback.push_back(rd(*c.dev, Reg::MEM_DATA));
+      }
+      const int x = px(rng), y = py(rng);
+      c.tri(x, y, x + d(rng), y + d(rng), x + d(rng), y + d(rng), rng(), rng(), rng(), rng() & 0xFFFFFF,
+            rng() & 0xFFFFFF, rng() & 0xFFFFFF);
+    }
+    c.dev->drain();
+    auto bytes = c.colour_bytes();
+    const auto m = c.dev->memory();
+    bytes.insert(bytes.end(), m.begin() + Canvas::kZBase, m.begin() + Canvas::kZBase + 160 * 120 * 4);
+    for (std::uint64_t r : readback)
+      for (int k = 0; k < 8; ++k) bytes.push_back(static_cast<std::uint8_t>(r >> (8 * k)));
+    return std::make_pair(bytes, c.dev->stats().pixels_depth_passed);
+  };
+  const auto one = run(1);
+  EXPECT_GT(one.second, 50000u);  // the scene draws
+  for (unsigned t : {2u, 3u}) {
+    const auto many = run(t);
+    EXPECT_EQ(many.first, one.first) << "threads " << t;
+    EXPECT_EQ(many.second, one.second) << "threads " << t;
+  }
+}
+
 TEST(SimEquivalence, GouraudWithEqualColoursEqualsFlat) {
   Canvas a(40, 40), b(40, 40);
   w(*a.dev, Reg::TRI_MODE, 1);

@@ -3,7 +3,8 @@
 namespace gpubridge::sim {
 
 BandPool::BandPool(unsigned workers) : workers_(workers == 0 ? 1 : workers) {
-  for (unsigned w = 1; w < workers_; ++w) threads_.emplace_back([this, w] { loop(w); });
+  if (workers_ > 1)
+    for (unsigned w = 0; w < workers_; ++w) threads_.emplace_back([this, w] { loop(w); });
 }
 
 BandPool::~BandPool() {
@@ -15,7 +16,7 @@ BandPool::~BandPool() {
   for (auto& t : threads_) t.join();
 }
 
-void BandPool::run(const std::function<void(unsigned)>& job) {
+void BandPool::start(const std::function<void(unsigned)>& job) {
   if (workers_ == 1) {
     job(0);
     return;
@@ -23,11 +24,14 @@ void BandPool::run(const std::function<void(unsigned)>& job) {
   {
     std::lock_guard lock(mutex_);
     job_ = &job;
-    running_ = workers_ - 1;
+    running_ = workers_;
     ++generation_;
   }
   start_.notify_all();
-  job(0);
+}
+
+void BandPool::wait() {
+  if (workers_ == 1) return;
   std::unique_lock lock(mutex_);
   done_.wait(lock, [this] { return running_ == 0; });
   job_ = nullptr;

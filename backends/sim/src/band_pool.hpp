@@ -1,6 +1,8 @@
 #pragma once
-// A fixed set of worker threads that run one job per worker and wait for all of them (a fork/join
-// barrier). Worker 0 is the calling thread, so a one-thread pool has no threads and no overhead.
+// A fixed set of worker threads that run one job per worker (a fork/join barrier). start() hands
+// the job over and returns at once, so the caller can prepare the next job while this one runs;
+// wait() returns when every worker has finished it. A one-worker pool has no threads: start()
+// runs the job on the calling thread.
 #include <condition_variable>
 #include <cstdint>
 #include <functional>
@@ -18,8 +20,11 @@ class BandPool {
   BandPool& operator=(const BandPool&) = delete;
 
   unsigned workers() const { return workers_; }
-  // Runs job(w) for every worker w in 0..workers-1 concurrently; returns when all have finished.
-  void run(const std::function<void(unsigned)>& job);
+  // Starts job(w) for every worker w in 0..workers-1 concurrently. The previous job must have been
+  // waited for; job must stay alive until wait() returns.
+  void start(const std::function<void(unsigned)>& job);
+  // Returns when every worker has finished the started job (at once when none is running).
+  void wait();
 
  private:
   void loop(unsigned worker);

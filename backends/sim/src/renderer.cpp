@@ -13,8 +13,14 @@ bool overlaps(std::uint64_t a, std::uint64_t alen, std::uint64_t b, std::uint64_
 
 Renderer::Renderer(VideoMemory& mem, const AccuracyKnobs& knobs, unsigned threads, bool vector_routines)
     : mem_(mem), knobs_(knobs), vector_(vector_routines), recip_(knobs.recip_bits, knobs.nr_steps), pool_(threads) {
-  if (pool_.workers() > 1) batch_.reserve(kMaxBatch);
+  if (pool_.workers() > 1) {
+    batch_.reserve(kMaxBatch);
+    drawing_.reserve(kMaxBatch);
+  }
+  draw_job_ = [this](unsigned worker) { draw_bands(worker); };
 }
+
+Renderer::~Renderer() { wait_drawing(); }  // the workers read drawing_: stop them before it goes
 
 // Bands can only be drawn independently when no buffer the draw reads overlaps one it writes in
 // another band: colour, depth and texture ranges must not alias.
@@ -41,8 +47,8 @@ void Renderer::draw(const Vertex& a, const Vertex& b, const Vertex& c, const std
   const bool batching = pool_.workers() > 1 && !observing && can_batch(st);
   if (batching) {
     draw_pending();
-    if (batch_state_ != state) flush();
-  } else if (!batch_.empty()) {
+    if (!batch_.empty() && batch_state_ != state) submit();
+  } else if (!batch_.empty() || drawing_active_) {
     flush();
   }
   if (!batching) prefetch_rows(a, b, c, st);
@@ -67,7 +73,7 @@ void Renderer::draw(const Vertex& a, const Vertex& b, const Vertex& c, const std
     return;
   }
   if (batch_state_ != state) batch_state_ = state;
-  if (batch_.size() >= kMaxBatch) flush();
+  if (batch_.size() >= kMaxBatch) submit();
 }
 
 void Renderer::draw_pending() {
@@ -103,31 +109,50 @@ void Renderer::prefetch_rows(const Vertex& a, const Vertex& b, const Vertex& c, 
 
 void Renderer::flush() {
   draw_pending();
+  submit();
+  wait_drawing();
+}
+
+void Renderer::submit() {
+  wait_drawing();
   if (batch_.empty()) {
     batch_state_.reset();
     return;
   }
-  const DrawState& st = *batch_state_;
-  const unsigned n = pool_.workers();
-  std::vector<RasterContext> ctx;
-  ctx.reserve(n);
-  for (unsigned w = 0; w < n; ++w) ctx.push_back(RasterContext{mem_, recip_, knobs_.z_bits, knobs_.fast, 0, {}, vector_});
-  pool_.run([&](unsigned w) {
-    RasterContext& c = ctx[w];
-    for (const Triangle& t : batch_) {
-      // First band of this worker at or after the triangle's first row.
-      int band = t.y0 / kBandRows;
-      band += static_cast<int>((w + n - static_cast<unsigned>(band) % n) % n);
-      for (; band * kBandRows < t.y1; band += static_cast<int>(n))
-        rasterize_rows(t, st, c, band * kBandRows, (band + 1) * kBandRows);
-    }
-  });
-  for (const auto& c : ctx) {
+  std::swap(batch_, drawing_);
+  batch_.clear();
+  drawing_state_ = std::move(batch_state_);
+  batch_state_.reset();
+  drawing_ctx_.clear();
+  for (unsigned w = 0; w < pool_.workers(); ++w)
+    drawing_ctx_.push_back(RasterContext{mem_, recip_, knobs_.z_bits, knobs_.fast, 0, {}, vector_});
+  drawing_active_ = true;
+  pool_.start(draw_job_);
+}
+
+void Renderer::wait_drawing() {
+  if (!drawing_active_) return;
+  pool_.wait();
+  for (const auto& c : drawing_ctx_) {
     errors_ |= c.errors;
     counters_.add(c.counters);
   }
-  batch_.clear();
-  batch_state_.reset();
+  drawing_.clear();
+  drawing_state_.reset();
+  drawing_active_ = false;
+}
+
+void Renderer::draw_bands(unsigned worker) {
+  const DrawState& st = *drawing_state_;
+  const unsigned n = pool_.workers();
+  RasterContext& c = drawing_ctx_[worker];
+  for (const Triangle& t : drawing_) {
+    // First band of this worker at or after the triangle's first row.
+    int band = t.y0 / kBandRows;
+    band += static_cast<int>((worker + n - static_cast<unsigned>(band) % n) % n);
+    for (; band * kBandRows < t.y1; band += static_cast<int>(n))
+      rasterize_rows(t, st, c, band * kBandRows, (band + 1) * kBandRows);
+  }
 }
 
 std::uint16_t Renderer::take_errors() {

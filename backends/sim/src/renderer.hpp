@@ -2,8 +2,11 @@
 // Runs kicked triangles through setup and the rasteriser. With one thread every triangle is drawn
 // at once. With N threads triangles are batched while the render state stays the same; a batch is
 // drawn by N workers that each walk all triangles in submission order and draw only the rows of
-// their own 16-row bands (band i → worker i % N), so the bytes are identical for any N.
+// their own 16-row bands (band i → worker i % N), so the bytes are identical for any N. The
+// calling thread (the device front end) decodes and sets up the next batch while the workers draw
+// the previous one; batches are drawn one after another, and flush() waits for both.
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -20,6 +23,9 @@ namespace gpubridge::sim {
 class Renderer {
  public:
   Renderer(VideoMemory& mem, const AccuracyKnobs& knobs, unsigned threads, bool vector_routines);
+  ~Renderer();
+  Renderer(const Renderer&) = delete;
+  Renderer& operator=(const Renderer&) = delete;
 
   void set_observer(PixelObserver observer) { observer_ = std::move(observer); }
   // Draws (or queues) one triangle. A state object different from the batch's flushes the batch.
@@ -43,6 +49,11 @@ class Renderer {
 
  private:
   bool can_batch(const DrawState& st) const;
+  // Hands the filling batch to the workers (after the one they are drawing) and returns.
+  void submit();
+  // Waits for the batch the workers are drawing and collects its errors and counters.
+  void wait_drawing();
+  void draw_bands(unsigned worker);
   void draw_pending();
   void prefetch_rows(const Vertex& a, const Vertex& b, const Vertex& c, const DrawState& st) const;
 
@@ -52,8 +63,13 @@ class Renderer {
   ReciprocalUnit recip_;
   BandPool pool_;
   PixelObserver observer_;
-  std::vector<Triangle> batch_;
+  std::vector<Triangle> batch_;  // being filled by the front end
   std::shared_ptr<const DrawState> batch_state_;
+  std::vector<Triangle> drawing_;  // being drawn by the workers
+  std::shared_ptr<const DrawState> drawing_state_;
+  std::vector<RasterContext> drawing_ctx_;  // one per worker
+  bool drawing_active_ = false;
+  std::function<void(unsigned)> draw_job_;
   Triangle slots_[2];
   int pending_ = -1;  // slot set up but not yet drawn (single-thread pipelining)
   std::shared_ptr<const DrawState> pending_state_;
