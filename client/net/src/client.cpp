@@ -182,8 +182,11 @@ Result<void> Client::send_raw(std::span<const std::uint8_t> a, std::span<const s
       b = b.subspan(done - from_a);
       continue;
     }
-    if (n < 0 && errno != EAGAIN && errno != EINTR)
-      return io_error("lost connection to " + address_.to_string() + ": " + errno_text(errno));
+    if (n < 0 && errno != EAGAIN && errno != EINTR) {
+      const std::string why = errno_text(errno);
+      if (auto words = daemon_last_words()) return *words;
+      return io_error("lost connection to " + address_.to_string() + ": " + why);
+    }
     // The daemon may be talking to us (errors, frames): read while waiting so neither side stalls.
     pollfd p{fd_, POLLOUT | POLLIN, 0};
     const int rc = ::poll(&p, 1, remaining_ms(deadline));
@@ -193,6 +196,23 @@ Result<void> Client::send_raw(std::span<const std::uint8_t> a, std::span<const s
     }
   }
   return {};
+}
+
+std::optional<Error> Client::daemon_last_words() {
+  auto error_in_inbox = [this]() -> std::optional<Error> {
+    for (auto& m : inbox_)
+      if (auto* e = std::get_if<protocol::ErrorMsg>(&m.payload)) return from_error_msg(*e);
+    return std::nullopt;
+  };
+  // The bytes the daemon wrote before closing stay readable after our send failed; read until
+  // its end of stream (or a short deadline: a reset connection may have lost them).
+  const auto deadline = Clock::now() + std::chrono::milliseconds(200);
+  while (Clock::now() < deadline) {
+    const auto r = pump(deadline, true);
+    if (auto e = error_in_inbox()) return e;
+    if (!r) break;
+  }
+  return std::nullopt;
 }
 
 Result<void> Client::pump(Clock::time_point deadline, bool block) {

@@ -101,6 +101,9 @@ class Client {
   Result<protocol::Message> wait_for(std::uint32_t request_id, protocol::MsgType type, Timeout timeout);
   // Reads what is available (waiting up to `wait` for the first byte) and stores frames/events/errors.
   Result<void> pump(std::chrono::steady_clock::time_point deadline, bool block);
+  // After a failed send: the ERROR the daemon sent before it closed (SERVER_FULL, SHUTTING_DOWN),
+  // if it is still readable, so the caller learns why instead of "Broken pipe".
+  std::optional<Error> daemon_last_words();
   Result<void> take_async_error();
   std::uint32_t next_request_id() { return ++request_counter_; }
 
