@@ -64,6 +64,8 @@ __attribute__((target_clones("avx2", "default"))) NarrowCounts shade_narrow_simd
     if (t.gouraud) word = (q[0] & 255u) | ((q[1] & 255u) << 8) | ((q[2] & 255u) << 16) | (q[3] << 24);
     u32x8 cold;
     GB_LOAD8(cold, cp);
+    if (t.blend != 0) word = GB_BLEND8(t.blend, word, cold);
+    word = (word & ~t.keep) | (cold & t.keep);
     const u32x8 out = (word & pass) | (cold & ~pass);
     GB_STORE8(cp, out);
     cp += t.pitch;

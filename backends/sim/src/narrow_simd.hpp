@@ -1,11 +1,12 @@
 #pragma once
 // The vector routine for small triangles (boxes at most 8 pixels wide), the commonest draw of a
-// dense mesh: untextured, RGBA8888 store without blend or mask, optional depth test/write. One row
-// of the box is one 8-lane step: the three edge functions, the coverage mask, every attribute plane
-// and the depth compare are lane vectors, the colour and depth rows are read and written whole and
-// merged under the mask. There is no branch per pixel or per row (a small triangle's rows are too
-// short for per-pixel branches to predict), and the arithmetic is the exact (q, r) stepping of the
-// scalar routine with 32-bit lanes, so the output is the same byte for byte.
+// dense mesh: untextured, RGBA8888 store with optional blend and write mask, optional depth
+// test/write. One row of the box is one 8-lane step: the three edge functions, the coverage mask,
+// every attribute plane and the depth compare are lane vectors, the colour and depth rows are read
+// and written whole and merged under the mask. There is no branch per pixel or per row (a small
+// triangle's rows are too short for per-pixel branches to predict), and the arithmetic is the
+// exact (q, r) stepping of the scalar routine with 32-bit lanes, so the output is the same byte
+// for byte.
 //
 // The caller guarantees (narrow_simd_fits): the 8-pixel window lies inside the framebuffer row and
 // both buffers inside VRAM; colour and depth buffers do not overlap; 8·den < 2^31; every edge value
@@ -31,6 +32,8 @@ struct NarrowTriangle {
   std::uint8_t* depth = nullptr;   // its depth word (when z_test or z_write)
   std::size_t pitch = 0;           // bytes per framebuffer row (colour and depth alike: 4 per pixel)
   unsigned z_func = 0;             // protocol::DepthFunc
+  unsigned blend = 0;              // protocol::BlendMode (0 = off)
+  std::uint32_t keep = 0;          // bytes of the colour word the write mask keeps
   bool gouraud = false, z_test = false, z_write = false;
 };
 

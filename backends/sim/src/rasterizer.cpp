@@ -418,10 +418,14 @@ bool draw_narrow(const Triangle& t, const DrawState& st, RasterContext& ctx, int
   n.gouraud = gouraud;
   n.z_test = st.z_test;
   n.z_write = st.z_write;
+  n.blend = static_cast<unsigned>(st.blend);
+  for (unsigned ch = 0; ch < 4; ++ch)
+    if (st.keep_mask & (1u << ch)) n.keep |= 0xFFu << (8 * ch);
   const NarrowCounts c = shade_narrow_simd(n);
   ctx.counters.scanned += static_cast<std::uint64_t>(w) * static_cast<std::uint64_t>(rows);
   ctx.counters.covered += c.covered;
   ctx.counters.passed += c.passed;
+  if (st.blend != protocol::BlendMode::Off) ctx.counters.blended += c.passed;
   return true;
 }
 
@@ -434,7 +438,8 @@ void rasterize_rows(const Triangle& t, const DrawState& st, RasterContext& ctx, 
   for (unsigned ch = 0; ch < 4; ++ch) colours_differ |= !t.plane[kR + ch].constant;
   const bool gouraud = st.gouraud && colours_differ;  // Gouraud only when colours differ
   const bool depth = st.z_test || st.z_write;
-  if (ctx.vector && st.simple_color && !st.textured && draw_narrow(t, st, ctx, ya, yz, gouraud, depth)) return;
+  const bool rgba8888 = st.fb_format == protocol::PixelFormat::RGBA8888;
+  if (ctx.vector && rgba8888 && !st.textured && draw_narrow(t, st, ctx, ya, yz, gouraud, depth)) return;
   const unsigned key = (gouraud ? 1u : 0u) | (st.textured ? 2u : 0u) | (depth ? 4u : 0u) | (st.simple_color ? 8u : 0u);
   kKernels[key](t, st, ctx, ya, yz);
 }
