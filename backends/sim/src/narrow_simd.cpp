@@ -1,6 +1,7 @@
 #include "narrow_simd.hpp"
 
 #include "simd_lanes.hpp"
+#include "texture8.hpp"
 
 namespace gpubridge::sim {
 namespace {
@@ -15,9 +16,9 @@ using simd::u32x8;
     (q) -= c_;                                            \
   } while (0)
 
-}  // namespace
-
-__attribute__((target_clones("avx2", "default"))) NarrowCounts shade_narrow_simd(const NarrowTriangle& t) {
+// One instance per plane count (constant loop bounds keep the lanes in registers).
+template <bool kTextured>
+[[gnu::always_inline]] inline NarrowCounts shade_narrow(const NarrowTriangle& t) {
   const i32x8 lane = {0, 1, 2, 3, 4, 5, 6, 7};
   const u32x8 in_box = GB_MASK(lane < static_cast<std::int32_t>(t.width));
   i32x8 e[3];
@@ -27,7 +28,7 @@ __attribute__((target_clones("avx2", "default"))) NarrowCounts shade_narrow_simd
   // attribute values, which are far below 2^32, so they are exact.
   const unsigned first = t.gouraud ? 0 : 4;
   const bool depth = t.z_test || t.z_write;
-  const unsigned last = depth ? NarrowTriangle::kPlanes : 4;
+  const unsigned last = kTextured ? 8 : depth ? 5 : 4;
   const u32x8 den = u32x8{} + t.den;
   // Only planes first..last-1 are read; no zero fill (a `rep stos` here cost more than a row).
   u32x8 q[NarrowTriangle::kPlanes], r[NarrowTriangle::kPlanes];
@@ -62,6 +63,7 @@ __attribute__((target_clones("avx2", "default"))) NarrowCounts shade_narrow_simd
     }
     u32x8 word = u32x8{} + t.flat;
     if (t.gouraud) word = (q[0] & 255u) | ((q[1] & 255u) << 8) | ((q[2] & 255u) << 16) | (q[3] << 24);
+    if constexpr (kTextured) word = texture8(t.texture, q[5], q[6], q[7], pass, 8, word);
     u32x8 cold;
     GB_LOAD8(cold, cp);
     if (t.blend != 0) word = GB_BLEND8(t.blend, word, cold);
@@ -84,6 +86,13 @@ __attribute__((target_clones("avx2", "default"))) NarrowCounts shade_narrow_simd
     n.passed += passed[k];
   }
   return n;
+}
+
+
+}  // namespace
+
+__attribute__((target_clones("avx2", "default"))) NarrowCounts shade_narrow_simd(const NarrowTriangle& t) {
+  return t.texture.tex ? shade_narrow<true>(t) : shade_narrow<false>(t);
 }
 
 }  // namespace gpubridge::sim

@@ -1,7 +1,7 @@
 #pragma once
 // The vector routine for small triangles (boxes at most 8 pixels wide), the commonest draw of a
-// dense mesh: untextured, RGBA8888 store with optional blend and write mask, optional depth
-// test/write. One row of the box is one 8-lane step: the three edge functions, the coverage mask,
+// dense mesh: RGBA8888 store with optional texture (as the span routine: texels fetched lane by
+// lane, filter and combine in lanes), blend and write mask, optional depth test/write. One row of the box is one 8-lane step: the three edge functions, the coverage mask,
 // every attribute plane and the depth compare are lane vectors, the colour and depth rows are read
 // and written whole and merged under the mask. There is no branch per pixel or per row (a small
 // triangle's rows are too short for per-pixel branches to predict), and the arithmetic is the
@@ -15,13 +15,16 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "texture_lanes.hpp"
+
 namespace gpubridge::sim {
 
 struct NarrowTriangle {
-  static constexpr unsigned kPlanes = 5;  // R, G, B, A, Z
+  static constexpr unsigned kPlanes = 8;  // R, G, B, A, Z, S, T, Q
   std::int32_t e[3] = {}, ex[3] = {}, ey[3] = {};  // edge values at the first row's box origin, steps
   // Planes at the first row's box origin (r < den) and their steps (rx, ry < den). Only the
-  // planes the routine uses are filled (R..A when gouraud, Z when depth): no zero fill per triangle.
+  // planes the routine uses are filled (R..A when gouraud, Z when depth or textured, S, T, Q when
+  // textured): no zero fill per triangle.
   std::uint32_t q[kPlanes], r[kPlanes];
   std::uint32_t qx[kPlanes], rx[kPlanes], qy[kPlanes], ry[kPlanes];
   std::uint32_t den = 1;
@@ -35,6 +38,7 @@ struct NarrowTriangle {
   unsigned blend = 0;              // protocol::BlendMode (0 = off)
   std::uint32_t keep = 0;          // bytes of the colour word the write mask keeps
   bool gouraud = false, z_test = false, z_write = false;
+  TextureLanes texture;  // texture.tex == nullptr: untextured
 };
 
 struct NarrowCounts {

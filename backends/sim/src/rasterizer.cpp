@@ -19,6 +19,15 @@ struct Steppers {
   std::int64_t q[kAttrCount], r[kAttrCount];
 };
 
+// No texel the draw samples lies in a buffer it writes (the vector routines sample eight texels
+// before they write eight pixels).
+bool texture_disjoint(const DrawState& st, bool depth) {
+  const std::uint64_t tlen = (std::uint64_t{1} << (st.tex.wl + st.tex.hl)) * protocol::bytes_per_pixel(st.tex.format);
+  const std::uint64_t pixels = std::uint64_t{st.fb_width} * st.fb_height;
+  auto apart = [&](std::uint64_t base, std::uint64_t len) { return st.tex.base + tlen <= base || base + len <= st.tex.base; };
+  return apart(st.fb_draw, pixels * st.bpp) && (!depth || apart(st.fb_z, pixels * 4));
+}
+
 // Rows this long or longer find their covered span by division instead of testing every pixel.
 constexpr int kSpanSolveWidth = 16;
 // Jumps along a span shorter than this are stepped instead of divided.
@@ -179,7 +188,7 @@ class Kernel {
     {
       if (st_.fb_format != protocol::PixelFormat::RGBA8888 || !st_.color_in_vram || skip_colour_) return;
       if (kDepth && (!st_.z_in_vram || !st_.buffers_disjoint)) return;
-      if (kTextured && (ctx_.fast || !tex_.direct() || !texture_disjoint())) return;
+      if (kTextured && (ctx_.fast || !tex_.direct() || !texture_disjoint(st_, kDepth))) return;
       if (t_.den >= (std::int64_t{1} << 30)) return;
       simd_tpl_.den = static_cast<std::uint32_t>(t_.den);
       for (unsigned p = 0; p < SimdSpan::kPlanes; ++p) {
@@ -216,26 +225,11 @@ class Kernel {
       simd_tpl_.keep = 0;
       for (unsigned c = 0; c < 4; ++c)
         if (st_.keep_mask & (1u << c)) simd_tpl_.keep |= 0xFFu << (8 * c);
-      if (kTextured) {
-        simd_tpl_.tex = &tex_;
-        simd_tpl_.recip = &ctx_.recip;
-        simd_tpl_.q_const = q_const_;
-        simd_tpl_.const_rc = const_rc_;
-        simd_tpl_.wl = st_.tex.wl;
-        simd_tpl_.hl = st_.tex.hl;
-        simd_tpl_.decal = st_.decal;
-      }
+      if (kTextured) simd_tpl_.texture = {&tex_, &ctx_.recip, q_const_, const_rc_, st_.tex.wl, st_.tex.hl, st_.decal};
       simd_ = true;
     }
   }
   static constexpr bool simd_plane_used(unsigned p) { return p < 4 ? kGouraud : p == 4 ? kDepth : kTextured; }
-  // No texel the draw samples lies in a buffer it writes.
-  bool texture_disjoint() const {
-    const std::uint64_t tlen = (std::uint64_t{1} << (st_.tex.wl + st_.tex.hl)) * protocol::bytes_per_pixel(st_.tex.format);
-    const std::uint64_t pixels = std::uint64_t{st_.fb_width} * st_.fb_height;
-    auto apart = [&](std::uint64_t base, std::uint64_t len) { return st_.tex.base + tlen <= base || base + len <= st_.tex.base; };
-    return apart(st_.fb_draw, pixels * 4) && (!kDepth || apart(st_.fb_z, pixels * 4));
-  }
 
   // Rows two ahead are fetched while this one is drawn (random triangles miss the caches).
   void prefetch_row(int y, int x, int count) const {
@@ -380,8 +374,19 @@ bool draw_narrow(const Triangle& t, const DrawState& st, RasterContext& ctx, int
   const int w = t.x1 - t.x0;
   if (w > 8 || t.x0 + 8 > static_cast<int>(st.fb_width) || !st.color_in_vram) return false;
   if (depth && (!st.z_in_vram || !st.buffers_disjoint)) return false;
+  if (st.textured && (ctx.fast || !st.tex.in_vram || !texture_disjoint(st, depth))) return false;
   if (t.den >= (std::int64_t{1} << 28)) return false;
   NarrowTriangle n;
+  // Every channel masked (with a Z write, or the draw would have been dropped): the colour stage,
+  // texture and blend included, does not run, as in the scalar routine.
+  const bool colour_stage = (st.keep_mask & 0xF) != 0xF;
+  const bool textured = st.textured && colour_stage;
+  const TextureUnit unit(st.tex, ctx.mem);
+  if (textured) {
+    const bool q_const = t.plane[kQ].constant && t.plane[kQ].q != 0;  // affine: one reciprocal
+    n.texture = {&unit, &ctx.recip, q_const, q_const ? ctx.recip(static_cast<std::uint32_t>(t.plane[kQ].q)) : Reciprocal{},
+                 st.tex.wl, st.tex.hl, st.decal};
+  }
   const std::int64_t k = ya - t.y0, rows = yz - ya;
   for (int i = 0; i < 3; ++i) {
     const Edge& e = t.edge[i];
@@ -392,7 +397,8 @@ bool draw_narrow(const Triangle& t, const DrawState& st, RasterContext& ctx, int
     n.ex[i] = static_cast<std::int32_t>(e.ex);
     n.ey[i] = static_cast<std::int32_t>(e.ey);
   }
-  for (unsigned p = gouraud ? 0 : 4; p < (depth ? 5u : 4u); ++p) {
+  const unsigned last = textured ? 8u : depth ? 5u : 4u;
+  for (unsigned p = gouraud ? 0 : 4; p < last; ++p) {
     const Plane& pl = t.plane[kR + p];
     std::int64_t q = pl.q, r = pl.r;
     if (k > 0) Plane::advance(q, r, pl.qy, pl.ry, k, t.den);
@@ -425,7 +431,11 @@ bool draw_narrow(const Triangle& t, const DrawState& st, RasterContext& ctx, int
   ctx.counters.scanned += static_cast<std::uint64_t>(w) * static_cast<std::uint64_t>(rows);
   ctx.counters.covered += c.covered;
   ctx.counters.passed += c.passed;
-  if (st.blend != protocol::BlendMode::Off) ctx.counters.blended += c.passed;
+  if (st.blend != protocol::BlendMode::Off && colour_stage) ctx.counters.blended += c.passed;
+  if (textured) {
+    ctx.counters.textured += c.passed;
+    ctx.counters.texel_bytes += c.passed * (st.tex.bilinear ? 4u : 1u) * protocol::bytes_per_pixel(st.tex.format);
+  }
   return true;
 }
 
@@ -439,7 +449,7 @@ void rasterize_rows(const Triangle& t, const DrawState& st, RasterContext& ctx, 
   const bool gouraud = st.gouraud && colours_differ;  // Gouraud only when colours differ
   const bool depth = st.z_test || st.z_write;
   const bool rgba8888 = st.fb_format == protocol::PixelFormat::RGBA8888;
-  if (ctx.vector && rgba8888 && !st.textured && draw_narrow(t, st, ctx, ya, yz, gouraud, depth)) return;
+  if (ctx.vector && rgba8888 && draw_narrow(t, st, ctx, ya, yz, gouraud, depth)) return;
   const unsigned key = (gouraud ? 1u : 0u) | (st.textured ? 2u : 0u) | (depth ? 4u : 0u) | (st.simple_color ? 8u : 0u);
   kKernels[key](t, st, ctx, ya, yz);
 }

@@ -1,7 +1,7 @@
 #include "span_simd.hpp"
 
 #include "simd_lanes.hpp"
-#include "texture.hpp"
+#include "texture8.hpp"
 
 namespace gpubridge::sim {
 namespace {
@@ -24,54 +24,6 @@ using simd::u32x8;
     }                                                \
   } while (0)
 
-
-// The texture stage for eight pixels (section 10): lanes that passed the depth test get their
-// texel coordinates and addressed neighbours one by one (64-bit products, a table lookup), then
-// the bilinear filter and the combine with the vertex colour `colour` run in lanes. Returns the
-// combined colour words. Inlined into each target clone of shade_span_simd.
-[[gnu::always_inline]] inline u32x8 texture8(const SimdSpan& s, u32x8 sq, u32x8 tq, u32x8 qq, u32x8 pass, unsigned n,
-                                             u32x8 colour) {
-  std::uint32_t sv[8], tv[8], qv[8], pv[8];
-  GB_STORE8(sv, sq);
-  GB_STORE8(tv, tq);
-  GB_STORE8(qv, qq);
-  GB_STORE8(pv, pass);
-  alignas(32) std::uint32_t c00[8] = {}, c10[8] = {}, c01[8] = {}, c11[8] = {}, fu[8] = {}, fv[8] = {};
-  for (unsigned k = 0; k < n; ++k) {
-    if (!pv[k]) continue;  // rejected by the depth test: never sampled (as in the scalar routine)
-    TexelCoords tc;
-    if (qv[k] != 0) {
-      const Reciprocal rc = s.q_const ? s.const_rc : (*s.recip)(qv[k]);
-      tc = texel_coords(static_cast<std::int32_t>(sv[k]), static_cast<std::int32_t>(tv[k]), rc, s.wl, s.hl);
-    }
-    s.tex->quad(tc, c00[k], c10[k], c01[k], c11[k], fu[k], fv[k]);
-  }
-  u32x8 texel;
-  GB_LOAD8(texel, c00);
-  if (s.tex->bilinear()) {
-    u32x8 t10, t01, t11, u, v;
-    GB_LOAD8(t10, c10);
-    GB_LOAD8(t01, c01);
-    GB_LOAD8(t11, c11);
-    GB_LOAD8(u, fu);
-    GB_LOAD8(v, fv);
-    const u32x8 w00 = (256u - u) * (256u - v), w10 = u * (256u - v), w01 = (256u - u) * v, w11 = u * v;
-    const u32x8 t00 = texel;
-    texel = u32x8{};
-    for (unsigned c = 0; c < 32; c += 8) {  // the weights sum to 2^16: every term stays below 2^24
-      const u32x8 sum = ((t00 >> c) & 255u) * w00 + ((t10 >> c) & 255u) * w10 + ((t01 >> c) & 255u) * w01 +
-                        ((t11 >> c) & 255u) * w11 + 32768u;
-      texel |= (sum >> 16) << c;
-    }
-  }
-  if (s.decal) return texel;
-  u32x8 out = {};
-  for (unsigned c = 0; c < 32; c += 8) {  // section 10.5 modulate: div255(texel · colour) per channel
-    const u32x8 x = ((texel >> c) & 255u) * ((colour >> c) & 255u);
-    out |= GB_DIV255(x) << c;
-  }
-  return out;
-}
 
 }  // namespace
 
@@ -125,7 +77,7 @@ template <bool kTextured>
     if (!none) {
       u32x8 word = u32x8{} + s.flat;
       if (s.gouraud) word = (q[0] & 255u) | ((q[1] & 255u) << 8) | ((q[2] & 255u) << 16) | (q[3] << 24);
-      if constexpr (kTextured) word = texture8(s, q[5], q[6], q[7], pass, n, word);
+      if constexpr (kTextured) word = texture8(s.texture, q[5], q[6], q[7], pass, n, word);
       if (reads_colour || !all) {
         u32x8 cold;
         GB_LOAD_N(cold, cp, n);
@@ -152,7 +104,7 @@ template <bool kTextured>
 }
 
 __attribute__((target_clones("avx2", "default"))) std::uint64_t shade_span_simd(const SimdSpan& s) {
-  return s.tex ? shade_span<true>(s) : shade_span<false>(s);
+  return s.texture.tex ? shade_span<true>(s) : shade_span<false>(s);
 }
 
 }  // namespace gpubridge::sim

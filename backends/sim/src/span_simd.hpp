@@ -8,11 +8,9 @@
 // output equals the scalar routine's byte for byte (tests compare them).
 #include <cstdint>
 
-#include "reciprocal.hpp"
+#include "texture_lanes.hpp"
 
 namespace gpubridge::sim {
-
-class TextureUnit;
 
 struct SimdSpan {
   static constexpr unsigned kPlanes = 8;  // R, G, B, A, Z, S, T, Q (setup.hpp's attribute order)
@@ -29,14 +27,9 @@ struct SimdSpan {
   unsigned blend = 0;                      // protocol::BlendMode (0 = off)
   std::uint32_t keep = 0;                  // bytes of the colour word the write mask keeps
   bool gouraud = false, z_test = false, z_write = false;
-  // Texture stage (tex == nullptr: untextured). Texels are fetched lane by lane (the texel
-  // coordinates need 64-bit products and a table lookup); filter and combine run in lanes.
-  const TextureUnit* tex = nullptr;
-  const ReciprocalUnit* recip = nullptr;
-  bool q_const = false;  // Q constant over the triangle: const_rc is every pixel's reciprocal
-  Reciprocal const_rc;
-  unsigned wl = 3, hl = 3;
-  bool decal = false;
+  // Texture stage (texture.tex == nullptr: untextured). Texels are fetched lane by lane (the
+  // texel coordinates need 64-bit products and a table lookup); filter and combine run in lanes.
+  TextureLanes texture;
 };
 
 // Returns the number of pixels that passed the depth test (all of them without a test).

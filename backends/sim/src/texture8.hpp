@@ -1,0 +1,60 @@
+#pragma once
+// The texture stage of the vector routines (span_simd.cpp, narrow_simd.cpp), for eight lanes.
+// Internal to those routines' .cpp files: it is inlined into their target clones.
+#include "simd_lanes.hpp"
+#include "texture.hpp"
+#include "texture_lanes.hpp"
+
+namespace gpubridge::sim {
+
+// The texture stage for eight pixels (section 10): lanes that passed the depth test get their
+// texel coordinates and addressed neighbours one by one (64-bit products, a table lookup), then
+// the bilinear filter and the combine with the vertex colour `colour` run in lanes. Returns the
+// combined colour words.
+[[gnu::always_inline]] inline simd::u32x8 texture8(const TextureLanes& s, simd::u32x8 sq, simd::u32x8 tq,
+                                                   simd::u32x8 qq, simd::u32x8 pass, unsigned n, simd::u32x8 colour) {
+  using simd::u32x8;
+  std::uint32_t sv[8], tv[8], qv[8], pv[8];
+  GB_STORE8(sv, sq);
+  GB_STORE8(tv, tq);
+  GB_STORE8(qv, qq);
+  GB_STORE8(pv, pass);
+  alignas(32) std::uint32_t c00[8] = {}, c10[8] = {}, c01[8] = {}, c11[8] = {}, fu[8] = {}, fv[8] = {};
+  for (unsigned k = 0; k < n; ++k) {
+    if (!pv[k]) continue;  // rejected by the depth test: never sampled (as in the scalar routine)
+    TexelCoords tc;
+    if (qv[k] != 0) {
+      const Reciprocal rc = s.q_const ? s.const_rc : (*s.recip)(qv[k]);
+      tc = texel_coords(static_cast<std::int32_t>(sv[k]), static_cast<std::int32_t>(tv[k]), rc, s.wl, s.hl);
+    }
+    s.tex->quad(tc, c00[k], c10[k], c01[k], c11[k], fu[k], fv[k]);
+  }
+  u32x8 texel;
+  GB_LOAD8(texel, c00);
+  if (s.tex->bilinear()) {
+    u32x8 t10, t01, t11, u, v;
+    GB_LOAD8(t10, c10);
+    GB_LOAD8(t01, c01);
+    GB_LOAD8(t11, c11);
+    GB_LOAD8(u, fu);
+    GB_LOAD8(v, fv);
+    const u32x8 w00 = (256u - u) * (256u - v), w10 = u * (256u - v), w01 = (256u - u) * v, w11 = u * v;
+    const u32x8 t00 = texel;
+    texel = u32x8{};
+    for (unsigned c = 0; c < 32; c += 8) {  // the weights sum to 2^16: every term stays below 2^24
+      const u32x8 sum = ((t00 >> c) & 255u) * w00 + ((t10 >> c) & 255u) * w10 + ((t01 >> c) & 255u) * w01 +
+                        ((t11 >> c) & 255u) * w11 + 32768u;
+      texel |= (sum >> 16) << c;
+    }
+  }
+  if (s.decal) return texel;
+  u32x8 out = {};
+  for (unsigned c = 0; c < 32; c += 8) {  // section 10.5 modulate: div255(texel · colour) per channel
+    const u32x8 x = ((texel >> c) & 255u) * ((colour >> c) & 255u);
+    out |= GB_DIV255(x) << c;
+  }
+  return out;
+}
+
+
+}  // namespace gpubridge::sim
