@@ -28,6 +28,14 @@ bool texture_disjoint(const DrawState& st, bool depth) {
   return apart(st.fb_draw, pixels * st.bpp) && (!depth || apart(st.fb_z, pixels * 4));
 }
 
+// The bytes of a colour word (byte c = channel c) that TRI_MODE's write mask keeps.
+std::uint32_t keep_bytes(std::uint8_t keep_mask) {
+  std::uint32_t bytes = 0;
+  for (unsigned c = 0; c < 4; ++c)
+    if (keep_mask & (1u << c)) bytes |= 0xFFu << (8 * c);
+  return bytes;
+}
+
 // Rows this long or longer find their covered span by division instead of testing every pixel.
 constexpr int kSpanSolveWidth = 16;
 // Jumps along a span shorter than this are stepped instead of divided.
@@ -185,49 +193,45 @@ class Kernel {
     return simd_;
   }
   void prepare_simd() {
-    {
-      if (st_.fb_format != protocol::PixelFormat::RGBA8888 || !st_.color_in_vram || skip_colour_) return;
-      if (kDepth && (!st_.z_in_vram || !st_.buffers_disjoint)) return;
-      if (kTextured && (ctx_.fast || !tex_.direct() || !texture_disjoint(st_, kDepth))) return;
-      if (t_.den >= (std::int64_t{1} << 30)) return;
-      simd_tpl_.den = static_cast<std::uint32_t>(t_.den);
-      for (unsigned p = 0; p < SimdSpan::kPlanes; ++p) {
-        const Plane& pl = t_.plane[kR + p];
-        if (!simd_plane_used(p)) {
-          simd_tpl_.q8[p] = simd_tpl_.r8[p] = 0;
-          for (unsigned k = 0; k < 8; ++k) simd_tpl_.qk[p][k] = simd_tpl_.rk[p][k] = 0;
-          continue;
-        }
-        const DivMod d = floor_divmod(8 * pl.rx, t_.den);
-        const std::int64_t q8 = 8 * pl.qx + d.q;
-        simd_tpl_.q8[p] = static_cast<std::uint32_t>(q8);
-        simd_tpl_.r8[p] = static_cast<std::uint32_t>(d.r);
-        std::int64_t qk = 0, rk = 0;  // lane k's offset: k steps from (0, 0)
-        for (unsigned k = 0; k < 8; ++k) {
-          simd_tpl_.qk[p][k] = static_cast<std::uint32_t>(qk);
-          simd_tpl_.rk[p][k] = static_cast<std::uint32_t>(rk);
-          qk += pl.qx;
-          rk += pl.rx;
-          if (rk >= t_.den) {
-            rk -= t_.den;
-            ++qk;
-          }
+    if (st_.fb_format != protocol::PixelFormat::RGBA8888 || !st_.color_in_vram || skip_colour_) return;
+    if (kDepth && (!st_.z_in_vram || !st_.buffers_disjoint)) return;
+    if (kTextured && (ctx_.fast || !tex_.direct() || !texture_disjoint(st_, kDepth))) return;
+    if (t_.den >= (std::int64_t{1} << 30)) return;
+    simd_tpl_.den = static_cast<std::uint32_t>(t_.den);
+    for (unsigned p = 0; p < SimdSpan::kPlanes; ++p) {
+      const Plane& pl = t_.plane[kR + p];
+      if (!simd_plane_used(p)) {
+        simd_tpl_.q8[p] = simd_tpl_.r8[p] = 0;
+        for (unsigned k = 0; k < 8; ++k) simd_tpl_.qk[p][k] = simd_tpl_.rk[p][k] = 0;
+        continue;
+      }
+      const DivMod d = floor_divmod(8 * pl.rx, t_.den);
+      const std::int64_t q8 = 8 * pl.qx + d.q;
+      simd_tpl_.q8[p] = static_cast<std::uint32_t>(q8);
+      simd_tpl_.r8[p] = static_cast<std::uint32_t>(d.r);
+      std::int64_t qk = 0, rk = 0;  // lane k's offset: k steps from (0, 0)
+      for (unsigned k = 0; k < 8; ++k) {
+        simd_tpl_.qk[p][k] = static_cast<std::uint32_t>(qk);
+        simd_tpl_.rk[p][k] = static_cast<std::uint32_t>(rk);
+        qk += pl.qx;
+        rk += pl.rx;
+        if (rk >= t_.den) {
+          rk -= t_.den;
+          ++qk;
         }
       }
-      simd_tpl_.flat = std::uint32_t{flat_.r} | (std::uint32_t{flat_.g} << 8) | (std::uint32_t{flat_.b} << 16) |
-                       (std::uint32_t{flat_.a} << 24);
-      simd_tpl_.zmask = zmask_;
-      simd_tpl_.gouraud = kGouraud;
-      simd_tpl_.z_test = kDepth && st_.z_test;
-      simd_tpl_.z_write = kDepth && st_.z_write;
-      simd_tpl_.z_func = static_cast<unsigned>(st_.z_func);
-      simd_tpl_.blend = static_cast<unsigned>(st_.blend);
-      simd_tpl_.keep = 0;
-      for (unsigned c = 0; c < 4; ++c)
-        if (st_.keep_mask & (1u << c)) simd_tpl_.keep |= 0xFFu << (8 * c);
-      if (kTextured) simd_tpl_.texture = {&tex_, &ctx_.recip, q_const_, const_rc_, st_.tex.wl, st_.tex.hl, st_.decal};
-      simd_ = true;
     }
+    simd_tpl_.flat = std::uint32_t{flat_.r} | (std::uint32_t{flat_.g} << 8) | (std::uint32_t{flat_.b} << 16) |
+                     (std::uint32_t{flat_.a} << 24);
+    simd_tpl_.zmask = zmask_;
+    simd_tpl_.gouraud = kGouraud;
+    simd_tpl_.z_test = kDepth && st_.z_test;
+    simd_tpl_.z_write = kDepth && st_.z_write;
+    simd_tpl_.z_func = static_cast<unsigned>(st_.z_func);
+    simd_tpl_.blend = static_cast<unsigned>(st_.blend);
+    simd_tpl_.keep = keep_bytes(st_.keep_mask);
+    if (kTextured) simd_tpl_.texture = {&tex_, &ctx_.recip, q_const_, const_rc_, st_.tex.wl, st_.tex.hl, st_.decal};
+    simd_ = true;
   }
   static constexpr bool simd_plane_used(unsigned p) { return p < 4 ? kGouraud : p == 4 ? kDepth : kTextured; }
 
@@ -425,8 +429,7 @@ bool draw_narrow(const Triangle& t, const DrawState& st, RasterContext& ctx, int
   n.z_test = st.z_test;
   n.z_write = st.z_write;
   n.blend = static_cast<unsigned>(st.blend);
-  for (unsigned ch = 0; ch < 4; ++ch)
-    if (st.keep_mask & (1u << ch)) n.keep |= 0xFFu << (8 * ch);
+  n.keep = keep_bytes(st.keep_mask);
   const NarrowCounts c = shade_narrow_simd(n);
   ctx.counters.scanned += static_cast<std::uint64_t>(w) * static_cast<std::uint64_t>(rows);
   ctx.counters.covered += c.covered;
