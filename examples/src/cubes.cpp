@@ -31,19 +31,30 @@ Mesh cube_mesh(bool corner_colours) {
 class Cubes final : public Example {
  public:
   ExampleInfo info() const override {
-    return {"cubes", "ICEpi SPI GPU", "a Gouraud-shaded cube and a bilinear-textured cube, rotating"};
+    return {"cubes", "ICEpi SPI GPU",
+            "a Gouraud-shaded cube and a bilinear-textured cube, rotating; the texture is re-uploaded every frame"};
   }
 
-  Result<void> setup(draw::Context& ctx) override {
+  // The 32x32 label: a border and a ring whose lit quarter turns by one step per frame.
+  static Image label(unsigned n) {
     Image img = make_image(32, 32);
     for (unsigned y = 0; y < 32; ++y)
       for (unsigned x = 0; x < 32; ++x) {
         const bool border = x < 2 || y < 2 || x > 29 || y > 29;
-        const double d = std::hypot(x - 15.5, y - 15.5);
+        const double dx = x - 15.5, dy = y - 15.5;
+        const double d = std::hypot(dx, dy);
         const bool ring = d > 7 && d < 10;
-        put(img, x, y, border ? 0.1 : ring ? 1.0 : 0.9, border ? 0.1 : ring ? 0.45 : 0.9, border ? 0.15 : ring ? 0.1 : 0.85);
+        // Quadrant of the pixel (0..3, counter-clockwise from +x) against the frame's lit quadrant.
+        const unsigned quadrant = dx >= 0 ? (dy >= 0 ? 0u : 3u) : (dy >= 0 ? 1u : 2u);
+        const bool lit = ring && quadrant == n % 4;
+        put(img, x, y, border ? 0.1 : lit ? 1.0 : ring ? 0.6 : 0.9, border ? 0.1 : lit ? 0.85 : ring ? 0.3 : 0.9,
+            border ? 0.15 : lit ? 0.2 : ring ? 0.1 : 0.85);
       }
-    auto t = ctx.create_texture(img, {.bilinear = true});
+    return img;
+  }
+
+  Result<void> setup(draw::Context& ctx) override {
+    auto t = ctx.create_texture(label(0), {.bilinear = true});
     if (!t) return t.error();
     texture_ = *t;
     gouraud_ = cube_mesh(true);
@@ -52,6 +63,8 @@ class Cubes final : public Example {
   }
 
   Result<void> frame(draw::Context& ctx, unsigned n) override {
+    // The textured cube's label is streamed: a new image every frame, uploaded in place.
+    if (auto r = ctx.update_texture(texture_, label(n)); !r) return r;
     if (auto r = ctx.clear({0.12, 0.1, 0.16, 1}); !r) return r;
     if (auto r = ctx.clear_depth(1.0); !r) return r;
     ctx.state() = {};

@@ -161,8 +161,12 @@ int run(const GlobalOptions& g, unsigned triangles, unsigned runs, double spi_mh
       if (!ex->frame(*ctx, examples::kGoldenFrame) || !ctx->swap()) return 1;
       host = std::min(host, std::chrono::duration<double>(Clock::now() - t0).count());
       frame_count = 0;
-      for (std::size_t i = before; i < rec.stream().commands.size(); ++i)
-        if (const auto* f = std::get_if<protocol::FramesCmd>(&rec.stream().commands[i].command)) frame_count += f->size();
+      for (std::size_t i = before; i < rec.stream().commands.size(); ++i) {
+        const auto& cmd = rec.stream().commands[i].command;
+        if (const auto* f = std::get_if<protocol::FramesCmd>(&cmd)) frame_count += f->size();
+        // A texture upload on the link: MEM_ADDR, then one MEM_DATA frame per 8 bytes.
+        if (const auto* u = std::get_if<protocol::UploadCmd>(&cmd)) frame_count += 1 + (u->data.size() + 7) / 8;
+      }
       tris = ctx->stats().emitted - emitted_before;
       // Host + simulator.
       auto sink = draw::SimulatorSink::create();
