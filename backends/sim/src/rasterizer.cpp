@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <optional>
 #include <utility>
 
 #include "narrow_simd.hpp"
@@ -385,10 +386,11 @@ bool draw_narrow(const Triangle& t, const DrawState& st, RasterContext& ctx, int
   // texture and blend included, does not run, as in the scalar routine.
   const bool colour_stage = (st.keep_mask & 0xF) != 0xF;
   const bool textured = st.textured && colour_stage;
-  const TextureUnit unit(st.tex, ctx.mem);
+  std::optional<TextureUnit> unit;  // built only for textured draws (this is the 10-px hot path)
   if (textured) {
+    unit.emplace(st.tex, ctx.mem);
     const bool q_const = t.plane[kQ].constant && t.plane[kQ].q != 0;  // affine: one reciprocal
-    n.texture = {&unit, &ctx.recip, q_const, q_const ? ctx.recip(static_cast<std::uint32_t>(t.plane[kQ].q)) : Reciprocal{},
+    n.texture = {&*unit, &ctx.recip, q_const, q_const ? ctx.recip(static_cast<std::uint32_t>(t.plane[kQ].q)) : Reciprocal{},
                  st.tex.wl, st.tex.hl, st.decal};
   }
   const std::int64_t k = ya - t.y0, rows = yz - ya;

@@ -70,7 +70,7 @@ class TextureUnit {
             mix(c00.a, c10.a, c01.a, c11.a)};
   }
 
-  // The texels sample() filters, for the vector span routine: the four neighbours as colour words
+  // The texels sample() filters, for the vector routines: the four neighbours as colour words
   // (byte c = channel c: R, G, B, A, as the framebuffer stores them) and the bilinear weights
   // (nearest: c00 only, fu = fv = 0). The texture must lie inside VRAM (direct_).
   [[gnu::always_inline]] void quad(TexelCoords c, std::uint32_t& c00, std::uint32_t& c10, std::uint32_t& c01,
