@@ -20,15 +20,22 @@ namespace gpubridge::sim {
   GB_STORE8(qv, qq);
   GB_STORE8(pv, pass);
   alignas(32) std::uint32_t c00[8] = {}, c10[8] = {}, c01[8] = {}, c11[8] = {}, fu[8] = {}, fv[8] = {};
-  for (unsigned k = 0; k < n; ++k) {
-    if (!pv[k]) continue;  // rejected by the depth test: never sampled (as in the scalar routine)
-    TexelCoords tc;
-    if (qv[k] != 0) {
-      const Reciprocal rc = s.q_const ? s.const_rc : (*s.recip)(qv[k]);
-      tc = texel_coords(static_cast<std::int32_t>(sv[k]), static_cast<std::int32_t>(tv[k]), rc, s.wl, s.hl);
+  // Texel coordinates of every lane first, in a branch-free loop of independent chains (the
+  // reciprocal's multiplies overlap across lanes); q = 0 gives (0, 0) as in the scalar routine.
+  TexelCoords tc[8];
+  if (s.q_const) {  // the same non-zero Q everywhere: one reciprocal for the triangle
+    for (unsigned k = 0; k < n; ++k)
+      tc[k] = texel_coords(static_cast<std::int32_t>(sv[k]), static_cast<std::int32_t>(tv[k]), s.const_rc, s.wl, s.hl);
+  } else {
+    for (unsigned k = 0; k < n; ++k) {
+      const std::uint32_t q = qv[k];
+      const TexelCoords c = texel_coords(static_cast<std::int32_t>(sv[k]), static_cast<std::int32_t>(tv[k]),
+                                         (*s.recip)(q != 0 ? q : 1), s.wl, s.hl);
+      tc[k] = q != 0 ? c : TexelCoords{};
     }
-    s.tex->quad(tc, c00[k], c10[k], c01[k], c11[k], fu[k], fv[k]);
   }
+  for (unsigned k = 0; k < n; ++k)
+    if (pv[k]) s.tex->quad(tc[k], c00[k], c10[k], c01[k], c11[k], fu[k], fv[k]);  // rejected lanes: never sampled
   u32x8 texel;
   GB_LOAD8(texel, c00);
   if (s.tex->bilinear()) {
