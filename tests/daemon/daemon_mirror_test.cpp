@@ -21,6 +21,7 @@
 
 #include "client_checks.hpp"
 #include "daemon_process.hpp"
+#include "in_process_daemon.hpp"
 #include "gpubridge/client/client.hpp"
 #include "gpubridge/common/image.hpp"
 #include "gpubridge/common/trace_files.hpp"
@@ -460,35 +461,16 @@ class InProcessMirrorDaemon {
       if (!model) return (why = model.error().message, false);
       mirror = std::make_unique<daemon::MirrorBackend>(std::move(emulated->backend), std::move(*model));
     }
-    daemon::HubOptions opts;
-    opts.mirror = true;
-    hub_.emplace(net_.get_executor(), device_.get_executor(), std::move(mirror), opts);
-    server_.emplace(net_, *hub_);
-    auto a = client::parse_address("unix:" + (dir / "d.sock").string());
-    auto bound = server_->listen(*a);
-    if (!bound) return (why = bound.error().message, false);
-    address_ = bound->to_string();
-    device_thread_ = std::thread([this] { device_.run(); });
-    net_thread_ = std::thread([this] { net_.run(); });
-    return true;
+    test::InProcessDaemon::Options opts;
+    opts.hub.mirror = true;
+    return daemon_.start(std::move(mirror), dir, why, opts);
   }
-  ~InProcessMirrorDaemon() {
-    if (server_) boost::asio::post(net_, [this] { server_->stop(); hub_->shutdown_sessions(); });
-    std::this_thread::sleep_for(50ms);
-    net_.stop();
-    if (net_thread_.joinable()) net_thread_.join();
-    device_guard_.reset();
-    device_.stop();
-    if (device_thread_.joinable()) device_thread_.join();
-    server_.reset();
-    hub_.reset();
-  }
-  const std::string& address() const { return address_; }
+  const std::string& address() const { return daemon_.address(); }
   // Changes the board's video memory on the device thread, between commands, like a stray write
   // the host never sent.
   void poke_board_memory(std::size_t offset, std::uint8_t xor_mask) {
     std::promise<void> done;
-    boost::asio::post(device_, [&] {
+    boost::asio::post(daemon_.device_context(), [&] {
       auto& device = dynamic_cast<sim::Device&>(stack_->target());
       device.memory()[offset] ^= xor_mask;
       done.set_value();
@@ -497,14 +479,8 @@ class InProcessMirrorDaemon {
   }
 
  private:
-  boost::asio::io_context net_{1}, device_{1};
-  boost::asio::executor_work_guard<boost::asio::io_context::executor_type> device_guard_ =
-      boost::asio::make_work_guard(device_);
-  std::shared_ptr<usb::emu::EmulatedStack> stack_;
-  std::optional<daemon::Hub> hub_;
-  std::optional<daemon::Server> server_;
-  std::string address_;
-  std::thread net_thread_, device_thread_;
+  std::shared_ptr<usb::emu::EmulatedStack> stack_;  // declared first: outlives the daemon using it
+  test::InProcessDaemon daemon_;
 };
 
 // Sends board_triangles.trace's register writes (one swap of the 64x48 RGB565 framebuffer at

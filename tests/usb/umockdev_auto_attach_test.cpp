@@ -20,6 +20,7 @@
 #include "gpubridge/daemon/server.hpp"
 #include "gpubridge/protocol/registers.hpp"
 #include "client_checks.hpp"
+#include "in_process_daemon.hpp"
 #include "umockdev_bed.hpp"
 
 namespace gpubridge {
@@ -44,46 +45,22 @@ fs::path make_temp_dir() {
 // the simulator fallback and the auto re-attach factory.
 class InProcessAutoDaemon {
  public:
-  ~InProcessAutoDaemon() {
-    if (server_) boost::asio::post(net_, [this] { hub_->stop_hotplug(); server_->stop(); hub_->shutdown_sessions(); });
-    std::this_thread::sleep_for(50ms);
-    net_.stop();
-    if (net_thread_.joinable()) net_thread_.join();
-    device_guard_.reset();
-    device_.stop();
-    if (device_thread_.joinable()) device_thread_.join();
-    server_.reset();
-    hub_.reset();
-  }
-
   // Starts like gpubridged: make_backend("auto") first (with the testbed as it is now).
   bool start(const daemon::DaemonConfig& cfg, const fs::path& socket_dir, std::string& started_on, std::string& why) {
     auto backend = daemon::make_backend(cfg.backend, cfg);
     if (!backend) return (why = backend.error().message, false);
     started_on = (*backend)->info().backend;
-    hub_.emplace(net_.get_executor(), device_.get_executor(), std::move(*backend), daemon::HubOptions{},
-                 daemon::make_simulator);
-    hub_->enable_hotplug(daemon::make_reattach_factory(cfg), std::chrono::milliseconds(cfg.reattach_interval_ms));
-    server_.emplace(net_, *hub_);
-    auto a = client::parse_address("unix:" + (socket_dir / "d.sock").string());
-    if (!a) return (why = a.error().message, false);
-    auto bound = server_->listen(*a);
-    if (!bound) return (why = bound.error().message, false);
-    address_ = bound->to_string();
-    device_thread_ = std::thread([this] { device_.run(); });
-    net_thread_ = std::thread([this] { net_.run(); });
-    return true;
+    test::InProcessDaemon::Options opts;
+    opts.fallback = daemon::make_simulator;
+    opts.before_listening = [&cfg](daemon::Hub& hub) {
+      hub.enable_hotplug(daemon::make_reattach_factory(cfg), std::chrono::milliseconds(cfg.reattach_interval_ms));
+    };
+    return daemon_.start(std::move(*backend), socket_dir, why, opts);
   }
-  const std::string& address() const { return address_; }
+  const std::string& address() const { return daemon_.address(); }
 
  private:
-  boost::asio::io_context net_{1}, device_{1};
-  boost::asio::executor_work_guard<boost::asio::io_context::executor_type> device_guard_ =
-      boost::asio::make_work_guard(device_);
-  std::optional<daemon::Hub> hub_;
-  std::optional<daemon::Server> server_;
-  std::string address_;
-  std::thread net_thread_, device_thread_;
+  test::InProcessDaemon daemon_;
 };
 
 TEST(AutoAttach, BoardPluggedInAfterStartReplacesTheSimulator) {
