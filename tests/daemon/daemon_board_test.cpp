@@ -7,6 +7,7 @@
 #include <future>
 #include <nlohmann/json.hpp>
 
+#include "bridge_chips.hpp"
 #include "daemon_process.hpp"
 #include "gpubridge/client/client.hpp"
 #include "gpubridge/common/image.hpp"
@@ -92,14 +93,7 @@ TEST_P(DaemonBoard, PlayedTraceReadBackThroughEmulatedBridgeEqualsInProcessRende
   fs::remove_all(dir, ec);
 }
 
-INSTANTIATE_TEST_SUITE_P(FourBridgeChips, DaemonBoard,
-                         ::testing::Values("ft232h-generic", "ch341a-generic", "mcp2210-generic", "cp2130-generic"),
-                         [](const ::testing::TestParamInfo<std::string>& param_info) {
-                           std::string n = param_info.param;
-                           for (auto& c : n)
-                             if (c == '-') c = '_';
-                           return n;
-                         });
+INSTANTIATE_TEST_SUITE_P(FourBridgeChips, DaemonBoard, test::kFourBridgeChips, test::chip_test_name);
 
 // Errors name the problem and what to do.
 // A CRC-only board (the shipped ch341a-generic profile) counts its swaps but must not hand

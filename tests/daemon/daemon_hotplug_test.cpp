@@ -7,6 +7,7 @@
 #include <future>
 #include <nlohmann/json.hpp>
 
+#include "bridge_chips.hpp"
 #include "client_checks.hpp"
 #include "daemon_process.hpp"
 #include "gpubridge/client/client.hpp"
@@ -231,14 +232,7 @@ TEST_P(DaemonHotplugChips, UnplugAndReplugAreNoticedWithoutClientTraffic) {
   EXPECT_EQ(d.daemon.terminate(std::chrono::milliseconds(2000)), 0);
 }
 
-INSTANTIATE_TEST_SUITE_P(FourBridgeChips, DaemonHotplugChips,
-                         ::testing::Values("ft232h-generic", "ch341a-generic", "mcp2210-generic", "cp2130-generic"),
-                         [](const ::testing::TestParamInfo<std::string>& param_info) {
-                           std::string n = param_info.param;
-                           for (auto& c : n)
-                             if (c == '-') c = '_';
-                           return n;
-                         });
+INSTANTIATE_TEST_SUITE_P(FourBridgeChips, DaemonHotplugChips, test::kFourBridgeChips, test::chip_test_name);
 
 TEST(DaemonHotplugErrors, BadOptionsAreNamed) {
   const auto dir = make_temp_dir("hp-err");
