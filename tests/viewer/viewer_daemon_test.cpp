@@ -17,6 +17,7 @@
 #include "gpubridge/common/image.hpp"
 #include "daemon_fixture.hpp"
 #include "process.hpp"
+#include "xvfb_suite.hpp"
 
 namespace gpubridge::viewer::test {
 namespace {
@@ -44,15 +45,11 @@ std::string triangle_trace(int clear_r, int clear_g, int clear_b) {
          "FB_DISPLAY ADDR=0\n";
 }
 
-class ViewerDaemon : public ::testing::Test {
+class ViewerDaemon : public XvfbSuite {
  protected:
-  static void SetUpTestSuite() { xvfb_ = std::make_unique<Xvfb>(); }
-  static void TearDownTestSuite() { xvfb_.reset(); }
   void SetUp() override {
-    if (xvfb_->display().empty()) {
-      if (std::getenv("CI")) FAIL() << "CI must run the viewer tests but " << xvfb_->reason();
-      GTEST_SKIP() << "viewer daemon tests skipped: " << xvfb_->reason();
-    }
+    XvfbSuite::SetUp();
+    if (no_display()) return;
     socket_ = "unix:" + (dir_.path() / "g.sock").string();
   }
 
@@ -87,11 +84,9 @@ class ViewerDaemon : public ::testing::Test {
                                                dir_.path(), name);
   }
 
-  static std::unique_ptr<Xvfb> xvfb_;
   TempDir dir_;
   std::string socket_;
 };
-std::unique_ptr<Xvfb> ViewerDaemon::xvfb_;
 
 TEST_F(ViewerDaemon, PlayedTraceReachesTheViewerPixelExactly) {
   auto daemon = start_daemon("daemon");

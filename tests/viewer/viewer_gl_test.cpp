@@ -13,6 +13,7 @@
 
 #include "gpubridge/common/image.hpp"
 #include "process.hpp"
+#include "xvfb_suite.hpp"
 
 namespace gpubridge::viewer::test {
 namespace {
@@ -42,26 +43,16 @@ Rgb expected_pixel(unsigned x, unsigned y, unsigned n, const std::string& format
                                        << want.b;
 }
 
-class ViewerGl : public ::testing::Test {
+class ViewerGl : public XvfbSuite {
  protected:
-  static void SetUpTestSuite() { xvfb_ = std::make_unique<Xvfb>(); }
-  static void TearDownTestSuite() { xvfb_.reset(); }
-  void SetUp() override {
-    if (xvfb_->display().empty()) {
-      if (std::getenv("CI")) FAIL() << "CI must run the viewer tests but " << xvfb_->reason();
-      GTEST_SKIP() << "viewer GL tests skipped: " << xvfb_->reason();
-    }
-  }
   ProcessResult view(std::vector<std::string> args) {
     args.insert(args.begin(), kViewer);
     return run_process(args, {"DISPLAY=" + xvfb_->display(), "WAYLAND_DISPLAY="});
   }
   static nlohmann::json summary(const ProcessResult& r) { return nlohmann::json::parse(r.out); }
 
-  static std::unique_ptr<Xvfb> xvfb_;
   TempDir dir_;
 };
-std::unique_ptr<Xvfb> ViewerGl::xvfb_;
 
 TEST_F(ViewerGl, ScreenshotIsExactlyTheFramesPixels) {
   for (const std::string format : {"RGBA8888", "RGB565", "RGBA2222"}) {

@@ -17,6 +17,7 @@
 #include "gpubridge/common/image.hpp"
 #include "daemon_fixture.hpp"
 #include "process.hpp"
+#include "xvfb_suite.hpp"
 
 namespace gpubridge::viewer::test {
 namespace {
@@ -45,15 +46,11 @@ std::uint8_t dimmed_grey(const std::uint8_t* rgba) {
   return static_cast<std::uint8_t>(((77u * rgba[0] + 150u * rgba[1] + 29u * rgba[2]) >> 8) / 2);
 }
 
-class ViewerMirror : public ::testing::Test {
+class ViewerMirror : public XvfbSuite {
  protected:
-  static void SetUpTestSuite() { xvfb_ = std::make_unique<Xvfb>(); }
-  static void TearDownTestSuite() { xvfb_.reset(); }
   void SetUp() override {
-    if (xvfb_->display().empty()) {
-      if (std::getenv("CI")) FAIL() << "CI must run the viewer tests but " << xvfb_->reason();
-      GTEST_SKIP() << "viewer mirror tests skipped: " << xvfb_->reason();
-    }
+    XvfbSuite::SetUp();
+    if (no_display()) return;
     socket_ = "unix:" + (dir_.path() / "g.sock").string();
     trace_ = (dir_.path() / "tri.txt").string();
     std::ofstream(trace_) << kTrace;
@@ -65,6 +62,18 @@ class ViewerMirror : public ::testing::Test {
   }
 
   ::testing::AssertionResult wait_subscribed(BackgroundProcess& viewer) { return test::wait_subscribed(viewer, socket_); }
+
+  // Once the viewer has subscribed: plays the trace, waits for the viewer to exit 0 and reads
+  // its JSON summary.
+  void play_until_done(BackgroundProcess& viewer, nlohmann::json& summary) {
+    ASSERT_TRUE(wait_subscribed(viewer));
+    const auto play = run_process({kCli, "play", trace_, "--connect", socket_});
+    ASSERT_EQ(play.exit_code, 0) << play.out << play.err;
+    const auto code = viewer.wait_exit(60s);
+    ASSERT_TRUE(code.has_value()) << "viewer did not finish: " << viewer.log();
+    ASSERT_EQ(*code, 0) << viewer.log();
+    summary = nlohmann::json::parse(viewer.output());
+  }
 
   std::unique_ptr<BackgroundProcess> start_viewer(std::vector<std::string> args) {
     args.insert(args.begin(), {kViewer, "--connect", socket_, "--offscreen", "--json", "--timeout", "60"});
@@ -96,24 +105,17 @@ class ViewerMirror : public ::testing::Test {
     return ::testing::AssertionSuccess();
   }
 
-  static std::unique_ptr<Xvfb> xvfb_;
   TempDir dir_;
   std::string socket_, trace_;
 };
-std::unique_ptr<Xvfb> ViewerMirror::xvfb_;
 
 TEST_F(ViewerMirror, SourceDiffSavesTheDiffPictureAndTheWindowShowsIt) {
   auto daemon = start_daemon({"--backend", "emulated:icebreaker", "--mirror"});
   const auto shot = (dir_.path() / "diff.png").string(), grab = (dir_.path() / "grab.png").string();
   auto viewer = start_viewer({"--source", "diff", "--frames", "1", "--screenshot", shot, "--grab-window", grab,
                               "--size", "640x480", "--scale", "integer", "--no-overlay"});
-  ASSERT_TRUE(wait_subscribed(*viewer));
-  const auto play = run_process({kCli, "play", trace_, "--connect", socket_});
-  ASSERT_EQ(play.exit_code, 0) << play.out << play.err;
-  const auto code = viewer->wait_exit(60s);
-  ASSERT_TRUE(code.has_value()) << "viewer did not finish: " << viewer->log();
-  ASSERT_EQ(*code, 0) << viewer->log();
-  const auto summary = nlohmann::json::parse(viewer->output());
+  nlohmann::json summary;
+  ASSERT_NO_FATAL_FAILURE(play_until_done(*viewer, summary));
   EXPECT_EQ(summary["source"], "diff") << summary.dump();
   EXPECT_EQ(summary["format"], "RGBA8888") << summary.dump();
   EXPECT_EQ(summary["crc_ok"], true);
@@ -143,13 +145,8 @@ TEST_F(ViewerMirror, KeyDSwitchesFromTheBoardToTheDiffOfTheSameSwap) {
   // Frame 1 is the board picture; D is typed when it arrives; frame 2 is the diff of the same
   // swap (the daemon re-sends the newest swap in the new picture), with no further play.
   auto viewer = start_viewer({"--frames", "2", "--screenshot", shot, "--press", "D"});
-  ASSERT_TRUE(wait_subscribed(*viewer));
-  const auto play = run_process({kCli, "play", trace_, "--connect", socket_});
-  ASSERT_EQ(play.exit_code, 0) << play.out << play.err;
-  const auto code = viewer->wait_exit(60s);
-  ASSERT_TRUE(code.has_value()) << "viewer did not finish: " << viewer->log();
-  ASSERT_EQ(*code, 0) << viewer->log();
-  const auto summary = nlohmann::json::parse(viewer->output());
+  nlohmann::json summary;
+  ASSERT_NO_FATAL_FAILURE(play_until_done(*viewer, summary));
   EXPECT_EQ(summary["source"], "diff") << summary.dump();
   auto diff = load_png(shot);
   ASSERT_TRUE(diff.ok());
