@@ -21,10 +21,11 @@ struct Outcome {
   Error error;
   std::uint64_t usb_ops = 0;
   std::uint64_t frames = 0;
+  std::uint64_t streamed_reads = 0;  // FTDI reads that went through the asynchronous IN queue
 };
 
 std::vector<std::uint8_t> payload() {
-  std::vector<std::uint8_t> v(600);
+  std::vector<std::uint8_t> v(1200);  // 150 memory words: 1,350 MISO bytes, more than the FT232H RX FIFO (streamed reads)
   std::mt19937 rng(5);
   for (auto& b : v) b = static_cast<std::uint8_t>(rng());
   return v;
@@ -61,7 +62,7 @@ Outcome run_session(BridgeChip chip, Arm arm) {
   b.set_scanout_callback([&](auto f) { shown = std::move(f); });
   if (auto r = b.upload(0x1000, data); !r) return finish(r.error());
   std::vector<std::uint8_t> bytes;
-  protocol::append(bytes, protocol::write_frame(Reg::FB_FORMAT, (std::uint64_t{5} << 16) | 30));  // 30x5 RGBA = 600 bytes
+  protocol::append(bytes, protocol::write_frame(Reg::FB_FORMAT, (std::uint64_t{10} << 16) | 30));  // 30x10 RGBA = 1200 bytes
   protocol::append(bytes, protocol::write_frame(Reg::FB_DISPLAY, 0x1000));
   if (auto r = b.write_frames(protocol::FrameView{bytes}); !r) return finish(r.error());
   auto back = b.readback(0x1000, static_cast<std::uint32_t>(data.size()));
@@ -74,6 +75,7 @@ Outcome run_session(BridgeChip chip, Arm arm) {
     EXPECT_EQ(shown->crc, protocol::crc32(data));
   }
   o.ok = true;
+  o.streamed_reads = b.bridge().stats().streamed_reads;
   o.usb_ops = s->usb_faults().ops;
   o.frames = s->slave().frames_completed();
   return o;
@@ -90,6 +92,9 @@ TEST_P(FaultSweep, UsbFaultsAtEveryOperation) {
   const auto clean = run_session(GetParam(), [](emu::EmulatedStack&) {});
   ASSERT_TRUE(clean.ok) << clean.error.message;
   ASSERT_GT(clean.usb_ops, 10u);
+  if (GetParam() == BridgeChip::FT232H) {
+    ASSERT_GT(clean.streamed_reads, 0u) << "the sweep must cover the streamed (asynchronous) read path";
+  }
   for (auto fault : {emu::UsbFault::NoDevice, emu::UsbFault::TimeoutPartial, emu::UsbFault::Stall}) {
     unsigned recovered = 0, failed = 0;
     for (std::uint64_t op = 0; op < clean.usb_ops; ++op) {

@@ -119,6 +119,121 @@ TEST(FtdiDriver, LargeReadsAreStrippedAtEveryPacketBoundaryAtFullSpeed) {
   }
 }
 
+// 300 ID reads (2,700 MISO bytes, more than the FT232H's 1 KiB RX FIFO) through one bridge.
+std::vector<std::uint8_t> many_id_reads() {
+  std::vector<std::uint8_t> mosi;
+  for (int i = 0; i < 300; ++i) protocol::append(mosi, protocol::read_frame(Reg::ID));
+  return mosi;
+}
+
+TEST(FtdiDriver, ReadsBeyondTheRxFifoStreamInOneRoundTripWithTheSameBytes) {
+  std::vector<std::uint8_t> results[2];
+  for (bool stream : {true, false}) {
+    FtdiRig rig;
+    FtdiConfig cfg;
+    cfg.stream_reads = stream;
+    auto bridge = FtdiMpsseBridge::open(rig.model, cfg);
+    ASSERT_TRUE(bridge) << bridge.error().message;
+    const auto mosi = many_id_reads();
+    const SpiWindow w{mosi, true, {}};
+    const BridgeStats before = (*bridge)->stats();
+    auto r = (*bridge)->transfer(std::span(&w, 1));
+    ASSERT_TRUE(r) << r.error().message;
+    const BridgeStats& after = (*bridge)->stats();
+    if (stream) {
+      EXPECT_EQ(after.streamed_reads - before.streamed_reads, 1u);
+      EXPECT_EQ(after.round_trips - before.round_trips, 1u) << "one wait for the device, however much is read";
+    } else {
+      EXPECT_EQ(after.streamed_reads, before.streamed_reads);
+      EXPECT_GE(after.round_trips - before.round_trips, 3u) << "2,700 bytes need at least three 1 KiB rounds";
+    }
+    EXPECT_TRUE(rig.model.violations().empty()) << rig.model.violations()[0];
+    results[stream ? 0 : 1] = std::move(*r);
+  }
+  ASSERT_EQ(results[0].size(), 2700u);
+  EXPECT_EQ(results[0], results[1]) << "streamed and synchronous reads must clock out the same MISO bytes";
+}
+
+// A UsbDevice without an asynchronous path (the base class's bulk_stream): the driver must fall
+// back to synchronous rounds, once, and still read correctly.
+class NoStreamDevice final : public UsbDevice {
+ public:
+  explicit NoStreamDevice(UsbDevice& inner) : in_(inner) {}
+  const UsbDeviceInfo& info() const override { return in_.info(); }
+  UsbStatus detach_kernel_driver(int i) override { return in_.detach_kernel_driver(i); }
+  UsbStatus claim_interface(int i) override { return in_.claim_interface(i); }
+  UsbStatus release_interface(int i) override { return in_.release_interface(i); }
+  UsbIo control_out(std::uint8_t rt, std::uint8_t rq, std::uint16_t v, std::uint16_t i, std::span<const std::uint8_t> d,
+                    unsigned t) override {
+    return in_.control_out(rt, rq, v, i, d, t);
+  }
+  UsbIo control_in(std::uint8_t rt, std::uint8_t rq, std::uint16_t v, std::uint16_t i, std::span<std::uint8_t> d, unsigned t) override {
+    return in_.control_in(rt, rq, v, i, d, t);
+  }
+  UsbIo bulk_out(std::uint8_t ep, std::span<const std::uint8_t> d, unsigned t) override { return in_.bulk_out(ep, d, t); }
+  UsbIo bulk_in(std::uint8_t ep, std::span<std::uint8_t> d, unsigned t) override { return in_.bulk_in(ep, d, t); }
+  UsbStatus clear_halt(std::uint8_t ep) override { return in_.clear_halt(ep); }
+  std::uint16_t max_packet_size(std::uint8_t ep) const override { return in_.max_packet_size(ep); }
+
+ private:
+  UsbDevice& in_;
+};
+
+TEST(FtdiDriver, DevicesWithoutAnAsynchronousPathFallBackToRounds) {
+  FtdiRig rig;
+  NoStreamDevice dev(rig.model);
+  auto bridge = FtdiMpsseBridge::open(dev, FtdiConfig{});
+  ASSERT_TRUE(bridge) << bridge.error().message;
+  const auto mosi = many_id_reads();
+  const SpiWindow w{mosi, true, {}};
+  for (int pass = 0; pass < 2; ++pass) {
+    auto r = (*bridge)->transfer(std::span(&w, 1));
+    ASSERT_TRUE(r) << r.error().message;
+    ASSERT_EQ(r->size(), mosi.size());
+    EXPECT_EQ((*r)[1], 0x53) << "ID magic 'S' in the first frame";
+  }
+  EXPECT_EQ((*bridge)->stats().streamed_reads, 0u);
+  EXPECT_TRUE(rig.model.violations().empty()) << rig.model.violations()[0];
+}
+
+TEST(FtdiDriver, AFaultInsideAStreamIsSpecificAndTheBridgeRecovers) {
+  // Find the operation indices a streamed read spans, then fail each of them once.
+  std::uint64_t first_op = 0, end_op = 0;
+  {
+    FtdiRig rig;
+    auto bridge = FtdiMpsseBridge::open(rig.model, FtdiConfig{});
+    ASSERT_TRUE(bridge);
+    const auto mosi = many_id_reads();
+    const SpiWindow w{mosi, true, {}};
+    first_op = rig.model.faults().ops;
+    ASSERT_TRUE((*bridge)->transfer(std::span(&w, 1)));
+    end_op = rig.model.faults().ops;
+  }
+  ASSERT_GT(end_op - first_op, 3u) << "several OUT and IN transfers make up the stream";
+  for (auto fault : {emu::UsbFault::TimeoutPartial, emu::UsbFault::Stall}) {
+    for (std::uint64_t op = first_op; op < end_op; ++op) {
+      SCOPED_TRACE("fault " + std::to_string(static_cast<int>(fault)) + " at op " + std::to_string(op));
+      FtdiRig rig;
+      rig.model.faults().at_op = op;
+      rig.model.faults().fault = fault;
+      rig.model.faults().partial_bytes = 100;
+      auto bridge = FtdiMpsseBridge::open(rig.model, FtdiConfig{});
+      ASSERT_TRUE(bridge);
+      const auto mosi = many_id_reads();
+      const SpiWindow w{mosi, true, {}};
+      auto bad = (*bridge)->transfer(std::span(&w, 1));
+      ASSERT_FALSE(bad) << "a lost transfer cannot give a complete read";
+      EXPECT_TRUE(bad.error().code == backends::kDeviceTimeout || bad.error().code == backends::kDeviceProtocol) << bad.error().message;
+      EXPECT_NE(bad.error().message.find("streamed read"), std::string::npos) << bad.error().message;
+      ASSERT_TRUE((*bridge)->recover()) << "purge + sync check bring the stream back in step";
+      auto good = (*bridge)->transfer(std::span(&w, 1));
+      ASSERT_TRUE(good) << good.error().message;
+      EXPECT_EQ((*good)[1], 0x53);
+      EXPECT_EQ((*good)[299 * 9 + 1], 0x53);
+    }
+  }
+}
+
 TEST(FtdiDriver, RejectsWiringTheChipCannotDo) {
   FtdiRig rig;
   FtdiConfig fc;

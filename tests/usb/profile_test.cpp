@@ -1,5 +1,9 @@
 // Board profiles: every shipped file loads; broken files are rejected naming file and key.
 #include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
 
 #include "gpubridge/usb/board_profile.hpp"
 
@@ -51,6 +55,44 @@ TEST(BoardProfiles, ErrorsNameFileAndKey) {
   }
   EXPECT_FALSE(parse_board_profile("{not json", "broken.json"));
   EXPECT_FALSE(parse_board_profile("[]", "array.json"));
+}
+
+TEST(BoardProfiles, StreamReadsIsAnFtdiSwitchDefaultingOn) {
+  auto on = parse_board_profile(kGood, "good.json");
+  ASSERT_TRUE(on) << on.error().message;
+  EXPECT_TRUE(on->stream_reads);
+  std::string off = kGood;
+  off.replace(off.find("\"spi_clock_hz\":30000000"), 23, "\"spi_clock_hz\":30000000,\"stream_reads\":false");
+  auto r = parse_board_profile(off, "off.json");
+  ASSERT_TRUE(r) << r.error().message;
+  EXPECT_FALSE(r->stream_reads);
+  std::string ch341 = off;
+  ch341.replace(ch341.find("\"ft232h\""), 8, "\"ch341a\"");
+  ch341.replace(ch341.find("\"0x0403\""), 8, "\"0x1a86\"");
+  ch341.replace(ch341.find("\"0x6014\""), 8, "\"0x5512\"");
+  ch341.replace(ch341.find("30000000"), 8, "1000000");
+  auto bad = parse_board_profile(ch341, "ch.json");
+  ASSERT_FALSE(bad);
+  EXPECT_NE(bad.error().message.find("ch.json: bridge.stream_reads"), std::string::npos) << bad.error().message;
+}
+
+// Found by fuzz_board_profile: a number literal beyond double's range makes nlohmann::json throw
+// out_of_range (not parse_error), which escaped the parser and terminated the process.
+TEST(BoardProfiles, NumberBeyondDoubleRangeIsAnError) {
+  std::string text = kGood;
+  text.replace(text.find("128"), 3, "1e999");
+  auto r = parse_board_profile(text, "boards/huge.json");
+  ASSERT_FALSE(r);
+  EXPECT_NE(r.error().message.find("boards/huge.json: not valid JSON"), std::string::npos) << r.error().message;
+
+  // load_cables reads its files the same way.
+  const auto dir = std::filesystem::temp_directory_path() / ("gpubridge-cables-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir / "cables");
+  std::ofstream(dir / "cables" / "huge.json") << R"({"name":"x","chip":"ft232h","max_spi_hz":1e999})";
+  auto cables = load_cables(dir);
+  std::filesystem::remove_all(dir);
+  ASSERT_FALSE(cables);
+  EXPECT_NE(cables.error().message.find("huge.json: not valid JSON"), std::string::npos) << cables.error().message;
 }
 
 }  // namespace

@@ -49,6 +49,37 @@ TEST(Umockdev, RealLibusbPathDrivesTheMpsseModel) {
   EXPECT_NE(gone.error().message.find("unplugged"), std::string::npos);
 }
 
+// libusb's asynchronous API (UsbDevice::bulk_stream): IN URBs queued before the commands go out,
+// so a read larger than the chip's RX FIFO streams instead of deadlocking the OUT URB.
+TEST(Umockdev, StreamedReadsQueueInUrbsWhileTheOutUrbWaits) {
+  Bed bed;
+  auto ctx = LibusbContext::create();
+  ASSERT_TRUE(ctx) << ctx.error().message;
+  auto dev = (*ctx)->open(UsbMatch{0x0403, 0x6014, "", ""});
+  ASSERT_TRUE(dev) << dev.error().message;
+  auto bridge = FtdiMpsseBridge::open(**dev, FtdiConfig{});
+  ASSERT_TRUE(bridge) << bridge.error().message;
+  std::vector<std::uint8_t> mosi;
+  for (int i = 0; i < 300; ++i) protocol::append(mosi, protocol::read_frame(protocol::Reg::ID));  // 2,700 MISO bytes
+  const SpiWindow w{mosi, true, {}};
+  auto r = (*bridge)->transfer(std::span(&w, 1));
+  ASSERT_TRUE(r) << r.error().message;
+  ASSERT_EQ(r->size(), mosi.size());
+  for (int i = 0; i < 300; ++i) ASSERT_EQ((*r)[static_cast<std::size_t>(i * 9 + 1)], 0x53) << "frame " << i;
+  EXPECT_EQ((*bridge)->stats().streamed_reads, 1u);
+  EXPECT_GE(bed.max_in_flight.load(), 2u) << "IN URBs were queued together";
+  EXPECT_GT(bed.out_refusals.load(), 0u) << "the OUT URB waited for the RX FIFO to drain: only queued INs let it finish";
+  EXPECT_TRUE(bed.model.violations().empty()) << bed.model.violations()[0];
+
+  // Unplug in the middle of a stream: the in-flight URBs fail with ENODEV and are reaped.
+  bed.model.faults().at_op = bed.model.faults().ops + 3;
+  bed.model.faults().fault = emu::UsbFault::NoDevice;
+  auto gone = (*bridge)->transfer(std::span(&w, 1));
+  ASSERT_FALSE(gone);
+  EXPECT_EQ(gone.error().code, backends::kDeviceGone) << gone.error().message;
+  EXPECT_NE(gone.error().message.find("streamed read"), std::string::npos) << gone.error().message;
+}
+
 TEST(Umockdev, NothingAttachedIsReportedPlainly) {
   UMockdevTestbed* empty = umockdev_testbed_new();
   auto ctx = LibusbContext::create();

@@ -2,6 +2,7 @@
 // FT232H profile at 30 MHz with BUSY wired). Figures come from the bytes and clocks the real
 // driver produced, not from wall time, so they predict hardware independent of this machine.
 #include <cstdio>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -29,6 +30,11 @@ struct Delta {
   std::uint64_t out() const { return now.usb_out_transfers - before.usb_out_transfers; }
   std::uint64_t in() const { return now.usb_in_transfers - before.usb_in_transfers; }
   std::uint64_t bytes_out() const { return now.usb_bytes_out - before.usb_bytes_out; }
+  std::uint64_t round_trips() const { return now.round_trips - before.round_trips; }
+  // SPI time plus the USB round trips the host had to wait for one after the other.
+  double predicted_ms(double clock, double round_trip_us) const {
+    return (static_cast<double>(spi_bits()) / clock + static_cast<double>(round_trips()) * round_trip_us * 1e-6) * 1e3;
+  }
 };
 
 int run_usb_bench(const GlobalOptions& g, const UsbBenchArgs& a) {
@@ -68,7 +74,7 @@ int run_usb_bench(const GlobalOptions& g, const UsbBenchArgs& a) {
   }
   const double payload_bits = 72.0 * a.writes;
   const double efficiency = payload_bits / static_cast<double>(w.spi_bits());
-  const double write_ms = (w.spi_bits() / clock + w.in() * a.round_trip_us * 1e-6) * 1e3;
+  const double write_ms = w.predicted_ms(clock, a.round_trip_us);
 
   // 2. Framebuffer readback, as scanout does it (single pass, FRAME_CRC checks it) and verified.
   const std::uint64_t fb_bytes = std::uint64_t{a.width} * a.height * protocol::bytes_per_pixel(*fmt);
@@ -79,10 +85,18 @@ int run_usb_bench(const GlobalOptions& g, const UsbBenchArgs& a) {
   }
   nlohmann::json readbacks = nlohmann::json::array();
   std::string text;
-  for (bool verify : {false, true}) {
+  // Streamed reads (FTDI's asynchronous IN queue) next to synchronous FIFO-sized rounds, same run.
+  struct Variant {
+    bool verify, stream;
+  };
+  std::vector<Variant> variants{{false, true}, {true, true}};
+  if (profile->stream_reads && b.bridge().chip().starts_with("FT")) variants.insert(variants.begin() + 1, Variant{false, false});
+  for (const Variant& v : variants) {
     usb::BoardOpenOptions ro = o;
-    ro.board.verify_readback = verify;
-    auto rb_board = usb::open_board(*profile, ro);
+    ro.board.verify_readback = v.verify;
+    usb::BoardProfile rp = *profile;
+    rp.stream_reads = v.stream && profile->stream_reads;
+    auto rb_board = usb::open_board(rp, ro);
     if (!rb_board) {
       std::fprintf(stderr, "gpubridge bench usb: %s\n", rb_board.error().message.c_str());
       return 1;
@@ -93,14 +107,17 @@ int run_usb_bench(const GlobalOptions& g, const UsbBenchArgs& a) {
       std::fprintf(stderr, "gpubridge bench usb: readback: %s\n", px.error().message.c_str());
       return 1;
     }
-    const double ms = (r.spi_bits() / clock + r.in() * a.round_trip_us * 1e-6) * 1e3;
-    readbacks.push_back({{"verified", verify}, {"bytes", fb_bytes}, {"spi_bits", r.spi_bits()}, {"usb_in_transfers", r.in()},
-                         {"usb_out_transfers", r.out()}, {"predicted_ms", ms}});
-    char line[256];
-    std::snprintf(line, sizeof line, "readback %ux%u %s (%llu B, %s): %llu SPI bits, %llu IN + %llu OUT transfers, predicted %.1f ms\n",
-                  a.width, a.height, a.format.c_str(), static_cast<unsigned long long>(fb_bytes), verify ? "read twice" : "single pass",
-                  static_cast<unsigned long long>(r.spi_bits()), static_cast<unsigned long long>(r.in()),
-                  static_cast<unsigned long long>(r.out()), ms);
+    const double ms = r.predicted_ms(clock, a.round_trip_us);
+    readbacks.push_back({{"verified", v.verify}, {"streamed", rp.stream_reads}, {"bytes", fb_bytes}, {"spi_bits", r.spi_bits()},
+                         {"usb_in_transfers", r.in()}, {"usb_out_transfers", r.out()}, {"round_trips", r.round_trips()},
+                         {"predicted_ms", ms}});
+    char line[320];
+    std::snprintf(line, sizeof line,
+                  "readback %ux%u %s (%llu B, %s, %s): %llu SPI bits, %llu IN + %llu OUT transfers, %llu round trips, predicted %.1f ms\n",
+                  a.width, a.height, a.format.c_str(), static_cast<unsigned long long>(fb_bytes), v.verify ? "read twice" : "single pass",
+                  rp.stream_reads ? "streamed" : "FIFO-sized rounds", static_cast<unsigned long long>(r.spi_bits()),
+                  static_cast<unsigned long long>(r.in()), static_cast<unsigned long long>(r.out()),
+                  static_cast<unsigned long long>(r.round_trips()), ms);
     text += line;
   }
 
@@ -117,6 +134,7 @@ int run_usb_bench(const GlobalOptions& g, const UsbBenchArgs& a) {
                        {"efficiency", efficiency},
                        {"usb_out_transfers", w.out()},
                        {"usb_in_transfers", w.in()},
+                       {"round_trips", w.round_trips()},
                        {"usb_bytes_out", w.bytes_out()},
                        {"busy_waits", b.bridge().stats().busy_waits},
                        {"predicted_ms", write_ms}}},

@@ -131,7 +131,7 @@ Result<BoardProfile> parse_board_profile(std::string_view text, const std::strin
   json root;
   try {
     root = json::parse(text);
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {  // parse_error, or out_of_range for a number beyond double (1e999)
     return make_error(file + ": not valid JSON: " + e.what(), backends::kBadRequest);
   }
   if (!root.is_object()) return make_error(file + ": expected a JSON object at the top level", backends::kBadRequest);
@@ -189,6 +189,9 @@ Result<BoardProfile> parse_board_profile(std::string_view text, const std::strin
   else if (edge == "falling") p.read_edge = ReadEdge::Falling;
   else return b.fail("read_edge", "expected \"rising\" or \"falling\"");
   TRY_SET(p.latency_ms, b.uint("latency_ms", 1, 255, 1));
+  TRY_SET(p.stream_reads, b.boolean("stream_reads", true));
+  if (!p.stream_reads && p.chip != BridgeChip::FT232H && p.chip != BridgeChip::FT2232H && p.chip != BridgeChip::FT4232H)
+    return b.fail("stream_reads", "only FTDI MPSSE streams reads; remove the key for this chip");
   if (auto r = b.no_unknown_keys(); !r) return r.error();
 
   const json* dev = top.get("device");
@@ -263,7 +266,7 @@ Result<std::vector<CableInfo>> load_cables(const std::filesystem::path& config_d
     json root;
     try {
       root = json::parse(text);
-    } catch (const json::parse_error& e) {
+    } catch (const json::exception& e) {  // parse_error, or out_of_range for a number beyond double (1e999)
       return make_error(f.string() + ": not valid JSON: " + e.what(), backends::kBadRequest);
     }
     if (!root.is_object()) return make_error(f.string() + ": expected a JSON object", backends::kBadRequest);

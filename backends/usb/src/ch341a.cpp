@@ -67,6 +67,7 @@ Result<void> Ch341aBridge::in(std::span<std::uint8_t> bytes) {
                         backends::kDeviceTimeout);
     const UsbIo io = dev_.bulk_in(kEpIn, bytes.subspan(got), timeout_ms_);
     ++stats_.usb_in_transfers;
+    ++stats_.round_trips;
     stats_.usb_bytes_in += io.transferred;
     got += io.transferred;
     if (!io.ok()) return usb_error(io.status, "CH341A: bulk IN (" + std::to_string(got) + " of " + std::to_string(bytes.size()) + " bytes)");

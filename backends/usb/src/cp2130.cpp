@@ -81,6 +81,7 @@ Result<void> Cp2130Bridge::in(std::span<std::uint8_t> bytes) {
     std::uint8_t packet[64];
     const UsbIo io = dev_.bulk_in(kEpIn, packet, kBulkTimeoutMs);
     ++stats_.usb_in_transfers;
+    ++stats_.round_trips;
     stats_.usb_bytes_in += io.transferred;
     if (!io.ok()) return usb_error(io.status, "CP2130: bulk IN");
     if (got + io.transferred > bytes.size())

@@ -19,6 +19,8 @@ constexpr std::uint8_t kSetBitsLow = 0x80, kSetDivisor = 0x86, kSendImmediate = 
                        kDisableDiv5 = 0x8A, kDisableAdaptive = 0x97, kDisable3Phase = 0x8D, kLoopbackOff = 0x85;
 constexpr std::uint8_t kWriteBytesNeg = 0x11, kDuplexReadPos = 0x31, kDuplexReadNeg = 0x35;
 constexpr std::size_t kMaxCommandBytes = 65536;
+// Status-only IN transfers tolerated while waiting for data (bounded polling of a stalled chip).
+constexpr unsigned kMaxEmptyTransfers = 4096;
 
 }  // namespace
 
@@ -171,15 +173,43 @@ Result<void> FtdiMpsseBridge::write_all(std::span<const std::uint8_t> bytes) {
   return {};
 }
 
+Result<bool> FtdiMpsseBridge::collect_in(InCollector& c, std::span<const std::uint8_t> transfer) const {
+  // Two modem-status bytes start every wMaxPacketSize chunk of what actually arrived.
+  bool had_data = false;
+  for (std::size_t p = 0; p < transfer.size(); p += packet_size_) {
+    const std::size_t len = std::min<std::size_t>(packet_size_, transfer.size() - p);
+    if (len <= 2) continue;
+    const std::size_t n = len - 2;
+    if (c.got + n > c.out.size())
+      return make_error(where() + ": chip sent " + std::to_string(c.got + n - c.out.size()) +
+                            " unexpected bytes (MPSSE command stream out of step); the bridge will be re-initialised",
+                        backends::kDeviceProtocol);
+    std::copy_n(transfer.begin() + static_cast<std::ptrdiff_t>(p + 2), n, c.out.begin() + static_cast<std::ptrdiff_t>(c.got));
+    c.got += n;
+    had_data = true;
+  }
+  const auto now = std::chrono::steady_clock::now();
+  if (had_data) {
+    c.empty_transfers = 0;
+    c.last_data = now;
+  } else if (c.got < c.out.size() &&
+             (++c.empty_transfers > kMaxEmptyTransfers || now - c.last_data > std::chrono::milliseconds(cfg_.timeout_ms))) {
+    // Status-only packets (the latency timer expired with nothing to send) for too long.
+    return make_error(where() + ": no data from the chip after " + std::to_string(c.empty_transfers) +
+                          " polls (waiting on BUSY or the chip stalled); check the board is powered and configured",
+                      backends::kDeviceTimeout);
+  }
+  return c.got == c.out.size();
+}
+
 Result<void> FtdiMpsseBridge::read_exact(std::span<std::uint8_t> out) {
-  std::size_t got = 0;
-  unsigned empty_reads = 0;
+  InCollector c{out, 0, 0, std::chrono::steady_clock::now()};
   bool retried_stall = false;
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(cfg_.timeout_ms);
   std::vector<std::uint8_t> buf;
-  while (got < out.size()) {
+  ++stats_.round_trips;
+  while (c.got < out.size()) {
     const std::size_t payload_per_packet = packet_size_ - 2u;
-    const std::size_t packets = std::min<std::size_t>((out.size() - got + payload_per_packet - 1) / payload_per_packet, 128);
+    const std::size_t packets = std::min<std::size_t>((out.size() - c.got + payload_per_packet - 1) / payload_per_packet, 128);
     buf.resize(packets * packet_size_);
     const UsbIo io = dev_.bulk_in(ep_in_, buf, cfg_.timeout_ms);
     ++stats_.usb_in_transfers;
@@ -188,31 +218,55 @@ Result<void> FtdiMpsseBridge::read_exact(std::span<std::uint8_t> out) {
       retried_stall = true;
       if (dev_.clear_halt(ep_in_) == UsbStatus::Ok) continue;
     }
-    if (!io.ok()) return usb_error(io.status, where() + ": bulk IN (" + std::to_string(got) + " of " +
+    if (!io.ok()) return usb_error(io.status, where() + ": bulk IN (" + std::to_string(c.got) + " of " +
                                                   std::to_string(out.size()) + " bytes received)");
-    // Two modem-status bytes start every wMaxPacketSize chunk of what actually arrived.
-    bool had_data = false;
-    for (std::size_t p = 0; p < io.transferred; p += packet_size_) {
-      const std::size_t len = std::min<std::size_t>(packet_size_, io.transferred - p);
-      if (len <= 2) continue;
-      const std::size_t n = len - 2;
-      if (got + n > out.size())
-        return make_error(where() + ": chip sent " + std::to_string(got + n - out.size()) +
-                              " unexpected bytes (MPSSE command stream out of step); the bridge will be re-initialised",
-                          backends::kDeviceProtocol);
-      std::copy_n(buf.begin() + static_cast<std::ptrdiff_t>(p + 2), n, out.begin() + static_cast<std::ptrdiff_t>(got));
-      got += n;
-      had_data = true;
-    }
-    if (!had_data) {
-      // Status-only packet (latency timer expired with nothing to send): bounded polling.
-      if (++empty_reads > 4096 || std::chrono::steady_clock::now() > deadline)
-        return make_error(where() + ": no data from the chip after " + std::to_string(empty_reads) +
-                              " polls (waiting on BUSY or the chip stalled); check the board is powered and configured",
-                          backends::kDeviceTimeout);
-    }
+    if (auto r = collect_in(c, std::span<const std::uint8_t>(buf).first(io.transferred)); !r) return r.error();
   }
   return {};
+}
+
+Result<std::optional<std::vector<std::uint8_t>>> FtdiMpsseBridge::stream_transfer(std::span<const std::uint8_t> cmd,
+                                                                                  std::size_t in_bytes) {
+  std::vector<std::uint8_t> miso(in_bytes);
+  InCollector c{miso, 0, 0, std::chrono::steady_clock::now()};
+  std::optional<Error> failure;
+  BulkStream s;
+  s.out_endpoint = ep_out_;
+  s.in_endpoint = ep_in_;
+  s.out = cmd;
+  s.out_chunk = 16 * 1024;
+  // Each IN transfer ends at the chip's next short packet; 32 packets keep a full-speed link busy
+  // and four in flight keep the chip's RX FIFO from ever stalling the MPSSE for a host round trip.
+  s.in_transfer_bytes = std::size_t{packet_size_} * 32;
+  s.in_queue_depth = 4;
+  s.timeout_ms = cfg_.timeout_ms;
+  const BulkStreamResult res = dev_.bulk_stream(s, [&](std::span<const std::uint8_t> transfer) {
+    ++stats_.usb_in_transfers;
+    stats_.usb_bytes_in += transfer.size();
+    auto r = collect_in(c, transfer);
+    if (!r) {
+      failure = r.error();
+      return StreamStep::Abort;
+    }
+    return *r ? StreamStep::Done : StreamStep::More;
+  });
+  if (res.status == UsbStatus::NotSupported && res.out_transferred == 0 && res.in_transfers == 0) {
+    stream_supported_ = false;
+    return std::optional<std::vector<std::uint8_t>>{};
+  }
+  ++stats_.round_trips;
+  ++stats_.streamed_reads;
+  stats_.usb_out_transfers += res.out_transfers;
+  stats_.usb_bytes_out += res.out_transferred;
+  if (failure) return *failure;
+  if (!res.ok())
+    return usb_error(res.status, where() + ": streamed read (" + std::to_string(c.got) + " of " + std::to_string(in_bytes) +
+                                     " bytes received, " + std::to_string(res.out_transferred) + " of " +
+                                     std::to_string(cmd.size()) + " command bytes sent)");
+  if (c.got != in_bytes)  // the stream ended Ok only after our Done, so this is a device-layer bug
+    return make_error(where() + ": stream ended with " + std::to_string(c.got) + " of " + std::to_string(in_bytes) + " bytes",
+                      backends::kDeviceProtocol);
+  return std::optional<std::vector<std::uint8_t>>{std::move(miso)};
 }
 
 std::vector<std::uint8_t> FtdiMpsseBridge::encode(std::span<const SpiWindow> windows) const {
@@ -255,8 +309,17 @@ Result<std::vector<std::uint8_t>> FtdiMpsseBridge::transfer(std::span<const SpiW
     stats_.spi_bits += 8 * w.mosi.size();
     if (cfg_.busy_pin) stats_.busy_waits += w.busy_waits.size();
   }
+  std::vector<std::uint8_t> cmd = encode(windows);
+
+  // More than one RX FIFO of reads: one stream instead of a round trip per FIFO-full.
+  if (total_in > fifo_ && cfg_.stream_reads && stream_supported_) {
+    cmd.push_back(kSendImmediate);
+    auto streamed = stream_transfer(cmd, total_in);
+    if (!streamed) return streamed.error();
+    if (*streamed) return std::move(**streamed);
+    cmd.pop_back();  // no asynchronous path on this device: synchronous rounds below
+  }
   miso.reserve(total_in);
-  const std::vector<std::uint8_t> cmd = encode(windows);
 
   // Walk the command stream to find round boundaries (only full-duplex commands produce IN bytes).
   std::size_t round_start = 0, round_in = 0, pos = 0;

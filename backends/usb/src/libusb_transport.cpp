@@ -7,6 +7,8 @@
 
 #include "gpubridge/backends/backend.hpp"
 #include "gpubridge/usb/usb_errors.hpp"
+#include "libusb_status.hpp"
+#include "libusb_stream.hpp"
 
 namespace gpubridge::usb {
 
@@ -18,25 +20,6 @@ struct LibusbContext::Raw {
 };
 
 namespace {
-
-UsbStatus status_of(int rc) {
-  switch (rc) {
-    case LIBUSB_SUCCESS: return UsbStatus::Ok;
-    case LIBUSB_ERROR_IO: return UsbStatus::Io;
-    case LIBUSB_ERROR_INVALID_PARAM: return UsbStatus::InvalidParam;
-    case LIBUSB_ERROR_ACCESS: return UsbStatus::Access;
-    case LIBUSB_ERROR_NO_DEVICE: return UsbStatus::NoDevice;
-    case LIBUSB_ERROR_NOT_FOUND: return UsbStatus::NotFound;
-    case LIBUSB_ERROR_BUSY: return UsbStatus::Busy;
-    case LIBUSB_ERROR_TIMEOUT: return UsbStatus::Timeout;
-    case LIBUSB_ERROR_OVERFLOW: return UsbStatus::Overflow;
-    case LIBUSB_ERROR_PIPE: return UsbStatus::Pipe;
-    case LIBUSB_ERROR_INTERRUPTED: return UsbStatus::Interrupted;
-    case LIBUSB_ERROR_NO_MEM: return UsbStatus::NoMem;
-    case LIBUSB_ERROR_NOT_SUPPORTED: return UsbStatus::NotSupported;
-    default: return UsbStatus::Other;
-  }
-}
 
 std::string port_path_of(libusb_device* dev) {
   std::uint8_t ports[8];
@@ -101,6 +84,9 @@ class LibusbDevice final : public UsbDevice {
     return {status_of(rc), static_cast<std::size_t>(done)};
   }
   UsbStatus clear_halt(std::uint8_t ep) override { return status_of(libusb_clear_halt(h_, ep)); }
+  BulkStreamResult bulk_stream(const BulkStream& s, const InSink& on_in) override {
+    return run_libusb_stream(ctx_->ctx, h_, s, on_in);
+  }
   std::uint16_t max_packet_size(std::uint8_t ep) const override {
     auto it = packet_.find(ep);
     return it == packet_.end() ? 0 : it->second;

@@ -36,6 +36,7 @@ Result<std::array<std::uint8_t, 64>> Mcp2210Bridge::command(std::span<const std:
   for (int attempt = 0;; ++attempt) {
     const int r = dev_.read(in, kReadTimeoutMs);
     ++stats_.usb_in_transfers;
+    ++stats_.round_trips;
     if (r < 0) return make_error("MCP2210: HID read failed (" + dev_.last_error() + ")", backends::kDeviceGone);
     if (r > 0) break;
     if (attempt >= 2) return make_error("MCP2210: no response report within " + std::to_string(3 * kReadTimeoutMs) + " ms",

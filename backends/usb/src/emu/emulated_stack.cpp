@@ -171,6 +171,7 @@ Result<std::unique_ptr<SpiBridge>> open_bridge(const BoardProfile& p, UsbDevice*
       c.read_edge = p.read_edge;
       c.latency_ms = p.latency_ms;
       c.clock_hz = p.spi_clock_hz;
+      c.stream_reads = p.stream_reads;
       auto b = FtdiMpsseBridge::open(*usb, c);
       if (!b) return b.error();
       return std::unique_ptr<SpiBridge>(std::move(*b));

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <optional>
 
 namespace gpubridge::usb::emu {
 namespace {
@@ -219,15 +220,20 @@ UsbIo MpsseModel::bulk_in(std::uint8_t endpoint, std::span<std::uint8_t> data, u
   Channel& c = ch_[ch];
   if (!c.claimed) return {UsbStatus::Io, 0};
   run(ch);  // time passed: stalled waits may have completed
+  const std::size_t limit = f == UsbFault::TimeoutPartial ? std::min(data.size(), faults_.partial_bytes) : data.size();
+  const auto packed = pack_in(c, data, limit);
+  if (!packed) return {UsbStatus::Overflow, 0};  // babble: the packet does not fit the buffer
+  return {f == UsbFault::TimeoutPartial ? UsbStatus::Timeout : UsbStatus::Ok, *packed};
+}
+
+std::optional<std::size_t> MpsseModel::pack_in(Channel& c, std::span<std::uint8_t> data, std::size_t limit) {
   const std::size_t mps = cfg_.high_speed ? 512 : 64;
   std::size_t pos = 0;
-  std::size_t limit = data.size();
-  if (f == UsbFault::TimeoutPartial) limit = std::min(limit, faults_.partial_bytes);
   do {
     const std::size_t payload = std::min(mps - 2, c.in.size());
     const std::size_t packet = payload + 2;
     if (pos + packet > data.size()) {
-      if (pos == 0) return {UsbStatus::Overflow, 0};  // babble: the packet does not fit the buffer
+      if (pos == 0) return std::nullopt;
       break;
     }
     if (pos + packet > limit) break;
@@ -240,8 +246,82 @@ UsbIo MpsseModel::bulk_in(std::uint8_t endpoint, std::span<std::uint8_t> data, u
     pos += packet;
     if (packet < mps) break;  // short packet ends the transfer
   } while (!c.in.empty());
-  if (f == UsbFault::TimeoutPartial) return {UsbStatus::Timeout, pos};
-  return {UsbStatus::Ok, pos};
+  return pos;
+}
+
+// The host keeps OUT and IN transfers queued at once; the model serialises that into one valid
+// schedule: the chip takes OUT bytes while its TX FIFO has room (the MPSSE stalls once its RX FIFO
+// is full), then one queued IN transfer drains what is waiting. Each OUT transfer and each IN
+// transfer is one operation of the fault plan, as it is one URB on a real bus.
+BulkStreamResult MpsseModel::bulk_stream(const BulkStream& s, const InSink& on_in) {
+  BulkStreamResult res;
+  const int ch = channel_of_endpoint(s.out_endpoint, false);
+  if (ch < 0 || channel_of_endpoint(s.in_endpoint, true) != ch || s.out_chunk == 0 || s.in_transfer_bytes == 0) {
+    violation("bulk stream on endpoints " + hex(s.out_endpoint) + "/" + hex(s.in_endpoint) + " that are not one channel's pair");
+    return {UsbStatus::Io, 0, 0, 0};
+  }
+  Channel& c = ch_[ch];
+  if (!c.claimed) {
+    violation("bulk stream on an unclaimed interface");
+    return {UsbStatus::Io, 0, 0, 0};
+  }
+  if (!c.mpsse) violation("bulk stream before MPSSE mode was enabled (goes to the UART)");
+  std::vector<std::uint8_t> in_buf(s.in_transfer_bytes);
+  std::size_t transfer_end = 0;  // end of the OUT transfer being taken by the chip (0 = none started)
+  bool consumer_done = false;
+  auto fail = [&](UsbStatus st) {
+    res.status = st;
+    return res;
+  };
+  while (res.out_transferred < s.out.size() || !consumer_done) {
+    bool progressed = false;
+    if (res.out_transferred < s.out.size()) {
+      if (transfer_end <= res.out_transferred) {
+        const UsbFault f = faults_.next();
+        if (f == UsbFault::NoDevice) return fail(UsbStatus::NoDevice);
+        if (f == UsbFault::Stall) return fail(UsbStatus::Pipe);
+        transfer_end = std::min(s.out.size(), res.out_transferred + s.out_chunk);
+        if (f == UsbFault::TimeoutPartial) {
+          const std::size_t n = std::min(faults_.partial_bytes, transfer_end - res.out_transferred);
+          const auto part = s.out.subspan(res.out_transferred, n);
+          out_log_.emplace_back(part.begin(), part.end());
+          c.pending.insert(c.pending.end(), part.begin(), part.end());
+          run(ch);
+          res.out_transferred += n;
+          return fail(UsbStatus::Timeout);
+        }
+      }
+      const std::size_t room = tx_fifo_bytes() - std::min(tx_fifo_bytes(), c.pending.size());
+      const std::size_t n = std::min(room, transfer_end - res.out_transferred);
+      if (n > 0) {
+        const auto part = s.out.subspan(res.out_transferred, n);
+        out_log_.emplace_back(part.begin(), part.end());
+        c.pending.insert(c.pending.end(), part.begin(), part.end());
+        res.out_transferred += n;
+        if (res.out_transferred == transfer_end) ++res.out_transfers;
+        progressed = true;
+      }
+      run(ch);
+    }
+    if (!consumer_done) {
+      const UsbFault f = faults_.next();
+      if (f == UsbFault::NoDevice) return fail(UsbStatus::NoDevice);
+      if (f == UsbFault::Stall) return fail(UsbStatus::Pipe);
+      run(ch);
+      const std::size_t limit = f == UsbFault::TimeoutPartial ? std::min(in_buf.size(), faults_.partial_bytes) : in_buf.size();
+      const auto packed = pack_in(c, in_buf, limit);
+      ++res.in_transfers;
+      if (!packed) return fail(UsbStatus::Overflow);
+      if (f == UsbFault::TimeoutPartial) return fail(UsbStatus::Timeout);
+      const StreamStep step = on_in(std::span<const std::uint8_t>(in_buf).first(*packed));
+      if (step == StreamStep::Abort) return res;
+      consumer_done = step == StreamStep::Done;
+      progressed = true;
+    }
+    // Consumer satisfied but the chip takes no more OUT bytes: the host's OUT transfer times out.
+    if (!progressed) return fail(UsbStatus::Timeout);
+  }
+  return res;
 }
 
 void MpsseModel::run(int ch) {

@@ -33,6 +33,7 @@ struct BoardProfile {
   bool busy_pin = false;      // FPGA BUSY output wired to the bridge (FTDI GPIOL1)
   ReadEdge read_edge = ReadEdge::Rising;
   std::uint8_t latency_ms = 1;
+  bool stream_reads = true;  // FTDI: reads beyond the RX FIFO through an asynchronous IN queue
   // FPGA design.
   std::uint32_t vram_kib = 0;
   unsigned max_width = 0, max_height = 0, fifo_depth = 0;

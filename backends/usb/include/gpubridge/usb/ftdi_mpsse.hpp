@@ -1,7 +1,10 @@
 #pragma once
 // FTDI FT232H / FT2232H / FT4232H (channels A/B) in MPSSE mode as an SpiBridge.
+#include <chrono>
 #include <cstdint>
 #include <memory>
+#include <optional>
+#include <vector>
 #include <string>
 
 #include "gpubridge/usb/spi_bridge.hpp"
@@ -19,6 +22,9 @@ struct FtdiConfig {
   std::uint8_t latency_ms = 1;
   std::uint32_t clock_hz = 30'000'000;
   unsigned timeout_ms = 1000;
+  // Reads larger than the RX FIFO go through one asynchronous stream (IN transfers queued while the
+  // commands are sent) instead of one round trip per FIFO-full. Off = synchronous rounds only.
+  bool stream_reads = true;
 };
 
 // FIFO sizes by chip (bcdDevice identifies the chip: 0x0900 FT232H, 0x0700 FT2232H, 0x0800 FT4232H).
@@ -50,6 +56,18 @@ class FtdiMpsseBridge final : public SpiBridge {
   Result<void> control(std::uint8_t request, std::uint16_t value, const char* what);
   Result<void> write_all(std::span<const std::uint8_t> bytes);
   Result<void> read_exact(std::span<std::uint8_t> out);
+  // Collects the payload of IN transfers into `out`, dropping each packet's two modem-status bytes.
+  struct InCollector {
+    std::span<std::uint8_t> out;
+    std::size_t got = 0;
+    unsigned empty_transfers = 0;
+    std::chrono::steady_clock::time_point last_data;
+  };
+  // Ok(true) once `out` is full; errors on surplus bytes or when the chip sends nothing for too long.
+  Result<bool> collect_in(InCollector& c, std::span<const std::uint8_t> transfer) const;
+  // Sends the whole command stream and reads its `in_bytes` of MISO through UsbDevice::bulk_stream.
+  // Ok(nullopt): the device has no asynchronous path (nothing was sent); use rounds instead.
+  Result<std::optional<std::vector<std::uint8_t>>> stream_transfer(std::span<const std::uint8_t> cmd, std::size_t in_bytes);
   Result<void> sync_check();
   std::string where() const;
 
@@ -62,6 +80,7 @@ class FtdiMpsseBridge final : public SpiBridge {
   std::uint32_t clock_hz_ = 0;
   std::uint8_t idle_value_, direction_;
   bool claimed_ = false;
+  bool stream_supported_ = true;  // until the device says NotSupported
   BridgeStats stats_;
 };
 

@@ -25,6 +25,10 @@ struct BridgeStats {
   std::uint64_t usb_bytes_out = 0, usb_bytes_in = 0;
   std::uint64_t spi_bits = 0;  // SCK cycles generated
   std::uint64_t busy_waits = 0;
+  // Times the host waited for the device before it could go on: every synchronous IN transfer,
+  // one per streamed read (FTDI with an asynchronous IN queue). What the USB latency multiplies.
+  std::uint64_t round_trips = 0;
+  std::uint64_t streamed_reads = 0;  // transfers whose reads went through UsbDevice::bulk_stream
 };
 
 class SpiBridge {

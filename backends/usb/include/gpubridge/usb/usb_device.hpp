@@ -4,6 +4,7 @@
 // to byte-exact chip models. Status codes mirror libusb's so both sides report the same faults.
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -45,6 +46,26 @@ struct UsbDeviceInfo {
   bool high_speed = false;
 };
 
+// A full-duplex bulk stream (see UsbDevice::bulk_stream).
+struct BulkStream {
+  std::uint8_t out_endpoint = 0, in_endpoint = 0;
+  std::span<const std::uint8_t> out;  // sent in order, in transfers of at most out_chunk bytes
+  std::size_t out_chunk = 16 * 1024;
+  std::size_t in_transfer_bytes = 16 * 1024;  // size of each queued IN transfer
+  unsigned in_queue_depth = 4;                // IN transfers kept in flight
+  unsigned timeout_ms = 1000;                 // the stream fails when no transfer completes for this long
+};
+
+// What the stream's consumer says after each IN transfer.
+enum class StreamStep { More, Done, Abort };
+
+struct BulkStreamResult {
+  UsbStatus status = UsbStatus::Ok;
+  std::size_t out_transferred = 0;
+  std::uint64_t out_transfers = 0, in_transfers = 0;
+  bool ok() const { return status == UsbStatus::Ok; }
+};
+
 inline constexpr std::uint8_t kRequestTypeVendorOut = 0x40;  // host-to-device, vendor, device
 inline constexpr std::uint8_t kRequestTypeVendorIn = 0xC0;   // device-to-host, vendor, device
 
@@ -65,6 +86,21 @@ class UsbDevice {
   virtual UsbStatus clear_halt(std::uint8_t endpoint) = 0;
   // wMaxPacketSize from the endpoint descriptor (0 if the endpoint does not exist).
   virtual std::uint16_t max_packet_size(std::uint8_t endpoint) const = 0;
+
+  // Sends `s.out` while IN transfers stay queued on `s.in_endpoint`, so a device that stops taking
+  // OUT data until the host drains its IN FIFO (an FTDI MPSSE reading more than its RX FIFO) streams
+  // at the link rate instead of one round trip per FIFO-full. Every completed IN transfer goes to
+  // `on_in` in order (status-only packets included); the stream ends Ok when the OUT data is sent
+  // and on_in has said Done, or at once (status Ok, consumer's decision) when on_in says Abort.
+  // Transfers still in flight are cancelled and reaped before this returns. Devices without an
+  // asynchronous path return NotSupported before sending anything; callers then fall back to
+  // synchronous rounds.
+  using InSink = std::function<StreamStep(std::span<const std::uint8_t>)>;
+  virtual BulkStreamResult bulk_stream(const BulkStream& s, const InSink& on_in) {
+    (void)s;
+    (void)on_in;
+    return {UsbStatus::NotSupported, 0, 0, 0};
+  }
 };
 
 }  // namespace gpubridge::usb

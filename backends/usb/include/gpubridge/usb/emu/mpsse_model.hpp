@@ -6,6 +6,7 @@
 // Anything a real chip would reject or a driver should never do is recorded as a violation.
 #include <cstdint>
 #include <deque>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -44,6 +45,7 @@ class MpsseModel final : public UsbDevice {
   UsbIo bulk_in(std::uint8_t endpoint, std::span<std::uint8_t> data, unsigned timeout_ms) override;
   UsbStatus clear_halt(std::uint8_t endpoint) override;
   std::uint16_t max_packet_size(std::uint8_t endpoint) const override;
+  BulkStreamResult bulk_stream(const BulkStream& s, const InSink& on_in) override;
 
   FaultPlan& faults() { return faults_; }
   const std::vector<std::string>& violations() const { return violations_; }
@@ -67,6 +69,9 @@ class MpsseModel final : public UsbDevice {
   int channel_of_endpoint(std::uint8_t ep, bool in) const;
   Channel* channel_of_index(std::uint16_t windex);
   void violation(std::string what);
+  // Moves waiting IN bytes into `data` as packets, each led by the two modem-status bytes, up to
+  // `limit` bytes and ending at a short packet; nullopt when not even one packet fits (babble).
+  std::optional<std::size_t> pack_in(Channel& c, std::span<std::uint8_t> data, std::size_t limit);
   void run(int ch);                          // interprets as much of `pending` as possible
   std::size_t execute(int ch, std::span<const std::uint8_t> cmd, bool& stalled);  // bytes consumed (0 = need more)
   void update_cs(Channel& c);
