@@ -97,7 +97,13 @@ class TextureUnit {
   // Texel (i, j) of an addressed (in-range) index pair, expanded to 8 bits per channel.
   [[gnu::always_inline]] protocol::Rgba8 fetch(std::int64_t i, std::int64_t j, std::uint16_t& errors) const {
     const std::uint64_t offset = ((static_cast<std::uint64_t>(j) << wl_) + static_cast<std::uint64_t>(i)) * bpp_;
-    if (direct_) return protocol::load_pixel(format_, direct_ + offset);
+    if (direct_) {
+      if (format_ == protocol::PixelFormat::RGBA8888) {  // inline: the generic decoder is a call per texel
+        const std::uint8_t* p = direct_ + offset;
+        return {p[0], p[1], p[2], p[3]};
+      }
+      return protocol::load_pixel(format_, direct_ + offset);
+    }
     std::uint8_t buf[4];
     if (!mem_.read(std::uint64_t{base_} + offset, buf, bpp_)) errors |= protocol::ERR_MEM_RANGE;
     return protocol::load_pixel(format_, buf);
