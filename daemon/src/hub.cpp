@@ -183,6 +183,9 @@ nlohmann::json Hub::status_json() const {
                                                             ? nlohmann::json(*mirror_.first_mismatch_pixels)
                                                             : nlohmann::json()},
                               {"last_mismatch", frame_or_null(mirror_.last_mismatch)},
+                              {"last_mismatch_pixels", mirror_.last_mismatch_pixels
+                                                           ? nlohmann::json(*mirror_.last_mismatch_pixels)
+                                                           : nlohmann::json()},
                               {"model_errors", decorator.model_errors},
                               {"unpaired_frames", decorator.unpaired_frames},
                               {"coalesced_swaps", decorator.coalesced_swaps}};
@@ -248,16 +251,18 @@ void Hub::compare_mirrored(const backends::ScanoutFrame& frame) {
   if (frame.crc == frame.reference->crc) return;
   ++mirror_.mismatches;
   mirror_.last_mismatch = frame.number;
-  if (mirror_.first_mismatch) return;
-  mirror_.first_mismatch = frame.number;
-  std::string where;
+  // Counting the differing pixels of every mismatch (not only the first) shows whether a fault
+  // grows or stays put; it costs one pass over the frame, and only when the CRCs differ.
+  std::optional<std::uint64_t> pixels;
   if (!frame.pixels.empty()) {
     std::uint64_t differing = 0;
-    if (diff_frame(frame, *frame.reference, &differing)) {
-      mirror_.first_mismatch_pixels = differing;
-      where = ", " + std::to_string(differing) + " pixels differ";
-    }
+    if (diff_frame(frame, *frame.reference, &differing)) pixels = differing;
   }
+  mirror_.last_mismatch_pixels = pixels;
+  if (mirror_.first_mismatch) return;
+  mirror_.first_mismatch = frame.number;
+  mirror_.first_mismatch_pixels = pixels;
+  const std::string where = pixels ? ", " + std::to_string(*pixels) + " pixels differ" : "";
   logger("daemon")->warn("mirror: frame {} differs from the simulator (board CRC 0x{:08X}, simulator CRC 0x{:08X}{}); "
                          "first mismatch, later ones are counted in status (mirror.mismatches)",
                          frame.number, frame.crc, frame.reference->crc, where);

@@ -561,6 +561,31 @@ TEST(DaemonMirror, TamperedBoardMemoryIsCountedAndShownMagentaExactlyWhereItDiff
   EXPECT_EQ(status["mirror"]["mismatches"], 1) << status.dump();
   EXPECT_EQ(status["mirror"]["first_mismatch"], b2->number) << status.dump();
   EXPECT_EQ(status["mirror"]["first_mismatch_pixels"], differing.size()) << status.dump();
+  EXPECT_EQ(status["mirror"]["last_mismatch_pixels"], differing.size()) << status.dump();
+
+  // Two more board pixels change: the latest mismatch counts three, the first one keeps its one.
+  daemon.poke_board_memory((std::size_t{3} * 64 + 5) * 2, 0x81);
+  daemon.poke_board_memory((std::size_t{40} * 64 + 60) * 2 + 1, 0x18);
+  ASSERT_TRUE(player->write_frames(swap.view(), 2000ms));
+  ASSERT_TRUE(player->fence(5000ms));
+  auto b3 = board->next_frame(5000ms);
+  auto s3 = sim->next_frame(5000ms);
+  ASSERT_TRUE(b3 && s3);
+  ASSERT_EQ(b3->number, s3->number);
+  const Image bi3 = to_image(*b3), si3 = to_image(*s3);
+  std::uint64_t differing3 = 0;
+  for (unsigned y = 0; y < bi3.height; ++y)
+    for (unsigned x = 0; x < bi3.width; ++x) differing3 += !std::equal(bi3.pixel(x, y), bi3.pixel(x, y) + 4, si3.pixel(x, y));
+  ASSERT_EQ(differing3, 3u) << "the pixel poked before and the two poked now";
+  status = status_of(*player);
+  EXPECT_EQ(status["mirror"]["mismatches"], 2) << status.dump();
+  EXPECT_EQ(status["mirror"]["first_mismatch"], b2->number) << status.dump();
+  EXPECT_EQ(status["mirror"]["last_mismatch"], b3->number) << status.dump();
+  EXPECT_EQ(status["mirror"]["first_mismatch_pixels"], 1) << status.dump();
+  EXPECT_EQ(status["mirror"]["last_mismatch_pixels"], differing3) << status.dump();
+  const auto text = run_process({GPUBRIDGE_CLI_PATH, "status", "--connect", daemon.address()});
+  ASSERT_EQ(text.exit_code, 0) << text.err;
+  EXPECT_NE(text.out.find("latest #" + std::to_string(b3->number) + ", 3 pixel(s) differ"), std::string::npos) << text.out;
   std::error_code ec;
   fs::remove_all(dir, ec);
 }
@@ -622,6 +647,7 @@ TEST(DaemonMirror, StatusAndCliReportTheMirrorsOwnCountersAsTheyChange) {
   ASSERT_TRUE(board->next_frame(5000ms));
   EXPECT_EQ(counted(status_of(*player)), (Counted{2, 0, 1, 2, 0}));
   EXPECT_TRUE(status_of(*player)["mirror"]["first_mismatch_pixels"].is_null());
+  EXPECT_TRUE(status_of(*player)["mirror"]["last_mismatch_pixels"].is_null());
 
   // Showing the upper half: the board has the uploaded bytes there, the simulator has no memory
   // there (its scanout reads zeros), so the pictures differ; the test counts where.

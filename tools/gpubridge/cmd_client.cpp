@@ -138,6 +138,12 @@ int run_status(const GlobalOptions& g, const ClientOptions& o) {
       if (m.contains("first_mismatch_pixels") && m["first_mismatch_pixels"].is_number())
         std::printf(", %llu pixel(s) differ",
                     static_cast<unsigned long long>(m["first_mismatch_pixels"].get<std::uint64_t>()));
+      if (mismatches > 1 && m.contains("last_mismatch") && m["last_mismatch"].is_number()) {
+        std::printf(", latest #%llu", static_cast<unsigned long long>(m["last_mismatch"].get<std::uint64_t>()));
+        if (m.contains("last_mismatch_pixels") && m["last_mismatch_pixels"].is_number())
+          std::printf(", %llu pixel(s) differ",
+                      static_cast<unsigned long long>(m["last_mismatch_pixels"].get<std::uint64_t>()));
+      }
       std::printf("; see the differences with `gpubridge screenshot --source diff`)");
     }
     std::printf("\n");

@@ -39,6 +39,7 @@ struct MirrorStats {
   std::uint64_t compared = 0, mismatches = 0;
   std::optional<std::uint32_t> first_mismatch, last_mismatch;  // frame numbers
   std::optional<std::uint64_t> first_mismatch_pixels;           // differing pixels; none for CRC-only boards
+  std::optional<std::uint64_t> last_mismatch_pixels;            // the same for the latest mismatch
 };
 
 // A scanned-out frame encoded once per requested source and format and shared by every subscriber.
