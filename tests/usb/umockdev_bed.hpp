@@ -6,7 +6,7 @@
 #include <atomic>
 #include <cerrno>
 #include <cstring>
-#include <deque>
+#include <map>
 #include <vector>
 #include <linux/ioctl.h>
 #include <linux/usbdevice_fs.h>
@@ -17,6 +17,7 @@
 #include "gpubridge/usb/emu/mpsse_model.hpp"
 #include "gpubridge/usb/emu/reference_target.hpp"
 #include "gpubridge/usb/usb_device.hpp"
+#include "umockdev_urbs.hpp"
 
 namespace gpubridge::usb::testing {
 
@@ -42,14 +43,12 @@ struct Bed {
   // of it (its TX FIFO refuses bytes while the MPSSE is stalled on a full RX FIFO), an IN URB when
   // the chip has something for it (a status-only packet at worst). They advance whenever libusb
   // reaps, in submission order per direction.
-  struct Flying {
-    UMockdevIoctlData* urb;
-    std::vector<std::uint8_t> out;  // OUT payload, copied at submission
-    std::size_t taken = 0;          // OUT bytes the chip has accepted so far
+  UrbQueue urbs;
+  struct OutPayload {
+    std::vector<std::uint8_t> bytes;  // copied at submission
+    std::size_t taken = 0;            // bytes the chip has accepted so far
   };
-  std::deque<Flying> flying;
-  std::deque<UMockdevIoctlData*> done;       // completed URBs waiting to be reaped
-  std::deque<UMockdevIoctlData*> discarded;  // cancelled URBs waiting to be reaped (-ENOENT)
+  std::map<UMockdevIoctlData*, OutPayload> out_payload;
   // Written on umockdev's ioctl thread, read by the test.
   std::atomic<unsigned> control_urbs{0}, bulk_urbs{0};
   std::atomic<unsigned> max_in_flight{0};  // most IN URBs queued at once
@@ -58,78 +57,44 @@ struct Bed {
   static gboolean on_ioctl(UMockdevIoctlBase*, UMockdevIoctlClient* client, gpointer self) {
     return static_cast<Bed*>(self)->handle(client);
   }
-
-  static usbdevfs_urb& urb_of(UMockdevIoctlData* d) { return *reinterpret_cast<usbdevfs_urb*>(d->data); }
-
-  void complete_urb(UMockdevIoctlData* d, const UsbIo& io, std::size_t length) {
-    urb_of(d).actual_length = static_cast<int>(length);
-    urb_of(d).status = -errno_of(io.status);
-    done.push_back(d);
-  }
+  static bool is_in(UMockdevIoctlData* d) { return UrbQueue::urb_of(d).endpoint & 0x80; }
 
   // Lets the chip take OUT data and fill one IN URB, as time passing on a real bus would.
   void advance() {
-    for (auto it = flying.begin(); it != flying.end(); ++it) {
-      if (urb_of(it->urb).endpoint & 0x80) continue;
-      const UsbIo io = model.bulk_out(urb_of(it->urb).endpoint, std::span<const std::uint8_t>(it->out).subspan(it->taken), 1000);
-      it->taken += io.transferred;
-      if (io.status == UsbStatus::Timeout && it->taken < it->out.size()) {
+    for (auto it = urbs.flying.begin(); it != urbs.flying.end(); ++it) {
+      if (is_in(*it)) continue;
+      OutPayload& out = out_payload[*it];
+      const UsbIo io = model.bulk_out(UrbQueue::urb_of(*it).endpoint, std::span<const std::uint8_t>(out.bytes).subspan(out.taken), 1000);
+      out.taken += io.transferred;
+      if (io.status == UsbStatus::Timeout && out.taken < out.bytes.size()) {
         ++out_refusals;  // TX FIFO full: the URB stays in flight
       } else {
-        complete_urb(it->urb, io, it->taken);
-        flying.erase(it);
+        const std::size_t taken = out.taken;
+        out_payload.erase(*it);
+        urbs.finish_flying(it, -errno_of(io.status), taken);
       }
       break;
     }
-    for (auto it = flying.begin(); it != flying.end(); ++it) {
-      usbdevfs_urb& urb = urb_of(it->urb);
-      if (!(urb.endpoint & 0x80)) continue;
-      UMockdevIoctlData* buf = umockdev_ioctl_data_resolve(it->urb, G_STRUCT_OFFSET(usbdevfs_urb, buffer),
+    for (auto it = urbs.flying.begin(); it != urbs.flying.end(); ++it) {
+      if (!is_in(*it)) continue;
+      usbdevfs_urb& urb = UrbQueue::urb_of(*it);
+      UMockdevIoctlData* buf = umockdev_ioctl_data_resolve(*it, G_STRUCT_OFFSET(usbdevfs_urb, buffer),
                                                             static_cast<gsize>(urb.buffer_length), nullptr);
       const UsbIo io = model.bulk_in(urb.endpoint, std::span(reinterpret_cast<std::uint8_t*>(buf->data), buf->data_len), 1000);
       umockdev_ioctl_data_unref(buf);
-      complete_urb(it->urb, io, io.transferred);
-      flying.erase(it);
+      urbs.finish_flying(it, -errno_of(io.status), io.transferred);
       break;
     }
-  }
-
-  void reap(UMockdevIoctlClient* client, UMockdevIoctlData* arg) {
-    if (done.empty() && discarded.empty()) advance();
-    UMockdevIoctlData* urb_data = nullptr;
-    if (!discarded.empty()) {
-      urb_data = discarded.front();
-      discarded.pop_front();
-      urb_of(urb_data).status = -ENOENT;
-    } else if (!done.empty()) {
-      urb_data = done.front();
-      done.pop_front();
-    } else {
-      umockdev_ioctl_client_complete(client, -1, EAGAIN);
-      return;
-    }
-    UMockdevIoctlData* ptr = umockdev_ioctl_data_resolve(arg, 0, sizeof(gpointer), nullptr);
-    umockdev_ioctl_data_set_ptr(ptr, 0, urb_data);
-    umockdev_ioctl_data_unref(ptr);
-    umockdev_ioctl_data_unref(urb_data);
-    umockdev_ioctl_client_complete(client, 0, 0);
   }
 
   gboolean handle(UMockdevIoctlClient* client) {
     const unsigned long request = umockdev_ioctl_client_get_request(client);
     UMockdevIoctlData* arg = umockdev_ioctl_client_get_arg(client);
     switch (request) {
-      case USBDEVFS_GET_CAPABILITIES: {
-        UMockdevIoctlData* d = umockdev_ioctl_data_resolve(arg, 0, sizeof(guint32), nullptr);
-        *reinterpret_cast<guint32*>(d->data) = USBDEVFS_CAP_BULK_SCATTER_GATHER | USBDEVFS_CAP_BULK_CONTINUATION |
-                                               USBDEVFS_CAP_NO_PACKET_SIZE_LIM | USBDEVFS_CAP_REAP_AFTER_DISCONNECT |
-                                               USBDEVFS_CAP_ZERO_PACKET;
-        umockdev_ioctl_data_unref(d);
-        umockdev_ioctl_client_complete(client, 0, 0);
-        return TRUE;
-      }
-      case USBDEVFS_GETDRIVER:  // no kernel driver bound
-        umockdev_ioctl_client_complete(client, -1, ENODATA);
+      case USBDEVFS_GET_CAPABILITIES:
+        UrbQueue::capabilities(client, arg,
+                               USBDEVFS_CAP_BULK_SCATTER_GATHER | USBDEVFS_CAP_BULK_CONTINUATION | USBDEVFS_CAP_NO_PACKET_SIZE_LIM |
+                                   USBDEVFS_CAP_REAP_AFTER_DISCONNECT | USBDEVFS_CAP_ZERO_PACKET);
         return TRUE;
       case USBDEVFS_CLAIMINTERFACE: {
         const UsbStatus d = model.detach_kernel_driver(0);
@@ -146,7 +111,7 @@ struct Bed {
         return TRUE;
       case USBDEVFS_SUBMITURB: {
         UMockdevIoctlData* urb_data = umockdev_ioctl_data_resolve(arg, 0, sizeof(usbdevfs_urb), nullptr);
-        usbdevfs_urb& urb = urb_of(urb_data);
+        usbdevfs_urb& urb = UrbQueue::urb_of(urb_data);
         UMockdevIoctlData* buf =
             umockdev_ioctl_data_resolve(urb_data, G_STRUCT_OFFSET(usbdevfs_urb, buffer), static_cast<gsize>(urb.buffer_length), nullptr);
         auto* bytes = reinterpret_cast<std::uint8_t*>(buf->data);
@@ -159,38 +124,24 @@ struct Bed {
           const std::size_t len = static_cast<std::size_t>(bytes[6] | bytes[7] << 8);
           const UsbIo io = (rt & 0x80) ? model.control_in(rt, req, value, index, std::span(bytes + 8, len), 1000)
                                        : model.control_out(rt, req, value, index, std::span<const std::uint8_t>(bytes + 8, len), 1000);
-          complete_urb(urb_data, io, io.transferred);
+          urbs.finish(urb_data, -errno_of(io.status), io.transferred);
         } else {
           ++bulk_urbs;
-          Flying f{urb_data, {}, 0};
-          if (!(urb.endpoint & 0x80)) f.out.assign(bytes, bytes + urb.buffer_length);
-          flying.push_back(std::move(f));
+          if (!(urb.endpoint & 0x80)) out_payload[urb_data].bytes.assign(bytes, bytes + urb.buffer_length);
+          urbs.flying.push_back(urb_data);
           unsigned in_flight = 0;
-          for (const Flying& x : flying) in_flight += (urb_of(x.urb).endpoint & 0x80) ? 1 : 0;
+          for (auto* x : urbs.flying) in_flight += is_in(x) ? 1 : 0;
           if (in_flight > max_in_flight) max_in_flight = in_flight;
         }
         umockdev_ioctl_data_unref(buf);
         umockdev_ioctl_client_complete(client, 0, 0);
         return TRUE;
       }
-      case USBDEVFS_REAPURB:
-      case USBDEVFS_REAPURBNDELAY:
-        reap(client, arg);
-        return TRUE;
-      case USBDEVFS_DISCARDURB: {
-        const auto client_addr = reinterpret_cast<gulong>(*reinterpret_cast<void**>(arg->data));
-        for (auto it = flying.begin(); it != flying.end(); ++it) {
-          if (it->urb->client_addr != client_addr) continue;
-          discarded.push_back(it->urb);
-          flying.erase(it);
-          umockdev_ioctl_client_complete(client, 0, 0);
-          return TRUE;
-        }
-        umockdev_ioctl_client_complete(client, -1, EINVAL);  // already completed: libusb reaps it normally
-        return TRUE;
-      }
       default:
-        return FALSE;
+        if (request == USBDEVFS_DISCARDURB)  // a cancelled OUT URB's payload goes with it
+          for (auto* d : urbs.flying)
+            if (d->client_addr == reinterpret_cast<gulong>(*reinterpret_cast<void**>(arg->data))) out_payload.erase(d);
+        return urbs.handle_common(request, client, arg, [this] { advance(); }) ? TRUE : FALSE;
     }
   }
 
@@ -223,9 +174,7 @@ struct Bed {
   }
 
   ~Bed() {
-    for (auto& f : flying) umockdev_ioctl_data_unref(f.urb);
-    for (auto* d : done) umockdev_ioctl_data_unref(d);
-    for (auto* d : discarded) umockdev_ioctl_data_unref(d);
+    urbs.clear();
     g_clear_object(&handler);
     g_clear_object(&testbed);
   }

@@ -8,10 +8,8 @@
 #include <atomic>
 #include <cerrno>
 #include <cstring>
-#include <deque>
 #include <linux/ioctl.h>
 #include <linux/usbdevice_fs.h>
-#include <mutex>
 #include <sys/ioctl.h>
 #include <umockdev.h>
 #include <vector>
@@ -22,6 +20,7 @@
 #include "gpubridge/usb/emu/reference_target.hpp"
 #include "gpubridge/usb/hidapi_transport.hpp"
 #include "test_profiles.hpp"
+#include "umockdev_urbs.hpp"
 
 namespace gpubridge::usb {
 namespace {
@@ -45,19 +44,12 @@ struct HidBed {
   emu::Mcp2210Model model{&slave, "EMUHID01"};
   UMockdevTestbed* testbed = nullptr;
   UMockdevIoctlBase* handler = nullptr;
-  std::deque<UMockdevIoctlData*> in_flight, done, discarded;
-  std::atomic<bool> unplugged{false};       // set by the test: every URB fails with ENODEV
+  testing::UrbQueue urbs;                // the interrupt IN URB hidapi keeps queued stays in `flying`
+  std::atomic<bool> unplugged{false};    // set by the test: every URB fails with ENODEV
   std::atomic<unsigned> reports_out{0}, reports_in{0}, string_requests{0};
 
   static gboolean on_ioctl(UMockdevIoctlBase*, UMockdevIoctlClient* client, gpointer self) {
     return static_cast<HidBed*>(self)->handle(client);
-  }
-  static usbdevfs_urb& urb_of(UMockdevIoctlData* d) { return *reinterpret_cast<usbdevfs_urb*>(d->data); }
-
-  void finish(UMockdevIoctlData* d, int status, std::size_t length) {
-    urb_of(d).status = status;
-    urb_of(d).actual_length = static_cast<int>(length);
-    done.push_back(d);
   }
 
   // Standard GET_DESCRIPTOR (strings) is all hidapi asks of endpoint 0 here.
@@ -68,46 +60,40 @@ struct HidBed {
       const auto d = string_descriptor(setup[2]);
       const std::size_t n = std::min(len, d.size());
       std::memcpy(setup + 8, d.data(), n);
-      return finish(urb_data, 0, n);
+      return urbs.finish(urb_data, 0, n);
     }
-    finish(urb_data, -EPIPE, 0);  // anything else stalls, as an MCP2210 would for unknown requests
+    urbs.finish(urb_data, -EPIPE, 0);  // anything else stalls, as an MCP2210 would for unknown requests
   }
 
+  // The interrupt IN URB completes when the model has a response report (or the device is gone).
   void advance() {
-    if (in_flight.empty()) return;
-    UMockdevIoctlData* urb_data = in_flight.front();
+    if (urbs.flying.empty()) return;
+    if (unplugged) {
+      while (!urbs.flying.empty()) urbs.finish_flying(urbs.flying.begin(), -ENODEV, 0);
+      return;
+    }
     std::uint8_t report[64];
     const int n = model.read(report, 0);
-    if (n < 0) {
-      in_flight.pop_front();
-      return finish(urb_data, -ENODEV, 0);
-    }
+    if (n < 0) return urbs.finish_flying(urbs.flying.begin(), -ENODEV, 0);
     if (n == 0) return;  // NAK: stays in flight
-    in_flight.pop_front();
-    usbdevfs_urb& urb = urb_of(urb_data);
+    UMockdevIoctlData* urb_data = urbs.flying.front();
+    const usbdevfs_urb& urb = testing::UrbQueue::urb_of(urb_data);
     UMockdevIoctlData* buf = umockdev_ioctl_data_resolve(urb_data, G_STRUCT_OFFSET(usbdevfs_urb, buffer),
                                                           static_cast<gsize>(urb.buffer_length), nullptr);
     const std::size_t len = std::min<std::size_t>(static_cast<std::size_t>(n), static_cast<std::size_t>(buf->data_len));
     std::memcpy(buf->data, report, len);
     umockdev_ioctl_data_unref(buf);
     ++reports_in;
-    finish(urb_data, 0, len);
+    urbs.finish_flying(urbs.flying.begin(), 0, len);
   }
 
   gboolean handle(UMockdevIoctlClient* client) {
     const unsigned long request = umockdev_ioctl_client_get_request(client);
     UMockdevIoctlData* arg = umockdev_ioctl_client_get_arg(client);
     switch (request) {
-      case USBDEVFS_GET_CAPABILITIES: {
-        UMockdevIoctlData* d = umockdev_ioctl_data_resolve(arg, 0, sizeof(guint32), nullptr);
-        *reinterpret_cast<guint32*>(d->data) = USBDEVFS_CAP_BULK_CONTINUATION | USBDEVFS_CAP_NO_PACKET_SIZE_LIM |
-                                               USBDEVFS_CAP_REAP_AFTER_DISCONNECT | USBDEVFS_CAP_ZERO_PACKET;
-        umockdev_ioctl_data_unref(d);
-        umockdev_ioctl_client_complete(client, 0, 0);
-        return TRUE;
-      }
-      case USBDEVFS_GETDRIVER:  // no usbhid bound
-        umockdev_ioctl_client_complete(client, -1, ENODATA);
+      case USBDEVFS_GET_CAPABILITIES:
+        testing::UrbQueue::capabilities(client, arg, USBDEVFS_CAP_BULK_CONTINUATION | USBDEVFS_CAP_NO_PACKET_SIZE_LIM |
+                                                         USBDEVFS_CAP_REAP_AFTER_DISCONNECT | USBDEVFS_CAP_ZERO_PACKET);
         return TRUE;
       case USBDEVFS_CLAIMINTERFACE:
       case USBDEVFS_RELEASEINTERFACE:
@@ -122,7 +108,7 @@ struct HidBed {
           return TRUE;
         }
         UMockdevIoctlData* urb_data = umockdev_ioctl_data_resolve(arg, 0, sizeof(usbdevfs_urb), nullptr);
-        usbdevfs_urb& urb = urb_of(urb_data);
+        const usbdevfs_urb& urb = testing::UrbQueue::urb_of(urb_data);
         UMockdevIoctlData* buf =
             umockdev_ioctl_data_resolve(urb_data, G_STRUCT_OFFSET(usbdevfs_urb, buffer), static_cast<gsize>(urb.buffer_length), nullptr);
         auto* bytes = reinterpret_cast<std::uint8_t*>(buf->data);
@@ -134,57 +120,18 @@ struct HidBed {
           report.insert(report.end(), bytes, bytes + urb.buffer_length);
           ++reports_out;
           const int w = model.write(report);
-          finish(urb_data, w < 0 ? -ENODEV : 0, w < 0 ? 0 : static_cast<std::size_t>(urb.buffer_length));
+          urbs.finish(urb_data, w < 0 ? -ENODEV : 0, w < 0 ? 0 : static_cast<std::size_t>(urb.buffer_length));
         } else if (urb.type == USBDEVFS_URB_TYPE_INTERRUPT && urb.endpoint == 0x81) {
-          in_flight.push_back(urb_data);
+          urbs.flying.push_back(urb_data);
         } else {
-          finish(urb_data, -EPIPE, 0);
+          urbs.finish(urb_data, -EPIPE, 0);
         }
         umockdev_ioctl_data_unref(buf);
         umockdev_ioctl_client_complete(client, 0, 0);
         return TRUE;
       }
-      case USBDEVFS_REAPURB:
-      case USBDEVFS_REAPURBNDELAY: {
-        if (unplugged)  // every URB still in flight fails
-          while (!in_flight.empty()) {
-            finish(in_flight.front(), -ENODEV, 0);
-            in_flight.pop_front();
-          }
-        if (done.empty() && discarded.empty()) advance();
-        UMockdevIoctlData* urb_data = nullptr;
-        if (!discarded.empty()) {
-          urb_data = discarded.front();
-          discarded.pop_front();
-          urb_of(urb_data).status = -ENOENT;
-        } else if (!done.empty()) {
-          urb_data = done.front();
-          done.pop_front();
-        } else {
-          umockdev_ioctl_client_complete(client, -1, EAGAIN);
-          return TRUE;
-        }
-        UMockdevIoctlData* ptr = umockdev_ioctl_data_resolve(arg, 0, sizeof(gpointer), nullptr);
-        umockdev_ioctl_data_set_ptr(ptr, 0, urb_data);
-        umockdev_ioctl_data_unref(ptr);
-        umockdev_ioctl_data_unref(urb_data);
-        umockdev_ioctl_client_complete(client, 0, 0);
-        return TRUE;
-      }
-      case USBDEVFS_DISCARDURB: {
-        const auto client_addr = reinterpret_cast<gulong>(*reinterpret_cast<void**>(arg->data));
-        for (auto it = in_flight.begin(); it != in_flight.end(); ++it) {
-          if ((*it)->client_addr != client_addr) continue;
-          discarded.push_back(*it);
-          in_flight.erase(it);
-          umockdev_ioctl_client_complete(client, 0, 0);
-          return TRUE;
-        }
-        umockdev_ioctl_client_complete(client, -1, EINVAL);
-        return TRUE;
-      }
       default:
-        return FALSE;
+        return urbs.handle_common(request, client, arg, [this] { advance(); }) ? TRUE : FALSE;
     }
   }
 
@@ -214,9 +161,7 @@ struct HidBed {
                                      nullptr);
   }
   ~HidBed() {
-    for (auto* d : in_flight) umockdev_ioctl_data_unref(d);
-    for (auto* d : done) umockdev_ioctl_data_unref(d);
-    for (auto* d : discarded) umockdev_ioctl_data_unref(d);
+    urbs.clear();
     g_clear_object(&handler);
     g_clear_object(&testbed);
   }
