@@ -74,6 +74,9 @@ TEST(BoardProfiles, StreamReadsIsAnFtdiSwitchDefaultingOn) {
   auto bad = parse_board_profile(ch341, "ch.json");
   ASSERT_FALSE(bad);
   EXPECT_NE(bad.error().message.find("ch.json: bridge.stream_reads"), std::string::npos) << bad.error().message;
+  std::string ch341_on = ch341;
+  ch341_on.replace(ch341_on.find("false"), 5, "true");
+  EXPECT_FALSE(parse_board_profile(ch341_on, "ch.json")) << "the key belongs to FTDI profiles whatever its value";
 }
 
 // Found by fuzz_board_profile: a number literal beyond double's range makes nlohmann::json throw

@@ -189,9 +189,9 @@ Result<BoardProfile> parse_board_profile(std::string_view text, const std::strin
   else if (edge == "falling") p.read_edge = ReadEdge::Falling;
   else return b.fail("read_edge", "expected \"rising\" or \"falling\"");
   TRY_SET(p.latency_ms, b.uint("latency_ms", 1, 255, 1));
+  const bool ftdi = p.chip == BridgeChip::FT232H || p.chip == BridgeChip::FT2232H || p.chip == BridgeChip::FT4232H;
+  if (!ftdi && b.get("stream_reads")) return b.fail("stream_reads", "only FTDI MPSSE streams reads; remove the key for this chip");
   TRY_SET(p.stream_reads, b.boolean("stream_reads", true));
-  if (!p.stream_reads && p.chip != BridgeChip::FT232H && p.chip != BridgeChip::FT2232H && p.chip != BridgeChip::FT4232H)
-    return b.fail("stream_reads", "only FTDI MPSSE streams reads; remove the key for this chip");
   if (auto r = b.no_unknown_keys(); !r) return r.error();
 
   const json* dev = top.get("device");
