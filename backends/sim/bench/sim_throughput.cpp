@@ -2,7 +2,8 @@
 // sheet (section 5.3): 640x480 RGBA8888 + Z, N random Gouraud triangles of fixed area, depth test
 // LESS, "front" order (every pixel passes and writes colour + Z). Frames are encoded before the
 // clock starts; the timed part is command decode + setup + rasterisation (Device::write).
-// Usage: sim_throughput [--threads N] [--repeat R] [--only 10|1000|50000] [--random-z] [--tri-mode WORD] [--accuracy KNOB=VALUE ...]
+// Usage: sim_throughput [--threads N] [--repeat R] [--only 10|1000|50000] [--random-z] [--format rgba8888|rgb565|rgba2222]
+//                       [--scalar] [--tri-mode WORD] [--accuracy KNOB=VALUE ...]
 // The last column is a CRC of video memory after the run: it must not change when the code gets faster.
 #include <algorithm>
 #include <chrono>
@@ -33,10 +34,10 @@ double cpu_seconds() {
 }
 
 std::vector<std::uint8_t> make_scene(unsigned count, double area, std::uint32_t seed, bool random_z,
-                                     std::uint64_t tri_mode) {
+                                     std::uint64_t tri_mode, unsigned format) {
   std::vector<std::uint8_t> out;
   auto put = [&](Reg r, std::uint64_t d) { protocol::append(out, protocol::write_frame(r, d)); };
-  put(Reg::FB_FORMAT, (480ull << 16) | 640);
+  put(Reg::FB_FORMAT, (std::uint64_t{format} << 32) | (480ull << 16) | 640);
   put(Reg::FB_DRAW, 0);
   put(Reg::FB_Z, 0x200000);
   put(Reg::CLEAR, 0);
@@ -71,10 +72,19 @@ int main(int argc, char** argv) {
   std::string only;  // "10", "1000" or "50000": run one workload
   std::uint64_t tri_mode = 1 | 4 | (1u << 3) | (1u << 6);  // Gouraud, Z test LESS, Z write (--tri-mode to change)
   bool random_z = false;  // --random-z: random depth per triangle (most pixels fail LESS) instead of front to back
+  unsigned format = 0;    // --format rgba8888|rgb565|rgba2222: the framebuffer's pixel format (FB_FORMAT.FORMAT)
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--threads") && i + 1 < argc) opt.threads = static_cast<unsigned>(std::atoi(argv[++i]));
     else if (!std::strcmp(argv[i], "--only") && i + 1 < argc) only = argv[++i];
     else if (!std::strcmp(argv[i], "--random-z")) random_z = true;
+    else if (!std::strcmp(argv[i], "--scalar")) opt.vector_routines = false;  // the reference routines only
+    else if (!std::strcmp(argv[i], "--format") && i + 1 < argc) {
+      const std::string f = argv[++i];
+      if (f == "rgba8888") format = 0;
+      else if (f == "rgb565") format = 1;
+      else if (f == "rgba2222") format = 2;
+      else return std::fprintf(stderr, "sim_throughput: --format %s: expected rgba8888, rgb565 or rgba2222\n", f.c_str()), 2;
+    }
     else if (!std::strcmp(argv[i], "--tri-mode") && i + 1 < argc) tri_mode = std::strtoull(argv[++i], nullptr, 0);
     else if (!std::strcmp(argv[i], "--repeat") && i + 1 < argc) repeat = static_cast<unsigned>(std::atoi(argv[++i]));
     else if (!std::strcmp(argv[i], "--accuracy") && i + 1 < argc) {
@@ -83,7 +93,7 @@ int main(int argc, char** argv) {
         return 2;
       }
     } else {
-      std::fprintf(stderr, "usage: sim_throughput [--threads N] [--repeat R] [--only 10|1000|50000] [--random-z] [--tri-mode WORD] [--accuracy KNOB=VALUE]...\n");
+      std::fprintf(stderr, "usage: sim_throughput [--threads N] [--repeat R] [--only 10|1000|50000] [--random-z] [--format F] [--scalar] [--tri-mode WORD] [--accuracy KNOB=VALUE]...\n");
       return 2;
     }
   }
@@ -92,13 +102,14 @@ int main(int argc, char** argv) {
     unsigned count;
     double area;
   } const works[] = {{"10 px", 500000, 10}, {"1000 px", 50000, 1000}, {"50000 px", 2000, 50000}};
-  std::printf("threads %u, accuracy %s\n", opt.threads, sim::to_string(opt.accuracy).c_str());
+  std::printf("threads %u, accuracy %s, format %s, %s routines\n", opt.threads, sim::to_string(opt.accuracy).c_str(),
+              format == 0 ? "rgba8888" : format == 1 ? "rgb565" : "rgba2222", opt.vector_routines ? "vector" : "scalar");
   std::printf("Wall-clock rates; cpu columns are process CPU time (all threads) per unit.\n");
   std::printf("| workload | triangles | Mtri/s | Mpix/s | ns/tri | ns/px | cpu ns/tri | cpu ns/px | memory CRC |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|\n");
   for (const auto& w : works) {
     if (!only.empty() && std::to_string(static_cast<int>(w.area)) != only) continue;
-    const auto frames = make_scene(w.count, w.area, 1, random_z, tri_mode);
+    const auto frames = make_scene(w.count, w.area, 1, random_z, tri_mode, format);
     double best = 1e30, best_cpu = 1e30;
     std::uint64_t pixels = 0;
     std::uint32_t crc = 0;

@@ -1,5 +1,6 @@
 #include "narrow_simd.hpp"
 
+#include "packed_lanes.hpp"
 #include "simd_lanes.hpp"
 #include "texture8.hpp"
 
@@ -17,7 +18,7 @@ using simd::u32x8;
   } while (0)
 
 // One instance per plane count (constant loop bounds keep the lanes in registers).
-template <bool kTextured>
+template <bool kTextured, unsigned kFormat>
 [[gnu::always_inline]] inline NarrowCounts shade_narrow(const NarrowTriangle& t) {
   const i32x8 lane = {0, 1, 2, 3, 4, 5, 6, 7};
   const u32x8 in_box = GB_MASK(lane < static_cast<std::int32_t>(t.width));
@@ -64,13 +65,19 @@ template <bool kTextured>
     u32x8 word = u32x8{} + t.flat;
     if (t.gouraud) word = (q[0] & 255u) | ((q[1] & 255u) << 8) | ((q[2] & 255u) << 16) | (q[3] << 24);
     if constexpr (kTextured) word = texture8(t.texture, q[5], q[6], q[7], pass, 8, word);
-    u32x8 cold;
-    GB_LOAD8(cold, cp);
-    if (t.blend != 0) word = GB_BLEND8(t.blend, word, cold);
-    word = (word & ~t.keep) | (cold & t.keep);
-    const u32x8 out = (word & pass) | (cold & ~pass);
-    GB_STORE8(cp, out);
-    cp += t.pitch;
+    if constexpr (kFormat != 0) {
+      u32x8 bayer;
+      GB_LOAD8(bayer, t.bayer[row & 3]);
+      simd::write_packed8<kFormat>(cp, 8, word, pass, true, t.blend, bayer, t.keep_packed);
+    } else {
+      u32x8 cold;
+      GB_LOAD8(cold, cp);
+      if (t.blend != 0) word = GB_BLEND8(t.blend, word, cold);
+      word = (word & ~t.keep) | (cold & t.keep);
+      const u32x8 out = (word & pass) | (cold & ~pass);
+      GB_STORE8(cp, out);
+    }
+    cp += t.colour_pitch;
     covered -= cov;  // mask lanes are all ones (−1)
     passed -= pass;
     for (unsigned i = 0; i < 3; ++i) e[i] += t.ey[i];
@@ -92,7 +99,11 @@ template <bool kTextured>
 }  // namespace
 
 __attribute__((target_clones("avx2", "default"))) NarrowCounts shade_narrow_simd(const NarrowTriangle& t) {
-  return t.texture.tex ? shade_narrow<true>(t) : shade_narrow<false>(t);
+  switch (t.format) {
+    case 1: return t.texture.tex ? shade_narrow<true, 1>(t) : shade_narrow<false, 1>(t);
+    case 2: return t.texture.tex ? shade_narrow<true, 2>(t) : shade_narrow<false, 2>(t);
+    default: return t.texture.tex ? shade_narrow<true, 0>(t) : shade_narrow<false, 0>(t);
+  }
 }
 
 }  // namespace gpubridge::sim

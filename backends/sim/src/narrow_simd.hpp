@@ -33,7 +33,11 @@ struct NarrowTriangle {
   std::uint32_t zmask = 0xFFFFFF;
   std::uint8_t* colour = nullptr;  // first pixel of the first row
   std::uint8_t* depth = nullptr;   // its depth word (when z_test or z_write)
-  std::size_t pitch = 0;           // bytes per framebuffer row (colour and depth alike: 4 per pixel)
+  std::size_t pitch = 0;           // bytes per depth row (4 per pixel)
+  std::size_t colour_pitch = 0;    // bytes per colour row (4, 2 or 1 per pixel)
+  unsigned format = 0;             // protocol::PixelFormat of the colour buffer
+  std::uint32_t keep_packed = 0;   // packed formats: the stored bits the write mask keeps
+  std::uint32_t bayer[4][8] = {};  // packed formats with dither: Bayer value of row (first + j) % 4, lane k
   unsigned z_func = 0;             // protocol::DepthFunc
   unsigned blend = 0;              // protocol::BlendMode (0 = off)
   std::uint32_t keep = 0;          // bytes of the colour word the write mask keeps

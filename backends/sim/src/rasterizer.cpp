@@ -37,6 +37,20 @@ std::uint32_t keep_bytes(std::uint8_t keep_mask) {
   return bytes;
 }
 
+// The bits of a packed pixel (RGB565, RGBA2222) that TRI_MODE's write mask keeps; 0 for RGBA8888.
+std::uint32_t keep_packed_bits(protocol::PixelFormat f, std::uint8_t keep_mask) {
+  std::uint32_t bits = 0;
+  if (f == protocol::PixelFormat::RGB565) {
+    if (keep_mask & 1) bits |= 0xF800;
+    if (keep_mask & 2) bits |= 0x07E0;
+    if (keep_mask & 4) bits |= 0x001F;
+  } else if (f == protocol::PixelFormat::RGBA2222) {
+    for (unsigned c = 0; c < 4; ++c)
+      if (keep_mask & (1u << c)) bits |= 3u << (6 - 2 * c);
+  }
+  return bits;
+}
+
 // Rows this long or longer find their covered span by division instead of testing every pixel.
 constexpr int kSpanSolveWidth = 16;
 // Jumps along a span shorter than this are stepped instead of divided.
@@ -184,8 +198,9 @@ class Kernel {
     }
   }
 
-  // The vector routine applies to RGBA8888 stores (blend and write mask included) with both
-  // buffers inside VRAM and disjoint (it tests eight depths before it writes eight colours), a
+  // The span vector routine applies to stores in any pixel format (blend, dither and write mask
+  // included; the small-triangle one to RGBA8888 only) with both buffers inside VRAM and
+  // disjoint (it tests eight depths before it writes eight colours), a
   // texture inside VRAM and disjoint from both (it samples eight texels before it writes), the
   // exact texel arithmetic (not the `fast` knob), and 2·den < 2^31 so remainders fit signed
   // 32-bit lanes. Quotients are kept modulo 2^32, which is all any consumer reads (the low 32
@@ -198,7 +213,7 @@ class Kernel {
     return simd_;
   }
   void prepare_simd() {
-    if (st_.fb_format != protocol::PixelFormat::RGBA8888 || !st_.color_in_vram || skip_colour_) return;
+    if (!st_.color_in_vram || skip_colour_) return;
     if (kDepth && (!st_.z_in_vram || !st_.buffers_disjoint)) return;
     if (kTextured && (ctx_.fast || !tex_.direct() || !texture_disjoint(st_, kDepth))) return;
     if (t_.den >= (std::int64_t{1} << 30)) return;
@@ -235,6 +250,8 @@ class Kernel {
     simd_tpl_.z_func = static_cast<unsigned>(st_.z_func);
     simd_tpl_.blend = static_cast<unsigned>(st_.blend);
     simd_tpl_.keep = keep_bytes(st_.keep_mask);
+    simd_tpl_.format = static_cast<unsigned>(st_.fb_format);
+    simd_tpl_.keep_packed = keep_packed_bits(st_.fb_format, st_.keep_mask);
     if (kTextured) simd_tpl_.texture = {&tex_, &ctx_.recip, q_const_, const_rc_, st_.tex.wl, st_.tex.hl, st_.decal};
     simd_ = true;
   }
@@ -243,10 +260,10 @@ class Kernel {
   // Rows two ahead are fetched while this one is drawn (random triangles miss the caches).
   void prefetch_row(int y, int x, int count) const {
     const std::size_t pix = static_cast<std::size_t>(y) * width_ + static_cast<std::size_t>(x);
-    for (int b = 0; b < count * 4; b += 64) {
-      __builtin_prefetch(color_ + pix * 4 + static_cast<std::size_t>(b), 1);
-      if (kDepth) __builtin_prefetch(zbuf_ + pix * 4 + static_cast<std::size_t>(b), 1);
-    }
+    const std::size_t colour_bytes = static_cast<std::size_t>(count) * st_.bpp, depth_bytes = static_cast<std::size_t>(count) * 4;
+    for (std::size_t b = 0; b < colour_bytes; b += 64) __builtin_prefetch(color_ + pix * st_.bpp + b, 1);
+    if (kDepth)
+      for (std::size_t b = 0; b < depth_bytes; b += 64) __builtin_prefetch(zbuf_ + pix * 4 + b, 1);
   }
 
   void simd_span(const Steppers& s, int x, int y, unsigned count) {
@@ -257,7 +274,9 @@ class Kernel {
       sp.r0[p] = used ? static_cast<std::uint32_t>(s.r[kR + p]) : 0;
     }
     const std::size_t pix = static_cast<std::size_t>(y) * width_ + static_cast<std::size_t>(x);
-    sp.colour = color_ + pix * 4;
+    sp.colour = color_ + pix * st_.bpp;
+    if (st_.dither && st_.fb_format != protocol::PixelFormat::RGBA8888)
+      for (unsigned k = 0; k < 8; ++k) sp.bayer[k] = kBayer4[y & 3][(static_cast<unsigned>(x) + k) & 3];
     sp.depth = kDepth ? zbuf_ + pix * 4 : nullptr;
     sp.count = count;
     const std::uint64_t passed = shade_span_simd(sp);
@@ -388,7 +407,8 @@ bool draw_narrow(const Triangle& t, const DrawState& st, RasterContext& ctx, int
   NarrowTriangle n;
   // Every channel masked (with a Z write, or the draw would have been dropped): the colour stage,
   // texture and blend included, does not run, as in the scalar routine.
-  const bool colour_stage = (st.keep_mask & 0xF) != 0xF;
+  const std::uint8_t stored = st.fb_format == protocol::PixelFormat::RGB565 ? 0x7 : 0xF;  // RGB565 has no alpha
+  const bool colour_stage = (st.keep_mask & stored) != stored;
   const bool textured = st.textured && colour_stage;
   std::optional<TextureUnit> unit;  // built only for textured draws (this is the 10-px hot path)
   if (textured) {
@@ -427,9 +447,16 @@ bool draw_narrow(const Triangle& t, const DrawState& st, RasterContext& ctx, int
            (std::uint32_t{t.flat[3]} << 24);
   n.zmask = ctx.z_bits >= 24 ? 0xFFFFFFu : 0xFFFFFFu & ~((1u << (24 - ctx.z_bits)) - 1);
   const std::size_t pix = static_cast<std::size_t>(ya) * st.fb_width + static_cast<std::size_t>(t.x0);
-  n.colour = ctx.mem.data() + st.fb_draw + pix * 4;
+  n.colour = ctx.mem.data() + st.fb_draw + pix * st.bpp;
   n.depth = depth ? ctx.mem.data() + st.fb_z + pix * 4 : nullptr;
   n.pitch = std::size_t{st.fb_width} * 4;
+  n.colour_pitch = std::size_t{st.fb_width} * st.bpp;
+  n.format = static_cast<unsigned>(st.fb_format);
+  n.keep_packed = keep_packed_bits(st.fb_format, st.keep_mask);
+  if (st.dither && st.fb_format != protocol::PixelFormat::RGBA8888)
+    for (unsigned j = 0; j < 4; ++j)
+      for (unsigned lane = 0; lane < 8; ++lane)
+        n.bayer[j][lane] = kBayer4[(static_cast<unsigned>(ya) + j) & 3][(static_cast<unsigned>(t.x0) + lane) & 3];
   n.z_func = static_cast<unsigned>(st.z_func);
   n.gouraud = gouraud;
   n.z_test = st.z_test;
@@ -457,8 +484,7 @@ void rasterize_rows(const Triangle& t, const DrawState& st, RasterContext& ctx, 
   for (unsigned ch = 0; ch < 4; ++ch) colours_differ |= !t.plane[kR + ch].constant;
   const bool gouraud = st.gouraud && colours_differ;  // Gouraud only when colours differ
   const bool depth = st.z_test || st.z_write;
-  const bool rgba8888 = st.fb_format == protocol::PixelFormat::RGBA8888;
-  if (ctx.vector && rgba8888 && draw_narrow(t, st, ctx, ya, yz, gouraud, depth)) return;
+  if (ctx.vector && draw_narrow(t, st, ctx, ya, yz, gouraud, depth)) return;
   const unsigned key = (gouraud ? 1u : 0u) | (st.textured ? 2u : 0u) | (depth ? 4u : 0u) | (st.simple_color ? 8u : 0u);
   kKernels[key](t, st, ctx, ya, yz);
 }

@@ -1,5 +1,6 @@
 #include "span_simd.hpp"
 
+#include "packed_lanes.hpp"
 #include "simd_lanes.hpp"
 #include "texture8.hpp"
 
@@ -29,8 +30,9 @@ using simd::u32x8;
 
 // One instance per plane count, so the plane loops have constant bounds and the lanes stay in
 // registers (a run-time bound cost the untextured spans 5-15%).
-template <bool kTextured>
+template <bool kTextured, unsigned kFormat>
 [[gnu::always_inline]] inline std::uint64_t shade_span(const SimdSpan& s) {
+  constexpr unsigned kBpp = kFormat == 0 ? 4 : kFormat == 1 ? 2 : 1;
   constexpr unsigned kUsed = kTextured ? 8 : 5;
   u32x8 q[kUsed], r[kUsed];
   const unsigned first = s.gouraud ? 0 : 4;
@@ -47,12 +49,14 @@ template <bool kTextured>
   }
   const u32x8 lane = {0, 1, 2, 3, 4, 5, 6, 7};
   const bool depth = s.z_test || s.z_write;
-  const bool reads_colour = s.blend != 0 || s.keep != 0;
+  const bool reads_colour = s.blend != 0 || (kFormat == 0 ? s.keep : s.keep_packed) != 0;
+  u32x8 bayer = {};
+  if constexpr (kFormat != 0) GB_LOAD8(bayer, s.bayer);
   u32x8 passed = {};
   for (unsigned i = 0; i < s.count; i += 8) {
     const unsigned n = s.count - i < 8 ? s.count - i : 8;
     u32x8 pass = GB_MASK((i32x8)lane < static_cast<std::int32_t>(n));
-    std::uint8_t* cp = s.colour + std::size_t{i} * 4;
+    std::uint8_t* cp = s.colour + std::size_t{i} * kBpp;
     bool none = false, all = n == 8;
     if (depth) {
       std::uint8_t* zp = s.depth + std::size_t{i} * 4;
@@ -78,7 +82,9 @@ template <bool kTextured>
       u32x8 word = u32x8{} + s.flat;
       if (s.gouraud) word = (q[0] & 255u) | ((q[1] & 255u) << 8) | ((q[2] & 255u) << 16) | (q[3] << 24);
       if constexpr (kTextured) word = texture8(s.texture, q[5], q[6], q[7], pass, n, word);
-      if (reads_colour || !all) {
+      if constexpr (kFormat != 0) {
+        simd::write_packed8<kFormat>(cp, n, word, pass, reads_colour || !all, s.blend, bayer, s.keep_packed);
+      } else if (reads_colour || !all) {
         u32x8 cold;
         GB_LOAD_N(cold, cp, n);
         if (s.blend != 0) word = GB_BLEND8(s.blend, word, cold);
@@ -104,7 +110,11 @@ template <bool kTextured>
 }
 
 __attribute__((target_clones("avx2", "default"))) std::uint64_t shade_span_simd(const SimdSpan& s) {
-  return s.texture.tex ? shade_span<true>(s) : shade_span<false>(s);
+  switch (s.format) {
+    case 1: return s.texture.tex ? shade_span<true, 1>(s) : shade_span<false, 1>(s);
+    case 2: return s.texture.tex ? shade_span<true, 2>(s) : shade_span<false, 2>(s);
+    default: return s.texture.tex ? shade_span<true, 0>(s) : shade_span<false, 0>(s);
+  }
 }
 
 }  // namespace gpubridge::sim

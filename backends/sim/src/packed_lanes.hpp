@@ -1,0 +1,91 @@
+#pragma once
+// Section 11 for eight pixels of a packed colour buffer (RGB565 big-endian halfwords, RGBA2222
+// bytes), shared by both vector routines (span_simd.cpp, narrow_simd.cpp): blend against the
+// stored pixels expanded by bit replication, quantise with the lanes' ordered dither, keep the
+// bits the write mask protects, store the passing lanes. Byte for byte what pixel.hpp's
+// store_colour() does per pixel (the vector equivalence tests compare them). Internal to those
+// routines' .cpp files: it is inlined into their target clones.
+#include <cstdint>
+#include <cstring>
+
+#include "simd_lanes.hpp"
+
+namespace gpubridge::sim::simd {
+
+typedef std::uint16_t u16x8 __attribute__((vector_size(16)));
+typedef std::uint8_t u8x8 __attribute__((vector_size(8)));
+
+// The first n stored pixels at p (later lanes 0).
+template <unsigned kFormat>
+[[gnu::always_inline]] inline u32x8 load_packed(const std::uint8_t* p, unsigned n) {
+  if constexpr (kFormat == 1) {
+    u16x8 h = {};
+    std::memcpy(&h, p, std::size_t{n} * 2);
+    const u32x8 v = __builtin_convertvector(h, u32x8);
+    return ((v & 0xFFu) << 8) | (v >> 8);  // big-endian in video memory
+  } else {
+    u8x8 b = {};
+    std::memcpy(&b, p, n);
+    return __builtin_convertvector(b, u32x8);
+  }
+}
+
+template <unsigned kFormat>
+[[gnu::always_inline]] inline void store_packed(std::uint8_t* p, u32x8 v, unsigned n) {
+  if constexpr (kFormat == 1) {
+    const u16x8 h = __builtin_convertvector(((v & 0xFFu) << 8) | ((v >> 8) & 0xFFu), u16x8);
+    std::memcpy(p, &h, std::size_t{n} * 2);
+  } else {
+    const u8x8 b = __builtin_convertvector(v, u8x8);
+    std::memcpy(p, &b, n);
+  }
+}
+
+// Stored pixels as colour words (byte c = channel c), channels widened by bit replication.
+template <unsigned kFormat>
+[[gnu::always_inline]] inline u32x8 expand_packed(u32x8 v) {
+  if constexpr (kFormat == 1) {
+    const u32x8 r = v >> 11, g = (v >> 5) & 63u, b = v & 31u;
+    return ((r << 3) | (r >> 2)) | (((g << 2) | (g >> 4)) << 8) | (((b << 3) | (b >> 2)) << 16) | (255u << 24);
+  } else {
+    return ((v >> 6) & 3u) * 0x55u | (((v >> 4) & 3u) * 0x55u) << 8 | (((v >> 2) & 3u) * 0x55u) << 16 |
+           ((v & 3u) * 0x55u) << 24;
+  }
+}
+
+// 8-bit channel c of `word` to n bits after adding the dither offset (saturating at 255).
+[[gnu::always_inline]] inline u32x8 quantise8(u32x8 word, unsigned c, unsigned n, u32x8 add) {
+  u32x8 v = ((word >> c) & 255u) + add;
+  const u32x8 over = GB_MASK(v > 255u);
+  v = (v & ~over) | (255u & over);
+  return v >> (8 - n);
+}
+
+// Colour words to packed pixels; `bayer` holds each lane's 4x4 Bayer value (0 without dither),
+// scaled per channel width as (bayer << (8 - n)) >> 4.
+template <unsigned kFormat>
+[[gnu::always_inline]] inline u32x8 pack_colour(u32x8 word, u32x8 bayer) {
+  if constexpr (kFormat == 1) {
+    const u32x8 add5 = bayer >> 1, add6 = bayer >> 2;
+    return (quantise8(word, 0, 5, add5) << 11) | (quantise8(word, 8, 6, add6) << 5) | quantise8(word, 16, 5, add5);
+  } else {
+    const u32x8 add2 = bayer << 2;
+    return (quantise8(word, 0, 2, add2) << 6) | (quantise8(word, 8, 2, add2) << 4) | (quantise8(word, 16, 2, add2) << 2) |
+           quantise8(word, 24, 2, add2);
+  }
+}
+
+// The whole colour write of n pixels at p. `need_old`: the stored pixels matter (blend, write
+// mask, or lanes that do not pass); without it nothing is read.
+template <unsigned kFormat>
+[[gnu::always_inline]] inline void write_packed8(std::uint8_t* p, unsigned n, u32x8 word, u32x8 pass, bool need_old,
+                                                 unsigned blend, u32x8 bayer, std::uint32_t keep_bits) {
+  const u32x8 old = need_old ? load_packed<kFormat>(p, n) : u32x8{};
+  if (blend != 0) word = GB_BLEND8(blend, word, expand_packed<kFormat>(old));
+  u32x8 out = pack_colour<kFormat>(word, bayer);
+  out = (out & ~keep_bits) | (old & keep_bits);
+  out = (out & pass) | (old & ~pass);
+  store_packed<kFormat>(p, out, n);
+}
+
+}  // namespace gpubridge::sim::simd
