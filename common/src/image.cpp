@@ -11,12 +11,25 @@
 namespace gpubridge {
 namespace {
 
-Result<Image> decode_with(png_image& img, const std::string& name) {
+// Most RGBA bytes one byte of PNG data can decode to: deflate expands at most 1032:1 and a 1-bit
+// pixel becomes 4 RGBA bytes (32:1), so no valid PNG comes near 65536:1.
+constexpr std::uint64_t kMaxExpansion = 1u << 16;
+
+// png_bytes: size of the PNG data (0 = unknown, no plausibility check).
+Result<Image> decode_with(png_image& img, const std::string& name, std::uint64_t png_bytes) {
+  const std::string dims = std::to_string(img.width) + "x" + std::to_string(img.height);
   if (img.width == 0 || img.height == 0 || img.width > kMaxImageDim || img.height > kMaxImageDim) {
-    const std::string dims = std::to_string(img.width) + "x" + std::to_string(img.height);
     png_image_free(&img);
     return make_error(name + ": image is " + dims + "; gpubridge accepts 1.." + std::to_string(kMaxImageDim) +
                       " pixels per side");
+  }
+  // The header alone must not buy a huge allocation: a 20-byte file claiming 16384x16384 pixels
+  // made us allocate and clear 1 GiB before libpng found the data missing (found with fuzz_png).
+  const std::uint64_t rgba_bytes = std::uint64_t{img.width} * img.height * 4;
+  if (png_bytes != 0 && rgba_bytes > png_bytes * kMaxExpansion) {
+    png_image_free(&img);
+    return make_error(name + ": the header says " + dims + " pixels but the file has only " + std::to_string(png_bytes) +
+                      " bytes, too few for that image; the PNG is truncated or corrupt");
   }
   img.format = PNG_FORMAT_RGBA;
   Image out;
@@ -42,7 +55,9 @@ Result<Image> load_png(const std::filesystem::path& path) {
     png_image_free(&img);
     return make_error(msg);
   }
-  return decode_with(img, path.string());
+  std::error_code ec;
+  const auto size = std::filesystem::file_size(path, ec);  // not a regular file (a pipe): no check
+  return decode_with(img, path.string(), ec ? 0 : size);
 }
 
 Result<Image> decode_png(std::span<const std::uint8_t> bytes, const std::string& name) {
@@ -54,7 +69,7 @@ Result<Image> decode_png(std::span<const std::uint8_t> bytes, const std::string&
     png_image_free(&img);
     return make_error(msg);
   }
-  return decode_with(img, name);
+  return decode_with(img, name, bytes.size());
 }
 
 Result<void> save_png(const std::filesystem::path& path, const Image& img) {

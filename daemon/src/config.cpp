@@ -20,7 +20,11 @@ class Reader {
   Error fail(const std::string& key, const std::string& what) const {
     return make_error(source_ + ": " + key + ": " + what);
   }
+  // Containers are named, not dumped: dump() recurses once per nesting level, so a deeply nested
+  // value overflowed the stack while reporting its wrong type (a 200 KB input to fuzz_daemon_config).
   static std::string shown(const json& v) {
+    if (v.is_array()) return "an array";
+    if (v.is_object()) return "an object";
     std::string s = v.dump();
     return s.size() > 40 ? s.substr(0, 37) + "..." : s;
   }
@@ -124,7 +128,7 @@ Result<DaemonConfig> load_config(const std::filesystem::path& path) {
   json doc;
   try {
     doc = json::parse(in, nullptr, true, /*ignore_comments=*/true);
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {  // parse_error, or out_of_range for a number beyond double (1e999)
     return make_error(path.string() + ": not valid JSON: " + e.what());
   }
   return parse_config(doc, path.string());

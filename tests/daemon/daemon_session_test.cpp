@@ -1,7 +1,10 @@
 // In-process tests: configuration parsing and the session dispatch over an in-memory stream.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <filesystem>
+#include <fstream>
 
 #include <nlohmann/json.hpp>
 
@@ -64,6 +67,28 @@ TEST(DaemonConfig, ErrorsNameTheKeyAndTheProblem) {
     ASSERT_FALSE(cfg) << c.json;
     EXPECT_NE(cfg.error().message.find(c.message), std::string::npos) << cfg.error().message;
   }
+}
+
+// A number literal beyond double's range makes nlohmann::json throw out_of_range, not parse_error;
+// load_config caught only parse_error, so such a file terminated gpubridged (fuzz_board_profile
+// found it in the board profile reader, which read JSON the same way).
+TEST(DaemonConfig, NumberBeyondDoubleRangeIsAnError) {
+  const auto path = std::filesystem::temp_directory_path() / ("gpubridged-huge-" + std::to_string(::getpid()) + ".json");
+  std::ofstream(path) << R"({"reattach_interval_ms": 1e999})";
+  auto cfg = load_config(path);
+  std::filesystem::remove(path);
+  ASSERT_FALSE(cfg);
+  EXPECT_NE(cfg.error().message.find("not valid JSON"), std::string::npos) << cfg.error().message;
+}
+
+// A wrong-typed value is described by its type, not dumped: dump() recursed once per nesting level
+// and a deeply nested array overflowed the stack while the error was being written.
+TEST(DaemonConfig, DeeplyNestedWrongValueIsAnError) {
+  constexpr std::size_t kDepth = 200000;
+  const std::string text = "{\"token\": " + std::string(kDepth, '[') + std::string(kDepth, ']') + "}";
+  auto cfg = parse_config(nlohmann::json::parse(text), "c.json");
+  ASSERT_FALSE(cfg);
+  EXPECT_EQ(cfg.error().message, "c.json: token: expected a string, got an array");
 }
 
 TEST(DaemonConfig, NonLoopbackTcpWithoutTokenIsRefused) {

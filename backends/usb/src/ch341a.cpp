@@ -69,6 +69,10 @@ Result<void> Ch341aBridge::in(std::span<std::uint8_t> bytes) {
     ++stats_.usb_in_transfers;
     ++stats_.round_trips;
     stats_.usb_bytes_in += io.transferred;
+    if (io.transferred > bytes.size() - got)  // never trust a count beyond the buffer (found by fuzz_usb_bridges)
+      return make_error("CH341A: bulk IN reported " + std::to_string(io.transferred) + " bytes for " +
+                            std::to_string(bytes.size() - got) + " requested (USB transport fault)",
+                        backends::kDeviceProtocol);
     got += io.transferred;
     if (!io.ok()) return usb_error(io.status, "CH341A: bulk IN (" + std::to_string(got) + " of " + std::to_string(bytes.size()) + " bytes)");
   }

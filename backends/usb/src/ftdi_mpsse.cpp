@@ -22,6 +22,14 @@ constexpr std::size_t kMaxCommandBytes = 65536;
 // Status-only IN transfers tolerated while waiting for data (bounded polling of a stalled chip).
 constexpr unsigned kMaxEmptyTransfers = 4096;
 
+// A transport must never report more IN bytes than the buffer holds; trusting such a count read
+// past the buffer (found by fuzz_usb_bridges).
+Error over_long_in(const std::string& where, std::size_t transferred, std::size_t buffer) {
+  return make_error(where + ": bulk IN reported " + std::to_string(transferred) + " bytes for a " + std::to_string(buffer) +
+                        "-byte buffer (USB transport fault)",
+                    backends::kDeviceProtocol);
+}
+
 }  // namespace
 
 std::size_t ftdi_fifo_bytes(std::uint16_t bcd) {
@@ -121,6 +129,7 @@ Result<void> FtdiMpsseBridge::recover() {
     const UsbIo io = dev_.bulk_in(ep_in_, buf, cfg_.timeout_ms);
     ++stats_.usb_in_transfers;
     if (!io.ok()) return usb_error(io.status, where() + ": drain stale data");
+    if (io.transferred > buf.size()) return over_long_in(where(), io.transferred, buf.size());
     if (io.transferred <= 2) break;
   }
   const std::uint8_t setup[] = {kDisableDiv5, kDisableAdaptive, kDisable3Phase, kLoopbackOff, kSetBitsLow, idle_value_, direction_};
@@ -220,6 +229,7 @@ Result<void> FtdiMpsseBridge::read_exact(std::span<std::uint8_t> out) {
     }
     if (!io.ok()) return usb_error(io.status, where() + ": bulk IN (" + std::to_string(c.got) + " of " +
                                                   std::to_string(out.size()) + " bytes received)");
+    if (io.transferred > buf.size()) return over_long_in(where(), io.transferred, buf.size());
     if (auto r = collect_in(c, std::span<const std::uint8_t>(buf).first(io.transferred)); !r) return r.error();
   }
   return {};

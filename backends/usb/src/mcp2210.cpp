@@ -38,6 +38,9 @@ Result<std::array<std::uint8_t, 64>> Mcp2210Bridge::command(std::span<const std:
     ++stats_.usb_in_transfers;
     ++stats_.round_trips;
     if (r < 0) return make_error("MCP2210: HID read failed (" + dev_.last_error() + ")", backends::kDeviceGone);
+    if (r > static_cast<int>(in.size()))  // never trust a count beyond the buffer (found by fuzz_usb_bridges)
+      return make_error("MCP2210: HID read reported " + std::to_string(r) + " bytes for a 64-byte report (HID transport fault)",
+                        backends::kDeviceProtocol);
     if (r > 0) break;
     if (attempt >= 2) return make_error("MCP2210: no response report within " + std::to_string(3 * kReadTimeoutMs) + " ms",
                                         backends::kDeviceTimeout);
