@@ -1,11 +1,23 @@
 #!/usr/bin/env python3
 """Writes the seed corpora of the fuzz targets (tests/fuzz/corpus/<target>/). The byte layouts
 follow docs/protocol.md sections 17 and 18; rerun after a format change:
-    python3 tests/fuzz/make_corpus.py
+    python3 tests/fuzz/make_corpus.py [path/to/gpubridge]
+The scene, config and board profile seeds are copies of the shipped examples/configs plus a few
+hand-written ones; the PNG seeds are frames written by `gpubridge render` (the project's own PNG
+writer, when the CLI path is given) plus a few colour types it never writes (grey, palette,
+16-bit, interlaced) built here; the USB seeds are scripts for fuzz_usb_bridges.cpp that open each
+chip and run one write and one read transfer successfully.
 """
+import base64
+import glob
 import json
 import os
+import shutil
 import struct
+import subprocess
+import sys
+import tempfile
+import zlib
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 
@@ -102,7 +114,157 @@ def write(target, name, data):
         f.write(data if isinstance(data, bytes) else data.encode())
 
 
+ROOT = os.path.dirname(os.path.dirname(HERE))
+
+EXTRA_SCENES = {
+    "arrays_state.json": {
+        "framebuffer": {"width": 32, "height": 24, "format": "RGB565", "depth": True},
+        "clear": {"color": [0, 0, 0, 1], "depth": 1},
+        "draws": [
+            {"z_test": True, "z_write": True, "z_func": "LEQUAL", "cull": "back", "scissor": [1, 1, 30, 20],
+             "blend": "ADD", "dither": True, "write_mask": "rgb", "gouraud": False, "color": [0.5, 0.5, 0.5],
+             "vertices": [[0, 0, 0.5, 1], [31, 0, 0.5, 2, 1, 0, 0, 1], [0, 23, 0.25, 0.5, 0, 1, 0, 1, 0, 1]]},
+        ],
+    },
+}
+
+
+def png_chunk(kind, data):
+    return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF)
+
+
+def png(width, height, depth, color_type, rows, interlace=0, extra=b""):
+    """A PNG from already-packed rows (filter byte 0 is added here; interlaced data is passed whole)."""
+    ihdr = struct.pack(">IIBBBBB", width, height, depth, color_type, 0, 0, interlace)
+    raw = rows if interlace else b"".join(b"\x00" + r for r in rows)
+    return (b"\x89PNG\r\n\x1a\n" + png_chunk(b"IHDR", ihdr) + extra + png_chunk(b"IDAT", zlib.compress(raw))
+            + png_chunk(b"IEND", b""))
+
+
+def adam7_gray8(width, height):
+    """Interlaced 8-bit grey: the seven Adam7 passes, each with filter bytes."""
+    passes = [(0, 0, 8, 8), (4, 0, 8, 8), (0, 4, 4, 8), (2, 0, 4, 4), (0, 2, 2, 4), (1, 0, 2, 2), (0, 1, 1, 2)]
+    out = b""
+    for x0, y0, dx, dy in passes:
+        xs = range(x0, width, dx)
+        for y in range(y0, height, dy):
+            if len(xs):
+                out += b"\x00" + bytes((x * 16 + y * 8) & 0xFF for x in xs)
+    return out
+
+
+def synth(width, height, depth, color_type, interlace, palette, trns, raw):
+    return struct.pack(">HHBBBBB", width, height, depth, color_type, interlace, len(palette) // 3, len(trns)) \
+        + palette + trns + raw
+
+
+SYNTH_PNGS = {
+    "synth_rgb8_4x4": synth(4, 4, 8, 2, 0, b"", b"", b"".join(bytes([f]) + bytes(range(12)) for f in range(4))),
+    "synth_palette4_interlaced": synth(5, 3, 4, 3, 1, bytes(range(48)), b"\x00\x80", bytes(range(40))),
+    "synth_gray16_alpha": synth(2, 2, 16, 4, 0, b"", b"", bytes(range(2 * 9))),
+}
+
+
+def handmade_pngs():
+    return {
+        "gray1.png": png(8, 2, 1, 0, [b"\xa5", b"\x5a"]),
+        "palette_trns.png": png(4, 2, 2, 3, [b"\x1b", b"\xe4"],
+                                extra=png_chunk(b"PLTE", bytes([255, 0, 0, 0, 255, 0, 0, 0, 255, 9, 9, 9]))
+                                + png_chunk(b"tRNS", b"\xff\x80\x00")),
+        "rgb16.png": png(2, 2, 16, 2, [bytes(range(12)), bytes(range(12, 24))]),
+        "gray_alpha8.png": png(3, 1, 8, 4, [b"\x10\xff\x80\x40\xf0\x00"]),
+        "interlaced_gray8.png": png(9, 9, 8, 0, adam7_gray8(9, 9), interlace=1),
+    }
+
+
+def rendered_pngs(gpubridge):
+    """8x8 and 16x8 frames written by the project's own PNG writer (gpubridge render)."""
+    scenes = {
+        "render_8x8.png": {"framebuffer": {"width": 8, "height": 8}, "clear": {"color": [0.2, 0.4, 0.6]},
+                           "draws": [{"vertices": [[0, 0, 0, 1, 1, 0, 0], [8, 0, 0, 1, 0, 1, 0], [0, 8, 0, 1, 0, 0, 1]]}]},
+        "render_16x8_alpha.png": {"framebuffer": {"width": 16, "height": 8, "format": "RGBA2222"},
+                                  "clear": {"color": [1, 1, 1, 0.25]},
+                                  "draws": [{"blend": "ALPHA", "color": [1, 0, 0, 0.5], "vertices": [[2, 1], [15, 4], [3, 7]]}]},
+    }
+    out = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        for name, scene in scenes.items():
+            src, dst = os.path.join(tmp, name + ".json"), os.path.join(tmp, name)
+            with open(src, "w") as f:
+                json.dump(scene, f)
+            subprocess.run([gpubridge, "render", src, "--out", dst], check=True, stdout=subprocess.DEVNULL)
+            with open(dst, "rb") as f:
+                out[name] = f.read()
+    return out
+
+
+def usb_script(chip, cs, clock_khz, body):
+    """fuzz_usb_bridges input: chip, options (0: FT232H, channel A, no BUSY), cs, packet size choice
+    (0: 512 bytes), clock in kHz, then the script. OK = a successful OUT or setup call; IN(data) =
+    a successful IN transfer of those bytes."""
+    return bytes([chip, 0, cs, 0]) + struct.pack("<H", clock_khz) + body
+
+
+OK = b"\x00"
+
+
+def IN(data):
+    return b"\x00" + bytes([len(data)]) + data
+
+
+def window(size, capture):
+    return struct.pack("<H", size) + bytes([1 if capture else 0, 0])
+
+
+def usb_seeds():
+    miso18 = bytes(range(18))
+    ftdi_open = OK * 2 + OK * 8 + OK * 2 + IN(b"\x32\x60") + OK * 3 + IN(b"\x32\x60\xfa\xab")
+    ftdi = ftdi_open + b"\x00" + window(100, False) + OK + b"\x00" + window(18, True) + OK + IN(b"\x32\x60" + miso18)
+    ch341a = (OK * 4 + b"\x00" + window(40, True) + OK + IN(bytes(range(40))) + OK + b"\x00" + window(10, False) + OK
+              + IN(bytes(10)) + OK)
+    reply = lambda *b: IN(bytes(b) + bytes(64 - len(b)))
+    mcp2210 = (OK + reply(0x11) + OK + reply(0x21, 0) + b"\x00" + window(9, True) + OK + reply(0x40, 0)
+               + OK + reply(0x42, 0, 9, 0x10, *range(9)))
+    cp2130 = OK * 4 + b"\x00" + window(9, True) + OK + IN(bytes(range(9))) + b"\x00" + window(64, False) + OK
+    return {
+        "ftdi_write_read": usb_script(0, 3, 30000, ftdi),
+        "ch341a_read_write": usb_script(1, 0, 1500, ch341a),
+        "mcp2210_read": usb_script(2, 0, 12000, mcp2210),
+        "cp2130_read_write": usb_script(3, 0, 12000, cp2130),
+    }
+
+
+def copy_files(target, pattern):
+    d = os.path.join(HERE, "corpus", target)
+    os.makedirs(d, exist_ok=True)
+    for f in sorted(glob.glob(os.path.join(ROOT, pattern))):
+        shutil.copyfile(f, os.path.join(d, os.path.basename(f)))
+
+
 def main():
+    copy_files("scene", "examples/scenes/*.json")
+    pngs = handmade_pngs()
+    if len(sys.argv) > 1:
+        pngs.update(rendered_pngs(sys.argv[1]))
+        inline = dict(EXTRA_SCENES["arrays_state.json"])
+        # An inline PNG texture: the 8x8 rendered frame, base64 in the scene.
+        inline["textures"] = [{"name": "frame", "png_base64": base64.b64encode(pngs["render_8x8.png"]).decode(),
+                               "format": "RGBA2222", "wrap_s": "CLAMP", "wrap_t": "MIRROR", "filter": "bilinear"}]
+        inline["draws"] = [dict(inline["draws"][0], texture="frame", texture_mode="decal")]
+        write("scene", "inline_png_texture.json", json.dumps(inline, indent=1))
+    # fuzz_png.cpp: the first byte picks the mode (1: chunk CRCs repaired, 2: PNG built from fields).
+    for name, data in pngs.items():
+        write("png", name, b"\x01" + data)
+    for name, data in SYNTH_PNGS.items():
+        write("png", name, b"\x02" + data)
+    for name, scene in EXTRA_SCENES.items():
+        write("scene", name, json.dumps(scene, indent=1))
+    copy_files("daemon_config", "configs/*.json")
+    write("daemon_config", "comments.json", '// a comment\n{"listen": ["tcp:127.0.0.1:7000", "unix:/tmp/x.sock"], '
+          '"token": "s3cret", /* inline */ "backend": "emulated:ft232h-generic", "limits": {"max_clients": 1}}\n')
+    copy_files("board_profile", "configs/boards/*.json")
+    for name, data in usb_seeds().items():
+        write("usb_bridges", name, data)
     for name, data in MESSAGES.items():
         # The fuzz target's first byte chooses the receive limit (odd: small limit); keep it even here
         # so the seeds parse with the full limit.
