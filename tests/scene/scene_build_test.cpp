@@ -4,6 +4,8 @@
 
 #include <variant>
 
+#include <nlohmann/json.hpp>
+
 #include "gpubridge/scene/scene.hpp"
 
 namespace gpubridge::scene {
@@ -110,6 +112,19 @@ TEST(SceneBuild, MemoryLayoutIsSequentialAndAligned) {
   EXPECT_EQ(ups[0]->data, std::vector<std::uint8_t>(128, 0));
   EXPECT_EQ(ups[1]->address, 2304u);
   EXPECT_EQ(ups[1]->data, std::vector<std::uint8_t>(512, 9));
+}
+
+// Scene names are file paths, which on Linux need not be UTF-8; the stream's metadata JSON used to
+// throw from dump() for such a name instead of building.
+TEST(SceneBuild, NonUtf8SceneNameStillBuilds) {
+  auto s = parse_scene(R"({"framebuffer": {"width": 8, "height": 8}})", "bad\xff.json", ".");
+  ASSERT_TRUE(s) << s.error().message;
+  auto b = build_commands(*s);
+  ASSERT_TRUE(b) << b.error().message;
+  const auto meta = nlohmann::json::parse(b->stream.metadata_json, nullptr, false);
+  ASSERT_FALSE(meta.is_discarded()) << b->stream.metadata_json;
+  EXPECT_EQ(meta["width"], 8);
+  EXPECT_EQ(meta["scene"].get<std::string>().rfind("bad", 0), 0u);
 }
 
 TEST(SceneBuild, TooLittleVideoMemoryIsAnError) {

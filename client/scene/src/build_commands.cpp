@@ -82,7 +82,9 @@ Result<BuiltScene> build_commands(const Scene& scene, const BuildOptions& option
                                             {"width", scene.width},
                                             {"height", scene.height},
                                             {"format", protocol::to_string(scene.format)}}
-                                 .dump();
+                                 // The name is a file path, which need not be UTF-8: replace bad bytes
+                                 // instead of letting dump() throw.
+                                 .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
   StreamWriter w(out.stream);
 
   // Setup: buffers, full scissor, clears.
