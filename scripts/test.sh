@@ -43,7 +43,7 @@ done
 echo "sanitizer suites: $passed executables passed"
 if [ -x scripts/fuzz-smoke.sh ]; then
   echo "== fuzz smoke (libFuzzer + ASan + UBSan) =="
-  GPUBRIDGE_FUZZ_BUILD_DIR="$SAN_DIR" ./scripts/fuzz-smoke.sh "${GPUBRIDGE_FUZZ_SECONDS:-10}"
+  GPUBRIDGE_FUZZ_BUILD_DIR="$SAN_DIR" ./scripts/fuzz-smoke.sh "${GPUBRIDGE_FUZZ_SECONDS:-5}"
 fi
 
 echo "== done in $(( $(date +%s) - start )) s =="
