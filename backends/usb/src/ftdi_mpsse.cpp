@@ -68,7 +68,7 @@ std::string FtdiMpsseBridge::where() const {
 Result<std::unique_ptr<FtdiMpsseBridge>> FtdiMpsseBridge::open(UsbDevice& dev, FtdiConfig cfg) {
   const auto bcd = dev.info().bcd_device;
   if (bcd != 0x0700 && bcd != 0x0800 && bcd != 0x0900 && bcd != 0x3600)
-    return make_error("FTDI device with bcdDevice 0x" + std::to_string(bcd) +
+    return make_error(fmt::format("FTDI device with bcdDevice 0x{:04X}", bcd) +
                           " is not an H-series MPSSE chip (FT232H/FT2232H/FT4232H); use a different adapter",
                       backends::kBadRequest);
   const int channels = bcd == 0x0900 ? 1 : 2;

@@ -3,11 +3,15 @@
 
 #include <algorithm>
 
+#include <fmt/format.h>
+
 #include "gpubridge/backends/backend.hpp"
 #include "gpubridge/usb/usb_errors.hpp"
 
 namespace gpubridge::usb {
 namespace {
+
+std::string hex(unsigned v) { return fmt::format("0x{:02X}", v); }
 
 constexpr std::uint8_t kCancelTransfer = 0x11, kSetChipSettings = 0x21, kSetSpiSettings = 0x40, kTransfer = 0x42;
 constexpr std::uint8_t kOk = 0x00, kBusy = 0xF8, kExternalOwner = 0xF7;
@@ -46,7 +50,7 @@ Result<std::array<std::uint8_t, 64>> Mcp2210Bridge::command(std::span<const std:
                                         backends::kDeviceTimeout);
   }
   if (in[0] != report[0])
-    return make_error("MCP2210: response echoes command 0x" + std::to_string(in[0]) + " instead of 0x" + std::to_string(report[0]) +
+    return make_error("MCP2210: response echoes command " + hex(in[0]) + " instead of " + hex(report[0]) +
                           " (report stream out of step)",
                       backends::kDeviceProtocol);
   return in;
@@ -66,7 +70,7 @@ Result<void> Mcp2210Bridge::recover() {
   r[16] = 0x01;
   auto s = command(r);
   if (!s) return s.error();
-  if ((*s)[1] != kOk) return make_error("MCP2210: chip settings rejected (status 0x" + std::to_string((*s)[1]) + ")", backends::kDeviceProtocol);
+  if ((*s)[1] != kOk) return make_error("MCP2210: chip settings rejected (status " + hex((*s)[1]) + ")", backends::kDeviceProtocol);
   configured_length_ = 0;
   return {};
 }
@@ -96,7 +100,7 @@ Result<void> Mcp2210Bridge::set_transfer_settings(std::size_t length) {
     if (!s) return s.error();
     if ((*s)[1] == kOk) break;
     if ((*s)[1] != kBusy || attempt >= kBusyRetries)
-      return make_error("MCP2210: SPI transfer settings rejected (status 0x" + std::to_string((*s)[1]) + ")", backends::kDeviceProtocol);
+      return make_error("MCP2210: SPI transfer settings rejected (status " + hex((*s)[1]) + ")", backends::kDeviceProtocol);
   }
   configured_length_ = length;
   return {};
@@ -125,7 +129,7 @@ Result<void> Mcp2210Bridge::window(std::span<const std::uint8_t> mosi, std::vect
     }
     if (a[1] == kExternalOwner)
       return make_error("MCP2210: SPI bus owned by an external master (0xF7); release the bus on the board", backends::kDeviceProtocol);
-    if (a[1] != kOk) return make_error("MCP2210: transfer rejected with status 0x" + std::to_string(a[1]), backends::kDeviceProtocol);
+    if (a[1] != kOk) return make_error("MCP2210: transfer rejected with status " + hex(a[1]), backends::kDeviceProtocol);
     sent += n;
     const std::size_t count = a[2];
     if (count > kMaxChunk || received + count > mosi.size())
@@ -134,7 +138,7 @@ Result<void> Mcp2210Bridge::window(std::span<const std::uint8_t> mosi, std::vect
     received += count;
     if (a[3] == kEngineDone) break;
     if (a[3] != kEngineStarted && a[3] != kEngineMore)
-      return make_error("MCP2210: unknown engine status 0x" + std::to_string(a[3]), backends::kDeviceProtocol);
+      return make_error("MCP2210: unknown engine status " + hex(a[3]), backends::kDeviceProtocol);
   }
   if (received != mosi.size())
     return make_error("MCP2210: transaction finished with " + std::to_string(received) + " of " + std::to_string(mosi.size()) +
