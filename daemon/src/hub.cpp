@@ -9,6 +9,7 @@
 #include "gpubridge/daemon/session.hpp"
 #include "gpubridge/protocol/crc32.hpp"
 #include "gpubridge/version.hpp"
+#include "gpubridge/common/json_text.hpp"
 
 namespace gpubridge::daemon {
 namespace {
@@ -151,7 +152,7 @@ std::string Hub::device_json() const {
                    {"max_height", info_.max_height}, {"vram_bytes", info_.vram_bytes},
                    {"id", info_.id},               {"caps", info_.caps},
                    {"mirror", options_.mirror},    {"daemon_version", kVersion}};
-  return j.dump();
+  return json_text(j);
 }
 
 nlohmann::json Hub::status_json() const {
@@ -294,7 +295,7 @@ void Hub::on_device_gone(const Error& e) {
 void Hub::broadcast_event(const nlohmann::json& event) {
   // Events use the reply path of each session, so they obey the same byte caps.
   for (auto& [id, w] : sessions_) {
-    if (auto s = w.lock(); s && s->handshaken()) s->send_event(event.dump());
+    if (auto s = w.lock(); s && s->handshaken()) s->send_event(json_text(event));
   }
 }
 

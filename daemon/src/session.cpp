@@ -6,6 +6,7 @@
 #include "gpubridge/common/log.hpp"
 #include "gpubridge/protocol/command_stream.hpp"
 #include "gpubridge/protocol/trace.hpp"
+#include "gpubridge/common/json_text.hpp"
 
 namespace gpubridge::daemon {
 namespace {
@@ -154,7 +155,7 @@ void Session::dispatch(Message& m) {
     case MsgType::Readback: handle_readback(m); return;
     case MsgType::Fence: handle_fence(m); return;
     case MsgType::StatusReq:
-      reply(m.request_id, protocol::StatusReply{hub_.status_json().dump()});
+      reply(m.request_id, protocol::StatusReply{json_text(hub_.status_json())});
       return;
     case MsgType::Subscribe: {
       const auto& s = std::get<protocol::Subscribe>(m.payload);
@@ -217,7 +218,7 @@ void Session::handle_hello(const Message& m) {
                       ("session-" + std::to_string(id_) + (safe.empty() ? "" : "-" + safe) + ".gbtrace");
     auto out = std::make_unique<std::ofstream>(path, std::ios::binary | std::ios::trunc);
     std::vector<std::uint8_t> header;
-    const std::string meta = nlohmann::json{{"source", "gpubridged"}, {"client", name_}, {"session", id_}}.dump();
+    const std::string meta = json_text(nlohmann::json{{"source", "gpubridged"}, {"client", name_}, {"session", id_}});
     if (*out && protocol::append_trace_header(meta, header)) {
       out->write(reinterpret_cast<const char*>(header.data()), static_cast<std::streamsize>(header.size()));
       recording_ = std::move(out);

@@ -15,6 +15,7 @@
 #include "gpubridge/examples/golden.hpp"
 #if GPUBRIDGE_DRAW_HAS_CLIENT
 #include "gpubridge/draw/client_sink.hpp"
+#include "gpubridge/common/json_text.hpp"
 #endif
 
 namespace {
@@ -51,7 +52,7 @@ int run_list(bool json) {
     else
       std::printf("%-12s %-18s %s\n", i.name.c_str(), i.seed.c_str(), i.description.c_str());
   }
-  if (json) std::puts(out.dump(2).c_str());
+  if (json) std::puts(json_text(out, 2).c_str());
   return 0;
 }
 
@@ -82,7 +83,7 @@ int run_render(const std::vector<std::string>& names, const std::string& out_dir
     });
     if (!r) return fail(r.error().message);
   }
-  if (json) std::puts(written.dump(2).c_str());
+  if (json) std::puts(json_text(written, 2).c_str());
   return 0;
 }
 
@@ -109,7 +110,7 @@ int run_stream(const std::vector<std::string>& names, const std::string& address
     summary.push_back({{"example", name}, {"frames", frames}, {"seconds", secs}, {"triangles", ctx->stats().emitted}});
     if (!json) std::printf("%-12s %u frames in %.2f s (%zu triangles sent)\n", name.c_str(), frames, secs, ctx->stats().emitted);
   }
-  if (json) std::puts(summary.dump(2).c_str());
+  if (json) std::puts(json_text(summary, 2).c_str());
   return 0;
 #else
   (void)names, (void)address, (void)frames, (void)fps, (void)json;
@@ -139,7 +140,7 @@ int run_goldens(const std::string& dir, bool write, bool json) {
     report.push_back({{"example", name}, {"path", path.string()}, {"differing_pixels", diff.differing_pixels},
                       {"max_difference", diff.max_difference}});
   }
-  if (json) std::puts(report.dump(2).c_str());
+  if (json) std::puts(json_text(report, 2).c_str());
   return failures ? 1 : 0;
 }
 

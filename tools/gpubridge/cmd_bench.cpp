@@ -11,6 +11,7 @@
 #include "command.hpp"
 #ifdef GPUBRIDGE_HAVE_BENCH_LIB
 #include "gpubridge/bench/accuracy_bench.hpp"
+#include "gpubridge/common/json_text.hpp"
 #endif
 
 namespace gpubridge::cli {
@@ -71,13 +72,13 @@ int run_accuracy(const GlobalOptions& g, const AccuracyArgs& a) {
   const auto json = bench::report_json(*report);
   if (!a.out_dir.empty()) {
     const std::filesystem::path dir(a.out_dir);
-    if (!write_file(dir / "accuracy-report.md", md) || !write_file(dir / "accuracy-report.json", json.dump(2) + "\n") ||
+    if (!write_file(dir / "accuracy-report.md", md) || !write_file(dir / "accuracy-report.json", json_text(json, 2) + "\n") ||
         !write_file(dir / "accuracy-front.svg", bench::report_svg(*report))) {
       std::fprintf(stderr, "gpubridge bench accuracy: cannot write the report files in %s\n", a.out_dir.c_str());
       return 1;
     }
   }
-  if (g.json) std::puts(json.dump(2).c_str());
+  if (g.json) std::puts(json_text(json, 2).c_str());
   else std::fputs(md.c_str(), stdout);
   if (!report->llvmpipe_ok) std::fprintf(stderr, "gpubridge bench accuracy: llvmpipe rows omitted: %s\n", report->llvmpipe.c_str());
   return 0;

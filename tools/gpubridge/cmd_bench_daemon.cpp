@@ -25,6 +25,7 @@
 #include "bench_group.hpp"
 #include "client_common.hpp"
 #include "gpubridge/protocol/messages.hpp"
+#include "gpubridge/common/json_text.hpp"
 
 namespace gpubridge::cli {
 namespace {
@@ -295,7 +296,7 @@ int run(const GlobalOptions& g, const std::string& daemon_path, std::uint64_t mi
   sim.stop();
   std::error_code ec;
   fs::remove_all(dir, ec);
-  if (g.json) std::puts(out.dump(2).c_str());
+  if (g.json) std::puts(json_text(out, 2).c_str());
   return 0;
 }
 

@@ -20,6 +20,7 @@
 #if __has_include("gpubridge/examples/example.hpp")
 #include "gpubridge/draw/sim_sink.hpp"
 #include "gpubridge/examples/example.hpp"
+#include "gpubridge/common/json_text.hpp"
 #define GPUBRIDGE_BENCH_GEOMETRY_EXAMPLES 1
 #endif
 
@@ -186,7 +187,7 @@ int run(const GlobalOptions& g, unsigned triangles, unsigned runs, double spi_mh
                   host * 1e3, sim_time * 1e3, spi_fps);
   }
 #endif
-  if (g.json) std::puts(report.dump(2).c_str());
+  if (g.json) std::puts(json_text(report, 2).c_str());
   return 0;
 }
 

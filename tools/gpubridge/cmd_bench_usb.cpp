@@ -10,6 +10,7 @@
 #include "command.hpp"
 #include "gpubridge/protocol/frame.hpp"
 #include "gpubridge/usb/board_factory.hpp"
+#include "gpubridge/common/json_text.hpp"
 
 namespace gpubridge::cli {
 namespace {
@@ -139,7 +140,7 @@ int run_usb_bench(const GlobalOptions& g, const UsbBenchArgs& a) {
                        {"busy_waits", b.bridge().stats().busy_waits},
                        {"predicted_ms", write_ms}}},
                      {"readback", readbacks}};
-    std::puts(j.dump(2).c_str());
+    std::puts(json_text(j, 2).c_str());
     return 0;
   }
   std::printf("board %s, %s%s at %.3g MHz (round trip assumed %.0f us)\n", profile->name.c_str(), std::string(b.bridge().chip()).c_str(),

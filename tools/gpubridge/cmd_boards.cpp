@@ -6,6 +6,7 @@
 
 #include "command.hpp"
 #include "gpubridge/usb/board_profile.hpp"
+#include "gpubridge/common/json_text.hpp"
 
 namespace gpubridge::cli {
 namespace {
@@ -40,7 +41,7 @@ int run_boards(const GlobalOptions& g, const std::string& dir) {
                      {"device",
                       {{"vram_kib", p.vram_kib}, {"max_width", p.max_width}, {"max_height", p.max_height}, {"fifo_depth", p.fifo_depth}}},
                      {"strict_link", p.strict_link}});
-    std::puts(out.dump(2).c_str());
+    std::puts(json_text(out, 2).c_str());
     return 0;
   }
   std::printf("%-16s %-8s %-10s %8s %9s %9s  %s\n", "BOARD", "BRIDGE", "VID:PID", "SPI MHz", "VRAM KiB", "MAX", "FPGA");
@@ -61,7 +62,7 @@ int run_cables(const GlobalOptions& g, const std::string& dir) {
     for (const auto& c : *cables)
       out.push_back({{"name", c.name}, {"chip", c.chip}, {"vid", hex4(c.vid)}, {"pid", hex4(c.pid)}, {"api", c.api},
                      {"max_spi_hz", c.max_spi_hz}, {"interfaces", c.interfaces}, {"description", c.description}});
-    std::puts(out.dump(2).c_str());
+    std::puts(json_text(out, 2).c_str());
     return 0;
   }
   std::printf("%-10s %-10s %-7s %8s  %s\n", "CABLE", "VID:PID", "API", "MAX MHz", "DESCRIPTION");

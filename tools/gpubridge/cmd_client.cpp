@@ -18,6 +18,7 @@
 #include "gpubridge/common/image.hpp"
 #include "gpubridge/common/trace_files.hpp"
 #include "gpubridge/protocol/text_trace.hpp"
+#include "gpubridge/common/json_text.hpp"
 
 namespace gpubridge::cli {
 
@@ -82,7 +83,7 @@ constexpr std::uint64_t kMaxFileBytes = 1ull << 32;  // uploads: the 32-bit addr
 
 std::atomic<bool> g_interrupted{false};  // executable-level: set by SIGINT during `play --loop`
 
-void print_json(const nlohmann::json& j) { std::puts(j.dump(2).c_str()); }
+void print_json(const nlohmann::json& j) { std::puts(json_text(j, 2).c_str()); }
 
 // ------------------------------------------------------------------------------ status
 int run_status(const GlobalOptions& g, const ClientOptions& o) {

@@ -10,6 +10,7 @@
 
 #include "command.hpp"
 #include "gpubridge/common/image.hpp"
+#include "gpubridge/common/json_text.hpp"
 
 namespace gpubridge::cli {
 namespace {
@@ -68,7 +69,7 @@ int run_compare(const GlobalOptions& g, const CompareArgs& args) {
                      {"tolerance", args.tolerance},
                      {"match", ok}};
     if (!args.diff.empty()) j["diff"] = args.diff;
-    std::puts(j.dump(2).c_str());
+    std::puts(json_text(j, 2).c_str());
   } else {
     std::printf("%s: %llu of %llu pixels differ, max channel difference %u (tolerance %u, %llu beyond)%s\n",
                 ok ? "match" : "MISMATCH", static_cast<unsigned long long>(differing),

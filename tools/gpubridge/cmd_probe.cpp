@@ -11,6 +11,7 @@
 #include "gpubridge/usb/bringup.hpp"
 #include "gpubridge/usb/hidapi_transport.hpp"
 #include "gpubridge/usb/libusb_transport.hpp"
+#include "gpubridge/common/json_text.hpp"
 
 namespace gpubridge::cli {
 namespace {
@@ -47,7 +48,7 @@ int probe_board(const GlobalOptions& g, const ProbeArgs& a) {
                      {"magic_ok", (i.id >> 32) == protocol::kIdMagic}, {"version", {(i.id >> 24) & 0xFF, (i.id >> 16) & 0xFF}},
                      {"variant", i.id & 0xFFFF}, {"vram_bytes", i.vram_bytes}, {"strict_link", (*board)->strict_link()},
                      {"spi_clock_hz", (*board)->bridge().clock_hz()}};
-    std::puts(j.dump(2).c_str());
+    std::puts(json_text(j, 2).c_str());
   } else {
     std::printf("board %s via %s%s at %.3g MHz: ID 0x%016llX (spigpu v%llu.%llu, variant 0x%04llX), %llu KiB VRAM, strict link %s\n",
                 profile->name.c_str(), i.bridge.c_str(), a.emulate ? " (emulated)" : "", (*board)->bridge().clock_hz() / 1e6,
@@ -101,7 +102,7 @@ int probe_bus(const GlobalOptions& g, const ProbeArgs& a) {
     }
   }
   if (g.json) {
-    std::puts(nlohmann::json{{"bridges", found}, {"usb_error", usb_problem}, {"looked_for", looked_for}}.dump(2).c_str());
+    std::puts(json_text(nlohmann::json{{"bridges", found}, {"usb_error", usb_problem}, {"looked_for", looked_for}}, 2).c_str());
     return usb_problem.empty() ? 0 : 1;
   }
   if (!usb_problem.empty()) std::fprintf(stderr, "gpubridge probe: cannot scan USB: %s\n", usb_problem.c_str());
@@ -150,10 +151,9 @@ int run_bringup(const GlobalOptions& g, const BringupArgs& a) {
     nlohmann::json steps = nlohmann::json::array();
     for (const auto& s : rep.steps)
       steps.push_back({{"name", s.name}, {"ok", s.ok}, {"skipped", s.skipped}, {"detail", s.detail}, {"seconds", s.seconds}});
-    std::puts(nlohmann::json{{"board", profile->name}, {"emulated", a.probe.emulate}, {"ok", rep.ok()}, {"best_clock_hz", rep.best_clock_hz},
-                             {"steps", steps}}
-                  .dump(2)
-                  .c_str());
+    const nlohmann::json report{{"board", profile->name}, {"emulated", a.probe.emulate}, {"ok", rep.ok()},
+                                {"best_clock_hz", rep.best_clock_hz}, {"steps", steps}};
+    std::puts(json_text(report, 2).c_str());
   } else {
     std::printf("bring-up of %s%s\n", profile->name.c_str(), a.probe.emulate ? " (emulated)" : "");
     for (const auto& s : rep.steps)

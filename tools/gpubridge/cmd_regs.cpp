@@ -6,6 +6,7 @@
 #include "command.hpp"
 #include "gpubridge/protocol/register_doc.hpp"
 #include "gpubridge/protocol/registers.hpp"
+#include "gpubridge/common/json_text.hpp"
 
 namespace gpubridge::cli {
 namespace {
@@ -30,7 +31,7 @@ int run_regs(const GlobalOptions& g, bool markdown) {
       }
       out.push_back({{"index", r.index}, {"name", r.name}, {"reset", r.reset}, {"summary", r.summary}, {"fields", fields}});
     }
-    std::puts(out.dump(2).c_str());
+    std::puts(json_text(out, 2).c_str());
     return 0;
   }
   for (const auto& r : register_table())

@@ -19,6 +19,7 @@
 #include "gpubridge/sim/timing.hpp"
 #if __has_include("gpubridge/scene/scene.hpp")
 #include "gpubridge/scene/scene.hpp"
+#include "gpubridge/common/json_text.hpp"
 #define GPUBRIDGE_RENDER_HAS_SCENES 1
 #endif
 
@@ -200,7 +201,7 @@ int run_render(const GlobalOptions& g, const RenderArgs& a) {
                      {"threads", opt.threads},
                      {"elapsed_ms", elapsed_ms}};
     if (a.timing) j["timing"] = timing;
-    std::puts(j.dump(2).c_str());
+    std::puts(json_text(j, 2).c_str());
   } else {
     std::printf("rendered %s (%s): %zu frame(s) scanned out, %llu triangles, %llu pixels written in %.2f ms\n",
                 a.input.c_str(), kind.c_str(), frames.size(), static_cast<unsigned long long>(st.triangles_kicked),
@@ -212,7 +213,7 @@ int run_render(const GlobalOptions& g, const RenderArgs& a) {
     for (const auto& t : timing)
       std::printf("timing frame %s: %.0f board cycles (pipeline %.0f, memory %.0f) = %.3f ms at %.1f MHz; SPI %.3f ms at "
                   "%.1f MHz; frame %.3f ms (%.1f fps)\n",
-                  t["frame"].dump().c_str(), t["board_cycles"].get<double>(), t["pipeline_cycles"].get<double>(),
+                  json_text(t["frame"]).c_str(), t["board_cycles"].get<double>(), t["pipeline_cycles"].get<double>(),
                   t["memory_cycles"].get<double>(), t["board_ms"].get<double>(), board.clock_mhz,
                   t["spi_ms"].get<double>(), board.spi_clock_mhz, t["frame_ms"].get<double>(), t["fps"].get<double>());
   }

@@ -10,6 +10,7 @@
 #include "gpubridge/common/trace_files.hpp"
 #include "gpubridge/protocol/crc32.hpp"
 #include "gpubridge/protocol/text_trace.hpp"
+#include "gpubridge/common/json_text.hpp"
 
 namespace gpubridge::cli {
 namespace {
@@ -70,7 +71,7 @@ int run_convert(const GlobalOptions& g, const std::string& in, const std::string
   if (g.json) {
     nlohmann::json j{{"input", in}, {"output", out}, {"format", binary ? "binary" : "text"},
                      {"commands", s->commands.size()}, {"counts", counts_json(c)}};
-    std::puts(j.dump(2).c_str());
+    std::puts(json_text(j, 2).c_str());
   } else {
     std::printf("wrote %s (%s, %zu commands: %zu frames in %zu batches, %zu uploads, %zu fences)\n", out.c_str(),
                 binary ? "binary" : "text", s->commands.size(), c.frames, c.batches, c.uploads, c.fences);
@@ -136,7 +137,7 @@ int run_dump(const GlobalOptions& g, const std::string& in) {
                      {"metadata", nlohmann::json::parse(s->metadata_json, nullptr, false)},
                      {"counts", counts_json(c)},
                      {"commands", cmds}};
-    std::puts(j.dump(2).c_str());
+    std::puts(json_text(j, 2).c_str());
     return 0;
   }
   std::printf("%s: metadata %s\n", in.c_str(), s->metadata_json.c_str());

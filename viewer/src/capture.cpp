@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "gpubridge/viewer/frame_source.hpp"
+#include "gpubridge/common/json_text.hpp"
 
 namespace gpubridge::viewer {
 
@@ -29,7 +30,7 @@ Result<void> finish_capture(const Options& options, const Frame& frame, const Im
     if (result.fps_drawn) j["fps_drawn"] = *result.fps_drawn;
     if (result.latency_ms_mean) j["latency_ms_mean"] = *result.latency_ms_mean;
     if (result.latency_ms_max) j["latency_ms_max"] = *result.latency_ms_max;
-    std::cout << j.dump() << std::endl;
+    std::cout << json_text(j) << std::endl;
   } else {
     std::cout << fmt::format("frame {} ({}{}, crc {:08x}{})", frame.number, describe_size(frame),
                              frame.source == protocol::FrameSource::Board ? "" : ", " + picture_name(frame.source),
