@@ -8,6 +8,7 @@
 #include "gpubridge/usb/emu/mpsse_model.hpp"
 #include "gpubridge/usb/emu/reference_target.hpp"
 #include "gpubridge/usb/ftdi_mpsse.hpp"
+#include "forwarding_usb_device.hpp"
 #include "test_profiles.hpp"
 
 namespace gpubridge::usb {
@@ -156,27 +157,8 @@ TEST(FtdiDriver, ReadsBeyondTheRxFifoStreamInOneRoundTripWithTheSameBytes) {
 
 // A UsbDevice without an asynchronous path (the base class's bulk_stream): the driver must fall
 // back to synchronous rounds, once, and still read correctly.
-class NoStreamDevice final : public UsbDevice {
- public:
-  explicit NoStreamDevice(UsbDevice& inner) : in_(inner) {}
-  const UsbDeviceInfo& info() const override { return in_.info(); }
-  UsbStatus detach_kernel_driver(int i) override { return in_.detach_kernel_driver(i); }
-  UsbStatus claim_interface(int i) override { return in_.claim_interface(i); }
-  UsbStatus release_interface(int i) override { return in_.release_interface(i); }
-  UsbIo control_out(std::uint8_t rt, std::uint8_t rq, std::uint16_t v, std::uint16_t i, std::span<const std::uint8_t> d,
-                    unsigned t) override {
-    return in_.control_out(rt, rq, v, i, d, t);
-  }
-  UsbIo control_in(std::uint8_t rt, std::uint8_t rq, std::uint16_t v, std::uint16_t i, std::span<std::uint8_t> d, unsigned t) override {
-    return in_.control_in(rt, rq, v, i, d, t);
-  }
-  UsbIo bulk_out(std::uint8_t ep, std::span<const std::uint8_t> d, unsigned t) override { return in_.bulk_out(ep, d, t); }
-  UsbIo bulk_in(std::uint8_t ep, std::span<std::uint8_t> d, unsigned t) override { return in_.bulk_in(ep, d, t); }
-  UsbStatus clear_halt(std::uint8_t ep) override { return in_.clear_halt(ep); }
-  std::uint16_t max_packet_size(std::uint8_t ep) const override { return in_.max_packet_size(ep); }
-
- private:
-  UsbDevice& in_;
+class NoStreamDevice final : public testing::ForwardingUsbDevice {
+  using ForwardingUsbDevice::ForwardingUsbDevice;  // everything but bulk_stream, which says NotSupported
 };
 
 TEST(FtdiDriver, DevicesWithoutAnAsynchronousPathFallBackToRounds) {

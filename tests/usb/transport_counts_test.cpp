@@ -14,6 +14,7 @@
 #include "gpubridge/usb/emu/reference_target.hpp"
 #include "gpubridge/usb/ftdi_mpsse.hpp"
 #include "gpubridge/usb/mcp2210.hpp"
+#include "forwarding_usb_device.hpp"
 
 namespace gpubridge::usb {
 namespace {
@@ -24,35 +25,20 @@ constexpr std::size_t kExtra = 6;
 
 // A chip model behind a transport that, once armed, reports kExtra bytes more than the buffer of
 // the next successful IN transfer (the bytes themselves are the model's).
-class OverReportingUsb final : public UsbDevice {
+class OverReportingUsb final : public testing::ForwardingUsbDevice {
  public:
-  explicit OverReportingUsb(UsbDevice& inner) : in_(inner) {}
+  using ForwardingUsbDevice::ForwardingUsbDevice;
   void arm() { armed_ = true; }
-  const UsbDeviceInfo& info() const override { return in_.info(); }
-  UsbStatus detach_kernel_driver(int i) override { return in_.detach_kernel_driver(i); }
-  UsbStatus claim_interface(int i) override { return in_.claim_interface(i); }
-  UsbStatus release_interface(int i) override { return in_.release_interface(i); }
-  UsbIo control_out(std::uint8_t rt, std::uint8_t rq, std::uint16_t v, std::uint16_t i, std::span<const std::uint8_t> d,
-                    unsigned t) override {
-    return in_.control_out(rt, rq, v, i, d, t);
-  }
-  UsbIo control_in(std::uint8_t rt, std::uint8_t rq, std::uint16_t v, std::uint16_t i, std::span<std::uint8_t> d, unsigned t) override {
-    return in_.control_in(rt, rq, v, i, d, t);
-  }
-  UsbIo bulk_out(std::uint8_t ep, std::span<const std::uint8_t> d, unsigned t) override { return in_.bulk_out(ep, d, t); }
   UsbIo bulk_in(std::uint8_t ep, std::span<std::uint8_t> d, unsigned t) override {
-    UsbIo io = in_.bulk_in(ep, d, t);
+    UsbIo io = ForwardingUsbDevice::bulk_in(ep, d, t);
     if (armed_ && io.ok()) {
       armed_ = false;
       io.transferred = d.size() + kExtra;
     }
     return io;
   }
-  UsbStatus clear_halt(std::uint8_t ep) override { return in_.clear_halt(ep); }
-  std::uint16_t max_packet_size(std::uint8_t ep) const override { return in_.max_packet_size(ep); }
 
  private:
-  UsbDevice& in_;
   bool armed_ = false;
 };
 
