@@ -70,8 +70,8 @@ class Stream {
         slot.completed = false;
         progressed = true;
         ++res_.in_transfers;
+        if (consumer_done_) continue;  // everything expected has arrived; leftovers do not matter
         if (const UsbStatus st = status_of_transfer(slot.transfer->status); st != UsbStatus::Ok) return fail(st);
-        if (consumer_done_) continue;
         const auto got = std::span<const std::uint8_t>(slot.buffer).first(static_cast<std::size_t>(slot.transfer->actual_length));
         const StreamStep step = on_in_(got);
         if (step == StreamStep::Abort) return res_;
