@@ -26,7 +26,11 @@ class Reader {
     if (v.is_array()) return "an array";
     if (v.is_object()) return "an object";
     std::string s = v.dump();
-    return s.size() > 40 ? s.substr(0, 37) + "..." : s;
+    if (s.size() <= 40) return s;
+    // Cut at a character boundary: a UTF-8 continuation byte (10xxxxxx) never starts the tail.
+    std::size_t cut = 37;
+    while (cut > 0 && (static_cast<unsigned char>(s[cut]) & 0xC0) == 0x80) --cut;
+    return s.substr(0, cut) + "...";
   }
 
   Result<void> read_string(const json& obj, const std::string& prefix, const char* key, std::string& out) const {

@@ -91,6 +91,26 @@ TEST(DaemonConfig, DeeplyNestedWrongValueIsAnError) {
   EXPECT_EQ(cfg.error().message, "c.json: token: expected a string, got an array");
 }
 
+// A long wrong-typed value is shortened for the message at a character boundary: cutting inside a
+// multi-byte UTF-8 character left an invalid byte sequence in the error text.
+TEST(DaemonConfig, ShortenedValueInAnErrorStaysUtf8) {
+  std::string value = "a";  // then é, two bytes each: the dump is "aé..., so byte 37 falls inside an é
+  for (int i = 0; i < 30; ++i) value += "\u00e9";
+  auto cfg = parse_config(nlohmann::json::parse("{\"reattach_interval_ms\": \"" + value + "\"}"), "c.json");
+  ASSERT_FALSE(cfg);
+  const std::string& m = cfg.error().message;
+  ASSERT_NE(m.find("..."), std::string::npos) << m;
+  // Valid UTF-8: every lead byte is followed by exactly its continuation bytes.
+  for (std::size_t i = 0; i < m.size();) {
+    const auto b = static_cast<unsigned char>(m[i]);
+    const std::size_t len = b < 0x80 ? 1 : (b >> 5) == 6 ? 2 : (b >> 4) == 14 ? 3 : (b >> 3) == 30 ? 4 : 0;
+    ASSERT_NE(len, 0u) << "stray byte at " << i << " in: " << m;
+    for (std::size_t k = 1; k < len; ++k)
+      ASSERT_TRUE(i + k < m.size() && (static_cast<unsigned char>(m[i + k]) & 0xC0) == 0x80) << "cut character at " << i;
+    i += len;
+  }
+}
+
 TEST(DaemonConfig, NonLoopbackTcpWithoutTokenIsRefused) {
   DaemonConfig cfg;
   cfg.listen = {"tcp:0.0.0.0:7420"};

@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "gpubridge/common/json_text.hpp"
 #include "gpubridge/geometry/encode.hpp"
 #include "gpubridge/scene/scene.hpp"
 
@@ -77,14 +78,12 @@ Result<BuiltScene> build_commands(const Scene& scene, const BuildOptions& option
   auto layout = plan_memory(scene, options.vram_bytes);
   if (!layout) return layout.error();
   out.layout = *layout;
-  out.stream.metadata_json = nlohmann::json{{"created_by", "gpubridge scene loader"},
-                                            {"scene", scene.name},
-                                            {"width", scene.width},
-                                            {"height", scene.height},
-                                            {"format", protocol::to_string(scene.format)}}
-                                 // The name is a file path, which need not be UTF-8: replace bad bytes
-                                 // instead of letting dump() throw.
-                                 .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+  // The scene name is a file path, which need not be UTF-8: json_text replaces bad bytes.
+  out.stream.metadata_json = json_text(nlohmann::json{{"created_by", "gpubridge scene loader"},
+                                                      {"scene", scene.name},
+                                                      {"width", scene.width},
+                                                      {"height", scene.height},
+                                                      {"format", protocol::to_string(scene.format)}});
   StreamWriter w(out.stream);
 
   // Setup: buffers, full scissor, clears.
