@@ -73,10 +73,10 @@ class Cubes final : public Example {
     const double t = n * 0.08;
     const auto vp = projection(ctx, 0.8, 0.5, 30) * geometry::look_at({0, 1.2, 7}, {0, 0, 0}, {0, 1, 0});
     ctx.set_transform(vp * geometry::translate({-1.7, 0, 0}) * geometry::rotate_y(t) * geometry::rotate_x(t * 0.7));
-    ctx.bind_texture(nullptr);
+    ctx.unbind_texture();
     if (auto r = ctx.draw_indexed(gouraud_.vertices, gouraud_.indices); !r) return r;
     ctx.set_transform(vp * geometry::translate({1.7, 0, 0}) * geometry::rotate_y(-t * 0.8) * geometry::rotate_z(t * 0.5));
-    ctx.bind_texture(&texture_);
+    if (auto r = ctx.bind_texture(texture_); !r) return r;
     return ctx.draw_indexed(textured_.vertices, textured_.indices);
   }
 

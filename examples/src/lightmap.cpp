@@ -58,16 +58,16 @@ class Lightmap final : public Example {
     // Pass 1: bricks (decal), writing depth.
     ctx.state() = {};
     ctx.state().z_test = ctx.state().z_write = true;
-    ctx.bind_texture(nullptr);
+    ctx.unbind_texture();
     if (auto r = ctx.draw_indexed(floor_.vertices, floor_.indices); !r) return r;
     ctx.state().tex_decal = true;
-    ctx.bind_texture(&bricks_);
+    if (auto r = ctx.bind_texture(bricks_); !r) return r;
     if (auto r = ctx.draw_indexed(wall_.vertices, wall_.indices); !r) return r;
     // Pass 2: the lightmap where the depth is EQUAL, multiplied into the bricks.
     ctx.state().z_func = protocol::DepthFunc::Equal;
     ctx.state().z_write = false;
     ctx.state().blend = protocol::BlendMode::Multiply;
-    ctx.bind_texture(&light_);
+    if (auto r = ctx.bind_texture(light_); !r) return r;
     return ctx.draw_indexed(wall_.vertices, wall_.indices);
   }
 

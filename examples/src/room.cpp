@@ -63,11 +63,11 @@ class Room final : public Example {
     ctx.state() = {};
     ctx.state().z_test = ctx.state().z_write = true;
     ctx.set_cull(geometry::CullMode::Back);
-    ctx.bind_texture(&floor_tex_);
+    if (auto r = ctx.bind_texture(floor_tex_); !r) return r;
     if (auto r = ctx.draw_indexed(floor_.vertices, floor_.indices); !r) return r;
-    ctx.bind_texture(&bricks_);
+    if (auto r = ctx.bind_texture(bricks_); !r) return r;
     if (auto r = ctx.draw_indexed(walls_.vertices, walls_.indices); !r) return r;
-    ctx.bind_texture(nullptr);
+    ctx.unbind_texture();
     return ctx.draw_indexed(ceiling_.vertices, ceiling_.indices);
   }
 

@@ -77,7 +77,7 @@ class Terrain final : public Example {
     const double cy = std::max(height_at(cx, cz), 0.2) + 4.0;
     const geometry::Vec3 eye{cx, cy, cz}, target{cx + 2 * std::sin(t * 0.08 + 0.3), cy - 1.6, cz - 6};
     ctx.set_transform(projection(ctx, 1.0, 0.3, 80) * geometry::look_at(eye, target, {0, 1, 0}));
-    ctx.bind_texture(&texture_);
+    if (auto r = ctx.bind_texture(texture_); !r) return r;
     return ctx.draw_indexed(mesh_.vertices, mesh_.indices);
   }
 

@@ -59,7 +59,7 @@ class Tetrahedron final : public Example {
     const double t = n * 0.06;
     const auto model = geometry::rotate_y(0.7 + t * 1.3) * geometry::rotate_x(0.5 + t * 0.7);
     ctx.set_transform(projection(ctx, 0.9, 0.5, 20) * geometry::look_at({0, 0, 4.2}, {0, 0, 0}, {0, 1, 0}) * model);
-    ctx.bind_texture(&texture_);
+    if (auto r = ctx.bind_texture(texture_); !r) return r;
     return ctx.draw_indexed(mesh_.vertices, mesh_.indices);
   }
 

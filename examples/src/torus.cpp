@@ -63,7 +63,7 @@ class Torus final : public Example {
       v[i] = draw::Vertex(positions_[i], {clamp01(1.0 * l + spec), clamp01(0.62 * l + spec), clamp01(0.25 * l + spec), 1});
     }
     ctx.set_transform(projection(ctx, 0.8, 0.5, 20) * geometry::look_at({0, 0, 4}, {0, 0, 0}, {0, 1, 0}) * model);
-    ctx.bind_texture(nullptr);
+    ctx.unbind_texture();
     return ctx.draw_indexed(v, indices_);
   }
 

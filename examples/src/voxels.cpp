@@ -86,7 +86,7 @@ class Voxels final : public Example {
     const geometry::Vec3 centre{kN / 2.0, 2.5, kN / 2.0};
     const geometry::Vec3 eye{centre.x + 17 * std::cos(a), 13, centre.z + 17 * std::sin(a)};
     ctx.set_transform(projection(ctx, 0.9, 0.5, 60) * geometry::look_at(eye, centre, {0, 1, 0}));
-    ctx.bind_texture(&atlas_);
+    if (auto r = ctx.bind_texture(atlas_); !r) return r;
     ctx.set_cull(geometry::CullMode::Back);
     // Opaque blocks first, writing depth; then the water, blended, tested but not written.
     ctx.state() = {};

@@ -232,7 +232,7 @@ TEST(DrawOnSimulator, TexturedQuadSamplesTheUploadedTexture) {
     }
   auto t = ctx->create_texture(tex);
   ASSERT_TRUE(t);
-  ctx->bind_texture(&*t);
+  ASSERT_TRUE(ctx->bind_texture(*t));
   ctx->state().tex_decal = true;
   // Screen-space quad covering the framebuffer, u/v 0..1: each texel covers a 4x4 pixel block.
   std::vector<geometry::ScreenVertex> q(6);

@@ -37,13 +37,16 @@ std::vector<std::uint32_t> upload_addresses(const protocol::CommandStream& s) {
   return out;
 }
 
-std::size_t count_writes(const protocol::CommandStream& s, Reg reg) {
-  std::size_t n = 0;
+// The data of every write of `reg`, in order.
+std::vector<std::uint64_t> writes(const protocol::CommandStream& s, Reg reg) {
+  std::vector<std::uint64_t> out;
   for (const auto& c : s.commands)
     if (const auto* f = std::get_if<protocol::FramesCmd>(&c.command))
-      for (std::size_t i = 0; i < f->size(); ++i) n += static_cast<Reg>(f->view()[i].index) == reg;
-  return n;
+      for (std::size_t i = 0; i < f->size(); ++i)
+        if (static_cast<Reg>(f->view()[i].index) == reg) out.push_back(f->view()[i].data);
+  return out;
 }
+std::size_t count_writes(const protocol::CommandStream& s, Reg reg) { return writes(s, reg).size(); }
 
 // 64x32 RGBA8888, single-buffered, no depth: the colour buffer is 8192 bytes at 0, textures follow.
 constexpr ContextOptions kSmall{.width = 64, .height = 32, .depth_buffer = false, .double_buffer = false};
@@ -91,7 +94,7 @@ TEST(DrawTextures, StreamingManyTexturesNeverRunsOutWhenEachIsReleased) {
   for (int frame = 1; frame < 200; ++frame) {
     auto next = ctx->create_texture(solid(64, 64, static_cast<std::uint8_t>(frame), 0, 0));
     ASSERT_TRUE(next) << "frame " << frame << ": " << next.error().message;
-    ctx->bind_texture(&*next);
+    ASSERT_TRUE(ctx->bind_texture(*next));
     EXPECT_TRUE(ctx->release_texture(*previous));
     previous = *next;
   }
@@ -149,7 +152,7 @@ TEST(DrawTextures, ReleasingTheBoundTextureUnbindsIt) {
   ASSERT_TRUE(ctx);
   auto t = ctx->create_texture(solid(8, 8, 1, 1, 1));
   ASSERT_TRUE(t);
-  ctx->bind_texture(&*t);
+  ASSERT_TRUE(ctx->bind_texture(*t));
   std::vector<geometry::ScreenVertex> tri(3);
   tri[0] = {0, 0, 0, 1, {1, 1, 1, 1}, {0, 0}};
   tri[1] = {16, 0, 0, 1, {1, 1, 1, 1}, {1, 0}};
@@ -164,24 +167,38 @@ TEST(DrawTextures, ReleasingTheBoundTextureUnbindsIt) {
   EXPECT_EQ(count_writes(sink.stream(), Reg::VERTEX), 6u);
 }
 
-TEST(DrawTextures, BindingAReleasedHandleFailsTheNextDraw) {
+TEST(DrawTextures, BindingAStaleOrEditedHandleFailsAtOnceAndKeepsTheBinding) {
   RecordingSink sink;
   auto ctx = Context::create(sink, kSmall);
   ASSERT_TRUE(ctx);
-  auto t = ctx->create_texture(solid(8, 8, 1, 1, 1));
-  ASSERT_TRUE(t);
-  const Texture copy = *t;
-  ASSERT_TRUE(ctx->release_texture(*t));
-  ctx->bind_texture(&copy);
+  auto a = ctx->create_texture(solid(8, 8, 1, 1, 1));
+  auto b = ctx->create_texture(solid(8, 8, 2, 2, 2));
+  ASSERT_TRUE(a && b);
+  ASSERT_TRUE(ctx->bind_texture(*a));
+  const Texture released = *b;
+  ASSERT_TRUE(ctx->release_texture(*b));
+  auto r = ctx->bind_texture(released);
+  ASSERT_FALSE(r);
+  EXPECT_NE(r.error().message.find("bind_texture: texture 2 (address 0x"), std::string::npos) << r.error().message;
+  EXPECT_NE(r.error().message.find("was released"), std::string::npos);
+  // A live id with a size edited by hand would sample memory outside the texture: rejected too.
+  Texture edited = *a;
+  edited.format.width = 1024;
+  EXPECT_FALSE(ctx->bind_texture(edited));
+  EXPECT_FALSE(ctx->update_texture(edited, solid(1024, 8, 0, 0, 0)));
+  // Neither failure changed the binding: the draw samples `a`.
   std::vector<geometry::ScreenVertex> tri(3);
   tri[1].x = 16;
   tri[2].y = 16;
-  auto r = ctx->draw_screen(tri);
-  ASSERT_FALSE(r);
-  EXPECT_NE(r.error().message.find("the bound texture"), std::string::npos) << r.error().message;
-  EXPECT_NE(r.error().message.find("was released"), std::string::npos);
-  ctx->bind_texture(nullptr);
-  EXPECT_TRUE(ctx->draw_screen(tri));
+  ASSERT_TRUE(ctx->draw_screen(tri));
+  ASSERT_TRUE(ctx->flush());
+  const auto base = writes(sink.stream(), Reg::TEX_BASE);
+  ASSERT_EQ(base.size(), 1u);
+  EXPECT_EQ(base[0], a->address);
+  ctx->unbind_texture();
+  ASSERT_TRUE(ctx->draw_screen(tri));
+  ASSERT_TRUE(ctx->flush());
+  EXPECT_EQ(count_writes(sink.stream(), Reg::TEXCOORD), 3u);  // the second draw is untextured
 }
 
 TEST(DrawTextures, UpdateRejectsOtherSizesAndReleasedTextures) {
@@ -214,7 +231,7 @@ TEST(DrawTextures, UpdateRejectsOtherSizesAndReleasedTextures) {
 
 // A textured quad covering the whole 32x32 framebuffer (decal: the texel colour alone).
 Result<Image> draw_textured_quad(Context& ctx, const Texture& t, bool swap_and_read = true) {
-  ctx.bind_texture(&t);
+  if (auto r = ctx.bind_texture(t); !r) return r.error();
   ctx.state().tex_decal = true;
   std::vector<geometry::ScreenVertex> q(6);
   const double xy[6][2] = {{0, 0}, {32, 0}, {32, 32}, {0, 0}, {32, 32}, {0, 32}};

@@ -28,9 +28,11 @@ Result<std::uint32_t> Context::allocate(std::uint64_t bytes, const char* what) {
   return *a;
 }
 
-bool Context::live(const Texture& texture) const {
+const Texture* Context::live(const Texture& texture) const {
   const auto it = textures_.find(texture.id);
-  return it != textures_.end() && it->second == texture.address;
+  if (it == textures_.end() || it->second.address != texture.address || !(it->second.format == texture.format))
+    return nullptr;
+  return &it->second;
 }
 
 Result<Context> Context::create(CommandSink& sink, const ContextOptions& options) {
@@ -107,21 +109,27 @@ Result<Texture> Context::create_texture(const Image& image, const TextureOptions
     return r.error();
   }
   t.id = next_texture_id_++;
-  textures_.emplace(t.id, t.address);
+  textures_.emplace(t.id, t);
   return t;
 }
 
-Result<void> Context::update_texture(const Texture& texture, const Image& image) {
-  if (!live(texture))
-    return make_error(fmt::format("update_texture: texture {} was released or never created by this context "
-                                  "(create_texture gives a live handle)", texture.id));
-  if (image.width != texture.format.width || image.height != texture.format.height)
+// Why a handle is not live, for bind_texture and update_texture.
+static Error stale_handle(const char* what, const Texture& texture) {
+  return make_error(fmt::format("{}: texture {} (address 0x{:x}) was released, changed by hand, or not created by this "
+                                "context; use the handle create_texture or load_texture returned",
+                                what, texture.id, texture.address));
+}
+
+Result<void> Context::update_texture(const Texture& handle, const Image& image) {
+  const Texture* texture = live(handle);
+  if (!texture) return stale_handle("update_texture", handle);
+  if (image.width != texture->format.width || image.height != texture->format.height)
     return make_error(fmt::format("update_texture: the image is {}x{} but the texture is {}x{} (updates keep the size; "
                                   "create a new texture for another size)",
-                                  image.width, image.height, texture.format.width, texture.format.height));
+                                  image.width, image.height, texture->format.width, texture->format.height));
   if (auto r = check_image_data(image, "update_texture:"); !r) return r;
   if (auto r = send_pending(); !r) return r;  // draws issued so far sample the old contents
-  return sink_->upload(texture.address, device_from_image(texture.format.format, image));
+  return sink_->upload(texture->address, device_from_image(texture->format.format, image));
 }
 
 bool Context::release_texture(Texture& texture) {
@@ -143,11 +151,11 @@ Result<Texture> Context::load_texture(const std::filesystem::path& png, const Te
   return t;
 }
 
-void Context::bind_texture(const Texture* texture) {
-  if (texture)
-    texture_ = *texture;
-  else
-    texture_.reset();
+Result<void> Context::bind_texture(const Texture& handle) {
+  const Texture* texture = live(handle);
+  if (!texture) return stale_handle("bind_texture", handle);
+  texture_ = *texture;
+  return {};
 }
 
 Result<void> Context::clear(geometry::Vec4 color) {
@@ -170,9 +178,6 @@ Result<void> Context::clear_depth(double z) {
 Result<void> Context::apply_state(geometry::PipelineOptions& opt) {
   if ((state_.z_test || state_.z_write) && !depth_)
     return make_error("depth test/write requested but this context has no depth buffer (ContextOptions::depth_buffer)");
-  if (texture_ && !live(*texture_))
-    return make_error(fmt::format("the bound texture (id {}, address 0x{:x}) was released; bind a live texture or nullptr",
-                                  texture_->id, texture_->address));
   geometry::RenderState s = state_;
   s.textured = texture_.has_value();
   const std::uint64_t mode = geometry::tri_mode_word(s);

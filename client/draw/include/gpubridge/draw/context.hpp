@@ -9,7 +9,7 @@
 //   ctx->clear_depth(1.0);
 //   ctx->state().z_test = ctx->state().z_write = true;
 //   ctx->set_transform(projection * view * model);
-//   ctx->bind_texture(&*tex);
+//   if (auto r = ctx->bind_texture(*tex); !r) return r;
 //   ctx->draw_indexed(cube_vertices, cube_indices);
 //   ctx->swap();
 //   ctx->release_texture(*tex);  // when no longer needed (see below)
@@ -22,13 +22,13 @@
 // allocator's (buffers, then textures in creation order).
 //
 // Texture handles are plain values (copy them freely); each carries an id that the Context
-// checks. Releasing one:
+// checks against its own record of the texture (address, size, format), which is what draws and
+// updates use, so a handle edited by hand cannot point a draw at the wrong memory. Releasing one:
 //   - frees its block at once: commands already issued that use it are sent before any later
 //     upload can overwrite that memory (uploads and register writes stay in order);
 //   - unbinds it if it is the bound texture (later draws are untextured until the next bind);
-//   - makes every copy of the handle stale: binding a stale handle makes the next draw fail
-//     ("the bound texture was released"), update_texture() rejects it, and releasing it again
-//     does nothing (returns false).
+//   - makes every copy of the handle stale: bind_texture() and update_texture() reject it with
+//     an error naming the texture, and releasing it again does nothing (returns false).
 #include <cstdint>
 #include <filesystem>
 #include <map>
@@ -104,8 +104,11 @@ class Context {
   // Frees the texture's video memory and clears the handle (see the top of this file). Returns
   // false when the handle was already released (or empty): nothing happens then.
   bool release_texture(Texture& texture);
-  // nullptr unbinds (untextured drawing). A released handle makes the next draw fail.
-  void bind_texture(const Texture* texture);
+  // Following draws sample this texture. A released, edited or foreign handle is an error and
+  // leaves the binding as it was.
+  Result<void> bind_texture(const Texture& texture);
+  // Following draws are untextured.
+  void unbind_texture() { texture_.reset(); }
 
   // --- drawing ---
   Result<void> clear(geometry::Vec4 color);
@@ -134,7 +137,8 @@ class Context {
   Context(CommandSink& sink, const ContextOptions& options)
       : sink_(&sink), options_(options), vram_(sink.vram_bytes()) {}
   Result<std::uint32_t> allocate(std::uint64_t bytes, const char* what);
-  bool live(const Texture& texture) const;
+  // The context's record of a live texture, when the handle matches it exactly.
+  const Texture* live(const Texture& texture) const;
   void write(protocol::Reg reg, std::uint64_t data);
   Result<void> send_pending();
   Result<void> apply_state(geometry::PipelineOptions& opt);
@@ -143,7 +147,7 @@ class Context {
   CommandSink* sink_;
   ContextOptions options_;
   VramAllocator vram_;
-  std::map<std::uint64_t, std::uint32_t> textures_;  // live texture id → address
+  std::map<std::uint64_t, Texture> textures_;  // live textures by id
   std::uint64_t next_texture_id_ = 1;
   std::uint32_t color_[2] = {0, 0};
   int back_ = 0;

@@ -38,6 +38,7 @@ struct TextureFormat {
   protocol::Wrap wrap_s = protocol::Wrap::Repeat;
   protocol::Wrap wrap_t = protocol::Wrap::Repeat;
   bool bilinear = false;
+  bool operator==(const TextureFormat&) const = default;
 };
 Result<std::uint64_t> tex_fmt_word(const TextureFormat& t);
 
