@@ -12,9 +12,15 @@ spdlog::level::level_enum g_level = spdlog::level::info;
 std::string g_pattern = "[%H:%M:%S.%e] [%n] [%^%l%$] %v";
 }  // namespace
 
+std::string log_levels_text() {
+  std::string out;
+  for (auto l : kLogLevels) out += (out.empty() ? "" : "|") + std::string(l);
+  return out;
+}
+
 void init_logging(std::string_view level, LogFormat format) {
   std::lock_guard lock(g_mutex);
-  g_level = spdlog::level::from_str(std::string(level));
+  g_level = is_log_level(level) ? spdlog::level::from_str(std::string(level)) : spdlog::level::info;
   if (format == LogFormat::Json)
     g_pattern = R"({"time":"%Y-%m-%dT%H:%M:%S.%e","channel":"%n","level":"%l","msg":"%v"})";
   spdlog::apply_all([](const std::shared_ptr<spdlog::logger>& l) {

@@ -18,6 +18,15 @@ namespace gpubridge::daemon {
 namespace {
 constexpr std::string_view kEmulatedPrefix = "emulated:";
 
+Result<std::pair<unsigned, unsigned>> parse_fake_size(const std::string& name) {
+  unsigned w = 0, h = 0;
+  char x = 0;
+  if (std::sscanf(name.c_str() + 5, "%u%c%u", &w, &x, &h) != 3 || x != 'x' || w < 1 || h < 1 ||
+      w > protocol::kMaxFramebufferDim || h > protocol::kMaxFramebufferDim)
+    return make_error("backend \"" + name + "\": expected fake:WIDTHxHEIGHT with sizes 1..1024");
+  return std::pair{w, h};
+}
+
 #ifdef GPUBRIDGE_HAVE_USB
 // `boards_dir` may name the configuration directory (holding boards/) or the boards/ directory
 // itself; the USB library wants the former.
@@ -127,12 +136,9 @@ Result<std::unique_ptr<backends::Backend>> make_backend(const std::string& name,
   if (name == "discard") return std::unique_ptr<backends::Backend>(std::make_unique<DiscardBackend>());
   if (name == "fake") return std::unique_ptr<backends::Backend>(std::make_unique<FakeScanoutBackend>());
   if (name.starts_with("fake:")) {  // fake:WxH, frames of that size (fan-out and memory tests)
-    unsigned w = 0, h = 0;
-    char x = 0;
-    if (std::sscanf(name.c_str() + 5, "%u%c%u", &w, &x, &h) != 3 || x != 'x' || w < 1 || h < 1 ||
-        w > protocol::kMaxFramebufferDim || h > protocol::kMaxFramebufferDim)
-      return make_error("backend \"" + name + "\": expected fake:WIDTHxHEIGHT with sizes 1..1024");
-    return std::unique_ptr<backends::Backend>(std::make_unique<FakeScanoutBackend>(w, h));
+    auto size = parse_fake_size(name);
+    if (!size) return size.error();
+    return std::unique_ptr<backends::Backend>(std::make_unique<FakeScanoutBackend>(size->first, size->second));
   }
 #ifdef GPUBRIDGE_HAVE_USB
   if (name == "auto") {
@@ -152,6 +158,48 @@ Result<std::unique_ptr<backends::Backend>> make_backend(const std::string& name,
   return make_error("backend \"" + name +
                     "\": board backends need the USB board path (gpubridge_usb), which this gpubridged was built "
                     "without; use \"sim\", \"auto\", \"fake\" or \"discard\"");
+#endif
+}
+
+Result<std::string> check_backend(const DaemonConfig& cfg) {
+  const std::string& name = cfg.backend;
+  const bool board = is_board_backend(name);
+  if (cfg.mirror && !board)
+    return make_error("--mirror needs a board backend (a board profile name, emulated:BOARD or auto), not \"" + name +
+                      "\": mirror mode compares a board with the simulator");
+  const std::string mirrored = cfg.mirror ? ", mirrored by the simulator" : "";
+  if (name == "sim") return simulator_available() ? Result<std::string>("the simulator") : make_simulator().error();
+  if (name == "discard") return std::string("discard (accepts every command, scans out nothing)");
+  if (name == "fake") return std::string("fake (test backend: registers, 1 MiB of memory, 64x48 frames)");
+  if (name.starts_with("fake:")) {
+    auto size = parse_fake_size(name);
+    if (!size) return size.error();
+    return "fake (test backend, " + std::to_string(size->first) + "x" + std::to_string(size->second) + " frames)";
+  }
+#ifdef GPUBRIDGE_HAVE_USB
+  const auto dir = config_dir_of(cfg);
+  if (name == "auto") {
+    auto profiles = usb::load_board_profiles(dir);
+    if (!profiles) return make_error("backend \"auto\": " + profiles.error().message);
+    const std::string first = "auto: the first of " + std::to_string(profiles->size()) + " board profiles in " +
+                              (dir / "boards").string() + " whose adapter is present";
+    if (cfg.mirror) return first + mirrored + " (with --mirror the daemon does not start when none is present)";
+    return first + ", else the simulator" + (cfg.reattach_interval_ms ? " until a board is plugged in" : "");
+  }
+  const bool emulate = name.starts_with(kEmulatedPrefix);
+  std::string profile_name = name;
+  if (emulate) {
+    auto spec = parse_emulated_spec(name.substr(kEmulatedPrefix.size()));
+    if (!spec) return spec.error();
+    profile_name = spec->profile;
+  }
+  auto profile = usb::find_board_profile(dir, profile_name);
+  if (!profile) return make_error("backend \"" + name + "\": " + profile.error().message);
+  return "board " + profile->name + " (" + std::string(usb::to_string(profile->chip)) + (emulate ? ", emulated" : "") +
+         ") from " + profile->file.string() + mirrored;
+#else
+  if (name == "auto") return std::string("auto: the simulator (this gpubridged has no USB board path)");
+  return make_backend(name, cfg).error();
 #endif
 }
 

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "gpubridge/client/address.hpp"
+#include "gpubridge/common/log.hpp"
 #include "gpubridge/protocol/messages.hpp"
 
 namespace gpubridge::daemon {
@@ -60,7 +61,7 @@ class Reader {
     out = static_cast<T>(n);
     return {};
   }
-  Result<void> known_keys(const json& obj, const std::string& prefix, std::initializer_list<const char*> keys) const {
+  Result<void> known_keys(const json& obj, const std::string& prefix, const std::vector<const char*>& keys) const {
     for (const auto& [k, v] : obj.items()) {
       bool found = false;
       for (const char* key : keys) found = found || k == key;
@@ -72,6 +73,23 @@ class Reader {
  private:
   std::string source_;
 };
+
+// Every limit once: its config key, its flag and its range. parse_config checks the file's values
+// against it and finalize_config checks the values flags set, so both report the same ranges.
+template <class Limits_, class F>
+void for_each_limit(Limits_& lim, F&& f) {
+  f("max_message_bytes", "--max-message", 4096, protocol::kMaxPayload, lim.max_message_bytes);
+  f("max_clients", "--max-clients", 1, 4096, lim.max_clients);
+  f("handshake_timeout_ms", "--handshake-timeout-ms", 10, 600000, lim.handshake_timeout_ms);
+  f("idle_timeout_ms", "--idle-timeout-ms", 0, 86400000, lim.idle_timeout_ms);
+  f("trickle_window_ms", "--trickle-window-ms", 10, 600000, lim.trickle_window_ms);
+  f("min_bytes_per_sec", "--min-bytes-per-sec", 0, 1u << 30, lim.min_bytes_per_sec);
+  f("queue_bytes", "--queue-bytes", 1u << 20, 1ull << 32, lim.queue_bytes);
+}
+
+std::string log_level_problem(const std::string& level) {
+  return "expected one of " + log_levels_text() + ", got " + Reader::shown(json(level));
+}
 
 #define GPUBRIDGE_TRY(expr) \
   do {                      \
@@ -109,21 +127,37 @@ Result<DaemonConfig> parse_config(const json& doc, const std::string& source) {
   GPUBRIDGE_TRY(rd.read_string(doc, "", "frames_dir", cfg.frames_dir));
   GPUBRIDGE_TRY(rd.read_string(doc, "", "record_dir", cfg.record_dir));
   GPUBRIDGE_TRY(rd.read_string(doc, "", "log_level", cfg.log_level));
+  if (!is_log_level(cfg.log_level)) return rd.fail("log_level", log_level_problem(cfg.log_level));
   if (doc.contains("limits")) {
     const auto& l = doc.at("limits");
     if (!l.is_object()) return rd.fail("limits", "expected an object");
-    GPUBRIDGE_TRY(rd.known_keys(l, "limits.", {"max_message_bytes", "max_clients", "handshake_timeout_ms", "idle_timeout_ms",
-                                               "trickle_window_ms", "min_bytes_per_sec", "queue_bytes"}));
-    auto& lim = cfg.limits;
-    GPUBRIDGE_TRY(rd.read_uint(l, "limits.", "max_message_bytes", 4096, protocol::kMaxPayload, lim.max_message_bytes));
-    GPUBRIDGE_TRY(rd.read_uint(l, "limits.", "max_clients", 1, 4096, lim.max_clients));
-    GPUBRIDGE_TRY(rd.read_uint(l, "limits.", "handshake_timeout_ms", 10, 600000, lim.handshake_timeout_ms));
-    GPUBRIDGE_TRY(rd.read_uint(l, "limits.", "idle_timeout_ms", 0, 86400000, lim.idle_timeout_ms));
-    GPUBRIDGE_TRY(rd.read_uint(l, "limits.", "trickle_window_ms", 10, 600000, lim.trickle_window_ms));
-    GPUBRIDGE_TRY(rd.read_uint(l, "limits.", "min_bytes_per_sec", 0, 1u << 30, lim.min_bytes_per_sec));
-    GPUBRIDGE_TRY(rd.read_uint(l, "limits.", "queue_bytes", 1u << 20, 1ull << 32, lim.queue_bytes));
+    std::vector<const char*> keys;
+    for_each_limit(cfg.limits, [&](const char* key, const char*, std::uint64_t, std::uint64_t, auto&) { keys.push_back(key); });
+    GPUBRIDGE_TRY(rd.known_keys(l, "limits.", keys));
+    Result<void> bad;
+    for_each_limit(cfg.limits, [&](const char* key, const char*, std::uint64_t lo, std::uint64_t hi, auto& value) {
+      if (bad) bad = rd.read_uint(l, "limits.", key, lo, hi, value);
+    });
+    if (!bad) return bad.error();
   }
   return cfg;
+}
+
+nlohmann::json config_to_json(const DaemonConfig& cfg) {
+  json doc{{"listen", cfg.listen},
+           {"backend", cfg.backend},
+           {"fallback_to_sim", cfg.fallback_to_sim},
+           {"mirror", cfg.mirror},
+           {"reattach_interval_ms", cfg.reattach_interval_ms},
+           {"boards_dir", cfg.boards_dir},
+           {"frames_dir", cfg.frames_dir},
+           {"record_dir", cfg.record_dir},
+           {"log_level", cfg.log_level}};
+  if (!cfg.token_file.empty()) doc["token_file"] = cfg.token_file;
+  json limits = json::object();
+  for_each_limit(cfg.limits, [&](const char* key, const char*, std::uint64_t, std::uint64_t, auto value) { limits[key] = value; });
+  doc["limits"] = limits;
+  return doc;
 }
 
 Result<DaemonConfig> load_config(const std::filesystem::path& path) {
@@ -159,9 +193,15 @@ Result<void> finalize_config(DaemonConfig& cfg) {
                         " is reachable from other machines; set a token (\"token\" / \"token_file\" or --token) "
                         "or bind 127.0.0.1");
   }
-  if (cfg.limits.max_message_bytes > protocol::kMaxPayload || cfg.limits.max_message_bytes < 4096)
-    return make_error("limits.max_message_bytes: expected 4096.." + std::to_string(protocol::kMaxPayload));
-  if (cfg.limits.max_clients < 1 || cfg.limits.max_clients > 4096) return make_error("limits.max_clients: expected 1..4096");
+  Result<void> bad;
+  for_each_limit(cfg.limits, [&](const char* key, const char* flag, std::uint64_t lo, std::uint64_t hi, auto value) {
+    const auto v = static_cast<std::uint64_t>(value);
+    if (bad && (v < lo || v > hi))
+      bad = make_error("limits." + std::string(key) + " (" + flag + "): expected an integer " + std::to_string(lo) +
+                       ".." + std::to_string(hi) + ", got " + std::to_string(v));
+  });
+  if (!bad) return bad;
+  if (!is_log_level(cfg.log_level)) return make_error("log_level (--log-level): " + log_level_problem(cfg.log_level));
   if (cfg.reattach_interval_ms > kMaxReattachIntervalMs)
     return make_error("reattach_interval_ms: expected 0.." + std::to_string(kMaxReattachIntervalMs) + " (0 = never), got " +
                       std::to_string(cfg.reattach_interval_ms));

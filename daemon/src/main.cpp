@@ -11,6 +11,10 @@
 #include <systemd/sd-daemon.h>
 #endif
 
+#include <nlohmann/json.hpp>
+
+#include "gpubridge/client/address.hpp"
+#include "gpubridge/common/json_text.hpp"
 #include "gpubridge/common/log.hpp"
 #include "gpubridge/daemon/backend_factory.hpp"
 #include "gpubridge/daemon/config.hpp"
@@ -123,6 +127,30 @@ int run(daemon::DaemonConfig cfg) {
   return exit_code;
 }
 
+// `--check-config`: what the daemon would serve, in words (or JSON), and the effective
+// configuration as a file --config accepts.
+int print_checked_config(const daemon::DaemonConfig& cfg, const std::string& config_path, const std::string& backend,
+                         bool json) {
+  std::vector<std::string> listen;
+  for (const auto& text : cfg.listen) listen.push_back(client::parse_address(text)->to_string());  // finalize parsed them
+  const std::string token = cfg.token.empty()       ? "none"
+                            : cfg.token_file.empty() ? "set (not shown)"
+                                                     : "from " + cfg.token_file + " (not shown)";
+  const auto effective = daemon::config_to_json(cfg);
+  if (json) {
+    const nlohmann::json out{{"ok", true},   {"config_file", config_path}, {"backend", backend},
+                             {"listen", listen}, {"token", token},        {"config", effective}};
+    std::printf("%s\n", json_text(out, 2).c_str());
+    return 0;
+  }
+  std::printf("gpubridged: configuration OK (%s)\n", config_path.empty() ? "defaults and flags" : config_path.c_str());
+  std::printf("  backend: %s\n", backend.c_str());
+  for (const auto& l : listen) std::printf("  listen:  %s\n", l.c_str());
+  std::printf("  token:   %s\n", token.c_str());
+  std::printf("effective configuration (loadable with --config):\n%s\n", json_text(effective, 2).c_str());
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -138,6 +166,7 @@ int main(int argc, char** argv) {
   bool foreground = false;
   bool no_fallback = false;
   bool mirror = false;
+  bool check_config = false, json = false;
   app.add_option("-c,--config", config_path, "JSON configuration file (see configs/gpubridged.json)");
   app.add_option("-l,--listen", listen, "unix:PATH or tcp:HOST:PORT (repeatable; replaces the config's list)");
   app.add_option("--token", token, "token TCP clients must present (required for non-loopback TCP)");
@@ -163,7 +192,12 @@ int main(int argc, char** argv) {
   app.add_option("--trickle-window-ms", trickle_ms, "window of the minimum-byte-rate check");
   app.add_option("--min-bytes-per-sec", min_rate, "minimum rate while a message is incomplete");
   app.add_option("--queue-bytes", queue_bytes, "outgoing bytes queued per session before reading pauses");
-  app.add_option("--log-level", log_level, "trace|debug|info|warn|error|off");
+  app.add_option("--log-level", log_level, gpubridge::log_levels_text())
+      ->check(CLI::IsMember(std::vector<std::string>(gpubridge::kLogLevels.begin(), gpubridge::kLogLevels.end())));
+  auto* check_flag = app.add_flag("--check-config", check_config,
+                                  "check the configuration (file and flags) and the backend it names without opening any "
+                                  "device, print the effective configuration and exit (0 valid, 2 not)");
+  app.add_flag("--json", json, "with --check-config: the result as JSON on stdout")->needs(check_flag);
   app.add_flag("--foreground", foreground,
                "stay in the foreground (gpubridged never forks; run it under systemd or your shell's job control)");
   try {
@@ -172,13 +206,16 @@ int main(int argc, char** argv) {
     return app.exit(e) == 0 ? 0 : 2;
   }
 
+  // Configuration errors exit 2; with --check-config --json they are also reported on stdout.
+  auto config_error = [&](const std::string& message) {
+    if (check_config && json) std::printf("%s\n", gpubridge::json_text(nlohmann::json{{"ok", false}, {"error", message}}).c_str());
+    std::fprintf(stderr, "gpubridged: %s\n", message.c_str());
+    return 2;
+  };
   gpubridge::daemon::DaemonConfig cfg;
   if (!config_path.empty()) {
     auto loaded = gpubridge::daemon::load_config(config_path);
-    if (!loaded) {
-      std::fprintf(stderr, "gpubridged: %s\n", loaded.error().message.c_str());
-      return 2;
-    }
+    if (!loaded) return config_error(loaded.error().message);
     cfg = std::move(*loaded);
   }
   if (!listen.empty()) cfg.listen = listen;
@@ -194,14 +231,16 @@ int main(int argc, char** argv) {
   if (!log_level.empty()) cfg.log_level = log_level;
   if (max_clients) cfg.limits.max_clients = *max_clients;
   if (max_message) cfg.limits.max_message_bytes = *max_message;
-  if (handshake_ms) cfg.limits.handshake_timeout_ms = std::max(10u, *handshake_ms);
+  if (handshake_ms) cfg.limits.handshake_timeout_ms = *handshake_ms;
   if (idle_ms) cfg.limits.idle_timeout_ms = *idle_ms;
-  if (trickle_ms) cfg.limits.trickle_window_ms = std::max(10u, *trickle_ms);
+  if (trickle_ms) cfg.limits.trickle_window_ms = *trickle_ms;
   if (min_rate) cfg.limits.min_bytes_per_sec = *min_rate;
-  if (queue_bytes) cfg.limits.queue_bytes = std::max<std::uint64_t>(*queue_bytes, 64 * 1024);
-  if (auto r = gpubridge::daemon::finalize_config(cfg); !r) {
-    std::fprintf(stderr, "gpubridged: %s\n", r.error().message.c_str());
-    return 2;
+  if (queue_bytes) cfg.limits.queue_bytes = *queue_bytes;
+  if (auto r = gpubridge::daemon::finalize_config(cfg); !r) return config_error(r.error().message);
+  if (check_config) {
+    auto backend_text = gpubridge::daemon::check_backend(cfg);
+    if (!backend_text) return config_error(backend_text.error().message);
+    return print_checked_config(cfg, config_path, *backend_text, json);
   }
   for (const auto& dir : {cfg.frames_dir, cfg.record_dir}) {
     std::error_code ec;

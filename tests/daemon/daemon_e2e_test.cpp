@@ -279,6 +279,44 @@ TEST_F(DaemonE2E, BadConfigNamesTheKey) {
   EXPECT_NE(r.err.find(cfg + ": limits.max_clients: expected an integer 1..4096, got \"ten\""), std::string::npos) << r.err;
 }
 
+// --check-config: names what would be served without opening it, prints a configuration that
+// --config accepts, and fails with the same message the daemon would give.
+TEST_F(DaemonE2E, CheckConfigDescribesTheBackendAndPrintsALoadableConfiguration) {
+  auto ok = run_process({GPUBRIDGED_PATH, "--check-config", "--json", "--backend", "icebreaker", "--mirror",
+                         "--listen", "unix:" + (dir_ / "c.sock").string(), "--max-clients", "7"}, 5s);
+  ASSERT_EQ(ok.exit_code, 0) << ok.err;
+  EXPECT_FALSE(fs::exists(dir_ / "c.sock"));  // nothing was started
+  const auto j = nlohmann::json::parse(ok.out);
+  EXPECT_TRUE(j.at("ok").get<bool>());
+  const auto backend = j.at("backend").get<std::string>();
+  EXPECT_NE(backend.find("board icebreaker (ft2232h) from "), std::string::npos) << backend;
+  EXPECT_NE(backend.find("mirrored by the simulator"), std::string::npos) << backend;
+  EXPECT_EQ(j.at("config").at("limits").at("max_clients"), 7);
+  const auto file = (dir_ / "effective.json").string();
+  std::ofstream(file) << j.at("config").dump(2);
+  auto again = run_process({GPUBRIDGED_PATH, "--config", file, "--check-config"}, 5s);
+  EXPECT_EQ(again.exit_code, 0) << again.err;
+  EXPECT_NE(again.out.find("configuration OK (" + file + ")"), std::string::npos) << again.out;
+  EXPECT_NE(again.out.find("\"max_clients\": 7"), std::string::npos) << again.out;
+
+  auto typo = run_process({GPUBRIDGED_PATH, "--check-config", "--json", "--backend", "icebreakr"}, 5s);
+  EXPECT_EQ(typo.exit_code, 2);
+  const auto e = nlohmann::json::parse(typo.out);
+  EXPECT_FALSE(e.at("ok").get<bool>());
+  EXPECT_NE(e.at("error").get<std::string>().find("no board profile named \"icebreakr\""), std::string::npos) << typo.out;
+  EXPECT_NE(typo.err.find("known: "), std::string::npos) << typo.err;
+  auto mirror_sim = run_process({GPUBRIDGED_PATH, "--check-config", "--backend", "sim", "--mirror"}, 5s);
+  EXPECT_EQ(mirror_sim.exit_code, 2);
+  EXPECT_NE(mirror_sim.err.find("--mirror needs a board backend"), std::string::npos) << mirror_sim.err;
+  auto small_queue = run_process({GPUBRIDGED_PATH, "--check-config", "--queue-bytes", "100"}, 5s);
+  EXPECT_EQ(small_queue.exit_code, 2);
+  EXPECT_NE(small_queue.err.find("limits.queue_bytes (--queue-bytes): expected an integer 1048576.."), std::string::npos)
+      << small_queue.err;
+  auto level = run_process({GPUBRIDGED_PATH, "--log-level", "verbose"}, 5s);
+  EXPECT_EQ(level.exit_code, 2);
+  EXPECT_NE(level.err.find("--log-level"), std::string::npos) << level.err;
+}
+
 TEST_F(DaemonE2E, SubscriberGetsEveryFrameAndScreenshotWritesIt) {
   start();
   auto sub = connect("sub");

@@ -61,6 +61,8 @@ TEST(DaemonConfig, ErrorsNameTheKeyAndTheProblem) {
       {R"({"limits": {"max_message_bytes": 99999999999}})", "c.json: limits.max_message_bytes: expected an integer 4096..16777216"},
       {R"({"token": 5})", "c.json: token: expected a string, got 5"},
       {R"([1])", "c.json: (top level): expected a JSON object"},
+      // spdlog reads an unknown level as "off": the daemon would have run silently.
+      {R"({"log_level": "verbose"})", "c.json: log_level: expected one of trace|debug|info|warn|error|off, got \"verbose\""},
   };
   for (const auto& c : cases) {
     auto cfg = parse_config(nlohmann::json::parse(c.json), "c.json");
@@ -109,6 +111,59 @@ TEST(DaemonConfig, ShortenedValueInAnErrorStaysUtf8) {
       ASSERT_TRUE(i + k < m.size() && (static_cast<unsigned char>(m[i + k]) & 0xC0) == 0x80) << "cut character at " << i;
     i += len;
   }
+}
+
+// Flags set limits after the file was read: finalize_config checks them against the same ranges
+// (they used to be clamped silently, to bounds other than the file's).
+TEST(DaemonConfig, LimitsSetByFlagsAreCheckedLikeTheFile) {
+  DaemonConfig cfg;
+  cfg.limits.queue_bytes = 100;
+  auto r = finalize_config(cfg);
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().message, "limits.queue_bytes (--queue-bytes): expected an integer 1048576..4294967296, got 100");
+  cfg = {};
+  cfg.limits.handshake_timeout_ms = 5;
+  r = finalize_config(cfg);
+  ASSERT_FALSE(r);
+  EXPECT_NE(r.error().message.find("limits.handshake_timeout_ms (--handshake-timeout-ms): expected an integer 10..600000"),
+            std::string::npos) << r.error().message;
+  cfg = {};
+  cfg.log_level = "loud";
+  EXPECT_FALSE(finalize_config(cfg));
+  EXPECT_TRUE(finalize_config(cfg = {}));
+}
+
+// --check-config prints the effective configuration in the file's own schema: it loads back to
+// the same settings, and the token itself never appears.
+TEST(DaemonConfig, EffectiveConfigurationLoadsBackAndHidesTheToken) {
+  const auto dir = std::filesystem::temp_directory_path() / ("gpubridged-eff-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "token") << "s3cret-token\n";
+  auto cfg = parse_config(nlohmann::json::parse(R"({
+    "listen": ["unix:/tmp/x.sock", "tcp:0.0.0.0:7420"], "backend": "emulated:icebreaker", "mirror": true,
+    "fallback_to_sim": false, "reattach_interval_ms": 250, "frames_dir": "f", "record_dir": "r", "log_level": "debug",
+    "limits": {"max_message_bytes": 65536, "max_clients": 8, "handshake_timeout_ms": 500,
+               "idle_timeout_ms": 0, "trickle_window_ms": 100, "min_bytes_per_sec": 10, "queue_bytes": 2097152}})"),
+                          "t.json");
+  ASSERT_TRUE(cfg) << cfg.error().message;
+  cfg->token_file = (dir / "token").string();
+  ASSERT_TRUE(finalize_config(*cfg));
+  ASSERT_EQ(cfg->token, "s3cret-token");
+  const auto doc = config_to_json(*cfg);
+  EXPECT_EQ(doc.dump().find("s3cret"), std::string::npos) << doc.dump();
+  auto again = parse_config(doc, "effective");
+  ASSERT_TRUE(again) << again.error().message;
+  ASSERT_TRUE(finalize_config(*again));
+  EXPECT_EQ(again->token, "s3cret-token");  // read again from token_file
+  EXPECT_EQ(config_to_json(*again), doc);
+  EXPECT_EQ(again->limits.queue_bytes, 2097152u);
+  EXPECT_EQ(again->reattach_interval_ms, 250u);
+  EXPECT_TRUE(again->mirror);
+  // A token given directly is left out, not written in clear.
+  DaemonConfig direct;
+  direct.token = "s3cret-token";
+  EXPECT_EQ(config_to_json(direct).dump().find("s3cret"), std::string::npos);
+  std::filesystem::remove_all(dir);
 }
 
 TEST(DaemonConfig, NonLoopbackTcpWithoutTokenIsRefused) {

@@ -21,7 +21,9 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   GlobalOptions global;
   app.add_flag("--json", global.json, "machine-readable JSON output")->configurable();
-  app.add_option("--log-level", global.log_level, "trace|debug|info|warn|error|off")->capture_default_str();
+  app.add_option("--log-level", global.log_level, gpubridge::log_levels_text())
+      ->check(CLI::IsMember(std::vector<std::string>(gpubridge::kLogLevels.begin(), gpubridge::kLogLevels.end())))
+      ->capture_default_str();
 
   auto& registry = command_registry();
   std::sort(registry.begin(), registry.end(), [](const auto& a, const auto& b) { return a.order < b.order; });

@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include "gpubridge/common/log.hpp"
 #include "gpubridge/version.hpp"
 
 namespace gpubridge::viewer {
@@ -64,8 +65,8 @@ Result<ParsedCommandLine> parse_command_line(int argc, const char* const* argv) 
   app.add_flag("!--no-overlay", o.overlay, "start with the overlay hidden");
   app.add_option("--size", size, "initial window size WIDTHxHEIGHT (default: the frame at a whole-number scale)");
   app.add_option("--screenshot-dir", o.screenshot_dir, "directory for screenshots taken with the S key");
-  app.add_option("--log-level", o.log_level, "trace | debug | info | warn | error | off (default warn)")
-      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "off"}));
+  app.add_option("--log-level", o.log_level, gpubridge::log_levels_text() + " (default warn)")
+      ->check(CLI::IsMember(std::vector<std::string>(gpubridge::kLogLevels.begin(), gpubridge::kLogLevels.end())));
   // Hidden (empty group): a generated test pattern instead of the daemon, for tests of the display.
   app.add_option("--test-source", o.test_source, "WxH[:FORMAT][@FPS]")->group("");
   app.add_option("--press", o.press, "keys typed when the first frame arrives")->group("");

@@ -15,6 +15,10 @@
 namespace gpubridge::daemon {
 
 Result<std::unique_ptr<backends::Backend>> make_backend(const std::string& name, const DaemonConfig& cfg);
+// What cfg.backend (with cfg.mirror) would serve, checked without opening any device: the name's
+// syntax, the board profile it names (found and valid), every profile for "auto". A one-line
+// description, or the error make_backend would give for the same reason (`gpubridged --check-config`).
+Result<std::string> check_backend(const DaemonConfig& cfg);
 // The simulator with default options (fallback when a board disappears).
 Result<std::unique_ptr<backends::Backend>> make_simulator();
 bool simulator_available();

@@ -43,7 +43,11 @@ struct DaemonConfig {
 // Parses a configuration document; `source` names it in error messages.
 Result<DaemonConfig> parse_config(const nlohmann::json& doc, const std::string& source);
 Result<DaemonConfig> load_config(const std::filesystem::path& path);
-// Cross-field checks after flags were applied: addresses parse, non-loopback TCP has a token,
+// The configuration as a document parse_config accepts: the effective settings after flags, for
+// `gpubridged --check-config --json`. Secrets stay out: `token_file` is kept when the token came
+// from one, a token given directly is left out.
+nlohmann::json config_to_json(const DaemonConfig& cfg);
+// Cross-field checks after flags were applied (and the ranges of flag-set limits): addresses parse, non-loopback TCP has a token,
 // token_file is read into token.
 Result<void> finalize_config(DaemonConfig& cfg);
 
