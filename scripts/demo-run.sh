@@ -1,0 +1,51 @@
+#!/usr/bin/env bash
+# The demo itself, on an existing build (scripts/demo.sh installs and builds first; CTest runs this
+# headless as demo.headless): starts gpubridged on the simulator and streams the demo scenes to it,
+# into gpubridge-view with a display, as PNG files without one.
+# Usage: scripts/demo-run.sh [BUILD_DIR]   (default build; environment as in scripts/demo.sh)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+bin=${1:-build}
+out=${DEMO_OUT:-out/demo}
+rundir=$(mktemp -d -t gpubridge-demo.XXXXXX)
+sock="$rundir/gpubridge.sock"
+pids=()
+cleanup() {
+  for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done
+  wait 2>/dev/null || true
+  rm -rf "$rundir"
+}
+trap cleanup EXIT
+
+have_display=0
+if [ -n "${DISPLAY:-}${WAYLAND_DISPLAY:-}" ]; then have_display=1; fi
+
+daemon_args=(--listen "unix:$sock" --backend sim --log-level warn)
+if [ "$have_display" = 0 ]; then
+  rm -rf "$out"; mkdir -p "$out"
+  daemon_args+=(--frames-dir "$out")
+fi
+"$bin/daemon/gpubridged" "${daemon_args[@]}" &
+daemon=$!
+pids+=($daemon)
+for _ in $(seq 100); do [ -S "$sock" ] && break; sleep 0.05; done
+[ -S "$sock" ] || { echo "demo: gpubridged did not start (socket $sock missing)" >&2; exit 1; }
+echo "gpubridged is serving the simulator at unix:$sock"
+
+if [ "$have_display" = 1 ]; then
+  "$bin/viewer/gpubridge-view" --connect "unix:$sock" --wait &
+  viewer=$!
+  pids+=($viewer)
+  "$bin/examples/gpubridge-demo" stream --connect "unix:$sock" --frames "${DEMO_FRAMES:-240}" --fps "${DEMO_FPS:-30}"
+  echo "demo: all scenes streamed; close the viewer window (or press Q) to finish"
+  wait "$viewer" || true
+else
+  "$bin/examples/gpubridge-demo" stream --connect "unix:$sock" --frames "${DEMO_FRAMES:-3}" --fps 0
+  # SIGTERM lets the daemon finish what it has in flight (every PNG is written) and exit.
+  kill -TERM "$daemon"
+  wait "$daemon" || { echo "demo: gpubridged did not exit cleanly" >&2; exit 1; }
+  echo "No display: wrote these scanned-out frames (one PNG per swap, scenes in turn):"
+  ls -1 "$out"/*.png | sed 's/^/  /'
+  echo "Every scene also renders in-process: $bin/examples/gpubridge-demo render --out $out/inprocess"
+fi
