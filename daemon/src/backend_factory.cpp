@@ -11,6 +11,7 @@
 #ifdef GPUBRIDGE_HAVE_USB
 #include "gpubridge/usb/board_factory.hpp"
 #include "gpubridge/usb/board_profile.hpp"
+#include "gpubridge/usb/hotplug_monitor.hpp"
 #endif
 
 namespace gpubridge::daemon {
@@ -222,6 +223,31 @@ std::function<Result<std::unique_ptr<backends::Backend>>()> make_reattach_factor
 #else
   (void)cfg;
   return {};
+#endif
+}
+
+Result<std::shared_ptr<void>> watch_board_usb(const DaemonConfig& cfg, std::function<void()> on_event) {
+  const std::string& name = cfg.backend;
+  if (!is_board_backend(name) || name.starts_with(kEmulatedPrefix) || cfg.reattach_interval_ms == 0)
+    return std::shared_ptr<void>();
+#ifdef GPUBRIDGE_HAVE_USB
+  std::vector<std::pair<std::uint16_t, std::uint16_t>> ids;
+  if (name == "auto") {
+    auto profiles = usb::load_board_profiles(config_dir_of(cfg));
+    if (!profiles) return profiles.error();
+    for (const auto& p : *profiles) ids.emplace_back(p.vid, p.pid);
+  } else {
+    auto profile = usb::find_board_profile(config_dir_of(cfg), name);
+    if (!profile) return profile.error();
+    ids.emplace_back(profile->vid, profile->pid);
+  }
+  if (ids.empty()) return std::shared_ptr<void>();
+  auto monitor = usb::HotplugMonitor::start(ids, [on_event = std::move(on_event)](bool, std::uint16_t, std::uint16_t) { on_event(); });
+  if (!monitor) return monitor.error();
+  return std::shared_ptr<void>(std::move(*monitor));
+#else
+  (void)on_event;
+  return std::shared_ptr<void>();
 #endif
 }
 

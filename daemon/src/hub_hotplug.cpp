@@ -3,7 +3,9 @@
 //
 // One steady timer on the network executor drives everything; each expiry posts one step to the
 // device executor and re-arms only after that step finished, so at most one probe or attempt is
-// in flight and the network thread never waits for USB:
+// in flight and the network thread never waits for USB. A libusb hot-plug notification
+// (hotplug_event) re-arms the timer to expire at once, or, while a step runs, makes that step
+// re-arm it at once, so an event is never lost and never starts a second step:
 // - attached board: a presence probe (ID register read). An unplug is thereby noticed even when no
 //   client is sending commands; a probe that finds NO_DEVICE takes the normal device-gone path.
 // - after a disappearance: one call of the re-attach factory (libusb/hidapi open + attach, or the
@@ -34,7 +36,7 @@ void Hub::enable_hotplug(BackendFactory reattach, std::chrono::milliseconds inte
   awaiting_first_board_ = info_.backend != "board";
   first_board_pending_ = awaiting_first_board_;
   attached_ = !awaiting_first_board_;
-  boost::asio::post(net_, [this] { arm_hotplug_timer(); });
+  boost::asio::post(net_, [this] { arm_hotplug_timer(hotplug_interval_); });
 }
 
 void Hub::stop_hotplug() {
@@ -42,15 +44,33 @@ void Hub::stop_hotplug() {
   hotplug_timer_.cancel();
 }
 
-void Hub::arm_hotplug_timer() {
+void Hub::arm_hotplug_timer(std::chrono::milliseconds delay) {
   if (hotplug_stopped_) return;
-  hotplug_timer_.expires_after(hotplug_interval_);
-  hotplug_timer_.async_wait([this](const boost::system::error_code& ec) {
-    if (ec || hotplug_stopped_) return;
+  // Re-arming cancels the pending wait, but its handler may already be queued with success: the
+  // generation tells it that it was superseded.
+  const std::uint64_t generation = ++hotplug_timer_generation_;
+  hotplug_timer_.expires_after(delay);
+  hotplug_timer_.async_wait([this, generation](const boost::system::error_code& ec) {
+    if (ec || hotplug_stopped_ || generation != hotplug_timer_generation_) return;
+    hotplug_step_running_ = true;
     boost::asio::post(device_, [this] {
       hotplug_tick();
-      boost::asio::post(net_, [this] { arm_hotplug_timer(); });
+      boost::asio::post(net_, [this] {
+        hotplug_step_running_ = false;
+        arm_hotplug_timer(std::exchange(hotplug_poke_, false) ? std::chrono::milliseconds(0) : hotplug_interval_);
+      });
     });
+  });
+}
+
+void Hub::hotplug_event() {
+  boost::asio::post(net_, [this] {
+    ++hotplug_events_;
+    if (hotplug_stopped_ || !reattach_ || hotplug_interval_.count() <= 0) return;
+    if (hotplug_step_running_)
+      hotplug_poke_ = true;  // that step re-arms at once when it is done
+    else
+      arm_hotplug_timer(std::chrono::milliseconds(0));
   });
 }
 
@@ -128,7 +148,11 @@ nlohmann::json Hub::hotplug_json() const {
           // nothing was ever detached).
           {"awaiting_first_board", first_board_pending_},
           {"detaches", detaches_},
-          {"reattaches", reattaches_}};
+          {"reattaches", reattaches_},
+          // libusb hot-plug notifications: whether they arrive, and how many did (plugs and unplugs
+          // of the boards' USB ids, whether or not they changed anything).
+          {"usb_notifications", hotplug_notifications_},
+          {"usb_events", hotplug_events_}};
 }
 
 }  // namespace gpubridge::daemon

@@ -77,6 +77,14 @@ int run(daemon::DaemonConfig cfg) {
         return daemon::make_mirror(std::move(*board));
       };
     hub.enable_hotplug(std::move(reattach), std::chrono::milliseconds(cfg.reattach_interval_ms));
+    // Plugs and unplugs of the board's USB ids wake the hot-plug step at once; polling stays the
+    // fallback (and finds an adapter udev had not yet made accessible when it was announced).
+    // Declared after the hub: stopped before it goes.
+    auto usb_watch = daemon::watch_board_usb(cfg, [&hub] { hub.hotplug_event(); });
+    if (!usb_watch)
+      log->info("hot-plug: no USB notifications ({}); checking every {} ms", usb_watch.error().message,
+                cfg.reattach_interval_ms);
+    hub.set_hotplug_notifications(usb_watch && *usb_watch);
     daemon::Server server(net, hub);
     for (const auto& text : cfg.listen) {
       auto addr = client::parse_address(text);

@@ -45,22 +45,30 @@ fs::path make_temp_dir() {
 // the simulator fallback and the auto re-attach factory.
 class InProcessAutoDaemon {
  public:
-  // Starts like gpubridged: make_backend("auto") first (with the testbed as it is now).
-  bool start(const daemon::DaemonConfig& cfg, const fs::path& socket_dir, std::string& started_on, std::string& why) {
+  // Starts like gpubridged: make_backend("auto") first (with the testbed as it is now), then the
+  // hot-plug timer and, with `notifications`, the libusb hot-plug watch.
+  bool start(const daemon::DaemonConfig& cfg, const fs::path& socket_dir, std::string& started_on, std::string& why,
+             bool notifications = false) {
     auto backend = daemon::make_backend(cfg.backend, cfg);
     if (!backend) return (why = backend.error().message, false);
     started_on = (*backend)->info().backend;
     test::InProcessDaemon::Options opts;
     opts.fallback = daemon::make_simulator;
-    opts.before_listening = [&cfg](daemon::Hub& hub) {
+    opts.before_listening = [this, &cfg, notifications, &why](daemon::Hub& hub) {
       hub.enable_hotplug(daemon::make_reattach_factory(cfg), std::chrono::milliseconds(cfg.reattach_interval_ms));
+      if (!notifications) return;
+      auto watch = daemon::watch_board_usb(cfg, [&hub] { hub.hotplug_event(); });
+      if (!watch) why = watch.error().message;
+      else watch_ = std::move(*watch);
+      hub.set_hotplug_notifications(watch_ != nullptr);
     };
-    return daemon_.start(std::move(*backend), socket_dir, why, opts);
+    return daemon_.start(std::move(*backend), socket_dir, why, opts) && (!notifications || watch_);
   }
   const std::string& address() const { return daemon_.address(); }
 
  private:
   test::InProcessDaemon daemon_;
+  std::shared_ptr<void> watch_;  // after daemon_: stops watching before the hub goes
 };
 
 TEST(AutoAttach, BoardPluggedInAfterStartReplacesTheSimulator) {
@@ -124,6 +132,63 @@ TEST(AutoAttach, BoardPluggedInAfterStartReplacesTheSimulator) {
     EXPECT_EQ(*id >> 56, 0x53u);
     EXPECT_GT(bed.bulk_urbs.load(), urbs_before) << "the ID read did not reach the USB device";
     EXPECT_TRUE(bed.model.violations().empty()) << bed.model.violations()[0];
+  }
+  std::error_code ec;
+  fs::remove_all(dir, ec);
+}
+
+// With libusb hot-plug notifications the plug and the unplug take effect at once: the poll
+// interval here is ten minutes, so without the notification neither would happen in the test.
+TEST(AutoAttach, UsbNotificationsAttachAndDetachWithoutWaitingForThePoll) {
+  usb::testing::Bed bed(/*plugged=*/false);
+  const fs::path dir = make_temp_dir();
+  fs::copy_file(fs::path(GPUBRIDGE_TEST_CONFIG_DIR) / "boards" / "ft232h-generic.json", dir / "boards" / "ft232h-generic.json");
+
+  daemon::DaemonConfig cfg;
+  cfg.backend = "auto";
+  cfg.boards_dir = dir.string();
+  cfg.reattach_interval_ms = 600000;
+
+  std::string started_on, why;
+  {
+    InProcessAutoDaemon d;
+    ASSERT_TRUE(d.start(cfg, dir, started_on, why, /*notifications=*/true)) << why;
+    ASSERT_EQ(started_on, "sim");
+    auto c = client::Client::connect(d.address(), 2000ms);
+    ASSERT_TRUE(c) << c.error().message;
+    ASSERT_TRUE(c->handshake("watcher", "", 2000ms));
+    {
+      const auto st = status_of(*c);
+      EXPECT_EQ(st["hotplug"]["usb_notifications"], true) << st.dump();
+      EXPECT_EQ(st["hotplug"]["usb_events"], 0) << st.dump();
+    }
+
+    const auto t0 = std::chrono::steady_clock::now();
+    bed.plug();
+    umockdev_testbed_uevent(bed.testbed, "/sys/devices/usb1", "add");  // what the kernel announces
+    const auto back = wait_event(*c, "device_back", 5000ms);
+    ASSERT_TRUE(back) << "the plug notification did not start an attach";
+    EXPECT_EQ((*back)["board"], "ft232h-generic") << back->dump();
+    EXPECT_EQ((*back)["first_attach"], true) << back->dump();
+    const auto attach_ms = std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::steady_clock::now() - t0);
+    std::printf("attached %lld ms after the plug notification\n", static_cast<long long>(attach_ms.count()));
+    {
+      const auto st = status_of(*c);
+      EXPECT_EQ(st["backend"], "board") << st.dump();
+      EXPECT_GE(st["hotplug"]["usb_events"].get<int>(), 1) << st.dump();
+    }
+
+    // Unplug: URBs fail with ENODEV from now on, and the kernel announces the removal. Nobody is
+    // sending commands, so only the notification's presence probe can notice it.
+    bed.model.faults().at_op = bed.model.faults().ops;
+    bed.model.faults().fault = usb::emu::UsbFault::NoDevice;
+    umockdev_testbed_uevent(bed.testbed, "/sys/devices/usb1", "remove");
+    const auto gone = wait_event(*c, "device_gone", 5000ms);
+    ASSERT_TRUE(gone) << "the unplug notification did not start a presence probe";
+    const auto st = status_of(*c);
+    EXPECT_EQ(st["backend"], "sim") << st.dump();
+    EXPECT_EQ(st["hotplug"]["detaches"], 1) << st.dump();
+    EXPECT_GE(st["hotplug"]["usb_events"].get<int>(), 2) << st.dump();
   }
   std::error_code ec;
   fs::remove_all(dir, ec);

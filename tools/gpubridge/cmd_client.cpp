@@ -119,13 +119,16 @@ int run_status(const GlobalOptions& g, const ClientOptions& o) {
   // Board backends only (daemons without hot-plug omit the object or report it disabled).
   if (j.contains("hotplug") && j["hotplug"].is_object() && j["hotplug"].value("enabled", false)) {
     const auto& h = j["hotplug"];
-    std::printf("hot-plug:  board %s, %llu unplug(s), %llu re-attach(es), checked every %llu ms\n",
+    std::printf("hot-plug:  board %s, %llu unplug(s), %llu re-attach(es), checked every %llu ms%s\n",
                 h.value("awaiting_first_board", false) ? "none yet (auto: looking for one)"
                 : h.value("attached", true)            ? "attached"
                                                        : "gone (looking for it)",
                 static_cast<unsigned long long>(h.value("detaches", std::uint64_t{0})),
                 static_cast<unsigned long long>(h.value("reattaches", std::uint64_t{0})),
-                static_cast<unsigned long long>(h.value("interval_ms", std::uint64_t{0})));
+                static_cast<unsigned long long>(h.value("interval_ms", std::uint64_t{0})),
+                h.value("usb_notifications", false)
+                    ? (" and on USB plug/unplug (" + std::to_string(h.value("usb_events", std::uint64_t{0})) + " so far)").c_str()
+                    : "");
   }
   // Mirror mode (gpubridged --mirror): board frames compared with the simulator's.
   if (j.contains("mirror") && j["mirror"].is_object() && j["mirror"].value("enabled", false)) {

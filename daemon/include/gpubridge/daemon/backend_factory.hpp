@@ -29,5 +29,11 @@ bool is_board_backend(const std::string& name);
 // it succeeds); "auto" looks for any present board but never settles for the simulator. Empty
 // for backends that cannot disappear (sim, fake, discard) or without the USB board path.
 std::function<Result<std::unique_ptr<backends::Backend>>()> make_reattach_factory(const DaemonConfig& cfg);
+// libusb hot-plug notifications for the USB ids of cfg's real board(s) (the named profile, or every
+// profile for "auto"); `on_event` runs on the watcher's thread for each plug or unplug (Hub::
+// hotplug_event). Holding the result keeps watching. nullptr when there is nothing to watch
+// (simulator, test and emulated backends, re-attach disabled); an error when notifications are
+// unavailable (the daemon then relies on polling).
+Result<std::shared_ptr<void>> watch_board_usb(const DaemonConfig& cfg, std::function<void()> on_event);
 
 }  // namespace gpubridge::daemon

@@ -113,6 +113,12 @@ class Hub {
   void enable_hotplug(BackendFactory reattach, std::chrono::milliseconds interval);
   // Shutdown: cancels the timer; no probe or attempt starts afterwards (network thread).
   void stop_hotplug();
+  // A USB device of the board(s) arrived or left (libusb hot-plug notification, any thread): the
+  // next probe or re-attach attempt runs now instead of at the end of the interval. With no
+  // enabled hot-plug, or after stop_hotplug(), it is only counted.
+  void hotplug_event();
+  // Whether such notifications arrive (status reports it); set once at start (network thread).
+  void set_hotplug_notifications(bool on) { hotplug_notifications_ = on; }
 
   std::string device_json() const;     // WELCOME's device description
   nlohmann::json status_json() const;  // STATUS_REPLY
@@ -131,7 +137,7 @@ class Hub {
   void compare_mirrored(const backends::ScanoutFrame& frame);            // network thread
   void on_device_gone(const Error& e);                                   // device thread
   void broadcast_event(const nlohmann::json& event);                     // network thread
-  void arm_hotplug_timer();                                              // network thread
+  void arm_hotplug_timer(std::chrono::milliseconds delay);               // network thread
   void hotplug_tick();                                                   // device thread
   void install_backend(std::unique_ptr<backends::Backend> backend);      // device thread
   nlohmann::json hotplug_json() const;                                   // network thread
@@ -165,6 +171,11 @@ class Hub {
   std::chrono::milliseconds hotplug_interval_{0};
   boost::asio::steady_timer hotplug_timer_{net_};
   bool hotplug_stopped_ = false;                // network thread
+  std::uint64_t hotplug_timer_generation_ = 0;  // network thread: a timer handler of an older arming does nothing
+  bool hotplug_step_running_ = false;           // network thread: a probe/attempt is on the device thread
+  bool hotplug_poke_ = false;                   // network thread: an event came during that step
+  bool hotplug_notifications_ = false;          // network thread
+  std::uint64_t hotplug_events_ = 0;            // network thread
   bool device_lost_ = false;                    // device thread: gone and not yet re-attached
   bool awaiting_first_board_ = false;           // device thread: `auto` on the simulator, no board yet
   bool attached_ = true;                        // network-thread copy of !device_lost_ && !awaiting_first_board_
