@@ -16,8 +16,23 @@ std::string lower(std::string s) {
   return s;
 }
 
+// Traces are read twice (format sniffing, then the reader) and sized before reading: they must be
+// regular files. Pipes and devices get a message saying so instead of "Operation not supported".
+Result<void> check_regular_file(const std::filesystem::path& path, const char* what) {
+  std::error_code ec;
+  const auto st = std::filesystem::status(path, ec);
+  if (ec || !std::filesystem::exists(st)) return make_error(path.string() + ": cannot open " + what + " (" +
+                                                            (ec ? ec.message() : std::string("no such file")) + ")");
+  if (std::filesystem::is_directory(st)) return make_error(path.string() + ": is a directory, not a " + what);
+  if (!std::filesystem::is_regular_file(st))
+    return make_error(path.string() + ": is not a regular file (a pipe or a device); save the " + what +
+                      " to a file and pass that");
+  return {};
+}
+
 // Reads a whole file after checking its size against `limit` (nothing is allocated first).
 Result<std::string> read_small_file(const std::filesystem::path& path, std::uint64_t limit, const char* what) {
+  if (auto r = check_regular_file(path, what); !r) return r.error();
   std::error_code ec;
   const auto size = std::filesystem::file_size(path, ec);
   if (ec) return make_error(path.string() + ": cannot open " + what + " (" + ec.message() + ")");
@@ -64,6 +79,7 @@ protocol::AssetLoader make_asset_loader(std::filesystem::path base_dir) {
 }
 
 Result<protocol::CommandStream> load_trace(const std::filesystem::path& path) {
+  if (auto r = check_regular_file(path, "trace"); !r) return r.error();
   auto src = FileSource::open(path);
   if (!src) return src.error();
   std::uint8_t magic[sizeof protocol::kTraceMagic] = {};

@@ -104,5 +104,17 @@ TEST_F(TraceFiles, FormatDetectionAndMissingFiles) {
   EXPECT_NE(missing.error().message.find("missing.trace: cannot open"), std::string::npos) << missing.error().message;
 }
 
+// Traces are sized and sniffed before reading, so they must be regular files; anything else is
+// named for what it is (file_size() on a device said "Operation not supported").
+TEST_F(TraceFiles, DirectoriesAndDevicesAreNamedForWhatTheyAre) {
+  fs::create_directories(dir_ / "sub.trace");
+  auto d = load_trace(dir_ / "sub.trace");
+  ASSERT_FALSE(d.ok());
+  EXPECT_NE(d.error().message.find("sub.trace: is a directory, not a trace"), std::string::npos) << d.error().message;
+  auto dev = load_trace("/dev/null");
+  ASSERT_FALSE(dev.ok());
+  EXPECT_EQ(dev.error().message, "/dev/null: is not a regular file (a pipe or a device); save the trace to a file and pass that");
+}
+
 }  // namespace
 }  // namespace gpubridge
