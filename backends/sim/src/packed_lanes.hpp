@@ -15,17 +15,23 @@ namespace gpubridge::sim::simd {
 typedef std::uint16_t u16x8 __attribute__((vector_size(16)));
 typedef std::uint8_t u8x8 __attribute__((vector_size(8)));
 
-// The first n stored pixels at p (later lanes 0).
+// The first n stored pixels at p; later lanes hold the next pixels of the row when `whole`
+// (eight pixels fit before the row ends), else 0. Eight pixels are copied with a constant size,
+// which becomes one load: a copy of n bytes is a call, or pieces that the vector load cannot
+// forward from.
 template <unsigned kFormat>
-[[gnu::always_inline]] inline u32x8 load_packed(const std::uint8_t* p, unsigned n) {
+[[gnu::always_inline]] inline u32x8 load_packed(const std::uint8_t* p, unsigned n, bool whole) {
+  constexpr std::size_t kBytes = kFormat == 1 ? 2 : 1;
   if constexpr (kFormat == 1) {
     u16x8 h = {};
-    std::memcpy(&h, p, std::size_t{n} * 2);
+    if (n == 8 || whole) std::memcpy(&h, p, 8 * kBytes);
+    else std::memcpy(&h, p, n * kBytes);
     const u32x8 v = __builtin_convertvector(h, u32x8);
     return ((v & 0xFFu) << 8) | (v >> 8);  // big-endian in video memory
   } else {
     u8x8 b = {};
-    std::memcpy(&b, p, n);
+    if (n == 8 || whole) std::memcpy(&b, p, 8 * kBytes);
+    else std::memcpy(&b, p, n * kBytes);
     return __builtin_convertvector(b, u32x8);
   }
 }
@@ -34,10 +40,12 @@ template <unsigned kFormat>
 [[gnu::always_inline]] inline void store_packed(std::uint8_t* p, u32x8 v, unsigned n) {
   if constexpr (kFormat == 1) {
     const u16x8 h = __builtin_convertvector(((v & 0xFFu) << 8) | ((v >> 8) & 0xFFu), u16x8);
-    std::memcpy(p, &h, std::size_t{n} * 2);
+    if (n == 8) std::memcpy(p, &h, 16);
+    else std::memcpy(p, &h, std::size_t{n} * 2);
   } else {
     const u8x8 b = __builtin_convertvector(v, u8x8);
-    std::memcpy(p, &b, n);
+    if (n == 8) std::memcpy(p, &b, 8);
+    else std::memcpy(p, &b, n);
   }
 }
 
@@ -76,11 +84,11 @@ template <unsigned kFormat>
 }
 
 // The whole colour write of n pixels at p. `need_old`: the stored pixels matter (blend, write
-// mask, or lanes that do not pass); without it nothing is read.
+// mask, or lanes that do not pass); without it nothing is read. `whole`: as for load_packed.
 template <unsigned kFormat>
 [[gnu::always_inline]] inline void write_packed8(std::uint8_t* p, unsigned n, u32x8 word, u32x8 pass, bool need_old,
-                                                 unsigned blend, u32x8 bayer, std::uint32_t keep_bits) {
-  const u32x8 old = need_old ? load_packed<kFormat>(p, n) : u32x8{};
+                                                 unsigned blend, u32x8 bayer, std::uint32_t keep_bits, bool whole) {
+  const u32x8 old = need_old ? load_packed<kFormat>(p, n, whole) : u32x8{};
   if (blend != 0) word = GB_BLEND8(blend, word, expand_packed<kFormat>(old));
   u32x8 out = pack_colour<kFormat>(word, bayer);
   out = (out & ~keep_bits) | (old & keep_bits);

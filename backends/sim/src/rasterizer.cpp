@@ -279,6 +279,7 @@ class Kernel {
       for (unsigned k = 0; k < 8; ++k) sp.bayer[k] = kBayer4[y & 3][(static_cast<unsigned>(x) + k) & 3];
     sp.depth = kDepth ? zbuf_ + pix * 4 : nullptr;
     sp.count = count;
+    sp.room = width_ - static_cast<unsigned>(x);
     const std::uint64_t passed = shade_span_simd(sp);
     ctx_.counters.passed += passed;
     if (st_.blend != protocol::BlendMode::Off) ctx_.counters.blended += passed;

@@ -24,6 +24,7 @@ struct SimdSpan {
   std::uint8_t* colour = nullptr;          // first pixel of the span
   std::uint8_t* depth = nullptr;           // first depth word of the span (when z_test or z_write)
   unsigned count = 0;                      // pixels in the span
+  unsigned room = 0;                       // pixels from the span's first to the end of its buffer row (>= count)
   unsigned z_func = 0;                     // protocol::DepthFunc
   unsigned blend = 0;                      // protocol::BlendMode (0 = off)
   std::uint32_t keep = 0;                  // bytes of the colour word the write mask keeps
