@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <fstream>
 #include <sstream>
+#include <string_view>
 #include <thread>
 
 #include "error_measure.hpp"
@@ -172,15 +173,22 @@ Result<Report> run_accuracy_bench(const AccuracyBenchOptions& opt, const std::fu
   goal("exact, 1 thread, 10-px triangles (front), tri/s vs llvmpipe", find("sim", "exact", "tri10-front", 1), 2.0, false);
   goal("exact, 1 thread, 1,000-px triangles (front), tri/s vs llvmpipe", find("sim", "exact", "tri1k-front", 1), 1.5, false);
   goal("exact, 1 thread, 50,000-px triangles (front), px/s vs llvmpipe", find("sim", "exact", "tri50k-front", 1), 1.0, true);
+  // The goal is for large triangles; the medium scene's scaling is listed beside it, marked as such
+  // (it was once labelled as a goal line by mistake).
   for (const char* scene : {"tri50k-front", "tri50k-random", "tri1k-front"}) {
     const Row* one = find("sim", "exact", scene, 1);
     const Row* two = find("sim", "exact", scene, 2);
     if (one && two) {
       std::ostringstream o;
-      o.precision(3);
+      o << std::fixed;
+      o.precision(2);
       const double ratio = one->seconds / two->seconds;
-      o << "exact, 2 threads vs 1 thread, " << scene << ": " << ratio << "x (goal >= 1.8x on large triangles, "
-        << (ratio >= 1.8 ? "met" : "MISSED") << ")";
+      const bool large = std::string_view(scene).starts_with("tri50k");
+      o << "exact, 2 threads vs 1 thread, " << scene << ": " << ratio << "x ";
+      if (large)
+        o << "(goal >= 1.8x on large triangles, " << (ratio >= 1.8 ? "met" : "MISSED") << ")";
+      else
+        o << "(1,000-px triangles, for reference: the 1.8x goal is for large triangles)";
       rep.goals.push_back(o.str());
     }
   }
