@@ -71,16 +71,21 @@ class InProcessAutoDaemon {
   std::shared_ptr<void> watch_;  // after daemon_: stops watching before the hub goes
 };
 
-TEST(AutoAttach, BoardPluggedInAfterStartReplacesTheSimulator) {
-  usb::testing::Bed bed(/*plugged=*/false);
-  const fs::path dir = make_temp_dir();
-  // Only the profile that matches the testbed's FT232H, so every attempt is this board's open.
+// `--backend auto` over a boards directory holding only the profile that matches the testbed's
+// FT232H, so every attempt is this board's open.
+daemon::DaemonConfig auto_config(const fs::path& dir, unsigned reattach_interval_ms) {
   fs::copy_file(fs::path(GPUBRIDGE_TEST_CONFIG_DIR) / "boards" / "ft232h-generic.json", dir / "boards" / "ft232h-generic.json");
-
   daemon::DaemonConfig cfg;
   cfg.backend = "auto";
   cfg.boards_dir = dir.string();
-  cfg.reattach_interval_ms = 50;
+  cfg.reattach_interval_ms = reattach_interval_ms;
+  return cfg;
+}
+
+TEST(AutoAttach, BoardPluggedInAfterStartReplacesTheSimulator) {
+  usb::testing::Bed bed(/*plugged=*/false);
+  const fs::path dir = make_temp_dir();
+  const auto cfg = auto_config(dir, 50);
 
   std::string started_on, why;
   {
@@ -142,12 +147,7 @@ TEST(AutoAttach, BoardPluggedInAfterStartReplacesTheSimulator) {
 TEST(AutoAttach, UsbNotificationsAttachAndDetachWithoutWaitingForThePoll) {
   usb::testing::Bed bed(/*plugged=*/false);
   const fs::path dir = make_temp_dir();
-  fs::copy_file(fs::path(GPUBRIDGE_TEST_CONFIG_DIR) / "boards" / "ft232h-generic.json", dir / "boards" / "ft232h-generic.json");
-
-  daemon::DaemonConfig cfg;
-  cfg.backend = "auto";
-  cfg.boards_dir = dir.string();
-  cfg.reattach_interval_ms = 600000;
+  const auto cfg = auto_config(dir, 600000);
 
   std::string started_on, why;
   {
