@@ -1,5 +1,9 @@
 #include "gpubridge/daemon/config.hpp"
 
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
 #include <fstream>
 #include <sstream>
 
@@ -158,6 +162,23 @@ nlohmann::json config_to_json(const DaemonConfig& cfg) {
   for_each_limit(cfg.limits, [&](const char* key, const char*, std::uint64_t, std::uint64_t, auto value) { limits[key] = value; });
   doc["limits"] = limits;
   return doc;
+}
+
+Result<void> check_output_dirs(const DaemonConfig& cfg) {
+  const std::pair<const char*, const std::string*> dirs[] = {{"frames_dir", &cfg.frames_dir}, {"record_dir", &cfg.record_dir}};
+  for (const auto& [key, value] : dirs) {
+    if (value->empty()) continue;
+    std::filesystem::path p = std::filesystem::absolute(*value);
+    std::error_code ec;
+    // The directory itself, or the nearest ancestor that exists (the daemon creates the rest).
+    while (!std::filesystem::exists(p, ec) && p.has_parent_path() && p != p.parent_path()) p = p.parent_path();
+    if (!std::filesystem::is_directory(p, ec))
+      return make_error(std::string(key) + ": " + *value + ": " + p.string() + " is not a directory");
+    if (::access(p.c_str(), W_OK | X_OK) != 0)
+      return make_error(std::string(key) + ": " + *value + ": " + p.string() + " is not writable by this user (" +
+                        std::strerror(errno) + "); choose another directory or fix its permissions");
+  }
+  return {};
 }
 
 Result<DaemonConfig> load_config(const std::filesystem::path& path) {

@@ -245,6 +245,7 @@ int main(int argc, char** argv) {
   if (min_rate) cfg.limits.min_bytes_per_sec = *min_rate;
   if (queue_bytes) cfg.limits.queue_bytes = *queue_bytes;
   if (auto r = gpubridge::daemon::finalize_config(cfg); !r) return config_error(r.error().message);
+  if (auto r = gpubridge::daemon::check_output_dirs(cfg); !r) return config_error(r.error().message);
   if (check_config) {
     auto backend_text = gpubridge::daemon::check_backend(cfg);
     if (!backend_text) return config_error(backend_text.error().message);

@@ -166,6 +166,34 @@ TEST(DaemonConfig, EffectiveConfigurationLoadsBackAndHidesTheToken) {
   std::filesystem::remove_all(dir);
 }
 
+// frames_dir / record_dir are checked before the daemon starts (and by --check-config): a path
+// through a regular file, or (for users other than root, whom permissions do not stop) a directory
+// the daemon may not write, is refused with the key named; a directory still to be created is fine.
+TEST(DaemonConfig, OutputDirectoriesMustBeWritableOrCreatable) {
+  const auto dir = std::filesystem::temp_directory_path() / ("gpubridged-out-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "file") << "x";
+  DaemonConfig cfg;
+  EXPECT_TRUE(check_output_dirs(cfg));  // unset
+  cfg.frames_dir = (dir / "new" / "frames").string();
+  cfg.record_dir = dir.string();
+  EXPECT_TRUE(check_output_dirs(cfg)) << check_output_dirs(cfg).error().message;
+  cfg.record_dir = (dir / "file" / "rec").string();
+  auto r = check_output_dirs(cfg);
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().message, "record_dir: " + cfg.record_dir + ": " + (dir / "file").string() + " is not a directory");
+  if (::geteuid() != 0) {
+    std::filesystem::create_directories(dir / "ro");
+    std::filesystem::permissions(dir / "ro", std::filesystem::perms::owner_read | std::filesystem::perms::owner_exec);
+    cfg.record_dir = (dir / "ro" / "rec").string();
+    r = check_output_dirs(cfg);
+    ASSERT_FALSE(r);
+    EXPECT_NE(r.error().message.find("is not writable by this user"), std::string::npos) << r.error().message;
+    std::filesystem::permissions(dir / "ro", std::filesystem::perms::owner_all);
+  }
+  std::filesystem::remove_all(dir);
+}
+
 TEST(DaemonConfig, NonLoopbackTcpWithoutTokenIsRefused) {
   DaemonConfig cfg;
   cfg.listen = {"tcp:0.0.0.0:7420"};

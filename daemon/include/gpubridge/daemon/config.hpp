@@ -47,6 +47,10 @@ Result<DaemonConfig> load_config(const std::filesystem::path& path);
 // `gpubridged --check-config --json`. Secrets stay out: `token_file` is kept when the token came
 // from one, a token given directly is left out.
 nlohmann::json config_to_json(const DaemonConfig& cfg);
+// frames_dir and record_dir: each unset, a writable directory, or creatable (its nearest existing
+// ancestor is a writable directory). Checked at start and by --check-config, so a daemon that
+// could not write its frames or recordings says so instead of logging a warning per frame.
+Result<void> check_output_dirs(const DaemonConfig& cfg);
 // Cross-field checks after flags were applied (and the ranges of flag-set limits): addresses parse, non-loopback TCP has a token,
 // token_file is read into token.
 Result<void> finalize_config(DaemonConfig& cfg);
