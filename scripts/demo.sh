@@ -11,4 +11,4 @@ cd "$(dirname "$0")/.."
 if [ "${GPUBRIDGE_SKIP_DEPS:-0}" != 1 ]; then ./scripts/install-deps.sh; fi
 ./scripts/build.sh
 
-exec ./scripts/demo-run.sh build
+exec ./scripts/demo-run.sh "${GPUBRIDGE_BUILD_DIR:-build}"

@@ -72,6 +72,25 @@ Result<EmulatedSpec> parse_emulated_spec(const std::string& spec) {
   return out;
 }
 
+// The profiles a board backend name stands for: every profile for "auto", else the one it names
+// ("emulated:NAME?..." names NAME). Used where no device is opened (--check-config, the USB watch).
+Result<std::vector<usb::BoardProfile>> board_profiles_of(const DaemonConfig& cfg, const std::string& name) {
+  if (name == "auto") {
+    auto profiles = usb::load_board_profiles(config_dir_of(cfg));
+    if (!profiles) return make_error("backend \"auto\": " + profiles.error().message);
+    return profiles;
+  }
+  std::string profile_name = name;
+  if (name.starts_with(kEmulatedPrefix)) {
+    auto spec = parse_emulated_spec(name.substr(kEmulatedPrefix.size()));
+    if (!spec) return spec.error();
+    profile_name = spec->profile;
+  }
+  auto profile = usb::find_board_profile(config_dir_of(cfg), profile_name);
+  if (!profile) return make_error("backend \"" + name + "\": " + profile.error().message);
+  return std::vector<usb::BoardProfile>{std::move(*profile)};
+}
+
 Result<std::unique_ptr<backends::Backend>> open_named_board(const std::string& name, bool emulate, const DaemonConfig& cfg,
                                                              const std::string& presence_file = {}) {
   auto profile = usb::find_board_profile(config_dir_of(cfg), name);
@@ -178,26 +197,17 @@ Result<std::string> check_backend(const DaemonConfig& cfg) {
     return "fake (test backend, " + std::to_string(size->first) + "x" + std::to_string(size->second) + " frames)";
   }
 #ifdef GPUBRIDGE_HAVE_USB
-  const auto dir = config_dir_of(cfg);
+  auto profiles = board_profiles_of(cfg, name);
+  if (!profiles) return profiles.error();
   if (name == "auto") {
-    auto profiles = usb::load_board_profiles(dir);
-    if (!profiles) return make_error("backend \"auto\": " + profiles.error().message);
     const std::string first = "auto: the first of " + std::to_string(profiles->size()) + " board profiles in " +
-                              (dir / "boards").string() + " whose adapter is present";
+                              (config_dir_of(cfg) / "boards").string() + " whose adapter is present";
     if (cfg.mirror) return first + mirrored + " (with --mirror the daemon does not start when none is present)";
     return first + ", else the simulator" + (cfg.reattach_interval_ms ? " until a board is plugged in" : "");
   }
-  const bool emulate = name.starts_with(kEmulatedPrefix);
-  std::string profile_name = name;
-  if (emulate) {
-    auto spec = parse_emulated_spec(name.substr(kEmulatedPrefix.size()));
-    if (!spec) return spec.error();
-    profile_name = spec->profile;
-  }
-  auto profile = usb::find_board_profile(dir, profile_name);
-  if (!profile) return make_error("backend \"" + name + "\": " + profile.error().message);
-  return "board " + profile->name + " (" + std::string(usb::to_string(profile->chip)) + (emulate ? ", emulated" : "") +
-         ") from " + profile->file.string() + mirrored;
+  const auto& profile = profiles->front();
+  return "board " + profile.name + " (" + std::string(usb::to_string(profile.chip)) +
+         (name.starts_with(kEmulatedPrefix) ? ", emulated" : "") + ") from " + profile.file.string() + mirrored;
 #else
   if (name == "auto") return std::string("auto: the simulator (this gpubridged has no USB board path)");
   return make_backend(name, cfg).error();
@@ -231,16 +241,10 @@ Result<std::shared_ptr<void>> watch_board_usb(const DaemonConfig& cfg, std::func
   if (!is_board_backend(name) || name.starts_with(kEmulatedPrefix) || cfg.reattach_interval_ms == 0)
     return std::shared_ptr<void>();
 #ifdef GPUBRIDGE_HAVE_USB
+  auto profiles = board_profiles_of(cfg, name);
+  if (!profiles) return profiles.error();
   std::vector<std::pair<std::uint16_t, std::uint16_t>> ids;
-  if (name == "auto") {
-    auto profiles = usb::load_board_profiles(config_dir_of(cfg));
-    if (!profiles) return profiles.error();
-    for (const auto& p : *profiles) ids.emplace_back(p.vid, p.pid);
-  } else {
-    auto profile = usb::find_board_profile(config_dir_of(cfg), name);
-    if (!profile) return profile.error();
-    ids.emplace_back(profile->vid, profile->pid);
-  }
+  for (const auto& p : *profiles) ids.emplace_back(p.vid, p.pid);
   if (ids.empty()) return std::shared_ptr<void>();
   auto monitor = usb::HotplugMonitor::start(ids, [on_event = std::move(on_event)](bool, std::uint16_t, std::uint16_t) { on_event(); });
   if (!monitor) return monitor.error();

@@ -4,7 +4,10 @@
 # Usage: demo_headless.sh SOURCE_DIR BUILD_DIR WORK_DIR
 set -eu
 src=$1 build=$2 work=$3
-frames=2 scenes=7
+frames=2
+# One PNG per swap: every scene the demo lists, `frames` times.
+scenes=$("$build/examples/gpubridge-demo" list | grep -c .)
+[ "$scenes" -gt 0 ] || { echo "gpubridge-demo list printed no scenes"; exit 1; }
 rm -rf "$work" && mkdir -p "$work"
 env -u DISPLAY -u WAYLAND_DISPLAY DEMO_OUT="$work/out" DEMO_FRAMES=$frames \
   "$src/scripts/demo-run.sh" "$build" > "$work/log" 2>&1 || { cat "$work/log"; echo "demo-run.sh failed"; exit 1; }

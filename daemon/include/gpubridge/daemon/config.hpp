@@ -51,8 +51,8 @@ nlohmann::json config_to_json(const DaemonConfig& cfg);
 // ancestor is a writable directory). Checked at start and by --check-config, so a daemon that
 // could not write its frames or recordings says so instead of logging a warning per frame.
 Result<void> check_output_dirs(const DaemonConfig& cfg);
-// Cross-field checks after flags were applied (and the ranges of flag-set limits): addresses parse, non-loopback TCP has a token,
-// token_file is read into token.
+// Cross-field checks after flags were applied: addresses parse, non-loopback TCP has a token,
+// limits (also those set by flags) are in range, token_file is read into token.
 Result<void> finalize_config(DaemonConfig& cfg);
 
 }  // namespace gpubridge::daemon
