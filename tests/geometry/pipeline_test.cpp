@@ -254,5 +254,98 @@ TEST(Pipeline, RejectsNonFiniteInput) {
   }
 }
 
+// A snapping tie x = k/16 + 1/32 and a w for which x·w / w comes back one ulp below x, so that
+// snapping the divided value rounds down where floor(16·x + 0.5) rounds up.
+struct TieCase {
+  double x, w;
+};
+TieCase tie_below_after_round_trip() {
+  std::mt19937_64 rng(16);
+  std::uniform_real_distribution<double> w(0.25, 8.0);
+  for (int k = 100;; ++k) {
+    const double x = (k + 0.5) / 16.0;
+    for (int i = 0; i < 64; ++i) {
+      const double ww = w(rng);
+      if ((x * ww) / ww < x) return {x, ww};
+    }
+  }
+}
+
+std::set<std::int16_t> sent_x(const std::vector<DeviceTriangle>& out) {
+  std::set<std::int16_t> xs;
+  for (const auto& t : out)
+    for (const auto& v : t) xs.insert(v.x);
+  return xs;
+}
+
+// docs/protocol.md 16.2: a vertex given in screen space is snapped from the x given, whatever w is;
+// only homogeneous input is snapped from X / W.
+TEST(Pipeline, ScreenVertexOnATieSnapsFromTheGivenXWhateverW) {
+  const TieCase c = tie_below_after_round_trip();
+  const auto rule = static_cast<std::int16_t>(std::floor(16.0 * c.x + 0.5));
+  ScreenVertex a, b, d;
+  a.x = c.x, a.y = 10.03125, a.z = 0.25, a.w = c.w;
+  b.x = c.x + 20, b.y = 10, b.z = 0.5, b.w = 2;
+  d.x = c.x, d.y = 30, d.z = 0.75, d.w = 3;
+  std::vector<DeviceTriangle> out;
+  ASSERT_TRUE(process_screen_triangle({a, b, d}, PipelineOptions{}, out));
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_EQ(out[0][0].x, rule) << "x = " << c.x << ", w = " << c.w;
+  EXPECT_EQ(out[0][0].y, 161);  // 10.03125: a tie in y too
+  EXPECT_EQ(out[0][0].z, static_cast<std::uint32_t>(std::floor(0.25 * 16777215.0 + 0.5)));
+  // The same point in homogeneous form is snapped from its divide, one ulp below the tie.
+  std::vector<DeviceTriangle> homogeneous;
+  ASSERT_TRUE(process_triangle({from_screen(a), from_screen(b), from_screen(d)}, PipelineOptions{}, homogeneous));
+  EXPECT_EQ(homogeneous[0][0].x, rule - 1) << "the search should have found a round trip that loses the tie";
+}
+
+// A vertex of a clipped triangle that no plane cut away keeps the user's x; the new vertices are
+// snapped from their X / W (section 16.2).
+TEST(Pipeline, ClippedTriangleKeepsTheGivenXOfItsSurvivingVertices) {
+  const TieCase c = tie_below_after_round_trip();
+  const auto rule = static_cast<std::int16_t>(std::floor(16.0 * c.x + 0.5));
+  ScreenVertex a, b, d;
+  a.x = c.x, a.y = 10, a.z = 0.5, a.w = c.w;
+  b.x = c.x + 40, b.y = 10, b.z = -0.5, b.w = 1;  // behind the near plane: the triangle is clipped
+  d.x = c.x, d.y = 50, d.z = 0.5, d.w = 2;
+  std::vector<DeviceTriangle> out;
+  PipelineStats st;
+  ASSERT_TRUE(process_screen_triangle({a, b, d}, PipelineOptions{}, out, &st));
+  EXPECT_EQ(st.clipped, 1u);
+  ASSERT_FALSE(out.empty());
+  EXPECT_TRUE(sent_x(out).contains(rule)) << "x = " << c.x << ", w = " << c.w;
+  EXPECT_FALSE(sent_x(out).contains(static_cast<std::int16_t>(rule - 1)));
+}
+
+// Texture-precision subdivision (W ratio 64) keeps the corners the user gave exact.
+TEST(Pipeline, SubdividedTriangleKeepsTheGivenXOfItsCorners) {
+  const TieCase c = tie_below_after_round_trip();
+  const auto rule = static_cast<std::int16_t>(std::floor(16.0 * c.x + 0.5));
+  ScreenVertex a, b, d;
+  a.x = c.x, a.y = 10, a.z = 0.5, a.w = c.w;
+  b.x = c.x + 40, b.y = 12, b.z = 0.5, b.w = c.w * 64;
+  d.x = c.x + 3, d.y = 50, d.z = 0.5, d.w = c.w;
+  PipelineOptions opt;
+  opt.textured = true;
+  std::vector<DeviceTriangle> out;
+  PipelineStats st;
+  ASSERT_TRUE(process_screen_triangle({a, b, d}, opt, out, &st));
+  EXPECT_GE(st.subdivided, 1u);
+  EXPECT_TRUE(sent_x(out).contains(rule)) << "x = " << c.x << ", w = " << c.w;
+  EXPECT_FALSE(sent_x(out).contains(static_cast<std::int16_t>(rule - 1)));
+}
+
+// x and w finite but x·w not: an error, not Inf in the pipeline.
+TEST(Pipeline, ScreenVertexWhoseHomogeneousFormOverflowsIsAnError) {
+  ScreenVertex a, b, d;
+  a.x = 1e300, a.w = 1e300;
+  b.x = 10, d.y = 10;
+  std::vector<DeviceTriangle> out;
+  const auto r = process_screen_triangle({a, b, d}, PipelineOptions{}, out);
+  ASSERT_FALSE(r);
+  EXPECT_NE(r.error().message.find("vertex 0: NaN or Inf"), std::string::npos) << r.error().message;
+  EXPECT_TRUE(out.empty());
+}
+
 }  // namespace
 }  // namespace gpubridge::geometry

@@ -199,9 +199,7 @@ Result<void> Context::apply_state(geometry::PipelineOptions& opt) {
   return {};
 }
 
-Result<void> Context::emit(const geometry::Triangle& tri, const geometry::PipelineOptions& opt, std::size_t first_index) {
-  scratch_.clear();
-  auto r = geometry::process_triangle(tri, opt, scratch_, &stats_);
+Result<void> Context::emit(const Result<void>& r, const geometry::PipelineOptions& opt, std::size_t first_index) {
   if (!r) return make_error(fmt::format("triangle at index {}: {}", first_index, r.error().message));
   for (const auto& t : scratch_) geometry::encode_triangle(t, opt.textured, pending_);
   if (pending_.size() >= options_.batch_frames) return send_pending();
@@ -225,7 +223,9 @@ Result<void> Context::draw_indexed(std::span<const Vertex> vertices, std::span<c
     transformed_[i] = geometry::Vertex{m * geometry::point(vertices[i].position), vertices[i].color, vertices[i].uv};
   for (std::size_t i = 0; i < indices.size(); i += 3) {
     const geometry::Triangle tri{transformed_[indices[i]], transformed_[indices[i + 1]], transformed_[indices[i + 2]]};
-    if (auto r = emit(tri, opt, i); !r) return r;
+    scratch_.clear();
+    const auto r = geometry::process_triangle(tri, opt, scratch_, &stats_);
+    if (auto sent = emit(r, opt, i); !sent) return sent;
   }
   return {};
 }
@@ -239,9 +239,10 @@ Result<void> Context::draw_screen(std::span<const geometry::ScreenVertex> vertic
     for (std::size_t k = i; k < i + 3; ++k)
       if (!(vertices[k].w > 0))
         return make_error(fmt::format("draw_screen: vertex {}: w = {} must be > 0", k, vertices[k].w));
-    const geometry::Triangle tri{geometry::from_screen(vertices[i]), geometry::from_screen(vertices[i + 1]),
-                                 geometry::from_screen(vertices[i + 2])};
-    if (auto r = emit(tri, opt, i); !r) return r;
+    scratch_.clear();
+    const auto r = geometry::process_screen_triangle({vertices[i], vertices[i + 1], vertices[i + 2]}, opt, scratch_,
+                                                     &stats_);
+    if (auto sent = emit(r, opt, i); !sent) return sent;
   }
   return {};
 }

@@ -14,6 +14,17 @@ bool finite(const Vertex& v) {
   return true;
 }
 
+bool finite(const ScreenVertex& v) {
+  for (double a : {v.x, v.y, v.z, v.w, v.color.x, v.color.y, v.color.z, v.color.w, v.uv.x, v.uv.y})
+    if (!std::isfinite(a)) return false;
+  return true;
+}
+
+Error not_finite(int vertex) {
+  return make_error(fmt::format("vertex {}: NaN or Inf in position, colour or texture coordinate "
+                                "(every value must be a finite number)", vertex));
+}
+
 // Whether edge a-b needs splitting for texture precision. Depends only on the two endpoints
 // (and symmetrically on them), so both triangles sharing the edge decide the same.
 bool edge_over_bound(const Vertex& a, const Vertex& b, const PipelineOptions& opt, double w_ratio) {
@@ -27,10 +38,34 @@ Vertex midpoint(const Vertex& a, const Vertex& b) {
   return Vertex{(a.pos + b.pos) * 0.5, (a.color + b.color) * 0.5, (a.uv + b.uv) * 0.5};
 }
 
+// The screen vertices the user gave (scene files, draw_screen) beside the window-homogeneous form
+// the pipeline clips and subdivides. A vertex is snapped from its perspective divide unless it is
+// one the user gave: then from the user's own x, y and z, because x·w / w need not give x back,
+// and on a snapping tie (x = k/16 + 1/32) one ulp moves the vertex by 1/16 px (docs/protocol.md
+// 16.2). Clipping and subdivision copy the vertices they keep, so "one the user gave" is exact
+// equality with its homogeneous form (position, colour and texture coordinates); new vertices
+// (intersections, midpoints) never equal one unless they are that point. Two given vertices with
+// the same homogeneous form (a zero-length edge) are both snapped from the first one's x.
+struct GivenScreen {
+  const std::array<ScreenVertex, 3>& screen;
+  const Triangle& homogeneous;
+
+  void apply(const Vertex& v, ScreenVertex& s) const {
+    for (int i = 0; i < 3; ++i)
+      if (homogeneous[i] == v) {
+        s.x = screen[i].x;
+        s.y = screen[i].y;
+        s.z = screen[i].z;
+        return;
+      }
+  }
+};
+
 class Emitter {
  public:
-  Emitter(const PipelineOptions& opt, std::vector<DeviceTriangle>& out, PipelineStats& st)
-      : opt_(opt), out_(out), st_(st) {
+  Emitter(const PipelineOptions& opt, std::vector<DeviceTriangle>& out, PipelineStats& st,
+          const GivenScreen* given = nullptr)
+      : opt_(opt), out_(out), st_(st), given_(given) {
     // The texel error terms that grow with the W ratio are proportional to the texture size
     // (docs/protocol.md section 15), so smaller textures tolerate proportionally larger ratios.
     const unsigned size = std::clamp(opt.texture_size, 1u, 1024u);
@@ -86,6 +121,8 @@ class Emitter {
  private:
   Result<void> emit(const Triangle& t) {
     std::array<ScreenVertex, 3> s{to_screen(t[0]), to_screen(t[1]), to_screen(t[2])};
+    if (given_)
+      for (int i = 0; i < 3; ++i) given_->apply(t[i], s[i]);
     if (!opt_.textured)
       for (auto& v : s) v.uv = {};  // S/T are not sent: their range must not limit untextured draws
     auto dev = convert_triangle(s, opt_.tex);
@@ -111,6 +148,7 @@ class Emitter {
   const PipelineOptions& opt_;
   std::vector<DeviceTriangle>& out_;
   PipelineStats& st_;
+  const GivenScreen* given_;
   double w_ratio_ = 32.0;
 };
 
@@ -158,17 +196,12 @@ ClippedPolygon clip_for_pipeline(const Triangle& tri, const PipelineOptions& opt
   return r;
 }
 
-Result<void> process_triangle(const Triangle& tri, const PipelineOptions& opt, std::vector<DeviceTriangle>& out,
-                              PipelineStats* stats) {
-  PipelineStats local;
-  PipelineStats& st = stats ? *stats : local;
-  ++st.input;
-  for (int i = 0; i < 3; ++i)
-    if (!finite(tri[i]))
-      return make_error(fmt::format("vertex {}: NaN or Inf in position, colour or texture coordinate "
-                                    "(every value must be a finite number)", i));
+namespace {
 
-  Emitter emitter(opt, out, st);
+// The pipeline after the input checks; `given` (screen-space input only) as in GivenScreen.
+Result<void> run_pipeline(const Triangle& tri, const GivenScreen* given, const PipelineOptions& opt,
+                          std::vector<DeviceTriangle>& out, PipelineStats& st) {
+  Emitter emitter(opt, out, st, given);
   // Fast path (the common case): every vertex strictly inside every plane, nothing to clip.
   bool all_inside = true;
   for (const auto& v : tri) {
@@ -191,6 +224,31 @@ Result<void> process_triangle(const Triangle& tri, const PipelineOptions& opt, s
   for (std::size_t i = 1; i + 1 < poly.count; ++i)
     if (auto r = emitter.subdivide(Triangle{poly.v[0], poly.v[i], poly.v[i + 1]}, 0); !r) return r;
   return {};
+}
+
+}  // namespace
+
+Result<void> process_triangle(const Triangle& tri, const PipelineOptions& opt, std::vector<DeviceTriangle>& out,
+                              PipelineStats* stats) {
+  PipelineStats local;
+  PipelineStats& st = stats ? *stats : local;
+  ++st.input;
+  for (int i = 0; i < 3; ++i)
+    if (!finite(tri[i])) return not_finite(i);
+  return run_pipeline(tri, nullptr, opt, out, st);
+}
+
+Result<void> process_screen_triangle(const std::array<ScreenVertex, 3>& tri, const PipelineOptions& opt,
+                                     std::vector<DeviceTriangle>& out, PipelineStats* stats) {
+  PipelineStats local;
+  PipelineStats& st = stats ? *stats : local;
+  ++st.input;
+  const Triangle homogeneous{from_screen(tri[0]), from_screen(tri[1]), from_screen(tri[2])};
+  // x·w can overflow where x and w do not: both forms must be finite.
+  for (int i = 0; i < 3; ++i)
+    if (!finite(tri[i]) || !finite(homogeneous[i])) return not_finite(i);
+  const GivenScreen given{tri, homogeneous};
+  return run_pipeline(homogeneous, &given, opt, out, st);
 }
 
 }  // namespace gpubridge::geometry

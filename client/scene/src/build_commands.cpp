@@ -146,10 +146,9 @@ Result<BuiltScene> build_commands(const Scene& scene, const BuildOptions& option
     scissor = sc;
     w.write(Reg::PRIM, static_cast<unsigned>(protocol::PrimType::List));
     for (std::size_t v = 0; v + 2 < d.vertices.size(); v += 3) {
-      const geometry::Triangle tri{geometry::from_screen(d.vertices[v]), geometry::from_screen(d.vertices[v + 1]),
-                                   geometry::from_screen(d.vertices[v + 2])};
       tris.clear();
-      auto r = geometry::process_triangle(tri, opt, tris, &out.stats);
+      auto r = geometry::process_screen_triangle({d.vertices[v], d.vertices[v + 1], d.vertices[v + 2]}, opt, tris,
+                                                 &out.stats);
       if (!r)
         return make_error(fmt::format("{}.vertices[{}..{}] (triangle {}): {}", where, v, v + 2, v / 3, r.error().message));
       for (const auto& t : tris) geometry::encode_triangle(t, d.state.textured, w.frames());

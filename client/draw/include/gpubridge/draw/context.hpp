@@ -115,7 +115,8 @@ class Context {
   Result<void> clear_depth(double z = 1.0);
   // Indexed triangle list: every 3 indices form a triangle. Vertices are transformed once each.
   Result<void> draw_indexed(std::span<const Vertex> vertices, std::span<const std::uint32_t> indices);
-  // Screen-space triangle list (pixels, y down; w for perspective-correct attributes).
+  // Screen-space triangle list (pixels, y down; w for perspective-correct attributes). Each vertex
+  // is snapped from the x, y given, whatever its w (docs/protocol.md 16.2).
   Result<void> draw_screen(std::span<const geometry::ScreenVertex> vertices);
   // Shows the back buffer (FB_DISPLAY) and, double-buffered, starts drawing into the other one.
   Result<void> swap();
@@ -142,7 +143,9 @@ class Context {
   void write(protocol::Reg reg, std::uint64_t data);
   Result<void> send_pending();
   Result<void> apply_state(geometry::PipelineOptions& opt);
-  Result<void> emit(const geometry::Triangle& tri, const geometry::PipelineOptions& opt, std::size_t first_index);
+  // Queues the device triangles the pipeline left in scratch_ for the triangle at first_index
+  // (r: the pipeline's result for it).
+  Result<void> emit(const Result<void>& r, const geometry::PipelineOptions& opt, std::size_t first_index);
 
   CommandSink* sink_;
   ContextOptions options_;

@@ -8,6 +8,12 @@
 //     → texture-precision subdivision (textured triangles only, see below)
 //     → perspective divide → snap/convert (convert_triangle) → back-face / zero-area cull
 //
+// Screen-space input (scene files, draw::Context::draw_screen) enters through
+// process_screen_triangle: the same pipeline on (x·w, y·w, z·w, w), except that every vertex the
+// user gave is snapped from the x, y (and converted from the z) the user gave, whatever w is.
+// Only vertices the pipeline creates (clip intersections, subdivision midpoints) are snapped from
+// their perspective divide (docs/protocol.md 16.2).
+//
 // Texture-precision subdivision: the device's texel-coordinate error is ≤ 1/256 texel for
 // 1024-texel textures (docs/protocol.md section 15) when, within a triangle, max W / min W ≤ 32
 // and |u − u_off|, |v − v_off| ≤ 4 texture sizes. The pipeline splits every EDGE whose two
@@ -79,6 +85,12 @@ ClippedPolygon clip_for_pipeline(const Triangle& tri, const PipelineOptions& opt
 // coordinate range that S/T cannot hold even after subdivision.
 Result<void> process_triangle(const Triangle& tri, const PipelineOptions& opt, std::vector<DeviceTriangle>& out,
                               PipelineStats* stats = nullptr);
+
+// Runs one screen-space triangle (x, y in pixels, z in [0, 1], w > 0 the perspective divisor)
+// through the pipeline. Differs from process_triangle(from_screen(...)) only in the snapping of
+// the given vertices: floor(16·x + 0.5) of the x given, exactly, also where x·w / w is not x.
+Result<void> process_screen_triangle(const std::array<ScreenVertex, 3>& tri, const PipelineOptions& opt,
+                                     std::vector<DeviceTriangle>& out, PipelineStats* stats = nullptr);
 
 // Window-homogeneous vertex from a screen-space vertex: (x·w, y·w, z·w, w).
 Vertex from_screen(const ScreenVertex& v);
