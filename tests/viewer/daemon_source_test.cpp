@@ -1,6 +1,8 @@
 // DaemonFrameSource pieces that need no daemon: the WELCOME description and the failure paths.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
+
 #include "gpubridge/viewer/daemon_frame_source.hpp"
 
 namespace gpubridge::viewer {
@@ -52,6 +54,24 @@ TEST(DaemonSource, RefusesAMalformedAddress) {
   const auto st = wait_for_end(s);
   EXPECT_EQ(st.state, SourceStatus::State::Failed);
   EXPECT_FALSE(st.message.empty());
+}
+
+// No --connect means the default socket, as for every other client (issue 15: the viewer failed with
+// `bad address "": unknown scheme` while `gpubridge status` found the daemon).
+TEST(DaemonSource, NoAddressMeansTheDefaultSocket) {
+  const std::string runtime = ::testing::TempDir() + "gpubridge-view-default-socket-test";
+  const char* old = std::getenv("XDG_RUNTIME_DIR");
+  const std::string saved = old ? old : "";
+  ::setenv("XDG_RUNTIME_DIR", runtime.c_str(), 1);
+  DaemonFrameSource s({"", "", 60, false});
+  s.start();
+  const auto st = wait_for_end(s);
+  if (old) ::setenv("XDG_RUNTIME_DIR", saved.c_str(), 1);
+  else ::unsetenv("XDG_RUNTIME_DIR");
+  EXPECT_EQ(st.state, SourceStatus::State::Failed);  // nothing listens there
+  EXPECT_EQ(st.address, "unix:" + runtime + "/gpubridge/gpubridge.sock");
+  EXPECT_EQ(st.message.find("bad address"), std::string::npos) << st.message;
+  EXPECT_NE(st.message.find(runtime + "/gpubridge/gpubridge.sock"), std::string::npos) << st.message;
 }
 
 }  // namespace

@@ -63,7 +63,7 @@ std::optional<std::pair<std::uint64_t, std::uint64_t>> mirror_counts(const std::
 }
 
 DaemonFrameSource::DaemonFrameSource(DaemonSourceConfig config) : config_(std::move(config)) {
-  auto parsed = client::parse_address(config_.address);
+  auto parsed = client::parse_connect_address(config_.address);
   display_address_ = parsed ? parsed->to_string() : config_.address;
 }
 
@@ -78,7 +78,7 @@ void DaemonFrameSource::run(std::stop_token stop) {
     status.message = std::move(message);
     publish_status(status);
   };
-  if (auto parsed = client::parse_address(config_.address); !parsed) {
+  if (auto parsed = client::parse_connect_address(config_.address); !parsed) {
     fail(parsed.error().message);
     return;
   }

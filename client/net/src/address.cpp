@@ -61,6 +61,10 @@ Result<Address> parse_address(std::string_view text) {
   return a;
 }
 
+Result<Address> parse_connect_address(std::string_view text) {
+  return parse_address(text.empty() ? std::string_view("unix:") : text);
+}
+
 bool is_loopback_host(std::string_view host) {
   if (host == "localhost" || host == "::1") return true;
   in_addr v4{};

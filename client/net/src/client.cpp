@@ -138,7 +138,7 @@ Client::~Client() {
 }
 
 Result<Client> Client::connect(std::string_view address, Timeout timeout) {
-  auto addr = parse_address(address.empty() ? std::string_view("unix:") : address);
+  auto addr = parse_connect_address(address);
   if (!addr) return addr.error();
   const auto deadline = Clock::now() + timeout;
   auto fd = addr->kind == Address::Kind::Unix ? open_unix(*addr, deadline) : open_tcp(*addr, deadline);

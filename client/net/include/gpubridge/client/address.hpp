@@ -23,6 +23,11 @@ struct Address {
 // "unix:" with an empty path (or the word "default") means default_socket_path().
 Result<Address> parse_address(std::string_view text);
 
+// The address a client connects to: parse_address(text), and the default socket when text is
+// empty (no --connect given). Every client (Client::connect, the viewer, the CLI) resolves its
+// --connect value here, so "no option" means the same daemon everywhere.
+Result<Address> parse_connect_address(std::string_view text);
+
 // $XDG_RUNTIME_DIR/gpubridge/gpubridge.sock; /run/gpubridge/gpubridge.sock for root without
 // XDG_RUNTIME_DIR; otherwise /tmp/gpubridge-<uid>/gpubridge.sock.
 std::string default_socket_path();
