@@ -354,6 +354,76 @@ TEST_F(DaemonE2E, SubscriberGetsEveryFrameAndScreenshotWritesIt) {
   EXPECT_EQ(img->rgba, f->pixels);
 }
 
+// --connect and --token are global options (issue 15): accepted before the command, as --json and
+// --log-level are, and after it (also after a nested command); refused for commands that do not
+// talk to the daemon instead of being ignored.
+TEST_F(DaemonE2E, ConnectIsAGlobalOptionBeforeOrAfterTheCommand) {
+  start();
+  const std::string at = "unix:" + socket_;
+  for (const auto& args : std::vector<std::vector<std::string>>{{"--connect", at, "status"},
+                                                                 {"status", "--connect", at},
+                                                                 {"--json", "--connect", at, "status"},
+                                                                 {"--connect", at, "reg", "read", "ID"},
+                                                                 {"reg", "read", "ID", "--connect", at},
+                                                                 {"--connect", at, "--token", "unused", "status"}}) {
+    const auto r = run_process(cli(args));
+    std::string line;
+    for (const auto& a : args) line += a + " ";
+    EXPECT_EQ(r.exit_code, 0) << line << ": " << r.err;
+    EXPECT_EQ(r.err.find("not expected"), std::string::npos) << line << ": " << r.err;
+  }
+  const auto local = run_process(cli({"--connect", at, "regs"}));
+  EXPECT_EQ(local.exit_code, 2);
+  EXPECT_NE(local.err.find("--connect and --token only apply to the commands that talk to gpubridged (status, "
+                            "play, screenshot, reg read, reg write, upload, readback)"),
+            std::string::npos)
+      << local.err;
+}
+
+// `gpubridge screenshot` says what happened when no frame comes (issue 15): nothing drawing,
+// the daemon going away, or (daemon_board_test) frames scanned out that carry no picture.
+TEST_F(DaemonE2E, ScreenshotWithNothingDrawingSaysSo) {
+  start();
+  auto drawer = connect("drawer");
+  ASSERT_TRUE(drawer.acquire_lease(LeaseMode::Wait, 1000ms));
+  const auto w = frames_of({protocol::write_frame(Reg::FB_DISPLAY, 0)});
+  ASSERT_TRUE(drawer.write_frames(protocol::FrameView{w}, 1000ms));  // one frame before: counted, not new
+  ASSERT_TRUE(drawer.fence(1000ms));
+  const auto r = run_process(cli({"screenshot", "--out", (dir_ / "none.png").string(), "--timeout", "300",
+                                  "--connect", "unix:" + socket_}));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("no frame within 0.3 s: nothing is drawing (the daemon scanned out no frame while we waited; "
+                       "1 since it started)"),
+            std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "none.png"));
+}
+
+TEST_F(DaemonE2E, ScreenshotWhenTheDaemonStopsSaysSo) {
+  start();
+  auto shot = std::async(std::launch::async, [&] {
+    return run_process(cli({"screenshot", "--out", (dir_ / "none.png").string(), "--connect", "unix:" + socket_}));
+  });
+  auto watcher = connect("watcher");
+  bool subscribed = false;
+  for (int i = 0; i < 500 && !subscribed; ++i) {
+    auto st = watcher.status(1000ms);
+    ASSERT_TRUE(st);
+    const auto status = nlohmann::json::parse(*st);
+    for (const auto& cl : status["clients"]) subscribed = subscribed || cl["subscribed"].get<bool>();
+    if (!subscribed) std::this_thread::sleep_for(10ms);
+  }
+  ASSERT_TRUE(subscribed) << "the screenshot client never subscribed";
+  watcher.close();
+  EXPECT_EQ(daemon_.terminate(), 0);
+  const auto r = shot.get();
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("gpubridge screenshot: gpubridged shut down before a frame arrived (SHUTTING_DOWN"),
+            std::string::npos)
+      << r.err;
+  EXPECT_EQ(r.err.find("is anything drawing"), std::string::npos) << r.err;
+}
+
 // A rate-limited subscriber (max_fps 2) skips frames that come too fast, but the newest one is
 // delivered when its interval ends: the last frame of an animation is never lost.
 TEST_F(DaemonE2E, RateLimitedSubscriberStillGetsTheLastFrame) {

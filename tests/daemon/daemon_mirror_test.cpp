@@ -395,6 +395,46 @@ TEST(DaemonMirror, CrcOnlyBoardIsComparedThroughFrameCrc) {
   fs::remove_all(dir, ec);
 }
 
+// `gpubridge screenshot` of a CRC-only board (issue 15): frames are scanned out while it waits but
+// none carries a board picture; it says so (and how to see them) instead of "is anything drawing?".
+TEST(DaemonMirror, ScreenshotOfACrcOnlyBoardSaysFramesCameWithoutPictures) {
+  const auto dir = make_temp_dir("shot-crc");
+  const std::string address = "unix:" + (dir / "d.sock").string();
+  Daemon daemon;
+  ASSERT_TRUE(daemon.start({"--listen", address, "--backend", "emulated:ch341a-generic", "--no-fallback",
+                            "--log-level", "warn"}))
+      << daemon.error();
+  auto watcher = client::Client::connect(address, 2000ms);
+  ASSERT_TRUE(watcher) << watcher.error().message;
+  ASSERT_TRUE(watcher->handshake("watcher", "", 2000ms));
+  auto screenshot = std::async(std::launch::async, [&] {
+    return run_process({GPUBRIDGE_CLI_PATH, "screenshot", "--out", (dir / "none.png").string(), "--timeout", "4000",
+                        "--connect", address});
+  });
+  bool subscribed = false;
+  for (int i = 0; i < 200 && !subscribed; ++i) {
+    const auto status = status_of(*watcher);  // named: a temporary would die before the loop body
+    for (const auto& cl : status["clients"]) subscribed = subscribed || cl.value("subscribed", false);
+    if (!subscribed) std::this_thread::sleep_for(10ms);
+  }
+  ASSERT_TRUE(subscribed);
+  const auto play = run_process({GPUBRIDGE_CLI_PATH, "play", kTrace, "--connect", address});
+  ASSERT_EQ(play.exit_code, 0) << play.err << play.out;
+  const auto r = screenshot.get();
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("the daemon scanned out 1 frame(s) while we waited 4 s, but no board picture of them reached "
+                       "this client"),
+            std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("\"scanout\": \"crc\""), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("nothing is drawing"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "none.png"));
+  watcher->close();
+  EXPECT_EQ(daemon.terminate(), 0);
+  std::error_code ec;
+  fs::remove_all(dir, ec);
+}
+
 TEST(DaemonMirror, WithoutMirrorModeSimAndDiffAreRefusedButBoardStillWorks) {
   const auto dir = make_temp_dir("mirror-off");
   const std::string address = "unix:" + (dir / "d.sock").string();

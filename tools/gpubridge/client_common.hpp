@@ -14,11 +14,11 @@
 namespace gpubridge::cli {
 
 struct ClientOptions {
-  std::string token;        // --token (or $GPUBRIDGE_TOKEN)
   unsigned timeout_ms = 10000;
 };
 
-// Adds --connect, --token and --timeout to a client subcommand.
+// Marks a subcommand as one that talks to the daemon (the global --connect and --token apply to
+// it) and adds its --timeout.
 void add_client_options(CLI::App* sub, GlobalOptions& g, ClientOptions& o);
 // Connects and handshakes; errors already name the address and what to do.
 Result<client::Client> open_client(const GlobalOptions& g, const ClientOptions& o, const std::string& name);

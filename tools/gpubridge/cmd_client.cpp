@@ -12,6 +12,7 @@
 #include <fstream>
 #include <thread>
 
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "client_common.hpp"
@@ -23,16 +24,17 @@
 namespace gpubridge::cli {
 
 void add_client_options(CLI::App* sub, GlobalOptions& g, ClientOptions& o) {
-  sub->add_option("--connect", g.connect, "daemon address: unix:PATH or tcp:HOST:PORT (default: the user's socket)");
-  sub->add_option("--token", o.token, "token for TCP daemons (default: $GPUBRIDGE_TOKEN)");
+  g.daemon_commands.push_back(sub);
   sub->add_option("--timeout", o.timeout_ms, "milliseconds to wait for each reply")->capture_default_str();
+  sub->footer("The daemon: unix:$XDG_RUNTIME_DIR/gpubridge/gpubridge.sock unless the global options --connect "
+              "unix:PATH|tcp:HOST:PORT and --token TOKEN (before or after the command) say otherwise.");
 }
 
 Result<client::Client> open_client(const GlobalOptions& g, const ClientOptions& o, const std::string& name) {
   const client::Timeout timeout{o.timeout_ms};
   auto c = client::Client::connect(g.connect, timeout);
   if (!c) return c.error();
-  std::string token = o.token;
+  std::string token = g.token;
   if (token.empty())
     if (const char* env = std::getenv("GPUBRIDGE_TOKEN")) token = env;
   if (auto r = c->handshake(name, token, timeout); !r) return r.error();
@@ -244,6 +246,63 @@ int run_play(const GlobalOptions& g, const ClientOptions& o, const PlayOptions& 
 }
 
 // ------------------------------------------------------------------------------ screenshot
+// The daemon's count of scanned-out frames (status "frames.count"), or nullopt when it does not say.
+std::optional<std::uint64_t> scanned_out(client::Client& c, client::Timeout timeout, std::string* backend = nullptr,
+                                         std::string* error = nullptr) {
+  auto s = c.status(timeout);
+  if (!s) {
+    if (error) *error = s.error().message;
+    return std::nullopt;
+  }
+  const auto j = nlohmann::json::parse(*s, nullptr, false);
+  if (j.is_discarded() || !j.is_object() || !j.contains("frames") || !j["frames"].is_object() ||
+      !j["frames"].contains("count") || !j["frames"]["count"].is_number_unsigned()) {
+    if (error) *error = "its status has no frame count";
+    return std::nullopt;
+  }
+  if (backend) *backend = j.value("backend", "");
+  return j["frames"]["count"].get<std::uint64_t>();
+}
+
+// Why no frame arrived, told from what the daemon did meanwhile: it closed the connection, it scanned
+// nothing out (nothing is drawing), or it scanned frames out that did not reach this client.
+std::string no_frame_message(client::Client& c, const Error& error, std::optional<std::uint64_t> before,
+                             unsigned received, unsigned wanted, const std::string& source, client::Timeout timeout) {
+  const std::string got = received ? fmt::format(" (got {} of the {} frames --skip {} asks for)", received, wanted,
+                                                 wanted - 1)
+                                   : "";
+  const double seconds = static_cast<double>(timeout.count()) / 1000.0;
+  if (client::is_protocol_error(error, protocol::ErrorCode::ShuttingDown))
+    return fmt::format("gpubridged shut down before a frame arrived{} ({})", got, error.message);
+  if (error.code == client::kConnectionError)
+    return fmt::format("the daemon closed the connection before a frame arrived{}: {} (did gpubridged stop or "
+                       "restart? `gpubridge status` tells)",
+                       got, error.message);
+  if (error.code != client::kTimeoutError) return fmt::format("no frame{}: {}", got, error.message);
+  std::string backend, status_error;
+  const auto after = scanned_out(c, timeout, &backend, &status_error);
+  if (!after)
+    return fmt::format("no frame within {:g} s{}, and the daemon did not answer a status request either ({}); is "
+                       "it overloaded or stuck?",
+                       seconds, got, status_error);
+  if (!before || *after == *before)
+    return fmt::format("no frame within {:g} s{}: nothing is drawing (the daemon scanned out no frame while we "
+                       "waited; {} since it started). Start a client that draws, e.g. `gpubridge play TRACE`, or "
+                       "wait longer with --timeout MS",
+                       seconds, got, *after);
+  if (received)
+    return fmt::format("only {} of the {} frames --skip {} asks for arrived within {:g} s of each other (the daemon "
+                       "scanned out {} meanwhile, and a subscriber that falls behind gets the newest only)",
+                       received, wanted, wanted - 1, seconds, *after - *before);
+  std::string hint;
+  if (backend != "sim")
+    hint = " A board whose profile says \"scanout\": \"crc\" reports swaps without pixels; with gpubridged "
+           "--mirror, --source sim shows the simulator's picture of them.";
+  return fmt::format("the daemon scanned out {} frame(s) while we waited {:g} s, but no {} picture of them reached "
+                     "this client.{}",
+                     *after - *before, seconds, source, hint);
+}
+
 int run_screenshot(const GlobalOptions& g, const ClientOptions& o, const std::string& out, unsigned skip,
                    const std::string& source_name) {
   const auto source = protocol::parse_frame_source(source_name);
@@ -254,6 +313,9 @@ int run_screenshot(const GlobalOptions& g, const ClientOptions& o, const std::st
   protocol::Subscribe request{protocol::FrameFormat::RGBA8888, 0, std::nullopt};
   if (*source != protocol::FrameSource::Board) request.source = *source;  // old daemons only know board
   if (auto r = c->subscribe(request, timeout); !r) return fail("screenshot", r.error().message);
+  // Counted once subscribed (every later swap is one we should get), to tell "nothing is drawing"
+  // from "frames came but not to us" if none arrives.
+  const auto before = scanned_out(*c, timeout);
   if (!g.json) {
     std::printf("waiting for a frame...\n");
     std::fflush(stdout);
@@ -261,7 +323,7 @@ int run_screenshot(const GlobalOptions& g, const ClientOptions& o, const std::st
   Result<client::ReceivedFrame> f = make_error("no frame");
   for (unsigned i = 0; i <= skip; ++i) {
     f = c->next_frame(timeout);
-    if (!f) return fail("screenshot", f.error().message + " (is anything drawing? run `gpubridge play TRACE`)");
+    if (!f) return fail("screenshot", no_frame_message(*c, f.error(), before, i, skip + 1, source_name, timeout));
   }
   const auto img = image_from_device(f->format, f->width, f->height, f->pixels);
   if (auto r = save_png(out, img); !r) return fail("screenshot", r.error().message);

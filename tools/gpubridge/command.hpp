@@ -13,7 +13,11 @@ namespace gpubridge::cli {
 struct GlobalOptions {
   bool json = false;          // --json: machine-readable output on stdout
   std::string log_level = "warn";
-  std::string connect;        // --connect unix:PATH|tcp:HOST:PORT (client commands)
+  std::string connect;        // --connect unix:PATH|tcp:HOST:PORT (commands that talk to gpubridged)
+  std::string token;          // --token (else $GPUBRIDGE_TOKEN)
+  // The subcommands --connect and --token apply to (registered by add_client_options); given
+  // with any other command they are a usage error rather than silently ignored.
+  std::vector<const CLI::App*> daemon_commands;
 };
 
 // A command's setup adds its subcommand(s) to the app and stores a runner in *run that is
