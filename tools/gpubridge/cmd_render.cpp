@@ -12,16 +12,12 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
+#include "command_input.hpp"
 #include "gpubridge/common/image.hpp"
-#include "gpubridge/common/trace_files.hpp"
+#include "gpubridge/common/json_text.hpp"
 #include "gpubridge/sim/device.hpp"
 #include "gpubridge/sim/run_stream.hpp"
 #include "gpubridge/sim/timing.hpp"
-#if __has_include("gpubridge/scene/scene.hpp")
-#include "gpubridge/scene/scene.hpp"
-#include "gpubridge/common/json_text.hpp"
-#define GPUBRIDGE_RENDER_HAS_SCENES 1
-#endif
 
 namespace gpubridge::cli {
 namespace {
@@ -45,26 +41,6 @@ struct FrameRecord {
 int fail(const std::string& msg, int code = 1) {
   std::fprintf(stderr, "gpubridge render: %s\n", msg.c_str());
   return code;
-}
-
-Result<protocol::CommandStream> load_input(const RenderArgs& a, std::uint64_t vram_bytes, std::string& kind) {
-  const fs::path p(a.input);
-  if (!fs::exists(p)) return make_error(a.input + ": no such file");
-  if (p.extension() == ".json") {
-#ifdef GPUBRIDGE_RENDER_HAS_SCENES
-    kind = "scene";
-    scene::BuildOptions bo;
-    bo.vram_bytes = vram_bytes;
-    auto built = scene::load_scene(p, bo);
-    if (!built) return built.error();
-    return std::move(built->stream);
-#else
-    (void)vram_bytes;
-    return make_error(a.input + ": scene files need the scene library, which this build lacks; render a trace");
-#endif
-  }
-  kind = "trace";
-  return load_trace(p);
 }
 
 nlohmann::json timing_json(const sim::TimingEstimate& e) {
@@ -91,7 +67,7 @@ int run_render(const GlobalOptions& g, const RenderArgs& a) {
   sim::Device& d = **dev;
 
   std::string kind;
-  auto stream = load_input(a, opt.vram_bytes, kind);
+  auto stream = load_commands(a.input, opt.vram_bytes, kind);
   if (!stream) return fail(stream.error().message);
 
   if (!a.frames_dir.empty()) {

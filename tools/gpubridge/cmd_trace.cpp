@@ -7,7 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
-#include "gpubridge/common/trace_files.hpp"
+#include "command_input.hpp"
 #include "gpubridge/protocol/crc32.hpp"
 #include "gpubridge/protocol/text_trace.hpp"
 #include "gpubridge/common/json_text.hpp"
@@ -16,6 +16,8 @@ namespace gpubridge::cli {
 namespace {
 
 using protocol::CommandStream;
+// Scene files are laid out in the simulator's default video memory (as `gpubridge render` does).
+constexpr std::uint64_t kSceneVramBytes = 8u << 20;
 
 struct TraceCounts {
   std::size_t batches = 0, frames = 0, uploads = 0, upload_bytes = 0, fences = 0, reads = 0, readbacks = 0;
@@ -57,7 +59,8 @@ int run_convert(const GlobalOptions& g, const std::string& in, const std::string
                  out.c_str());
     return 2;
   }
-  auto s = load_trace(in);
+  std::string kind;
+  auto s = load_commands(in, kSceneVramBytes, kind);
   if (!s) {
     std::fprintf(stderr, "gpubridge trace convert: %s\n", s.error().message.c_str());
     return 1;
@@ -124,7 +127,8 @@ nlohmann::json command_json(std::size_t i, const protocol::TimedCommand& tc) {
 }
 
 int run_dump(const GlobalOptions& g, const std::string& in) {
-  auto s = load_trace(in);
+  std::string kind;
+  auto s = load_commands(in, kSceneVramBytes, kind);
   if (!s) {
     std::fprintf(stderr, "gpubridge trace dump: %s\n", s.error().message.c_str());
     return 1;
@@ -178,15 +182,18 @@ GPUBRIDGE_COMMAND("trace", 40, [](CLI::App& app, GlobalOptions& g, auto& runners
     std::string in, out, to;
   };
   auto conv = std::make_shared<ConvertArgs>();
-  auto* convert = trace->add_subcommand("convert", "convert a trace between the binary and text forms");
-  convert->add_option("IN", conv->in, "input trace (format detected from its content)")->required();
+  auto* convert = trace->add_subcommand(
+      "convert", "convert a trace between the binary and text forms, or save a scene file's commands as a trace");
+  convert->add_option("IN", conv->in,
+                      "input trace (format detected from its content), or a scene file (.json): its command stream")
+      ->required();
   convert->add_option("OUT", conv->out, "output trace (.gbt/.gbtrace binary, .trace/.txt text)")->required();
   convert->add_option("--to", conv->to, "output format when the extension does not say: text|binary");
   runners.emplace_back(convert, [&g, conv] { return run_convert(g, conv->in, conv->out, conv->to); });
 
   auto in = std::make_shared<std::string>();
   auto* dump = trace->add_subcommand("dump", "list a trace's commands (register writes by name; --json for tools)");
-  dump->add_option("IN", *in, "trace file (binary or text)")->required();
+  dump->add_option("IN", *in, "trace file (binary or text), or a scene file (.json)")->required();
   runners.emplace_back(dump, [&g, in] { return run_dump(g, *in); });
   for (auto* sub : {convert, dump}) sub->fallthrough();
 });
