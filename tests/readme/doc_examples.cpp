@@ -1,0 +1,163 @@
+// What every shell line of README.md and docs/*.md must do when run as written (see
+// doc_examples.hpp for the fields, readme_test.cpp for how they run).
+//
+// Adding a line to a document: add its Step at the same position of that block, saying what it
+// must do (run(...).prints(...).leaves(...), daemon(...), viewer(...), alongside(...)), or, if it
+// cannot run in a test, skip(line, why) naming where it is covered instead. A line that needs
+// hardware runs in its documented no-hardware form: .instead(command, why). Until the document and
+// this list agree, the test fails and names the document line.
+#include "doc_examples.hpp"
+
+namespace gpubridge::readme {
+namespace {
+
+// The default socket under the private XDG_RUNTIME_DIR, as the programs print it.
+const std::string kDefaultSocket = R"(unix:[^ ]*/run/gpubridge/gpubridge\.sock)";
+
+std::vector<Example> make() {
+  std::vector<Example> all;
+
+  all.push_back({"README.md", "Two commands (fresh Debian 12)", 0, "README_TwoCommands_Demo",
+                 {skip("./scripts/demo.sh", "installs Debian packages (root) and rebuilds; its main job runs as "
+                                            "CTest demo.headless (scripts/demo-run.sh on this build)")}});
+  all.push_back({"README.md", "Two commands (fresh Debian 12)", 1, "README_TwoCommands_Test",
+                 {skip("./scripts/test.sh", "is the whole test suite, this test included")}});
+
+  all.push_back({"README.md", "Using it", 0, "README_UsingIt", {
+      run("build/tools/gpubridge render examples/scenes/gouraud-triangle.json --out frame.png")
+          .prints(R"(1 frame\(s\) scanned out, 1 triangles)")
+          .prints(R"(wrote frame\.png: 160x120)")
+          .leaves("frame.png"),
+      run("build/tools/gpubridge render examples/scenes/gouraud-triangle.json --out frame-4t.png --threads 4")
+          .prints(R"(wrote frame-4t\.png: 160x120)")
+          .leaves("frame-4t.png"),
+      run("build/tools/gpubridge compare frame.png frame-4t.png --tolerance 0 --diff diff.png")
+          .prints(R"(match: 0 of 19200 pixels differ)")
+          .leaves("diff.png"),
+      run("build/tools/gpubridge trace convert examples/scenes/gouraud-triangle.json session.gbt")
+          .prints(R"(wrote session\.gbt \(binary, \d+ commands)")
+          .leaves("session.gbt"),
+      run("build/tools/gpubridge trace convert session.gbt session.trace")
+          .prints(R"(wrote session\.trace \(text)")
+          .leaves("session.trace"),
+
+      daemon("build/daemon/gpubridged --backend sim &").prints("listening on " + kDefaultSocket).prints("ready"),
+      run("build/daemon/gpubridged --config configs/gpubridged.json --check-config")
+          .prints("configuration OK")
+          .prints("effective configuration"),
+      run("build/tools/gpubridge status").prints("daemon: +gpubridged .* at " + kDefaultSocket).prints("backend: +sim"),
+      // Failed with `bad address "": unknown scheme` before issue 15. It must find the daemon on the
+      // default socket and show the frames the next line plays.
+      viewer("build/viewer/gpubridge-view &", {"gpubridge-view - " + kDefaultSocket + R"( - .*160x120)"}),
+      alongside("build/tools/gpubridge play session.trace --fps 30 --repeat 150 &")
+          .prints(R"(played session\.trace: \d+ register writes, 150 swaps)"),
+      run("build/tools/gpubridge screenshot --out next-frame.png")
+          .prints(R"(frame #\d+ \(160x120, board\) written to next-frame\.png)")
+          .leaves("next-frame.png"),
+      run("build/tools/gpubridge reg read STATUS").prints(R"(STATUS = 0x[0-9a-f]{16})"),
+      // The global --connect before the command (CLI11 refused it before issue 15).
+      run("build/tools/gpubridge --connect unix:$XDG_RUNTIME_DIR/gpubridge/gpubridge.sock status")
+          .prints("daemon: +gpubridged .* at " + kDefaultSocket),
+
+      run("build/tools/gpubridge boards").prints(R"(icebreaker +ft2232h +0403:6010)"),
+      // No bridge on a test machine; one that has some lists them.
+      run("build/tools/gpubridge probe").prints(R"(No USB-SPI bridges found|0403:|1a86:|04d8:|10c4:)"),
+      run("build/tools/gpubridge bringup --board icebreaker")
+          .instead("build/tools/gpubridge bringup --board icebreaker --emulate",
+                   "no board here: the --emulate form the line's comment gives")
+          .prints(R"(register-echo +ok)")
+          .prints(R"(scenes +ok)")
+          .prints("PASS"),
+      daemon("build/daemon/gpubridged --backend auto &").warns("auto: no board attached.*using the simulator"),
+      run("touch plugged"),
+      daemon("build/daemon/gpubridged --backend 'emulated:ft232h-generic?presence=plugged' &"),
+      daemon("build/daemon/gpubridged --backend icebreaker --mirror &")
+          .instead("build/daemon/gpubridged --backend emulated:icebreaker --mirror",
+                   "no board here: the emulated form the line's comment gives"),
+      viewer("build/viewer/gpubridge-view --source diff &", {"gpubridge-view - " + kDefaultSocket + R"( - .* - diff)"}),
+      // The emulated board's SPI model is slower than the simulator.
+      alongside("build/tools/gpubridge play session.trace --fps 30 --repeat 150 &")
+          .prints(R"(played session\.trace: .*150 swaps)")
+          .within(120),
+      run("build/tools/gpubridge screenshot --source sim --out sim.png")
+          .prints(R"(frame #\d+ \(160x120, sim\) written to sim\.png)")
+          .leaves("sim.png"),
+
+      skip("build/tools/gpubridge bench accuracy --out-dir docs",
+           "rewrites docs/accuracy-report.* and runs for minutes; CTest bench_accuracy_quick_smoke runs it with --quick"),
+      skip("build/tools/gpubridge bench daemon",
+           "a 20-second measurement on a machine shared with the rest of the suite; CTest bench_daemon_smoke runs "
+           "it with fewer rounds"),
+      run("build/tools/gpubridge bench usb")
+          .prints(R"(write-heavy frame: 30000 register writes, payload/SPI clock bits = [\d.]+%)"),
+      skip("build/bench/protocol/protocol_parser_bench",
+           "Google Benchmark runs for minutes (and is built only with libbenchmark)"),
+  }});
+
+  all.push_back({"README.md", "Testing", 0, "README_Testing", {
+      skip("ctest --test-dir build -L daemon", "runs part of this suite (CTest inside CTest)"),
+      skip("scripts/fuzz-smoke.sh 600", "10 minutes per fuzz target, by hand; scripts/test.sh runs the 5-second smoke"),
+      skip("build/examples/gpubridge-demo goldens --dir examples/golden --write",
+           "rewrites the committed goldens; the comparing form runs in docs/examples.md"),
+      skip("build/tools/gpubridge bench accuracy --out-dir docs",
+           "rewrites docs/accuracy-report.*; CTest bench_accuracy_quick_smoke runs it with --quick"),
+  }});
+
+  all.push_back({"docs/daemon.md", "Running", 0, "docs_daemon_Running", {
+      daemon("gpubridged").prints("listening on " + kDefaultSocket),
+      daemon("gpubridged --listen unix:/tmp/gb.sock --backend fake --log-level debug", "unix:gb.sock")
+          .instead("gpubridged --listen unix:gb.sock --backend fake --log-level debug",
+                   "/tmp/gb.sock would be shared by test runs in parallel: a path in the private checkout")
+          .prints("listening on unix:gb.sock"),
+      run("gpubridge status --connect unix:/tmp/gb.sock")
+          .instead("gpubridge status --connect unix:gb.sock", "the daemon above, on its private path")
+          .prints("daemon: +gpubridged .* at unix:gb.sock")
+          .prints("backend: +fake"),
+      daemon("gpubridged --config configs/gpubridged.json --listen tcp:127.0.0.1:7420 --listen unix:")
+          .instead("gpubridged --config configs/gpubridged.json --listen tcp:127.0.0.1:0 --listen unix:",
+                   "port 7420 may be taken by a test run in parallel: port 0 (a free one, printed)")
+          .prints(R"(listening on tcp:127\.0\.0\.1:[1-9]\d*)")
+          .prints("listening on " + kDefaultSocket),
+  }});
+
+  all.push_back({"docs/examples.md", "Running them", 0, "docs_examples_RunningThem", {
+      run("build/examples/gpubridge-demo list").prints("tetrahedron").prints("lightmap"),
+      run("build/examples/gpubridge-demo render all --out frames --first 0 --frames 8")
+          .prints(R"(frames/tetrahedron-0007\.png)")
+          .leaves("frames/room-0000.png")
+          .leaves("frames/lightmap-0007.png")
+          .within(120),
+      daemon("build/daemon/gpubridged &"),
+      run("build/examples/gpubridge-demo stream room --fps 30").within(120),
+      run("build/examples/gpubridge-demo goldens --dir examples/golden")
+          .prints(R"(tetrahedron +identical)")
+          .prints(R"(lightmap +identical)")
+          .within(120),
+      skip("build/examples/gpubridge-demo goldens --dir examples/golden --write",
+           "rewrites the committed goldens (the line above compares with them)"),
+  }});
+
+  all.push_back({"docs/viewer.md", "gpubridge-view", 0, "docs_viewer_Start", {
+      daemon("gpubridged --backend sim &"),
+      // A window the user keeps open (its shell waits); nothing draws in this block.
+      viewer("gpubridge-view", {"gpubridge-view - " + kDefaultSocket + " - sim"}),
+      skip("gpubridge-view --connect tcp:lab-pc:7420 --token \"$(cat token)\"",
+           "needs a daemon on another machine and its token; TCP with a right and a wrong token runs in "
+           "tests/viewer (viewer_daemon_test)"),
+  }});
+  all.push_back({"docs/viewer.md", "Headless use", 0, "docs_viewer_Headless", {
+      skip("gpubridge-view --connect unix:/tmp/g.sock --frames 3 --screenshot out.png --offscreen --json",
+           "needs a daemon on /tmp/g.sock with a client drawing; these headless options run against a real "
+           "daemon in tests/viewer (viewer_daemon_test)"),
+  }});
+  return all;
+}
+
+}  // namespace
+
+const std::vector<Example>& documented_examples() {
+  static const std::vector<Example> all = make();
+  return all;
+}
+
+}  // namespace gpubridge::readme
