@@ -10,7 +10,7 @@
 #include <memory>
 #include <vector>
 
-#include "band_pool.hpp"
+#include "gpubridge/common/band_pool.hpp"
 #include "draw_state.hpp"
 #include "gpubridge/sim/device.hpp"
 #include "rasterizer.hpp"

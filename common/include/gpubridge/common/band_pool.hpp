@@ -10,7 +10,7 @@
 #include <thread>
 #include <vector>
 
-namespace gpubridge::sim {
+namespace gpubridge {
 
 class BandPool {
  public:
@@ -39,4 +39,4 @@ class BandPool {
   bool stop_ = false;
 };
 
-}  // namespace gpubridge::sim
+}  // namespace gpubridge

@@ -1,6 +1,6 @@
-#include "band_pool.hpp"
+#include "gpubridge/common/band_pool.hpp"
 
-namespace gpubridge::sim {
+namespace gpubridge {
 
 BandPool::BandPool(unsigned workers) : workers_(workers == 0 ? 1 : workers) {
   if (workers_ > 1)
@@ -56,4 +56,4 @@ void BandPool::loop(unsigned worker) {
   }
 }
 
-}  // namespace gpubridge::sim
+}  // namespace gpubridge

@@ -1,0 +1,102 @@
+#include "gpubridge/dmc1/device.hpp"
+
+
+#include "column_buffers.hpp"
+#include "column_renderer.hpp"
+#include "command_fifo.hpp"
+#include "dispatcher.hpp"
+#include "gpubridge/dmc1/scanout.hpp"
+
+namespace gpubridge::dmc1 {
+
+struct Device::Impl {
+  Impl(const DeviceOptions& o, std::shared_ptr<const TextureMemory> t, const Palette& p)
+      : dispatcher(t), renderer(t, o.threads), scanout(p), timing(o.timing), screen(kFramePixels, 0) {
+    fifo.clear(0);
+  }
+
+  // Runs the renderer over the FIFO; delivers the frame when the batch completed one.
+  void drain() {
+    if (fifo.empty()) return;
+    renderer.run(fifo, buffers, scanout, screen.data());
+    const bool frame_done = fifo.frame_complete;
+    fifo.clear(dispatcher.draw_buffer());
+    if (!frame_done) return;
+    ++stats.frames;
+    if (!callback) return;
+    Frame f;
+    f.number = frames_sent++;
+    f.rgb565 = screen;
+    const auto& cycles = timing.frame_cycles();
+    f.gpu_cycles = cycles.empty() ? 0 : cycles.back();
+    callback(f);
+  }
+
+  Dispatcher dispatcher;
+  ColumnRenderer renderer;
+  Scanout scanout;
+  TimingModel timing;
+  CommandFifo fifo;
+  ColumnBuffers buffers;
+  std::vector<std::uint16_t> screen;
+  DeviceStats stats;
+  FrameCallback callback;
+  std::uint32_t frames_sent = 0;
+};
+
+Result<std::unique_ptr<Device>> Device::create(const DeviceOptions& options, std::shared_ptr<const TextureMemory> textures,
+                                               const Palette& palette) {
+  if (options.threads < 1 || options.threads > 64)
+    return make_error("DMC-1 threads " + std::to_string(options.threads) + ": expected 1..64");
+  if (!textures) return make_error("DMC-1 device needs a texture memory (load one with load_texture_memory)");
+  if (!(options.timing.clock_mhz > 0)) return make_error("DMC-1 timing: clock_mhz must be positive");
+  return std::unique_ptr<Device>(new Device(std::make_unique<Impl>(options, std::move(textures), palette)));
+}
+
+Device::Device(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+Device::~Device() = default;
+
+void Device::submit(std::span<const std::uint64_t> words) {
+  Impl& m = *impl_;
+  for (const std::uint64_t w : words) {
+    m.dispatcher.push(w, m.fifo, m.timing, m.stats);
+    if (m.fifo.full()) m.drain();
+  }
+}
+
+void Device::flush() { impl_->drain(); }
+
+void Device::reset() {
+  Impl& m = *impl_;
+  m.fifo.clear(0);
+  m.dispatcher.reset();
+  m.buffers = {};
+  m.timing.reset();
+}
+
+void Device::set_frame_callback(FrameCallback cb) { impl_->callback = std::move(cb); }
+std::span<const std::uint16_t> Device::screen() const { return impl_->screen; }
+unsigned Device::column() const { return impl_->dispatcher.column(); }
+const DeviceStats& Device::stats() const { return impl_->stats; }
+const TimingModel& Device::timing() const { return impl_->timing; }
+std::uint8_t Device::picked_height() const { return impl_->dispatcher.registers().picked_height; }
+unsigned Device::threads() const { return impl_->renderer.threads(); }
+
+Image frame_image(std::span<const std::uint16_t> rgb565) {
+  Image img;
+  img.width = kColumns;
+  img.height = kRows;
+  img.rgba.assign(kFramePixels * 4, 0);
+  for (std::size_t i = 0; i < kFramePixels; ++i) {
+    const std::uint16_t w = i < rgb565.size() ? rgb565[i] : 0;  // a short buffer leaves the rest black
+    const unsigned r5 = w >> 11, g6 = (w >> 5) & 63, b5 = w & 31;
+    std::uint8_t* px = img.pixel(static_cast<unsigned>(i / kRows), kRows - 1 - static_cast<unsigned>(i % kRows));
+    px[0] = static_cast<std::uint8_t>(r5 << 3 | r5 >> 2);
+    px[1] = static_cast<std::uint8_t>(g6 << 2 | g6 >> 4);
+    px[2] = static_cast<std::uint8_t>(b5 << 3 | b5 >> 2);
+    px[3] = 255;
+  }
+  return img;
+}
+
+}  // namespace gpubridge::dmc1
