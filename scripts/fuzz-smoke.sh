@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Short libFuzzer runs of every fuzz target under ASan+UBSan: the protocol message parser, binary and
 # text traces, the daemon session dispatch, scene files (parse + build), the daemon config, board
-# profiles, PNG decoding and the four USB-SPI bridge drivers fed scripted USB replies.
+# profiles, PNG decoding, the four USB-SPI bridge drivers fed scripted USB replies, and the DMC-1
+# stream files and UART link (with the simulator behind them).
 #   scripts/fuzz-smoke.sh [seconds-per-target]   (default 20; scripts/test.sh passes 10)
 # Configures build-fuzz/ with clang++ (-DGPUBRIDGE_FUZZ=ON -DGPUBRIDGE_SANITIZE=ON), builds only the
 # fuzz targets, runs each from its seed corpus (tests/fuzz/corpus/<target>/, copied so the repo is
@@ -37,14 +38,15 @@ cmake --build "$build" --target fuzz_targets daemon_session_fuzz -j"$(nproc)"
 artifacts="$build/fuzz-artifacts"
 mkdir -p "$artifacts"
 declare -A max_len=([message_parser]=65536 [binary_trace]=65536 [text_trace]=16384 [daemon_session]=65536
-                    [scene]=32768 [daemon_config]=8192 [board_profile]=8192 [png]=16384 [usb_bridges]=4096)
+                    [scene]=32768 [daemon_config]=8192 [board_profile]=8192 [png]=16384 [usb_bridges]=4096
+                    [dmc1_stream]=16384 [dmc1_link]=8192)
 declare -A binary=([message_parser]=tests/fuzz/fuzz_message_parser [binary_trace]=tests/fuzz/fuzz_binary_trace
                    [text_trace]=tests/fuzz/fuzz_text_trace [daemon_session]=tests/daemon/daemon_session_fuzz)
 declare -A corpus=([message_parser]=message_parser [binary_trace]=binary_trace [text_trace]=text_trace
                    [daemon_session]=message_parser)
 targets=(message_parser binary_trace text_trace daemon_session)
 # The newer targets exist when their library is in the tree (tests/fuzz/CMakeLists.txt).
-for target in scene daemon_config board_profile png usb_bridges; do
+for target in scene daemon_config board_profile png usb_bridges dmc1_stream dmc1_link; do
   if [ -x "$build/tests/fuzz/fuzz_$target" ]; then
     targets+=("$target")
     binary[$target]=tests/fuzz/fuzz_$target

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # The README's test command: installs dependencies, builds, and runs every test.
 #  1. gcc build of everything + the whole CTest suite (unit, end-to-end daemon/viewer/USB-model tests).
-#  2. clang build with AddressSanitizer + UndefinedBehaviorSanitizer of the protocol, simulator and accuracy
-#     suites, which run again under the sanitizers, plus a short smoke run of every libFuzzer target.
+#  2. clang build with AddressSanitizer + UndefinedBehaviorSanitizer of the protocol, simulator, accuracy
+#     and DMC-1 suites, which run again under the sanitizers, plus a short smoke run of every libFuzzer
+#     target.
 # Long fuzz runs are not part of this; see "Testing" in README.md.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -23,16 +24,17 @@ cmake -S . -B "$SAN_DIR" -G Ninja -DCMAKE_BUILD_TYPE=Release \
   -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ \
   -DGPUBRIDGE_SANITIZE=ON -DGPUBRIDGE_FUZZ=ON -DGPUBRIDGE_BUILD_BENCH=OFF >/dev/null
 # Only the suites that decode untrusted input or do the arithmetic are rebuilt and rerun under the
-# sanitizers: every test executable of tests/protocol, tests/sim and tests/accuracy, plus the fuzzers.
+# sanitizers: every test executable of tests/protocol, tests/sim, tests/accuracy and tests/dmc1, plus
+# the fuzzers.
 san_dirs=()
-for d in tests/protocol tests/sim tests/accuracy tests/fuzz; do
+for d in tests/protocol tests/sim tests/accuracy tests/dmc1 tests/fuzz; do
   [ -f "$d/CMakeLists.txt" ] && san_dirs+=("$d/all")
 done
 cmake --build "$SAN_DIR" -j "$(nproc)" --target "${san_dirs[@]}"
 echo "== tests (sanitizer build) =="
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 ASAN_OPTIONS=detect_leaks=1
 passed=0
-for d in tests/protocol tests/sim tests/accuracy; do
+for d in tests/protocol tests/sim tests/accuracy tests/dmc1; do
   [ -d "$SAN_DIR/$d" ] || continue
   while IFS= read -r exe; do
     echo "-- $exe"

@@ -241,8 +241,36 @@ def copy_files(target, pattern):
         shutil.copyfile(f, os.path.join(d, os.path.basename(f)))
 
 
+def dmc1_seeds():
+    """Stream-file seeds (dmc1_stream) and UART byte seeds (dmc1_link) from the golden streams."""
+    stream = {}
+    words = []
+    with open(os.path.join(ROOT, "tests/dmc1/data/streams/edge.dmc1")) as f:
+        lines = f.read().splitlines()
+    stream["edge_head.dmc1"] = "\n".join(lines[:120]) + "\n"
+    for line in lines:
+        line = line.split("#")[0].strip()
+        if line:
+            words.append(int(line, 16))
+    nfo = "".join("0," + "".join("0x%02x," % ((w >> (8 * b)) & 255) for b in range(7, -1, -1)) + "\n" for w in words[:80])
+    stream["edge_head.nfo"] = nfo
+    stream["bases.nfo"] = "7, 0b1, 0o17, 255, 0, 0XC0, 0, 0, 1\n0,0,0,0,0,0xc0,0,0,1,\n"
+    stream["bad.dmc1"] = "00000000c0000001\nnot a word\n"
+    link = {}
+    framed = b"\x00\xaa" + b"".join(w.to_bytes(8, "big") for w in words[:100])
+    link["edge_head.bin"] = b"\x17" + framed  # first byte: the wire model's baud selector
+    lcd = b"".join(bytes(8) + w.to_bytes(8, "big") for w in (1 << 32 | 1 << 33, 1 << 32, 0x11, 0x3A, 0x155, 0x29))
+    link["screen_init.bin"] = b"\x00\x12\x00\xaa" + (0x400).to_bytes(8, "big") + lcd
+    return stream, link
+
+
 def main():
     copy_files("scene", "examples/scenes/*.json")
+    stream, link = dmc1_seeds()
+    for name, data in stream.items():
+        write("dmc1_stream", name, data)
+    for name, data in link.items():
+        write("dmc1_link", name, data)
     pngs = handmade_pngs()
     if len(sys.argv) > 1:
         pngs.update(rendered_pngs(sys.argv[1]))

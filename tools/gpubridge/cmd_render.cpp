@@ -13,6 +13,7 @@
 
 #include "command.hpp"
 #include "command_input.hpp"
+#include "render_dmc1.hpp"
 #include "gpubridge/common/image.hpp"
 #include "gpubridge/common/json_text.hpp"
 #include "gpubridge/sim/device.hpp"
@@ -31,6 +32,8 @@ struct RenderArgs {
   unsigned threads = 1;
   bool timing = false;
   std::uint64_t vram_mib = 8;
+  std::string device = "spigpu";
+  std::string textures, palette, raw;  // DMC-1 only
 };
 
 struct FrameRecord {
@@ -50,6 +53,14 @@ nlohmann::json timing_json(const sim::TimingEstimate& e) {
 }
 
 int run_render(const GlobalOptions& g, const RenderArgs& a) {
+  if (a.device == "dmc1") {
+    if (!a.accuracy.empty() || !a.dump_attributes.empty() || a.vram_mib != 8)
+      return fail("--accuracy, --dump-attributes and --vram-mib are spigpu options; the DMC-1 is always bit-exact", 2);
+    return render_dmc1(g, Dmc1RenderArgs{a.input, a.out, a.raw, a.frames_dir, a.textures, a.palette, a.timing_params,
+                                         a.threads, a.timing});
+  }
+  if (!a.textures.empty() || !a.palette.empty() || !a.raw.empty())
+    return fail("--textures, --palette and --raw are DMC-1 options; add --device dmc1", 2);
   if (a.out.empty() && a.frames_dir.empty() && !a.timing && a.dump_attributes.empty())
     return fail("nothing to produce; pass --out FILE.png (or --frames-dir, --timing, --dump-attributes)", 2);
   sim::DeviceOptions opt;
@@ -203,9 +214,18 @@ int run_render(const GlobalOptions& g, const RenderArgs& a) {
 
 GPUBRIDGE_COMMAND("render", 10, [](CLI::App& app, GlobalOptions& g, auto& runners) {
   auto* sub = app.add_subcommand(
-      "render", "render a trace (text/binary) or a scene file (.json) in-process on the simulator and write a PNG");
+      "render",
+      "render a trace (text/binary) or a scene file (.json) in-process on the simulator and write a PNG; with --device "
+      "dmc1, a DMC-1 command stream (.dmc1 or tinygpus .nfo) on the bit-exact DMC-1");
   auto a = std::make_shared<RenderArgs>();
-  sub->add_option("INPUT", a->input, "trace (.trace/.txt text, .gbt binary) or scene (.json)")->required();
+  sub->add_option("INPUT", a->input, "trace (.trace/.txt text, .gbt binary) or scene (.json); DMC-1: stream (.dmc1, .nfo)")
+      ->required();
+  sub->add_option("--device", a->device, "device kind: spigpu (the gpubridge GPU) or dmc1 (sylefeb's DMC-1)")
+      ->check(CLI::IsMember({"spigpu", "dmc1"}))
+      ->capture_default_str();
+  sub->add_option("--textures", a->textures, "DMC-1: texture memory image (raw or .gz), mapped at 0x200000");
+  sub->add_option("--palette", a->palette, "DMC-1: palette, 768 bytes of R6, G6, B6");
+  sub->add_option("--raw", a->raw, "DMC-1: every frame as little-endian RGB565 words in the GPU's output order");
   sub->add_option("--out,-o", a->out, "PNG of the last scanned-out frame (FB_DRAW if nothing was swapped)");
   sub->add_option("--accuracy", a->accuracy,
                   "simulator knobs KNOB=VALUE: recip_bits=1..16 nr_steps=0..4 subpixel_bits=0..4 z_bits=1..24 fast=0|1")
@@ -213,8 +233,11 @@ GPUBRIDGE_COMMAND("render", 10, [](CLI::App& app, GlobalOptions& g, auto& runner
   sub->add_option("--threads", a->threads, "rasteriser threads (output is identical for any count)")
       ->check(CLI::Range(1u, 64u))
       ->capture_default_str();
-  sub->add_flag("--timing", a->timing, "predict board time per frame with the timing model (docs/protocol.md section 19)");
-  sub->add_option("--board-timing", a->timing_params, "timing model settings KEY=VALUE (clock_mhz, spi_clock_mhz, ...)")
+  sub->add_flag("--timing", a->timing,
+                "predict board time per frame with the timing model (docs/protocol.md section 19; DMC-1: docs/dmc1.md)");
+  sub->add_option("--board-timing", a->timing_params,
+                  "timing model settings KEY=VALUE (clock_mhz, spi_clock_mhz, ...; DMC-1: clock_mhz, "
+                  "screen_cycles_per_word, ...)")
       ->expected(1, 32);
   sub->add_option("--dump-attributes", a->dump_attributes,
                   "CSV of every covered pixel: x,y,triangle,z,r,g,b,a,u,v (exact values, docs/simulator.md)");

@@ -21,12 +21,15 @@ struct ColumnRenderer::Band {
   }
 
   // The write stage: normal mode stores {L4 << 4, texel}; lightmap mode only the light byte.
-  // Every written pixel also writes its depth.
-  void write(unsigned row, bool lightmap, std::uint16_t entry, std::uint32_t dist) {
+  // Every written pixel also writes its depth. Branch-free: whether a pixel lands depends on
+  // texels and depths the branch predictor cannot guess.
+  void write(unsigned row, bool lightmap, bool opaque, std::uint16_t entry, std::uint32_t dist) {
     std::uint32_t& d = buffers.depth[row];
-    if (!depth_passes(d, dist, tag)) return;
-    column[row] = lightmap ? static_cast<std::uint16_t>((column[row] & 0xFF) | entry << 8) : entry;
-    d = tag | dist;
+    std::uint16_t& e = column[row];
+    const bool ok = opaque && depth_passes(d, dist, tag);
+    const std::uint16_t value = lightmap ? static_cast<std::uint16_t>((e & 0xFF) | entry << 8) : entry;
+    e = ok ? value : e;
+    d = ok ? (tag | dist) : d;
   }
 
   // Rows of the job inside this band, as pixel indices j (row = start + j); false when none.
@@ -41,29 +44,35 @@ struct ColumnRenderer::Band {
   void fill(const SpanJob& job) {
     unsigned j0, j1;
     if (!rows(job, j0, j1)) return;
-    for (unsigned j = j0; j <= j1; ++j) write(job.start + j, job.lightmap, job.entry, job.dist);
+    for (unsigned j = j0; j <= j1; ++j) write(job.start + j, job.lightmap, true, job.entry, job.dist);
   }
 
-  // Wall: constant u, depth and light; v advances by v_step (11 fractional bits) per row.
+  // Wall: constant u, depth and light; v advances by v_step (11 fractional bits) per row. The
+  // texels are gathered first: independent loads overlap their cache misses, which a loop that
+  // tests each texel before the next load serialises.
   void wall(const SpanJob& job) {
     unsigned j0, j1;
     if (!rows(job, j0, j1)) return;
-    const unsigned l4 = light_nibble(job.light, job.dist);
+    std::uint8_t texels[kRows];
     std::uint32_t v = job.v_fixed + j0 * job.v_step;
-    for (unsigned j = j0; j <= j1; ++j, v += job.v_step) {
-      const std::uint8_t t = texel(job.binding, job.u, (v >> 11) & 255);
-      if (t == kTransparentTexel && !job.lightmap) continue;
-      write(job.start + j, job.lightmap, job.lightmap ? t : static_cast<std::uint16_t>(l4 << 12 | t), job.dist);
+    for (unsigned j = j0; j <= j1; ++j, v += job.v_step) texels[j - j0] = texel(job.binding, job.u, (v >> 11) & 255);
+    const unsigned l4 = light_nibble(job.light, job.dist);
+    for (unsigned j = j0; j <= j1; ++j) {
+      const std::uint8_t t = texels[j - j0];
+      write(job.start + j, job.lightmap, t != kTransparentTexel || job.lightmap,
+            job.lightmap ? t : static_cast<std::uint16_t>(l4 << 12 | t), job.dist);
     }
   }
 
   // Plane: pixel j's texel uses dot_u/dot_v after j row events and dot_ray after max(j - 1, 0);
   // its depth uses dot_ray after j + 1 (the RTL reads the 1/n table one cycle late and keeps the
-  // previous ray_t in the register the depth test reads).
+  // previous ray_t in the register the depth test reads). Texels are gathered first, as for walls.
   void plane(const SpanJob& job) {
     unsigned j0, j1;
     if (!rows(job, j0, j1)) return;
     const unsigned shift = job.lightmap ? 14 : 10;  // lightmaps: one texel per 16 texture texels
+    std::uint8_t texels[kRows];
+    std::uint32_t dists[kRows];
     std::int32_t dr = wrap24(job.dot_ray + std::int64_t{job.ny} * j0);
     std::int32_t du = wrap24(job.dot_u + std::int64_t{job.uy} * j0);
     std::int32_t dv = wrap24(job.dot_v + std::int64_t{job.vy} * j0);
@@ -75,18 +84,22 @@ struct ColumnRenderer::Band {
       dr = wrap24(std::int64_t{dr} + job.ny);
       du = wrap24(std::int64_t{du} + job.uy);
       dv = wrap24(std::int64_t{dv} + job.vy);
-      const std::uint8_t t = job.background ? kBackgroundTexel : texel(job.binding, u, v);
-      if (t == kTransparentTexel && !job.lightmap) continue;
-      const std::uint32_t dist = static_cast<std::uint32_t>(t_depth) << 1 & 0x7FFFFFFF;
+      texels[j - j0] = job.background ? kBackgroundTexel : texel(job.binding, u, v);
+      dists[j - j0] = static_cast<std::uint32_t>(t_depth) << 1 & 0x7FFFFFFF;
+    }
+    for (unsigned j = j0; j <= j1; ++j) {
+      const std::uint8_t t = texels[j - j0];
+      const std::uint32_t dist = dists[j - j0];
       const unsigned l4 = job.background ? 15 : light_nibble(job.light, dist);
-      write(job.start + j, job.lightmap, job.lightmap ? t : static_cast<std::uint16_t>(l4 << 12 | t), dist);
+      write(job.start + j, job.lightmap, t != kTransparentTexel || job.lightmap,
+            job.lightmap ? t : static_cast<std::uint16_t>(l4 << 12 | t), dist);
     }
   }
 
   void pixels(const SpanJob& job, const PixelWrite* writes) {
     for (std::uint32_t i = 0; i < job.writes; ++i) {
       const PixelWrite& w = writes[job.first_write + i];
-      if (w.row >= lo && w.row <= hi) write(w.row, job.lightmap, w.entry, w.dist);
+      if (w.row >= lo && w.row <= hi) write(w.row, job.lightmap, true, w.entry, w.dist);
     }
   }
 };

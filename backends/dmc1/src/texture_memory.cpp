@@ -1,7 +1,11 @@
 #include "gpubridge/dmc1/texture_memory.hpp"
 
 #include <algorithm>
+#include <cstdlib>
 #include <cstring>
+#include <new>
+
+#include <sys/mman.h>
 
 #include <zlib.h>
 
@@ -48,7 +52,16 @@ Result<std::vector<std::uint8_t>> gunzip(std::span<const std::uint8_t> in, std::
 
 }  // namespace
 
-TextureMemory::TextureMemory() : bytes_(kSize, 0) {}
+void TextureMemory::Free::operator()(std::uint8_t* p) const { std::free(p); }
+
+TextureMemory::TextureMemory() {
+  constexpr std::size_t kHugePage = 2u << 20;
+  auto* p = static_cast<std::uint8_t*>(std::aligned_alloc(kHugePage, kSize));
+  if (!p) throw std::bad_alloc();
+  madvise(p, kSize, MADV_HUGEPAGE);  // advice only: without huge pages it still works
+  std::memset(p, 0, kSize);
+  bytes_.reset(p);
+}
 
 Result<std::shared_ptr<const TextureMemory>> TextureMemory::from_image(std::span<const std::uint8_t> image) {
   if (image.size() > kMaxImageBytes)
@@ -56,7 +69,7 @@ Result<std::shared_ptr<const TextureMemory>> TextureMemory::from_image(std::span
                       "24-bit addresses and the image starts at 0x200000, so at most " +
                       std::to_string(kMaxImageBytes) + " bytes");
   auto m = std::make_shared<TextureMemory>();
-  std::memcpy(m->bytes_.data() + kImageBase, image.data(), image.size());
+  std::memcpy(m->bytes_.get() + kImageBase, image.data(), image.size());
   m->image_bytes_ = image.size();
   return std::shared_ptr<const TextureMemory>(std::move(m));
 }

@@ -35,7 +35,7 @@ class TextureMemory {
 
   std::uint8_t read(std::uint32_t address) const { return bytes_[address & kAddressMask]; }
   // The 16 MiB address space, so that hot loops index it directly with a masked address.
-  const std::uint8_t* data() const { return bytes_.data(); }
+  const std::uint8_t* data() const { return bytes_.get(); }
   std::size_t image_bytes() const { return image_bytes_; }
 
   // Header of texture id `tid` (0..1023): 24-bit little-endian address and (hp2 << 4) | wp2.
@@ -49,7 +49,12 @@ class TextureMemory {
   }
 
  private:
-  std::vector<std::uint8_t> bytes_;
+  struct Free {
+    void operator()(std::uint8_t* p) const;
+  };
+  // 2 MiB-aligned and backed by huge pages where the kernel allows: texel reads land anywhere in
+  // the image, and 4 KiB pages would make most of them TLB misses.
+  std::unique_ptr<std::uint8_t[], Free> bytes_;
   std::size_t image_bytes_ = 0;
 };
 

@@ -1,0 +1,162 @@
+// `gpubridge render --device dmc1 STREAM --textures FILE --palette FILE --out frame.png [--raw out.rgb565]
+// [--frames-dir DIR] [--timing] [--json]`: runs a DMC-1 stream on the in-process DMC-1 and writes its
+// frames. The output is the RTL's, bit for bit (docs/dmc1.md).
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include <nlohmann/json.hpp>
+
+#include "gpubridge/common/image.hpp"
+#include "gpubridge/common/json_text.hpp"
+#include "gpubridge/dmc1/device.hpp"
+#include "gpubridge/dmc1/stream.hpp"
+#include "gpubridge/dmc1/uart.hpp"
+#include "render_dmc1.hpp"
+
+namespace gpubridge::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+int fail(const std::string& msg, int code = 1) {
+  std::fprintf(stderr, "gpubridge render: %s\n", msg.c_str());
+  return code;
+}
+
+// Appends little-endian RGB565 words (the golden format).
+void append_raw(std::vector<std::uint8_t>& out, std::span<const std::uint16_t> words) {
+  for (const std::uint16_t w : words) {
+    out.push_back(static_cast<std::uint8_t>(w));
+    out.push_back(static_cast<std::uint8_t>(w >> 8));
+  }
+}
+
+Result<void> write_file(const std::string& path, const std::vector<std::uint8_t>& bytes) {
+  std::ofstream f(path, std::ios::binary | std::ios::trunc);
+  if (!f) return make_error(path + ": cannot create the file (check the directory exists and is writable)");
+  f.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  f.close();
+  if (!f) return make_error(path + ": write failed (disk full?)");
+  return {};
+}
+
+}  // namespace
+
+int render_dmc1(const GlobalOptions& g, const Dmc1RenderArgs& a) {
+  if (a.out.empty() && a.raw.empty() && a.frames_dir.empty() && !a.timing)
+    return fail("nothing to produce; pass --out FILE.png (or --raw, --frames-dir, --timing)", 2);
+  if (a.textures.empty() || a.palette.empty())
+    return fail("the DMC-1 needs its texture memory and palette: pass --textures FILE and --palette FILE "
+                "(tests/dmc1/data has textures.bin.gz and palette.bin)", 2);
+  dmc1::DeviceOptions opt;
+  opt.threads = a.threads;
+  for (const auto& s : a.timing_params)
+    if (auto r = dmc1::apply_timing_setting(opt.timing, s); !r) return fail(r.error().message, 2);
+  auto textures = dmc1::load_texture_memory(a.textures);
+  if (!textures) return fail(textures.error().message);
+  auto palette = dmc1::load_palette(a.palette);
+  if (!palette) return fail(palette.error().message);
+  auto stream = dmc1::load_stream(a.input);
+  if (!stream) return fail(stream.error().message);
+  auto dev = dmc1::Device::create(opt, *textures, *palette);
+  if (!dev) return fail(dev.error().message, 2);
+  dmc1::Device& d = **dev;
+
+  if (!a.frames_dir.empty()) {
+    std::error_code ec;
+    fs::create_directories(a.frames_dir, ec);
+    if (ec) return fail("--frames-dir " + a.frames_dir + ": " + ec.message());
+  }
+  std::vector<std::uint8_t> raw;
+  std::vector<std::uint16_t> last;
+  std::vector<std::uint64_t> cycles;
+  std::string frame_error;
+  d.set_frame_callback([&](const dmc1::Frame& f) {
+    if (!a.raw.empty()) append_raw(raw, f.rgb565);
+    last = f.rgb565;
+    cycles.push_back(f.gpu_cycles);
+    if (!a.frames_dir.empty() && frame_error.empty()) {
+      char name[32];
+      std::snprintf(name, sizeof name, "frame-%05u.png", f.number);
+      if (auto r = save_png(fs::path(a.frames_dir) / name, dmc1::frame_image(f.rgb565)); !r) frame_error = r.error().message;
+    }
+  });
+  const auto t0 = std::chrono::steady_clock::now();
+  d.submit(stream->words);
+  d.flush();
+  const double elapsed_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  if (!frame_error.empty()) return fail(frame_error);
+
+  // Without a complete frame, show what the panel holds: the columns sent so far.
+  const bool partial = cycles.empty();
+  const unsigned columns = d.column();
+  if (partial) {
+    last.assign(d.screen().begin(), d.screen().end());
+    if (!a.raw.empty()) append_raw(raw, last);
+    std::fprintf(stderr,
+                 "gpubridge render: warning: %s ended after %u of 320 columns without completing a frame; the image shows "
+                 "the panel (unsent columns black)\n",
+                 a.input.c_str(), columns);
+  } else if (columns != 0) {
+    std::fprintf(stderr, "gpubridge render: warning: %s ends %u column(s) into another frame; those are not written\n",
+                 a.input.c_str(), columns);
+  }
+  if (!a.out.empty())
+    if (auto r = save_png(a.out, dmc1::frame_image(last)); !r) return fail(r.error().message);
+  if (!a.raw.empty())
+    if (auto r = write_file(a.raw, raw); !r) return fail(r.error().message);
+
+  const auto& tp = opt.timing;
+  const dmc1::DeviceStats& st = d.stats();
+  const double words_per_frame = cycles.empty() ? static_cast<double>(stream->words.size())
+                                                : static_cast<double>(stream->words.size()) / static_cast<double>(cycles.size());
+  const double uart_fps = dmc1::uart_frames_per_second(words_per_frame, dmc1::kStandaloneBaud);
+  nlohmann::json timing = nlohmann::json::array();
+  for (std::size_t i = 0; i < cycles.size(); ++i)
+    timing.push_back({{"frame", i},
+                      {"gpu_cycles", cycles[i]},
+                      {"gpu_ms", static_cast<double>(cycles[i]) / (tp.clock_mhz * 1e3)},
+                      {"fps", tp.clock_mhz * 1e6 / static_cast<double>(cycles[i])}});
+  if (g.json) {
+    nlohmann::json j{{"input", a.input},
+                     {"device", "dmc1"},
+                     {"format", dmc1::to_string(stream->format)},
+                     {"commands", stream->words.size()},
+                     {"frames", cycles.size()},
+                     {"partial_columns", columns},
+                     {"output", a.out},
+                     {"raw", a.raw},
+                     {"walls", st.walls},
+                     {"planes", st.planes},
+                     {"terrains", st.terrains},
+                     {"backgrounds", st.backgrounds},
+                     {"parameters", st.parameters},
+                     {"dropped_spans", st.dropped_spans},
+                     {"texture_binds", st.texture_binds},
+                     {"threads", d.threads()},
+                     {"elapsed_ms", elapsed_ms}};
+    if (a.timing) {
+      j["timing"] = timing;
+      j["clock_mhz"] = tp.clock_mhz;
+      j["uart_baud"] = dmc1::kStandaloneBaud;
+      j["uart_frames_per_second"] = uart_fps;
+    }
+    std::puts(json_text(j, 2).c_str());
+    return 0;
+  }
+  std::printf("rendered %s (DMC-1, %s format): %zu commands, %zu frame(s) in %.2f ms\n", a.input.c_str(),
+              std::string(dmc1::to_string(stream->format)).c_str(), stream->words.size(), cycles.size(), elapsed_ms);
+  if (!a.out.empty()) std::printf("wrote %s: 320x240, %s\n", a.out.c_str(), partial ? "the panel (no complete frame)" : "the last frame");
+  if (!a.raw.empty()) std::printf("wrote %s: %zu bytes of RGB565\n", a.raw.c_str(), raw.size());
+  if (a.timing) {
+    for (const auto& t : timing)
+      std::printf("timing frame %s: %s GPU cycles = %.3f ms at %.1f MHz (%.1f fps)\n", json_text(t["frame"]).c_str(),
+                  json_text(t["gpu_cycles"]).c_str(), t["gpu_ms"].get<double>(), tp.clock_mhz, t["fps"].get<double>());
+    std::printf("UART link at %u baud: %.0f bytes per frame, %.2f frames/s\n", dmc1::kStandaloneBaud, words_per_frame * 8, uart_fps);
+  }
+  return 0;
+}
+
+}  // namespace gpubridge::cli
