@@ -167,7 +167,7 @@ TEST(UartLink, GoldenStreamEndToEnd) {
     auto dev = Device::create({}, test::golden_textures(), test::golden_palette());
     ASSERT_TRUE(dev.ok());
     std::vector<std::uint16_t> frame;
-    (*dev)->set_frame_callback([&](const Frame& fr) { frame = fr.rgb565; });
+    (*dev)->set_frame_callback([&](const Frame& fr) { frame.assign(fr.rgb565.begin(), fr.rgb565.end()); });
     SocReceiver rx([&](std::uint64_t w) { (*dev)->submit(std::span(&w, 1)); }, nullptr);
     rx.bytes(wire);
     (*dev)->flush();

@@ -16,6 +16,9 @@
 #include "gpubridge/dmc1/device.hpp"
 #include "gpubridge/dmc1/stream.hpp"
 #include "gpubridge/dmc1/uart.hpp"
+#ifdef GPUBRIDGE_HAVE_DMC1_LEVEL
+#include "gpubridge/examples/dmc1_level.hpp"
+#endif
 
 namespace gpubridge::cli {
 namespace {
@@ -33,8 +36,8 @@ struct Dmc1BenchArgs {
 
 struct Row {
   std::string stream;
-  std::size_t commands = 0, frames = 0;
-  std::uint64_t cycles = 0;                // timing model, per frame (first frame)
+  std::size_t commands = 0, frames = 0;    // per pass over the stream
+  std::uint64_t cycles = 0;                // timing model, first frame
   std::vector<double> fps;                 // best over runs, per thread count
   std::vector<double> cpu_fps;             // frames per CPU-second, best over runs
 };
@@ -88,6 +91,7 @@ int run(const GlobalOptions& g, const Dmc1BenchArgs& a) {
       if (e.path().extension() == ".dmc1") names.push_back(e.path().stem().string());
     std::sort(names.begin(), names.end());
     if (names.empty()) return fail((dir / "streams").string() + ": no .dmc1 streams found");
+    names.push_back("level");
   }
   std::vector<std::unique_ptr<dmc1::Device>> devices;
   for (unsigned t : a.threads) {
@@ -97,18 +101,29 @@ int run(const GlobalOptions& g, const Dmc1BenchArgs& a) {
     if (!d) return fail(d.error().message, 2);
     devices.push_back(std::move(d).value());
   }
-  std::vector<Row> rows;
+  std::vector<std::pair<std::string, std::vector<std::uint64_t>>> streams;
   for (const auto& name : names) {
+    if (name == "level") continue;
     auto s = dmc1::load_stream(dir / "streams" / (name + ".dmc1"));
     if (!s) return fail(s.error().message);
+    streams.emplace_back(name, std::move(s->words));
+  }
+#ifdef GPUBRIDGE_HAVE_DMC1_LEVEL
+  // The example client's frames: coherent like a recorded game frame (neighbouring columns read
+  // neighbouring texels), 16 positions along its camera path.
+  if (a.streams.empty() || std::find(a.streams.begin(), a.streams.end(), "level") != a.streams.end())
+    streams.emplace_back("level", examples::dmc1_level::path_commands(examples::dmc1_level::hall(), 16));
+#endif
+  std::vector<Row> rows;
+  for (auto& [name, words] : streams) {
     Row row;
     row.stream = name;
-    row.commands = s->words.size();
+    row.commands = words.size();
     row.fps.assign(a.threads.size(), 0);
     row.cpu_fps.assign(a.threads.size(), 0);
     for (unsigned r = 0; r < a.runs; ++r)  // thread counts alternate within each run (noisy shared machines)
       for (std::size_t i = 0; i < devices.size(); ++i) {
-        const Rate rate = measure(*devices[i], s->words, a.min_ms, row.frames);
+        const Rate rate = measure(*devices[i], words, a.min_ms, row.frames);
         row.fps[i] = std::max(row.fps[i], rate.wall);
         row.cpu_fps[i] = std::max(row.cpu_fps[i], rate.cpu);
       }
@@ -120,34 +135,44 @@ int run(const GlobalOptions& g, const Dmc1BenchArgs& a) {
   const double clock_mhz = dmc1::TimingParameters{}.clock_mhz;
   const double uart_baud = dmc1::kStandaloneBaud;
   nlohmann::json j = nlohmann::json::array();
-  std::string md = "| stream | commands | sim frames/s";
-  for (std::size_t i = 0; i < a.threads.size(); ++i) md += i ? " | " + std::to_string(a.threads[i]) + " threads" : " (1 thread)";
-  md += " | 2 vs 1 | frames per CPU-second (1 thread) | board cycles/frame | board frames/s | sim vs board | UART frames/s "
-        "|\n|---|---:|---:|";
-  for (std::size_t i = 1; i < a.threads.size(); ++i) md += "---:|";
-  md += "---:|---:|---:|---:|---:|---:|\n";
+  std::string md = "| stream | commands/frame |";
+  std::string rule = "|---|---:|";
+  for (unsigned t : a.threads) {
+    md += " frames/s, " + std::to_string(t) + (t == 1 ? " thread |" : " threads |");
+    rule += "---:|";
+  }
+  if (a.threads.size() > 1) {
+    md += " " + std::to_string(a.threads[1]) + " vs " + std::to_string(a.threads[0]) + " |";
+    rule += "---:|";
+  }
+  md += " frames per CPU-second | board cycles/frame | board frames/s | sim vs board | UART frames/s |\n";
+  md += rule + "---:|---:|---:|---:|---:|\n";
   for (const Row& r : rows) {
     const double board_fps = r.cycles ? clock_mhz * 1e6 / static_cast<double>(r.cycles) : 0;
-    const double per_frame_commands = r.frames ? static_cast<double>(r.commands) / static_cast<double>(r.frames) : 0;
-    const double uart_fps = per_frame_commands > 0 ? uart_baud / (10.0 * 8 * per_frame_commands) : 0;
+    const double per_frame = r.frames ? static_cast<double>(r.commands) / static_cast<double>(r.frames) : 0;
+    const double uart_fps = dmc1::uart_frames_per_second(per_frame, uart_baud);
     const double ratio = r.fps.size() > 1 && r.fps[0] > 0 ? r.fps[1] / r.fps[0] : 0;
     char buf[512];
-    md += "| " + r.stream + " | " + std::to_string(r.commands);
+    std::snprintf(buf, sizeof buf, "| %s | %.0f |", r.stream.c_str(), per_frame);
+    md += buf;
     for (double f : r.fps) {
-      std::snprintf(buf, sizeof buf, " | %.0f", f);
+      std::snprintf(buf, sizeof buf, " %.0f |", f);
       md += buf;
     }
-    std::snprintf(buf, sizeof buf, " | %.2fx | %.0f | %llu | %.1f | %.0fx | %.2f |\n", ratio, r.cpu_fps[0],
-                  static_cast<unsigned long long>(r.cycles),
+    if (r.fps.size() > 1) {
+      std::snprintf(buf, sizeof buf, " %.2fx |", ratio);
+      md += buf;
+    }
+    std::snprintf(buf, sizeof buf, " %.0f | %llu | %.1f | %.0fx | %.2f |\n", r.cpu_fps[0], static_cast<unsigned long long>(r.cycles),
                   board_fps, board_fps > 0 ? r.fps[0] / board_fps : 0, uart_fps);
     md += buf;
     nlohmann::json fps = nlohmann::json::object();
     for (std::size_t i = 0; i < a.threads.size(); ++i) fps[std::to_string(a.threads[i])] = r.fps[i];
     j.push_back({{"stream", r.stream},
-                 {"commands", r.commands},
+                 {"commands_per_frame", per_frame},
                  {"frames", r.frames},
                  {"frames_per_second", fps},
-                 {"two_vs_one_thread", ratio},
+                 {"second_vs_first_thread_count", ratio},
                  {"frames_per_cpu_second", r.cpu_fps[0]},
                  {"board_cycles_per_frame", r.cycles},
                  {"board_frames_per_second", board_fps},
@@ -176,7 +201,9 @@ GPUBRIDGE_COMMAND("bench-dmc1", 83, [](CLI::App& app, GlobalOptions& g, auto& ru
       "(timing model) and the rate a 115,200-baud UART link allows; Markdown, or JSON with --json");
   auto a = std::make_shared<Dmc1BenchArgs>();
   sub->add_option("--data", a->data, "directory with streams/*.dmc1, textures.bin.gz and palette.bin")->capture_default_str();
-  sub->add_option("--stream", a->streams, "only this stream (repeatable; a name in DIR/streams without .dmc1)");
+  sub->add_option("--stream", a->streams,
+                  "only this stream (repeatable): a name in DIR/streams without .dmc1, or level (the example client's "
+                  "frames)");
   sub->add_option("--threads", a->threads, "thread counts to measure (alternately)")->check(CLI::Range(1u, 64u))->capture_default_str();
   sub->add_option("--runs", a->runs, "runs per thread count; the best is reported")->check(CLI::Range(1u, 100u))->capture_default_str();
   sub->add_option("--min-ms", a->min_ms, "each run renders the stream repeatedly for at least this long")

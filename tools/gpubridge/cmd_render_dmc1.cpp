@@ -75,7 +75,7 @@ int render_dmc1(const GlobalOptions& g, const Dmc1RenderArgs& a) {
   std::string frame_error;
   d.set_frame_callback([&](const dmc1::Frame& f) {
     if (!a.raw.empty()) append_raw(raw, f.rgb565);
-    last = f.rgb565;
+    last.assign(f.rgb565.begin(), f.rgb565.end());
     cycles.push_back(f.gpu_cycles);
     if (!a.frames_dir.empty() && frame_error.empty()) {
       char name[32];

@@ -5,34 +5,64 @@
 #include "fixed_point.hpp"
 
 namespace gpubridge::dmc1 {
+namespace {
+
+// The sampler's addressing for one bound texture, with its masks computed once per span.
+struct Sampler {
+  const std::uint8_t* memory;  // the 16 MiB texture address space
+  std::uint32_t base, wmask, hmask, wp2;
+
+  Sampler(const std::uint8_t* m, const TextureBinding& b)
+      : memory(m), base(b.base), wmask((1u << b.wp2) - 1), hmask((1u << b.hp2) - 1), wp2(b.wp2) {}
+  std::uint8_t operator()(std::uint32_t u, std::uint32_t v) const {
+    return memory[(base + ((u & wmask) | ((v & hmask) << wp2))) & TextureMemory::kAddressMask];
+  }
+};
+
+// The write stage for n rows: normal mode stores the entry {L4 << 4, texel}; lightmap mode only
+// its low byte, as the light byte; every written pixel also writes its depth. Masks instead of
+// branches (whether a pixel lands depends on texels and depths no predictor can guess), and over
+// arrays the span loops filled first, so that it vectorises; the gathering loops before it are
+// then free to overlap their texel loads.
+template <bool kLightmap>
+void write_rows(std::uint16_t* __restrict column, std::uint32_t* __restrict depth, std::uint32_t tag, unsigned n,
+                const std::uint16_t* __restrict entry, const std::uint32_t* __restrict dist,
+                const std::uint8_t* __restrict opaque) {
+  for (unsigned i = 0; i < n; ++i) {
+    const std::uint32_t d = depth[i], z = dist[i];
+    const std::uint32_t m = 0u - static_cast<std::uint32_t>(depth_passes(d, z, tag) & (opaque[i] != 0));
+    depth[i] = (d & ~m) | ((tag | z) & m);
+    const std::uint16_t e = column[i];
+    const auto value = kLightmap ? static_cast<std::uint16_t>((e & 0xFF) | entry[i] << 8) : entry[i];
+    column[i] = static_cast<std::uint16_t>((e & ~m) | (value & m));
+  }
+}
+
+// The same with one entry and depth for every row (background fills, terrain writes).
+template <bool kLightmap>
+void fill_rows(std::uint16_t* __restrict column, std::uint32_t* __restrict depth, std::uint32_t tag, unsigned n,
+               std::uint16_t entry, std::uint32_t z) {
+  for (unsigned i = 0; i < n; ++i) {
+    const std::uint32_t d = depth[i];
+    const std::uint32_t m = 0u - static_cast<std::uint32_t>(depth_passes(d, z, tag));
+    depth[i] = (d & ~m) | ((tag | z) & m);
+    const std::uint16_t e = column[i];
+    const auto value = kLightmap ? static_cast<std::uint16_t>((e & 0xFF) | entry << 8) : entry;
+    column[i] = static_cast<std::uint16_t>((e & ~m) | (value & m));
+  }
+}
+
+}  // namespace
 
 // One worker's rows [lo, hi] of every column in the batch.
 struct ColumnRenderer::Band {
-  const std::uint8_t* memory;  // the 16 MiB texture address space
+  const std::uint8_t* memory;
   ColumnBuffers& buffers;
   unsigned lo, hi;
   std::uint16_t* column = nullptr;  // the draw buffer's entries
   std::uint32_t tag = 0;            // the draw buffer in bit 31 (depth buffer tag)
 
-  std::uint8_t texel(const TextureBinding& b, std::uint32_t u, std::uint32_t v) const {
-    u &= (1u << b.wp2) - 1;
-    v &= (1u << b.hp2) - 1;
-    return memory[(b.base + (u | (v << b.wp2))) & TextureMemory::kAddressMask];
-  }
-
-  // The write stage: normal mode stores {L4 << 4, texel}; lightmap mode only the light byte.
-  // Every written pixel also writes its depth. Branch-free: whether a pixel lands depends on
-  // texels and depths the branch predictor cannot guess.
-  void write(unsigned row, bool lightmap, bool opaque, std::uint16_t entry, std::uint32_t dist) {
-    std::uint32_t& d = buffers.depth[row];
-    std::uint16_t& e = column[row];
-    const bool ok = opaque && depth_passes(d, dist, tag);
-    const std::uint16_t value = lightmap ? static_cast<std::uint16_t>((e & 0xFF) | entry << 8) : entry;
-    e = ok ? value : e;
-    d = ok ? (tag | dist) : d;
-  }
-
-  // Rows of the job inside this band, as pixel indices j (row = start + j); false when none.
+  // Rows of the job inside this band, as pixel indices j0..j1 (row = start + j); false when none.
   bool rows(const SpanJob& job, unsigned& j0, unsigned& j1) const {
     const unsigned a = std::max<unsigned>(job.start, lo), b = std::min<unsigned>(job.end, hi);
     if (a > b) return false;
@@ -41,65 +71,98 @@ struct ColumnRenderer::Band {
     return true;
   }
 
-  void fill(const SpanJob& job) {
-    unsigned j0, j1;
-    if (!rows(job, j0, j1)) return;
-    for (unsigned j = j0; j <= j1; ++j) write(job.start + j, job.lightmap, true, job.entry, job.dist);
+  template <bool kLightmap>
+  void fill(const SpanJob& job, unsigned j0, unsigned j1) {
+    const unsigned first = job.start + j0;
+    fill_rows<kLightmap>(column + first, buffers.depth.data() + first, tag, j1 - j0 + 1, job.entry, job.dist);
   }
 
-  // Wall: constant u, depth and light; v advances by v_step (11 fractional bits) per row. The
-  // texels are gathered first: independent loads overlap their cache misses, which a loop that
-  // tests each texel before the next load serialises.
-  void wall(const SpanJob& job) {
-    unsigned j0, j1;
-    if (!rows(job, j0, j1)) return;
-    std::uint8_t texels[kRows];
-    std::uint32_t v = job.v_fixed + j0 * job.v_step;
-    for (unsigned j = j0; j <= j1; ++j, v += job.v_step) texels[j - j0] = texel(job.binding, job.u, (v >> 11) & 255);
-    const unsigned l4 = light_nibble(job.light, job.dist);
-    for (unsigned j = j0; j <= j1; ++j) {
-      const std::uint8_t t = texels[j - j0];
-      write(job.start + j, job.lightmap, t != kTransparentTexel || job.lightmap,
-            job.lightmap ? t : static_cast<std::uint16_t>(l4 << 12 | t), job.dist);
+  // Wall: constant u, depth and light; v advances by v_step (11 fractional bits) per row.
+  template <bool kLightmap>
+  void wall(const SpanJob& job, unsigned j0, unsigned j1) {
+    const Sampler texel(memory, job.binding);
+    const unsigned n = j1 - j0 + 1;
+    const std::uint32_t column_base = texel.base + (job.u & texel.wmask);  // u is constant down a wall
+    const auto light = static_cast<std::uint16_t>(kLightmap ? 0 : light_nibble(job.light, job.dist) << 12);
+    const std::uint32_t step = job.v_step, dist_value = job.dist;
+    std::uint8_t t[kRows], opaque[kRows];
+    std::uint16_t entry[kRows];
+    std::uint32_t dist[kRows];
+    std::uint32_t v = job.v_fixed + j0 * step;
+    for (unsigned i = 0; i < n; ++i, v += step)  // texel gather (scalar)
+      t[i] = texel.memory[(column_base + ((((v >> 11) & 255) & texel.hmask) << texel.wp2)) & TextureMemory::kAddressMask];
+    for (unsigned i = 0; i < n; ++i) {  // element-wise: vectorises
+      entry[i] = static_cast<std::uint16_t>(light | t[i]);
+      dist[i] = dist_value;
+      opaque[i] = kLightmap || t[i] != kTransparentTexel;
     }
+    const unsigned first = job.start + j0;
+    write_rows<kLightmap>(column + first, buffers.depth.data() + first, tag, n, entry, dist, opaque);
   }
 
   // Plane: pixel j's texel uses dot_u/dot_v after j row events and dot_ray after max(j - 1, 0);
   // its depth uses dot_ray after j + 1 (the RTL reads the 1/n table one cycle late and keeps the
-  // previous ray_t in the register the depth test reads). Texels are gathered first, as for walls.
-  void plane(const SpanJob& job) {
-    unsigned j0, j1;
-    if (!rows(job, j0, j1)) return;
-    const unsigned shift = job.lightmap ? 14 : 10;  // lightmaps: one texel per 16 texture texels
-    std::uint8_t texels[kRows];
-    std::uint32_t dists[kRows];
-    std::int32_t dr = wrap24(job.dot_ray + std::int64_t{job.ny} * j0);
-    std::int32_t du = wrap24(job.dot_u + std::int64_t{job.uy} * j0);
-    std::int32_t dv = wrap24(job.dot_v + std::int64_t{job.vy} * j0);
-    for (unsigned j = j0; j <= j1; ++j) {
-      const std::int32_t t_texel = plane_ray_t(j == 0 ? dr : wrap24(std::int64_t{dr} - job.ny), job.ded);
-      const std::int32_t t_depth = plane_ray_t(wrap24(std::int64_t{dr} + job.ny), job.ded);
-      const auto u = static_cast<std::uint32_t>(plane_coordinate(t_texel, du, job.u_offset) >> shift) & 255;
-      const auto v = static_cast<std::uint32_t>(plane_coordinate(t_texel, dv, job.v_offset) >> shift) & 255;
-      dr = wrap24(std::int64_t{dr} + job.ny);
-      du = wrap24(std::int64_t{du} + job.uy);
-      dv = wrap24(std::int64_t{dv} + job.vy);
-      texels[j - j0] = job.background ? kBackgroundTexel : texel(job.binding, u, v);
-      dists[j - j0] = static_cast<std::uint32_t>(t_depth) << 1 & 0x7FFFFFFF;
+  // previous ray_t in the register the depth test reads). So ray_t is computed once per row and
+  // used twice: as pixel j's depth and as pixel j + 2's texel coordinate. kFlat: floors and
+  // ceilings, whose texture axes have no row component (uy = vy = 0).
+  template <bool kLightmap, bool kFlat>
+  void plane(const SpanJob& job, unsigned j0, unsigned j1) {
+    const Sampler texel(memory, job.binding);
+    constexpr unsigned kShift = kLightmap ? 14 : 10;  // lightmaps: one texel per 16 texture texels
+    const unsigned n = j1 - j0 + 1;
+    const std::int32_t ny = job.ny, uy = job.uy, vy = job.vy, ded = job.ded, u_offset = job.u_offset, v_offset = job.v_offset;
+    const unsigned light = job.light;
+    const bool background = job.background;
+    std::int32_t ray_t[kRows + 2];  // ray_t[k]: dot_ray after j0 - 1 + k events
+    std::int32_t dr = wrap24(job.dot_ray + std::int64_t{ny} * (std::int64_t{j0} - 1));
+    for (unsigned k = 0; k < n + 2; ++k, dr = wrap24(std::int64_t{dr} + ny)) ray_t[k] = plane_ray_t(dr, ded);
+    if (j0 == 0) ray_t[0] = ray_t[1];  // pixel 0's texel uses dot_ray after 0 events, not -1
+    std::uint8_t t[kRows], opaque[kRows];
+    std::uint16_t entry[kRows];
+    std::uint32_t dist[kRows];
+    std::int32_t du = wrap24(job.dot_u + std::int64_t{uy} * j0);
+    std::int32_t dv = wrap24(job.dot_v + std::int64_t{vy} * j0);
+    for (unsigned i = 0; i < n; ++i) {  // texel gather (table and texture loads: scalar)
+      const auto u = static_cast<std::uint32_t>(plane_coordinate(ray_t[i], du, u_offset) >> kShift) & 255;
+      const auto v = static_cast<std::uint32_t>(plane_coordinate(ray_t[i], dv, v_offset) >> kShift) & 255;
+      t[i] = background ? kBackgroundTexel : texel(u, v);
+      if constexpr (!kFlat) {
+        du = wrap24(std::int64_t{du} + uy);
+        dv = wrap24(std::int64_t{dv} + vy);
+      }
     }
-    for (unsigned j = j0; j <= j1; ++j) {
-      const std::uint8_t t = texels[j - j0];
-      const std::uint32_t dist = dists[j - j0];
-      const unsigned l4 = job.background ? 15 : light_nibble(job.light, dist);
-      write(job.start + j, job.lightmap, t != kTransparentTexel || job.lightmap,
-            job.lightmap ? t : static_cast<std::uint16_t>(l4 << 12 | t), dist);
+    for (unsigned i = 0; i < n; ++i) {  // depth, light and entry (element-wise: vectorises)
+      dist[i] = static_cast<std::uint32_t>(ray_t[i + 2]) << 1 & 0x7FFFFFFF;
+      const unsigned l4 = kLightmap ? 0 : background ? 15 : light_nibble(light, dist[i]);
+      entry[i] = static_cast<std::uint16_t>(l4 << 12 | t[i]);
+      opaque[i] = kLightmap || t[i] != kTransparentTexel;
     }
+    const unsigned first = job.start + j0;
+    write_rows<kLightmap>(column + first, buffers.depth.data() + first, tag, n, entry, dist, opaque);
   }
 
+  template <bool kLightmap>
   void pixels(const SpanJob& job, const PixelWrite* writes) {
     for (std::uint32_t i = 0; i < job.writes; ++i) {
       const PixelWrite& w = writes[job.first_write + i];
-      if (w.row >= lo && w.row <= hi) write(w.row, job.lightmap, true, w.entry, w.dist);
+      if (w.row < lo || w.row > hi) continue;
+      fill_rows<kLightmap>(column + w.row, buffers.depth.data() + w.row, tag, 1, w.entry, w.dist);
+    }
+  }
+
+  template <bool kLightmap>
+  void draw(const SpanJob& s, const PixelWrite* writes) {
+    if (s.type == JobType::Pixels) return pixels<kLightmap>(s, writes);
+    unsigned j0, j1;
+    if (!rows(s, j0, j1)) return;
+    switch (s.type) {
+      case JobType::Fill: fill<kLightmap>(s, j0, j1); break;
+      case JobType::Wall: wall<kLightmap>(s, j0, j1); break;
+      case JobType::Plane:
+        if (s.uy == 0 && s.vy == 0) plane<kLightmap, true>(s, j0, j1);
+        else plane<kLightmap, false>(s, j0, j1);
+        break;
+      default: break;
     }
   }
 };
@@ -115,18 +178,15 @@ void ColumnRenderer::run(const CommandFifo& fifo, ColumnBuffers& buffers, const 
     band.column = buffers.entries[buffer].data();
     band.tag = buffer << 31;
     for (const SpanJob& s : fifo.jobs) {
-      switch (s.type) {
-        case JobType::Fill: band.fill(s); break;
-        case JobType::Wall: band.wall(s); break;
-        case JobType::Plane: band.plane(s); break;
-        case JobType::Pixels: band.pixels(s, fifo.writes.data()); break;
-        case JobType::EndOfColumn:
-          scanout.column(band.column + band.lo, screen + std::size_t{s.column} * kRows + band.lo, band.hi - band.lo + 1);
-          buffer ^= 1;
-          band.column = buffers.entries[buffer].data();
-          band.tag = buffer << 31;
-          break;
+      if (s.type != JobType::EndOfColumn) {
+        if (s.lightmap) band.draw<true>(s, fifo.writes.data());
+        else band.draw<false>(s, fifo.writes.data());
+        continue;
       }
+      scanout.column(band.column + band.lo, screen + std::size_t{s.column} * kRows + band.lo, band.hi - band.lo + 1);
+      buffer ^= 1;
+      band.column = buffers.entries[buffer].data();
+      band.tag = buffer << 31;
     }
   };
   pool_.start(job);

@@ -26,7 +26,7 @@ struct Device::Impl {
     if (!callback) return;
     Frame f;
     f.number = frames_sent++;
-    f.rgb565 = screen;
+    f.rgb565 = screen;  // a view: no copy per frame
     const auto& cycles = timing.frame_cycles();
     f.gpu_cycles = cycles.empty() ? 0 : cycles.back();
     callback(f);

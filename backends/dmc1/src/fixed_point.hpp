@@ -12,8 +12,10 @@ constexpr std::int32_t sext(std::uint64_t v, unsigned bits) {
   v &= (m << 1) - 1;
   return static_cast<std::int32_t>(static_cast<std::int64_t>(v ^ m) - static_cast<std::int64_t>(m));
 }
-// An int24 register after an assignment.
-constexpr std::int32_t wrap24(std::int64_t v) { return sext(static_cast<std::uint64_t>(v), 24); }
+// An int24 register after an assignment (two shifts: it sits in every per-row step).
+constexpr std::int32_t wrap24(std::int64_t v) {
+  return static_cast<std::int32_t>(static_cast<std::uint32_t>(v) << 8) >> 8;
+}
 // An int32 register (the multiply-add's result) after an assignment.
 constexpr std::int32_t wrap32(std::int64_t v) { return static_cast<std::int32_t>(static_cast<std::uint32_t>(v)); }
 
@@ -43,7 +45,9 @@ constexpr std::int32_t plane_ray_t(std::int32_t dot_ray, std::int32_t ded) {
 // A plane texture coordinate register (tr_u / tr_v): ((t * dot) mod 2^32 >>> 10) + offset. Only
 // bits below 24 are ever read, so the int24 wrap is left to the caller's mask.
 constexpr std::int32_t plane_coordinate(std::int32_t ray_t, std::int32_t dot, std::int32_t offset) {
-  return (wrap32(static_cast<std::int64_t>(ray_t) * dot) >> 10) + offset;
+  // The low 32 bits of the product are the unsigned 32-bit product's.
+  const std::uint32_t product = static_cast<std::uint32_t>(ray_t) * static_cast<std::uint32_t>(dot);
+  return (static_cast<std::int32_t>(product) >> 10) + offset;
 }
 
 // Distance darkening: L4 = max(0, L - min(10, obscure)), obscure = 15 beyond 65,535, else dist >> 12.

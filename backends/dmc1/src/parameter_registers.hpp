@@ -3,6 +3,7 @@
 // leave behind. All zero at reset; nothing clears them afterwards (docs/dmc1.md, "Persistent state").
 #include <cstdint>
 
+#include "fixed_point.hpp"
 #include "gpubridge/dmc1/texture_memory.hpp"
 
 namespace gpubridge::dmc1 {
@@ -26,14 +27,9 @@ struct ParameterRegisters {
   TextureBinding binding;
 
   void advance_dots(std::uint32_t events) {
-    dot_ray = wrap(dot_ray + static_cast<std::int64_t>(events) * ny);
-    dot_u = wrap(dot_u + static_cast<std::int64_t>(events) * uy);
-    dot_v = wrap(dot_v + static_cast<std::int64_t>(events) * vy);
-  }
-
- private:
-  static std::int32_t wrap(std::int64_t v) {
-    return static_cast<std::int32_t>(static_cast<std::uint32_t>(v) << 8) >> 8;  // int24
+    dot_ray = wrap24(dot_ray + static_cast<std::int64_t>(events) * ny);
+    dot_u = wrap24(dot_u + static_cast<std::int64_t>(events) * uy);
+    dot_v = wrap24(dot_v + static_cast<std::int64_t>(events) * vy);
   }
 };
 

@@ -31,11 +31,12 @@ struct DeviceOptions {
 };
 
 // A completed frame in the GPU's output order: column 0 rows 0..239, then column 1, ... (word i is
-// column i / 240, row i % 240; row 0 is the bottom of the screen in the demos' convention).
+// column i / 240, row i % 240; row 0 is the bottom of the screen in the demos' convention). The
+// pixels are the device's screen: valid during the callback only; copy what you keep.
 struct Frame {
   std::uint32_t number = 0;
-  std::vector<std::uint16_t> rgb565;  // kFramePixels words, {r5, g6, b5}
-  std::uint64_t gpu_cycles = 0;       // predicted by the timing model
+  std::span<const std::uint16_t> rgb565;  // kFramePixels words, {r5, g6, b5}
+  std::uint64_t gpu_cycles = 0;           // predicted by the timing model
 };
 using FrameCallback = std::function<void(const Frame&)>;
 
