@@ -4,6 +4,7 @@
 
 #include "gpubridge/dmc1/command.hpp"
 #include "gpubridge/dmc1/device.hpp"
+#include "gpubridge/dmc1/link.hpp"
 #include "gpubridge/dmc1/uart.hpp"
 #include "golden_data.hpp"
 
@@ -179,6 +180,40 @@ TEST(UartLink, GoldenStreamEndToEnd) {
 TEST(UartLink, TheRecordedFrameNeedsAboutTwoAndAHalfSecondsAt115200) {
   // frame.nfo: 3,777 commands; the sheet: about 0.38 frames/s.
   EXPECT_NEAR(uart_frames_per_second(3777, kStandaloneBaud), 0.381, 0.001);
+}
+
+}  // namespace
+}  // namespace gpubridge::dmc1
+
+namespace gpubridge::dmc1 {
+namespace {
+
+TEST(LinkModel, At115200TheLinkSetsThePace) {
+  const auto words = test::golden_stream("mixed");
+  auto e = estimate_link(words, kStandaloneBaud, test::golden_textures());
+  ASSERT_TRUE(e.ok()) << e.error().message;
+  EXPECT_EQ(e->frames, 1u);
+  // 3,699 commands of 80 bits at 115,200 baud: 2.57 s; the GPU needs 43 ms of it.
+  EXPECT_NEAR(e->seconds, 3699 * 80.0 / 115200, 0.01);
+  EXPECT_LT(e->gpu_busy, 0.05);
+  EXPECT_FALSE(e->overflow);
+  EXPECT_LE(e->max_fifo, 1u);
+}
+
+TEST(LinkModel, AFastLinkFillsTheFifoWithoutFlowControl) {
+  const auto words = test::golden_stream("mixed");
+  auto fast = estimate_link(words, 20e6, test::golden_textures());
+  ASSERT_TRUE(fast.ok());
+  EXPECT_TRUE(fast->overflow);
+  EXPECT_GT(fast->max_fifo, kStandaloneFifoDepth);
+  auto limit = fastest_lossless_baud(words, test::golden_textures());
+  ASSERT_TRUE(limit.ok());
+  EXPECT_GT(*limit, 115200.0);
+  EXPECT_LT(*limit, 20e6);
+  auto at = estimate_link(words, *limit, test::golden_textures());
+  EXPECT_FALSE(at->overflow);
+  auto above = estimate_link(words, *limit * 1.05, test::golden_textures());
+  EXPECT_TRUE(above->overflow);
 }
 
 }  // namespace

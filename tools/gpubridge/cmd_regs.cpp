@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
+#include "gpubridge/dmc1/command.hpp"
 #include "gpubridge/protocol/register_doc.hpp"
 #include "gpubridge/protocol/registers.hpp"
 #include "gpubridge/common/json_text.hpp"
@@ -11,7 +12,28 @@
 namespace gpubridge::cli {
 namespace {
 
-int run_regs(const GlobalOptions& g, bool markdown) {
+// The DMC-1's command fields (its "registers" are the fields of one 64-bit command word).
+int run_dmc1_fields(const GlobalOptions& g, bool markdown) {
+  if (markdown) {
+    std::fputs(dmc1::field_table_markdown().c_str(), stdout);
+    return 0;
+  }
+  if (g.json) {
+    nlohmann::json out = nlohmann::json::array();
+    for (const auto& f : dmc1::fields())
+      out.push_back({{"command", dmc1::to_string(f.kind)}, {"field", f.name}, {"lsb", f.lsb}, {"width", f.width},
+                     {"signed", f.is_signed}, {"meaning", f.meaning}});
+    std::puts(json_text(out, 2).c_str());
+    return 0;
+  }
+  for (const auto& f : dmc1::fields())
+    std::printf("%-10s %-15s bits %2u..%-2u %s\n", std::string(dmc1::to_string(f.kind)).c_str(), std::string(f.name).c_str(),
+                f.lsb, f.lsb + f.width - 1, std::string(f.meaning).c_str());
+  return 0;
+}
+
+int run_regs(const GlobalOptions& g, bool markdown, const std::string& device) {
+  if (device == "dmc1") return run_dmc1_fields(g, markdown);
   using namespace protocol;
   if (markdown) {
     std::fputs(register_table_markdown().c_str(), stdout);
@@ -42,10 +64,14 @@ int run_regs(const GlobalOptions& g, bool markdown) {
 }  // namespace
 
 GPUBRIDGE_COMMAND("regs", 90, [](CLI::App& app, GlobalOptions& g, auto& runners) {
-  auto* sub = app.add_subcommand("regs", "list the spigpu v1 registers (the table docs/protocol.md is generated from)");
+  auto* sub = app.add_subcommand("regs",
+                                 "list the spigpu v1 registers (the table docs/protocol.md is generated from), or with "
+                                 "--device dmc1 the DMC-1's command fields (docs/dmc1.md)");
   auto markdown = std::make_shared<bool>(false);
-  sub->add_flag("--markdown", *markdown, "print the Markdown tables used in docs/protocol.md");
-  runners.emplace_back(sub, [&g, markdown] { return run_regs(g, *markdown); });
+  auto device = std::make_shared<std::string>("spigpu");
+  sub->add_flag("--markdown", *markdown, "print the Markdown tables used in docs/protocol.md (docs/dmc1.md for dmc1)");
+  sub->add_option("--device", *device, "device kind: spigpu or dmc1")->check(CLI::IsMember({"spigpu", "dmc1"}))->capture_default_str();
+  runners.emplace_back(sub, [&g, markdown, device] { return run_regs(g, *markdown, *device); });
 });
 
 }  // namespace gpubridge::cli

@@ -132,6 +132,23 @@ std::string describe(std::uint64_t word) {
   return s;
 }
 
+std::string field_table_markdown() {
+  std::string md = "| command | tag | field | bits | signed | meaning |\n|---|---|---|---|---|---|\n";
+  auto bits = [](unsigned hi, unsigned lo) { return hi == lo ? std::to_string(lo) : std::to_string(hi) + ":" + std::to_string(lo); };
+  for (unsigned k = 0; k < kCommandKinds; ++k) {
+    const auto kind = static_cast<CommandKind>(k);
+    std::string tag = "tex1[31:30] = " + std::to_string(k < 3 ? k : 3);
+    if (kind == CommandKind::EndOfColumn) tag += ", bit 0 = 1";
+    else if (!is_span(kind)) tag += ", bit 0 = 0, tex0[31:30] = " + std::to_string(k - 3);
+    const auto fs = fields_of(kind);
+    if (fs.empty()) md += "| " + std::string(to_string(kind)) + " | " + tag + " | | | | the rest is ignored |\n";
+    for (const Field& f : fs)
+      md += "| " + std::string(to_string(kind)) + " | " + tag + " | " + std::string(f.name) + " | " +
+            bits(f.lsb + f.width - 1u, f.lsb) + " | " + (f.is_signed ? "yes" : "no") + " | " + std::string(f.meaning) + " |\n";
+  }
+  return md;
+}
+
 namespace {
 std::uint64_t build(CommandKind k, std::initializer_list<std::pair<std::string_view, std::int64_t>> values) {
   std::uint64_t w = blank_word(k);

@@ -53,8 +53,10 @@ void set_field(std::uint64_t& word, const Field& f, std::int64_t value);
 // The word of kind k with every field zero (tag bits set).
 std::uint64_t blank_word(CommandKind k);
 
-// "wall rows 10..20 light 3 texture 5 depth 4660 v_init 7 u_init 9": for disassembly and errors.
+// "wall texture=5 start=10 end=20 light=3 depth=4660 v_init=7 u_init=9": for disassembly and errors.
 std::string describe(std::uint64_t word);
+// The field table as docs/dmc1.md carries it (`gpubridge regs --device dmc1 --markdown`).
+std::string field_table_markdown();
 
 // Builders (values are truncated to their fields; see fields()).
 struct SpanRows {

@@ -52,6 +52,10 @@ class TimingModel {
   const std::vector<std::uint64_t>& frame_cycles() const { return frames_; }
   // Cycle at which everything queued so far has been drawn and sent.
   std::uint64_t drain_cycle() const { return now_ > sender_free_ ? now_ : sender_free_; }
+  // Cycle at which the GPU takes its next command.
+  std::uint64_t next_dispatch() const { return now_; }
+  // No command arrives before `cycle` (a link slower than the GPU): the drawer idles until then.
+  void idle_until(std::uint64_t cycle) { now_ = cycle > now_ ? cycle : now_; }
   void reset() { *this = TimingModel(p_); }
 
  private:
