@@ -7,6 +7,7 @@
 
 #include "gpubridge/dmc1/command.hpp"
 #include "gpubridge/dmc1/device.hpp"
+#include "gpubridge/examples/dmc1_level.hpp"
 #include "golden_data.hpp"
 #include "reference_model.hpp"
 
@@ -77,6 +78,45 @@ TEST(Equivalence, RandomStreamsMatchTheEventLevelModel) {
       EXPECT_EQ(bad, 0u) << "seed " << seed << ", " << threads << " thread(s): first difference at column " << first / kRows
                          << " row " << first % kRows;
     }
+  }
+}
+
+// The example client's frames: coherent, every span kind, PLANE_A per span, terrain at the window.
+TEST(Equivalence, TheExampleLevelMatchesTheEventLevelModel) {
+  const auto words = examples::dmc1_level::path_commands(examples::dmc1_level::hall(), 6);
+  ReferenceModel ref(golden_textures(), golden_palette());
+  ref.run(words);
+  for (unsigned threads : {1u, 2u}) EXPECT_TRUE(device_output(words, threads, words.size()) == ref.output()) << threads;
+}
+
+// Every level frame stays inside what the RTL goldens cover: each column draws (its sky filler
+// first), wall depths keep their v step exact (below 0x4000), planes never use texture 0.
+TEST(ExampleLevel, FramesStayInContract) {
+  const auto lv = examples::dmc1_level::hall();
+  for (unsigned f = 0; f < examples::dmc1_level::kPathFrames; f += 4) {
+    const auto words = examples::dmc1_level::frame_commands(lv, examples::dmc1_level::camera_path(lv, f / 64.0));
+    unsigned columns = 0, spans_in_column = 0;
+    for (const std::uint64_t w : words) {
+      const CommandKind k = kind_of(w);
+      if (k == CommandKind::EndOfColumn) {
+        EXPECT_GT(spans_in_column, 0u) << "frame " << f << " column " << columns;
+        ++columns;
+        spans_in_column = 0;
+        continue;
+      }
+      if (!is_span(k)) continue;
+      ++spans_in_column;
+      const unsigned start = (w >> 10) & 255, end = (w >> 18) & 255, tid = w & 1023;
+      EXPECT_LE(start, end) << describe(w);
+      EXPECT_LT(end, kRows) << describe(w);
+      if (k == CommandKind::Plane) {
+        EXPECT_NE(tid, 0u) << describe(w);
+      }
+      if (k == CommandKind::Wall && tid != 0) {
+        EXPECT_LT((w >> 32) & 0xFFFF, 0x4000u) << describe(w);
+      }
+    }
+    EXPECT_EQ(columns, kColumns);
   }
 }
 

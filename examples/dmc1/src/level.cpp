@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 
 #include "gpubridge/dmc1/command.hpp"
@@ -149,6 +150,17 @@ std::vector<std::uint64_t> path_commands(const Level& lv, unsigned frames) {
     out.insert(out.end(), words.begin(), words.end());
   }
   return out;
+}
+
+std::vector<std::uint64_t> golden_frame_commands(unsigned frame) {
+  const Level lv = hall();
+  return frame_commands(lv, camera_path(lv, static_cast<double>(frame % kPathFrames) / kPathFrames));
+}
+
+std::string golden_name(unsigned frame) {
+  char name[32];
+  std::snprintf(name, sizeof name, "level-%02u.png", frame);
+  return name;
 }
 
 }  // namespace gpubridge::examples::dmc1_level

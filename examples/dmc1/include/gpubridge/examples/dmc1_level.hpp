@@ -37,4 +37,11 @@ std::vector<std::uint64_t> frame_commands(const Level& level, const Camera& came
 // `frames` frames evenly spaced along the camera path.
 std::vector<std::uint64_t> path_commands(const Level& level, unsigned frames);
 
+// The golden frames (examples/dmc1/golden/): positions on a lap of kPathFrames frames, chosen to show
+// the window and terrain, a pillar close up and the brick walls.
+inline constexpr unsigned kPathFrames = 64;
+inline constexpr unsigned kGoldenFrames[] = {0, 12, 40};
+std::vector<std::uint64_t> golden_frame_commands(unsigned frame);
+std::string golden_name(unsigned frame);  // "level-NN.png"
+
 }  // namespace gpubridge::examples::dmc1_level
