@@ -19,37 +19,35 @@ struct Sampler {
   }
 };
 
-// The write stage for n rows: normal mode stores the entry {L4 << 4, texel}; lightmap mode only
+// The write stage for one row: normal mode stores the entry {L4 << 4, texel}; lightmap mode only
 // its low byte, as the light byte; every written pixel also writes its depth. Masks instead of
-// branches (whether a pixel lands depends on texels and depths no predictor can guess), and over
-// arrays the span loops filled first, so that it vectorises; the gathering loops before it are
-// then free to overlap their texel loads.
+// branches: whether a pixel lands depends on texels and depths no predictor can guess, and the
+// loops below over __restrict arrays vectorise.
+template <bool kLightmap>
+inline void write_row(std::uint16_t& column, std::uint32_t& depth, std::uint32_t tag, std::uint16_t entry, std::uint32_t z,
+                      bool opaque) {
+  const std::uint32_t d = depth;
+  const std::uint32_t m = 0u - static_cast<std::uint32_t>(depth_passes(d, z, tag) & opaque);
+  depth = (d & ~m) | ((tag | z) & m);
+  const std::uint16_t e = column;
+  const auto value = kLightmap ? static_cast<std::uint16_t>((e & 0xFF) | entry << 8) : entry;
+  column = static_cast<std::uint16_t>((e & ~m) | (value & m));
+}
+
+// n rows from arrays the span loops filled first (so the texel-gathering loops before it are free
+// to overlap their loads).
 template <bool kLightmap>
 void write_rows(std::uint16_t* __restrict column, std::uint32_t* __restrict depth, std::uint32_t tag, unsigned n,
                 const std::uint16_t* __restrict entry, const std::uint32_t* __restrict dist,
                 const std::uint8_t* __restrict opaque) {
-  for (unsigned i = 0; i < n; ++i) {
-    const std::uint32_t d = depth[i], z = dist[i];
-    const std::uint32_t m = 0u - static_cast<std::uint32_t>(depth_passes(d, z, tag) & (opaque[i] != 0));
-    depth[i] = (d & ~m) | ((tag | z) & m);
-    const std::uint16_t e = column[i];
-    const auto value = kLightmap ? static_cast<std::uint16_t>((e & 0xFF) | entry[i] << 8) : entry[i];
-    column[i] = static_cast<std::uint16_t>((e & ~m) | (value & m));
-  }
+  for (unsigned i = 0; i < n; ++i) write_row<kLightmap>(column[i], depth[i], tag, entry[i], dist[i], opaque[i] != 0);
 }
 
-// The same with one entry and depth for every row (background fills, terrain writes).
+// n rows with one entry and depth (background fills, terrain writes).
 template <bool kLightmap>
 void fill_rows(std::uint16_t* __restrict column, std::uint32_t* __restrict depth, std::uint32_t tag, unsigned n,
                std::uint16_t entry, std::uint32_t z) {
-  for (unsigned i = 0; i < n; ++i) {
-    const std::uint32_t d = depth[i];
-    const std::uint32_t m = 0u - static_cast<std::uint32_t>(depth_passes(d, z, tag));
-    depth[i] = (d & ~m) | ((tag | z) & m);
-    const std::uint16_t e = column[i];
-    const auto value = kLightmap ? static_cast<std::uint16_t>((e & 0xFF) | entry << 8) : entry;
-    column[i] = static_cast<std::uint16_t>((e & ~m) | (value & m));
-  }
+  for (unsigned i = 0; i < n; ++i) write_row<kLightmap>(column[i], depth[i], tag, entry, z, true);
 }
 
 }  // namespace
