@@ -4,6 +4,7 @@
 // format-then-parse unchanged; the output does not depend on the thread count.
 #include <memory>
 #include <string_view>
+#include <vector>
 
 #include "fuzz_check.hpp"
 #include "gpubridge/dmc1/device.hpp"
@@ -23,16 +24,28 @@ std::shared_ptr<const TextureMemory> textures() {
   return mem;
 }
 
+// One device per thread count for every input, back to its reset state each time. Both see the
+// same inputs in the same order, so their screens (the panel keeps columns across a reset) agree
+// as long as the thread count changes nothing.
 std::vector<std::uint16_t> run(std::span<const std::uint64_t> words, unsigned threads) {
-  Palette p;
-  for (unsigned i = 0; i < 256; ++i) p.set(i, static_cast<std::uint8_t>(i & 63), static_cast<std::uint8_t>((i >> 2) & 63), 63);
-  DeviceOptions o;
-  o.threads = threads;
-  auto dev = Device::create(o, textures(), p);
-  FUZZ_CHECK(dev.ok());
-  (*dev)->submit(words);
-  (*dev)->flush();
-  return {(*dev)->screen().begin(), (*dev)->screen().end()};
+  static const auto devices = [] {
+    Palette p;
+    for (unsigned i = 0; i < 256; ++i) p.set(i, static_cast<std::uint8_t>(i & 63), static_cast<std::uint8_t>((i >> 2) & 63), 63);
+    std::vector<std::unique_ptr<Device>> d;
+    for (unsigned t : {1u, 3u}) {
+      DeviceOptions o;
+      o.threads = t;
+      auto dev = Device::create(o, textures(), p);
+      FUZZ_CHECK(dev.ok());
+      d.push_back(std::move(dev).value());
+    }
+    return d;
+  }();
+  Device& dev = *devices[threads == 1 ? 0 : 1];
+  dev.reset();
+  dev.submit(words);
+  dev.flush();
+  return {dev.screen().begin(), dev.screen().end()};
 }
 
 }  // namespace
