@@ -83,8 +83,24 @@ std::vector<Example> make() {
           .prints(R"(frame #\d+ \(160x120, sim\) written to sim\.png)")
           .leaves("sim.png"),
 
+      run("build/tools/gpubridge render --device dmc1 tests/dmc1/data/streams/mixed.dmc1 --textures "
+          "tests/dmc1/data/textures.bin.gz     --palette tests/dmc1/data/palette.bin --out mixed.png --raw mixed.rgb565 "
+          "--timing")
+          .prints(R"(rendered .*mixed\.dmc1 \(DMC-1, dmc1 format\): \d+ commands, 1 frame)")
+          .prints(R"(wrote mixed\.rgb565: 153600 bytes of RGB565)")
+          .prints(R"(timing frame 0: \d+ GPU cycles)")
+          .leaves("mixed.png")
+          .leaves("mixed.rgb565"),
+      run("build/examples/dmc1/gpubridge-dmc1-demo write --frames 64 --out level.dmc1")
+          .prints(R"(wrote level\.dmc1: 64 frame\(s\))")
+          .leaves("level.dmc1"),
+      run("build/tools/gpubridge regs --device dmc1").prints(R"(wall +texture +bits +0\.\.9)"),
+
       skip("build/tools/gpubridge bench accuracy --out-dir docs",
            "rewrites docs/accuracy-report.* and runs for minutes; CTest bench_accuracy_quick_smoke runs it with --quick"),
+      skip("build/tools/gpubridge bench dmc1",
+           "measures for seconds per stream on a machine shared with the rest of the suite; CTest "
+           "dmc1_bench_smoke runs it with one short round"),
       skip("build/tools/gpubridge bench daemon",
            "a 20-second measurement on a machine shared with the rest of the suite; CTest bench_daemon_smoke runs "
            "it with fewer rounds"),
@@ -99,8 +115,33 @@ std::vector<Example> make() {
       skip("scripts/fuzz-smoke.sh 600", "10 minutes per fuzz target, by hand; scripts/test.sh runs the 5-second smoke"),
       skip("build/examples/gpubridge-demo goldens --dir examples/golden --write",
            "rewrites the committed goldens; the comparing form runs in docs/examples.md"),
+      skip("build/examples/dmc1/gpubridge-dmc1-demo goldens --write",
+           "rewrites the committed goldens; CTest dmc1_level_goldens runs the comparing form"),
       skip("build/tools/gpubridge bench accuracy --out-dir docs",
            "rewrites docs/accuracy-report.*; CTest bench_accuracy_quick_smoke runs it with --quick"),
+  }});
+
+  all.push_back({"docs/dmc1.md", "Quick start", 0, "docs_dmc1_QuickStart", {
+      run("build/tools/gpubridge render --device dmc1 tests/dmc1/data/streams/mixed.dmc1 --textures "
+          "tests/dmc1/data/textures.bin.gz     --palette tests/dmc1/data/palette.bin --out mixed.png --raw mixed.rgb565 "
+          "--timing")
+          .prints(R"(rendered .*mixed\.dmc1 \(DMC-1, dmc1 format\): \d+ commands, 1 frame)")
+          .prints(R"(wrote mixed\.rgb565: 153600 bytes of RGB565)")
+          .prints(R"(timing frame 0: \d+ GPU cycles)")
+          .leaves("mixed.png")
+          .leaves("mixed.rgb565"),
+      run("cmp mixed.rgb565 tests/dmc1/data/golden/mixed.rgb565"),
+      run("build/examples/dmc1/gpubridge-dmc1-demo write --frames 64 --out level.dmc1")
+          .prints(R"(wrote level\.dmc1: 64 frame\(s\))")
+          .leaves("level.dmc1"),
+      run("build/tools/gpubridge render --device dmc1 level.dmc1 --textures tests/dmc1/data/textures.bin.gz     "
+          "--palette tests/dmc1/data/palette.bin --frames-dir level-frames")
+          .prints(R"(64 frame\(s\))")
+          .leaves("level-frames/frame-00063.png")
+          .within(120),
+      skip("build/tools/gpubridge bench dmc1",
+           "measures for seconds per stream; CTest dmc1_bench_smoke runs it with one short round"),
+      run("build/tools/gpubridge regs --device dmc1").prints(R"(wall +texture +bits +0\.\.9)"),
   }});
 
   all.push_back({"docs/daemon.md", "Running", 0, "docs_daemon_Running", {
