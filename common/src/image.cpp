@@ -1,5 +1,6 @@
 #include "gpubridge/common/image.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <memory>
@@ -16,12 +17,19 @@ namespace {
 constexpr std::uint64_t kMaxExpansion = 1u << 16;
 
 // png_bytes: size of the PNG data (0 = unknown, no plausibility check).
-Result<Image> decode_with(png_image& img, const std::string& name, std::uint64_t png_bytes) {
+Result<Image> decode_with(png_image& img, const std::string& name, std::uint64_t png_bytes, const PngLimits& limits) {
   const std::string dims = std::to_string(img.width) + "x" + std::to_string(img.height);
-  if (img.width == 0 || img.height == 0 || img.width > kMaxImageDim || img.height > kMaxImageDim) {
+  const unsigned side = std::min(limits.max_side, kMaxImageDim);
+  const std::string purpose = limits.purpose.empty() ? "gpubridge" : limits.purpose;
+  if (img.width == 0 || img.height == 0 || img.width > side || img.height > side) {
     png_image_free(&img);
-    return make_error(name + ": image is " + dims + "; gpubridge accepts 1.." + std::to_string(kMaxImageDim) +
+    return make_error(name + ": image is " + dims + "; " + purpose + " accepts 1.." + std::to_string(side) +
                       " pixels per side");
+  }
+  if (limits.max_pixels != 0 && std::uint64_t{img.width} * img.height > limits.max_pixels) {
+    png_image_free(&img);
+    return make_error(name + ": image is " + dims + ", more than the " + std::to_string(limits.max_pixels) + " pixels " +
+                      purpose + " accepts (checked before decoding)");
   }
   // The header alone must not buy a huge allocation: a 20-byte file claiming 16384x16384 pixels
   // made us allocate and clear 1 GiB before libpng found the data missing (found with fuzz_png).
@@ -46,7 +54,7 @@ Result<Image> decode_with(png_image& img, const std::string& name, std::uint64_t
 
 }  // namespace
 
-Result<Image> load_png(const std::filesystem::path& path) {
+Result<Image> load_png(const std::filesystem::path& path, const PngLimits& limits) {
   png_image img;
   std::memset(&img, 0, sizeof img);
   img.version = PNG_IMAGE_VERSION;
@@ -57,10 +65,10 @@ Result<Image> load_png(const std::filesystem::path& path) {
   }
   std::error_code ec;
   const auto size = std::filesystem::file_size(path, ec);  // not a regular file (a pipe): no check
-  return decode_with(img, path.string(), ec ? 0 : size);
+  return decode_with(img, path.string(), ec ? 0 : size, limits);
 }
 
-Result<Image> decode_png(std::span<const std::uint8_t> bytes, const std::string& name) {
+Result<Image> decode_png(std::span<const std::uint8_t> bytes, const std::string& name, const PngLimits& limits) {
   png_image img;
   std::memset(&img, 0, sizeof img);
   img.version = PNG_IMAGE_VERSION;
@@ -69,7 +77,7 @@ Result<Image> decode_png(std::span<const std::uint8_t> bytes, const std::string&
     png_image_free(&img);
     return make_error(msg);
   }
-  return decode_with(img, name, bytes.size());
+  return decode_with(img, name, bytes.size(), limits);
 }
 
 Result<void> save_png(const std::filesystem::path& path, const Image& img) {

@@ -6,8 +6,8 @@
 #include <cstring>
 #include <fstream>
 
-#include "gpubridge/common/file_read.hpp"
 #include "gpubridge/common/image.hpp"
+#include "gpubridge/common/regular_file.hpp"
 
 namespace gpubridge {
 namespace {
@@ -31,18 +31,19 @@ protocol::AssetLoader make_asset_loader(std::filesystem::path base_dir) {
     std::filesystem::path p(asset.path);
     if (p.is_relative()) p = base / p;
     if (asset.kind == protocol::TraceAsset::Kind::Hex) {
-      auto text = read_small_file(p, kMaxTraceAssetBytes * 3, "hex file");  // ≥ 2 characters per byte
+      auto text = read_regular_file(p, kMaxTraceAssetBytes * 3, "hex file");  // ≥ 2 characters per byte
       if (!text) return text.error();
       auto bytes = protocol::parse_hex_bytes(*text);
       if (!bytes) return make_error(p.string() + ":" + bytes.error().message);
       return std::move(bytes).value();
     }
-    auto img = load_png(p);
+    // The asset limit, in pixels of the target format, is checked against the PNG's header.
+    PngLimits limits;
+    limits.max_pixels = kMaxTraceAssetBytes / protocol::bytes_per_pixel(asset.format);
+    limits.purpose = "an .upload of " + std::string(protocol::to_string(asset.format)) + " (at most " +
+                     std::to_string(kMaxTraceAssetBytes) + " bytes)";
+    auto img = load_png(p, limits);
     if (!img) return img.error();
-    const std::uint64_t size = std::uint64_t{img->width} * img->height * protocol::bytes_per_pixel(asset.format);
-    if (size > kMaxTraceAssetBytes)
-      return make_error(p.string() + ": " + std::to_string(img->width) + "x" + std::to_string(img->height) +
-                        " image is too large to upload (limit " + std::to_string(kMaxTraceAssetBytes) + " bytes)");
     return device_from_image(asset.format, *img);
   };
 }
@@ -71,7 +72,7 @@ Result<protocol::CommandStream> load_trace(const std::filesystem::path& path) {
   }
   if (trace_format_for_path(path) == TraceFormat::Binary)
     return make_error(path.string() + ": not a binary trace (no GBTRACE magic) although named .gbt");
-  auto text = read_small_file(path, kMaxTextTraceBytes, "text trace");
+  auto text = read_regular_file(path, kMaxTextTraceBytes, "text trace");
   if (!text) return text.error();
   return protocol::parse_text_trace(*text, path.string(), make_asset_loader(path.parent_path()));
 }

@@ -4,12 +4,11 @@
 
 #include <cerrno>
 #include <cstring>
-#include <fstream>
-#include <sstream>
 
 #include <nlohmann/json.hpp>
 
 #include "gpubridge/client/address.hpp"
+#include "gpubridge/common/regular_file.hpp"
 #include "gpubridge/common/log.hpp"
 #include "gpubridge/protocol/messages.hpp"
 
@@ -82,8 +81,9 @@ class Reader {
 // against it and finalize_config checks the values flags set, so both report the same ranges.
 template <class Limits_, class F>
 void for_each_limit(Limits_& lim, F&& f) {
-  f("max_message_bytes", "--max-message", 4096, protocol::kMaxPayload, lim.max_message_bytes);
+  f("max_message_bytes", "--max-message", protocol::kMinMaxPayload, protocol::kMaxPayload, lim.max_message_bytes);
   f("max_clients", "--max-clients", 1, 4096, lim.max_clients);
+  f("max_pending_handshakes", "--max-pending-handshakes", 1, 4096, lim.max_pending_handshakes);
   f("handshake_timeout_ms", "--handshake-timeout-ms", 10, 600000, lim.handshake_timeout_ms);
   f("idle_timeout_ms", "--idle-timeout-ms", 0, 86400000, lim.idle_timeout_ms);
   f("trickle_window_ms", "--trickle-window-ms", 10, 600000, lim.trickle_window_ms);
@@ -182,11 +182,12 @@ Result<void> check_output_dirs(const DaemonConfig& cfg) {
 }
 
 Result<DaemonConfig> load_config(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  if (!in) return make_error(path.string() + ": cannot open the configuration file");
+  // A directory, FIFO or device is refused by what it is, without blocking or reading 2 GB.
+  auto text = read_regular_file(path, kMaxConfigFileBytes, "configuration file");
+  if (!text) return text.error();
   json doc;
   try {
-    doc = json::parse(in, nullptr, true, /*ignore_comments=*/true);
+    doc = json::parse(*text, nullptr, true, /*ignore_comments=*/true);
   } catch (const json::exception& e) {  // parse_error, or out_of_range for a number beyond double (1e999)
     return make_error(path.string() + ": not valid JSON: " + e.what());
   }
@@ -195,10 +196,9 @@ Result<DaemonConfig> load_config(const std::filesystem::path& path) {
 
 Result<void> finalize_config(DaemonConfig& cfg) {
   if (!cfg.token_file.empty()) {
-    std::ifstream in(cfg.token_file);
-    if (!in) return make_error("token_file: cannot read " + cfg.token_file);
-    std::string line;
-    std::getline(in, line);
+    auto text = read_regular_file(cfg.token_file, kMaxTokenFileBytes, "token file");
+    if (!text) return make_error("token_file: " + text.error().message);
+    std::string line = text->substr(0, text->find('\n'));
     while (!line.empty() && (line.back() == '\r' || line.back() == ' ' || line.back() == '\t')) line.pop_back();
     if (line.empty()) return make_error("token_file: " + cfg.token_file + " is empty (expected the token on its first line)");
     cfg.token = line;

@@ -109,11 +109,15 @@ int run(daemon::DaemonConfig cfg) {
       if (ec) return;
       log->info("signal {}: shutting down", sig);
       notify("STOPPING=1");
-      server.stop();  // no new connections; socket and lock removed now
-      hub.stop_hotplug();
+      // Nothing new connects; the socket and its lock stay until the process is done, so no
+      // second daemon starts on the path while this one still runs.
+      server.stop_accepting();
+      // No hot-plug step, no new device work; a batch that is running stops between frames, and
+      // no more frames are handed to the network thread.
+      hub.stop();
       const auto open = hub.shutdown_sessions();
-      // Sessions close once their last reply is flushed; never wait longer than 1.5 s in total.
-      const auto give_up = std::chrono::steady_clock::now() + std::chrono::milliseconds(open ? 1500 : 0);
+      // Sessions close once their last reply is flushed; never wait longer than 1 s in total.
+      const auto give_up = std::chrono::steady_clock::now() + std::chrono::milliseconds(open ? 1000 : 0);
       std::function<void()> poll = [&, give_up] {
         if (hub.session_count() == 0 || std::chrono::steady_clock::now() >= give_up) {
           net.stop();
@@ -126,10 +130,11 @@ int run(daemon::DaemonConfig cfg) {
       stop_poll();
     });
     net.run();
-    server.stop();
-    // The device thread may still be inside a hub step (a probe or re-attach attempt): let it
-    // finish before the hub it works on is destroyed.
+    // The device thread may still be inside a request (stopping at its next cancel point) or a
+    // hot-plug step: let it finish before the hub it works on is destroyed.
+    hub.stop();
     join_device();
+    server.stop();  // socket and lock files removed, the lock released: now another daemon may start
   }
   log->info("stopped");
   return exit_code;
@@ -167,7 +172,7 @@ int main(int argc, char** argv) {
   std::string config_path;
   std::vector<std::string> listen;
   std::string token, token_file, backend, boards_dir, frames_dir, record_dir, log_level;
-  std::optional<unsigned> max_clients, handshake_ms, idle_ms, trickle_ms, min_rate;
+  std::optional<unsigned> max_clients, max_pending, handshake_ms, idle_ms, trickle_ms, min_rate;
   std::optional<std::uint32_t> max_message;
   std::optional<std::uint64_t> queue_bytes;
   std::optional<unsigned> reattach_ms;
@@ -193,10 +198,14 @@ int main(int argc, char** argv) {
   app.add_option("--boards-dir", boards_dir, "directory of board profiles (JSON)");
   app.add_option("--frames-dir", frames_dir, "write every scanned-out frame as frame_NNNNNN.png here");
   app.add_option("--record", record_dir, "write each session's command stream as a binary trace here");
-  app.add_option("--max-clients", max_clients, "connection cap (1..4096)");
+  app.add_option("--max-clients", max_clients, "clients served at once (1..4096; counted at HELLO)");
+  app.add_option("--max-pending-handshakes", max_pending,
+                 "connections per transport still waiting for their HELLO (1..4096; the oldest gives way)");
   app.add_option("--max-message", max_message, "largest accepted message payload in bytes");
   app.add_option("--handshake-timeout-ms", handshake_ms, "HELLO deadline");
-  app.add_option("--idle-timeout-ms", idle_ms, "close sessions silent this long (0 = never; subscribers exempt)");
+  app.add_option("--idle-timeout-ms", idle_ms,
+                 "close sessions silent this long, subscribers that answer no keepalive, and clients that take "
+                 "nothing written to them (0 = never)");
   app.add_option("--trickle-window-ms", trickle_ms, "window of the minimum-byte-rate check");
   app.add_option("--min-bytes-per-sec", min_rate, "minimum rate while a message is incomplete");
   app.add_option("--queue-bytes", queue_bytes, "outgoing bytes queued per session before reading pauses");
@@ -238,6 +247,7 @@ int main(int argc, char** argv) {
   if (!record_dir.empty()) cfg.record_dir = record_dir;
   if (!log_level.empty()) cfg.log_level = log_level;
   if (max_clients) cfg.limits.max_clients = *max_clients;
+  if (max_pending) cfg.limits.max_pending_handshakes = *max_pending;
   if (max_message) cfg.limits.max_message_bytes = *max_message;
   if (handshake_ms) cfg.limits.handshake_timeout_ms = *handshake_ms;
   if (idle_ms) cfg.limits.idle_timeout_ms = *idle_ms;

@@ -42,7 +42,8 @@ backends::DeviceInfo MirrorBackend::info() const { return board_->info(); }
 
 template <class T>
 Result<T> MirrorBackend::decide(Result<T> board_result, const Result<void>& model_result, const char* what) {
-  if (board_result && !model_result) {
+  // A batch cancelled in the model (shutdown, client gone) is no disagreement with the board.
+  if (board_result && !model_result && model_result.error().code != backends::kCancelled) {
     std::uint64_t n;
     {
       std::lock_guard lock(mu_);
@@ -92,6 +93,11 @@ Result<void> MirrorBackend::reset() {
   auto b = board_->reset();
   auto m = model_->reset();
   return decide(std::move(b), m, "a reset");
+}
+
+void MirrorBackend::set_cancel_flag(const std::atomic<bool>* flag) {
+  board_->set_cancel_flag(flag);
+  model_->set_cancel_flag(flag);
 }
 
 void MirrorBackend::set_scanout_callback(backends::ScanoutCallback cb) {

@@ -53,6 +53,8 @@ backends::DeviceInfo FakeScanoutBackend::info() const {
   d.max_width = width_;
   d.max_height = height_;
   d.vram_bytes = memory_.size();
+  d.id = regs_[protocol::index_of(protocol::Reg::ID)];  // the constants its registers hold
+  d.caps = regs_[protocol::index_of(protocol::Reg::CAPS)];
   return d;
 }
 

@@ -25,6 +25,11 @@ struct LineError {
   std::string message;  // what is wrong; what to do
 };
 
+// A token as error messages show it: at most 40 bytes (cut at a character boundary, then "..."
+// and the token's length), control bytes escaped (\0, \t, \xNN), so a 20 MB token or a NUL in
+// it can neither flood nor cut the message.
+std::string shown(std::string_view token);
+
 // Decimal or 0x-hex unsigned integer that fits 64 bits (no sign, no fraction).
 std::optional<std::uint64_t> parse_u64(std::string_view s);
 bool iequals(std::string_view a, std::string_view b);

@@ -85,9 +85,9 @@ class TextTraceReader {
 
   static std::optional<LineError> number(const Token& t, std::uint64_t max, const char* what, std::uint64_t& out) {
     auto n = text::parse_u64(t.text);
-    if (!n) return LineError{t.column, "'" + std::string(t.text) + "' is not a " + what + "; write decimal or 0x hex"};
+    if (!n) return LineError{t.column, "'" + text::shown(t.text) + "' is not a " + what + "; write decimal or 0x hex"};
     if (*n > max)
-      return LineError{t.column, std::string(what) + " " + std::string(t.text) + " exceeds " + std::to_string(max)};
+      return LineError{t.column, std::string(what) + " " + text::shown(t.text) + " exceeds " + std::to_string(max)};
     out = *n;
     return std::nullopt;
   }
@@ -132,7 +132,7 @@ class TextTraceReader {
       }
       auto idx = text::parse_u64(t[1].text);
       if (!idx || *idx > 0x7F)
-        return LineError{t[1].column, "unknown register '" + std::string(t[1].text) +
+        return LineError{t[1].column, "unknown register '" + text::shown(t[1].text) +
                                           "'; run `gpubridge regs` for the names, or give an index 0x00..0x7F"};
       emit(ReadRegCmd{static_cast<std::uint8_t>(*idx)});
       return std::nullopt;
@@ -152,7 +152,7 @@ class TextTraceReader {
       for (std::size_t i = 2; i < t.size(); ++i) {
         auto bytes = parse_hex_bytes(t[i].text);
         if (!bytes)
-          return LineError{t[i].column, "'" + std::string(t[i].text).substr(0, 32) +
+          return LineError{t[i].column, "'" + text::shown(t[i].text) +
                                             "' is not hex bytes; write pairs of hex digits (00..ff)"};
         data.insert(data.end(), bytes->begin(), bytes->end());
       }
@@ -169,7 +169,7 @@ class TextTraceReader {
         if (t.size() == 5) {
           auto f = parse_pixel_format(t[4].text);
           if (!f)
-            return LineError{t[4].column, "'" + std::string(t[4].text) +
+            return LineError{t[4].column, "'" + text::shown(t[4].text) +
                                               "' is not a pixel format; use RGBA8888, RGB565 or RGBA2222"};
           asset.format = *f;
         }
@@ -177,7 +177,7 @@ class TextTraceReader {
         asset.kind = TraceAsset::Kind::Hex;
         if (t.size() == 5) return LineError{t[4].column, "a hex upload takes no format; the file holds device bytes"};
       } else {
-        return LineError{t[2].column, "'" + std::string(t[2].text) + "' is not an upload kind; use png or hex"};
+        return LineError{t[2].column, "'" + text::shown(t[2].text) + "' is not an upload kind; use png or hex"};
       }
       if (!loader_)
         return LineError{t[3].column, "this reader cannot open files (no loader); convert with `gpubridge trace`"};

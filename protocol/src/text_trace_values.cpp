@@ -109,10 +109,10 @@ std::string raw_index(std::uint8_t index) {
   return buf;
 }
 
-// Value of one field from its text; `shown` is "FIELD=value" for messages.
-std::optional<std::string> parse_field_value(const Field& f, std::string_view v, const std::string& shown,
+// Value of one field from its text; `item` is "FIELD=value" as messages show it.
+std::optional<std::string> parse_field_value(const Field& f, std::string_view v, const std::string& item,
                                              std::uint64_t& bits) {
-  if (v.empty()) return shown + " has no value; write " + std::string(f.name) + "=<value>";
+  if (v.empty()) return item + " has no value; write " + std::string(f.name) + "=<value>";
   if (f.kind == FieldKind::Enum) {
     for (const auto& e : f.values) {
       if (iequals(e.name, v)) {
@@ -128,14 +128,14 @@ std::optional<std::string> parse_field_value(const Field& f, std::string_view v,
         }
       }
     }
-    return shown + " is not a " + std::string(f.name) + " value; use one of " + enum_names(f);
+    return item + " is not a " + std::string(f.name) + " value; use one of " + enum_names(f);
   }
   if (f.kind == FieldKind::Flag) {
     if (v == "0" || v == "1") {
       bits = v == "1" ? 1 : 0;
       return std::nullopt;
     }
-    return shown + " is not a flag value; use 0 or 1";
+    return item + " is not a flag value; use 0 or 1";
   }
   const auto range = raw_range(f);
   const std::string fmt = describe_field_format(f);
@@ -144,7 +144,7 @@ std::optional<std::string> parse_field_value(const Field& f, std::string_view v,
     // Hex gives the field's raw bits (two's complement for signed fields).
     auto n = parse_u64(v);
     if (!n || (f.width < 64 && *n >> f.width))
-      return shown + " does not fit the " + std::to_string(f.width) + "-bit field " + std::string(f.name) +
+      return item + " does not fit the " + std::to_string(f.width) + "-bit field " + std::string(f.name) +
              "; raw hex bits must be below " + hex(f.width < 64 ? (1ull << f.width) : 0) + " (" + fmt + ")";
     bits = *n;
     return std::nullopt;
@@ -153,17 +153,17 @@ std::optional<std::string> parse_field_value(const Field& f, std::string_view v,
   if (auto problem = parse_decimal_raw(v, f, raw)) {
     if (problem->empty()) {
       if (f.frac_bits == 0)
-        return shown + " is not an integer (" + std::string(f.name) + " is " + fmt + ")";
-      return shown + " is not a multiple of 1/" + u128_to_string(static_cast<u128>(1) << f.frac_bits) + " (" +
+        return item + " is not an integer (" + std::string(f.name) + " is " + fmt + ")";
+      return item + " is not a multiple of 1/" + u128_to_string(static_cast<u128>(1) << f.frac_bits) + " (" +
              std::string(f.name) + " is " + fmt + "); round it to a representable value";
     }
     if (*problem == "is out of range")
-      return shown + " is out of range " + range_text + " (" + std::string(f.name) + " is " + fmt + ")";
-    return shown + " " + *problem + "; write a decimal, a 0x hex value" +
+      return item + " is out of range " + range_text + " (" + std::string(f.name) + " is " + fmt + ")";
+    return item + " " + *problem + "; write a decimal, a 0x hex value" +
            (f.frac_bits ? std::string(" or a decimal fraction") : std::string());
   }
   if (raw < range.min || raw > range.max)
-    return shown + " is out of range " + range_text + " (" + std::string(f.name) + " is " + fmt + ")";
+    return item + " is out of range " + range_text + " (" + std::string(f.name) + " is " + fmt + ")";
   bits = static_cast<std::uint64_t>(raw) & (f.width >= 64 ? ~0ull : ((1ull << f.width) - 1));
   return std::nullopt;
 }
@@ -179,7 +179,7 @@ std::optional<LineError> parse_named(const RegisterDesc& r, std::span<const Toke
   const bool field_form = tokens[1].text.find('=') != std::string_view::npos;
   if (!field_form) {
     if (tokens.size() > 2)
-      return LineError{tokens[2].column, "unexpected '" + std::string(tokens[2].text) + "' after the value of " + name +
+      return LineError{tokens[2].column, "unexpected '" + shown(tokens[2].text) + "' after the value of " + name +
                                              "; write either `" + name + " value` or `" + name + " FIELD=value ...`"};
     const Token& v = tokens[1];
     const bool fractional = v.text.find('.') != std::string_view::npos;
@@ -192,14 +192,14 @@ std::optional<LineError> parse_named(const RegisterDesc& r, std::span<const Toke
         return LineError{v.column, "a fractional or negative value needs a single-field register; " + name +
                                        " has fields " + field_names(r) + ": write " + name + " FIELD=value ..."};
       std::uint64_t bits = 0;
-      if (auto e = parse_field_value(*only, v.text, std::string(only->name) + "=" + std::string(v.text), bits))
+      if (auto e = parse_field_value(*only, v.text, std::string(only->name) + "=" + shown(v.text), bits))
         return LineError{v.column, *e};
       out.data = only->put(0, bits);
       return std::nullopt;
     }
     auto n = parse_u64(v.text);
     if (!n)
-      return LineError{v.column, "'" + std::string(v.text) + "' is not a value for " + name +
+      return LineError{v.column, "'" + shown(v.text) + "' is not a value for " + name +
                                      "; write a decimal or 0x hex number, or FIELD=value pairs (fields: " +
                                      field_names(r) + ")"};
     const auto check = check_write(r.index, *n);
@@ -216,24 +216,43 @@ std::optional<LineError> parse_named(const RegisterDesc& r, std::span<const Toke
     const Token& t = tokens[i];
     const auto eq = t.text.find('=');
     if (eq == std::string_view::npos)
-      return LineError{t.column, "expected FIELD=value, found '" + std::string(t.text) + "' (fields of " + name +
+      return LineError{t.column, "expected FIELD=value, found '" + shown(t.text) + "' (fields of " + name +
                                      ": " + field_names(r) + ")"};
     const auto fname = t.text.substr(0, eq);
     const Field* f = r.field(fname);
     if (!f)
-      return LineError{t.column, "unknown field '" + std::string(fname) + "' of " + name + "; its fields are " +
+      return LineError{t.column, "unknown field '" + shown(fname) + "' of " + name + "; its fields are " +
                                      field_names(r)};
     if (assigned & f->mask())
       return LineError{t.column, "field " + std::string(f->name) + " is set twice; set it once"};
     assigned |= f->mask();
     std::uint64_t bits = 0;
-    if (auto e = parse_field_value(*f, t.text.substr(eq + 1), std::string(t.text), bits)) return LineError{t.column, *e};
+    if (auto e = parse_field_value(*f, t.text.substr(eq + 1), shown(t.text), bits)) return LineError{t.column, *e};
     out.data = f->put(out.data, bits);
   }
   return std::nullopt;
 }
 
 }  // namespace
+
+std::string shown(std::string_view token) {
+  constexpr std::size_t kShownBytes = 40;
+  std::size_t cut = token.size();
+  if (cut > kShownBytes) {
+    cut = kShownBytes;  // a UTF-8 continuation byte (10xxxxxx) never starts the cut-off tail
+    while (cut > 0 && (static_cast<unsigned char>(token[cut]) & 0xC0) == 0x80) --cut;
+  }
+  std::string out;
+  for (const char c : token.substr(0, cut)) {
+    const auto u = static_cast<unsigned char>(c);
+    if (u == 0) out += "\\0";
+    else if (u == '\t') out += "\\t";
+    else if (u < 0x20 || u == 0x7F) out += "\\x" + std::string(1, "0123456789ABCDEF"[u >> 4]) + "0123456789ABCDEF"[u & 15];
+    else out += c;
+  }
+  if (cut < token.size()) out += "... (" + std::to_string(token.size()) + " bytes)";
+  return out;
+}
 
 std::vector<Token> tokenize(std::string_view line) {
   std::vector<Token> out;
@@ -288,21 +307,21 @@ std::optional<LineError> parse_register_tokens(std::span<const Token> tokens, Fr
   if (!first.text.empty() && first.text[0] >= '0' && first.text[0] <= '9') {
     auto idx = parse_u64(first.text);
     if (!idx || *idx > 0x7F)
-      return LineError{first.column, "'" + std::string(first.text) +
+      return LineError{first.column, "'" + shown(first.text) +
                                          "' is not a register index; raw frames are `0xIDX 0xDATA` with IDX ≤ 0x7F"};
     if (tokens.size() != 2)
       return LineError{tokens.size() < 2 ? first.column + first.text.size() : tokens[2].column,
                        "a raw frame is exactly `0xIDX 0xDATA`"};
     auto data = parse_u64(tokens[1].text);
     if (!data)
-      return LineError{tokens[1].column, "'" + std::string(tokens[1].text) +
+      return LineError{tokens[1].column, "'" + shown(tokens[1].text) +
                                              "' is not a 64-bit value; write decimal or 0x hex (at most 16 hex digits)"};
     out = Frame{false, static_cast<std::uint8_t>(*idx), *data};
     return std::nullopt;
   }
   const RegisterDesc* r = find_register(first.text);
   if (!r)
-    return LineError{first.column, "unknown register '" + std::string(first.text) +
+    return LineError{first.column, "unknown register '" + shown(first.text) +
                                        "'; run `gpubridge regs` for the names, or write a raw frame 0xIDX 0xDATA"};
   return parse_named(*r, tokens, out);
 }
@@ -399,12 +418,12 @@ Result<std::vector<std::uint8_t>> parse_hex_bytes(std::string_view s) {
     col += tok.size();
     if (tok.size() > 2 && tok[0] == '0' && (tok[1] == 'x' || tok[1] == 'X')) tok.remove_prefix(2);
     if (tok.size() % 2 != 0)
-      return make_error(std::to_string(line) + ":" + std::to_string(tok_col) + ": '" + std::string(tok) +
+      return make_error(std::to_string(line) + ":" + std::to_string(tok_col) + ": '" + text::shown(tok) +
                         "' has an odd number of hex digits; write whole bytes (two digits each)");
     for (std::size_t k = 0; k < tok.size(); k += 2) {
       const int hi = nibble(tok[k]), lo = nibble(tok[k + 1]);
       if (hi < 0 || lo < 0)
-        return make_error(std::to_string(line) + ":" + std::to_string(tok_col) + ": '" + std::string(tok) +
+        return make_error(std::to_string(line) + ":" + std::to_string(tok_col) + ": '" + text::shown(tok) +
                           "' is not hex bytes; use digits 0-9 and a-f");
       out.push_back(static_cast<std::uint8_t>(hi * 16 + lo));
     }

@@ -47,12 +47,13 @@ class InProcessDaemon {
     return true;
   }
 
-  // Stops like gpubridged on SIGTERM: no more re-attach attempts, listeners closed, sessions told.
+  // Stops like gpubridged on SIGTERM: listeners closed, no more re-attach attempts or device work,
+  // sessions told; the socket and lock files go last.
   ~InProcessDaemon() {
     if (server_)
       boost::asio::post(net_, [this] {
-        hub_->stop_hotplug();
-        server_->stop();
+        server_->stop_accepting();
+        hub_->stop();
         hub_->shutdown_sessions();
       });
     std::this_thread::sleep_for(std::chrono::milliseconds(50));

@@ -28,6 +28,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   FUZZ_CHECK(cfg->reattach_interval_ms <= daemon::kMaxReattachIntervalMs);
   FUZZ_CHECK(lim.max_message_bytes >= 4096 && lim.max_message_bytes <= protocol::kMaxPayload);
   FUZZ_CHECK(lim.max_clients >= 1 && lim.max_clients <= 4096);
+  FUZZ_CHECK(lim.max_pending_handshakes >= 1 && lim.max_pending_handshakes <= 4096);
   FUZZ_CHECK(lim.handshake_timeout_ms >= 10 && lim.handshake_timeout_ms <= 600000);
   FUZZ_CHECK(lim.idle_timeout_ms <= 86400000);
   FUZZ_CHECK(lim.trickle_window_ms >= 10 && lim.trickle_window_ms <= 600000);

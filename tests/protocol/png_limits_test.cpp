@@ -76,5 +76,27 @@ TEST(PngLimits, MaximallyCompressibleLargeImagesStillDecode) {
   EXPECT_EQ(img->rgba[3], 255);
 }
 
+// A caller's own limits (the 64 MiB .upload asset, 1024-texel textures) are checked against the
+// header too, so a 70 KB PNG of 4096x4096 is refused without decoding 64 MiB of RGBA first.
+TEST(PngLimits, CallerLimitsAreCheckedFromTheHeader) {
+  constexpr std::uint32_t kSide = 4096;
+  const Bytes png = gray1_png(kSide, kSide, Bytes(std::size_t{kSide} * (1 + kSide / 8), 0));
+  PngLimits texture;
+  texture.max_side = 1024;
+  texture.purpose = "a texture";
+  auto img = decode_png(png, "big.png", texture);
+  ASSERT_FALSE(img);
+  EXPECT_EQ(img.error().message, "big.png: image is 4096x4096; a texture accepts 1..1024 pixels per side");
+  PngLimits upload;
+  upload.max_pixels = 1u << 20;
+  upload.purpose = "an upload";
+  img = decode_png(png, "big.png", upload);
+  ASSERT_FALSE(img);
+  EXPECT_EQ(img.error().message,
+            "big.png: image is 4096x4096, more than the 1048576 pixels an upload accepts (checked before decoding)");
+  upload.max_pixels = std::uint64_t{kSide} * kSide;
+  EXPECT_TRUE(decode_png(png, "big.png", upload));
+}
+
 }  // namespace
 }  // namespace gpubridge

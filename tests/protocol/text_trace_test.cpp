@@ -150,6 +150,21 @@ TEST(TextTrace, BadLinesReportLineAndColumn) {
   }
 }
 
+// A token is shown at most 40 bytes long, control bytes escaped: a 20 MB token used to be echoed
+// whole (and a NUL in it cut the message where it was printed).
+TEST(TextTrace, LongAndBinaryTokensAreShownShortened) {
+  std::string token(1u << 20, '7');
+  token[3] = '\0';
+  token[5] = '\x1b';
+  const auto e = error_of("CLEAR_COLOR " + token);
+  const std::string shown = "777\\07\\x1B" + std::string(34, '7') + "... (1048576 bytes)";
+  EXPECT_EQ(e.rfind("scene.trace:1:13: '" + shown + "' is not a value for CLEAR_COLOR; ", 0), 0u) << e.substr(0, 300);
+  EXPECT_LT(e.size(), 300u);
+  const auto unknown = error_of(std::string(100, 'Q') + " 1");
+  EXPECT_LT(unknown.size(), 200u) << unknown.substr(0, 300);
+  EXPECT_NE(unknown.find("... (100 bytes)"), std::string::npos) << unknown;
+}
+
 TEST(TextTrace, SecondMetaIsAnError) {
   EXPECT_EQ(error_of(".meta {}\n.meta {}\n").rfind("scene.trace:2:1: .meta appears twice", 0), 0u);
 }

@@ -192,6 +192,9 @@ int run_play(const GlobalOptions& g, const ClientOptions& o, const PlayOptions& 
       !r)
     return fail("play", r.error().message);
   std::signal(SIGINT, [](int) { g_interrupted = true; });
+  // Ctrl-C stops at once, even inside a call waiting for the daemon (a full socket, a fence).
+  c->set_interrupt_flag(&g_interrupted);
+  auto stopped = [](const Result<void>& r) { return !r && r.error().code == client::kInterrupted; };
 
   const auto start = Clock::now();
   std::uint64_t frames = 0, swaps = 0, commands = 0, passes = 0;
@@ -206,11 +209,12 @@ int run_play(const GlobalOptions& g, const ClientOptions& o, const PlayOptions& 
         frames += f->size();
         const auto n = count_swaps(f->view());
         swaps += n;
-        if (n && p.fps > 0) {
+        if (r && n && p.fps > 0) {
           // Pace on swaps: the next swap may not happen before swaps/fps seconds after the start.
-          if (auto fr = c->fence(timeout); !fr) return fail("play", fr.error().message);
+          r = c->fence(timeout);
           const auto due = start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(swaps / p.fps));
-          std::this_thread::sleep_until(due);
+          while (r && !g_interrupted && Clock::now() < due)
+            std::this_thread::sleep_for(std::min<Clock::duration>(due - Clock::now(), std::chrono::milliseconds(50)));
         }
       } else if (auto* u = std::get_if<protocol::UploadCmd>(&tc.command)) {
         r = c->upload(u->address, u->data, {}, timeout);
@@ -219,28 +223,37 @@ int run_play(const GlobalOptions& g, const ClientOptions& o, const PlayOptions& 
         r = c->fence(timeout);
       } else if (auto* rr = std::get_if<protocol::ReadRegCmd>(&tc.command)) {
         auto v = c->read_register(rr->index, timeout);
-        if (!v) return fail("play", v.error().message);
-        const auto* desc = protocol::find_register(rr->index);
-        if (pass == 0) reads.push_back({{"register", desc ? std::string(desc->name) : std::to_string(rr->index)}, {"value", *v}});
+        if (v) {
+          const auto* desc = protocol::find_register(rr->index);
+          if (pass == 0)
+            reads.push_back({{"register", desc ? std::string(desc->name) : std::to_string(rr->index)}, {"value", *v}});
+        } else {
+          r = v.error();
+        }
       } else if (auto* rb = std::get_if<protocol::ReadbackCmd>(&tc.command)) {
         auto data = c->readback(rb->address, rb->length, {}, timeout);
-        if (!data) return fail("play", data.error().message);
+        if (!data) r = data.error();
       }
+      if (stopped(r)) break;
       if (!r) return fail("play", r.error().message);
     }
   }
-  if (auto r = c->fence(timeout); !r) return fail("play", r.error().message);
+  // Interrupted: what was sent but not executed yet is dropped (closing the connection without a
+  // fence makes the daemon drop the client's queued work and free the lease).
+  if (!g_interrupted)
+    if (auto r = c->fence(timeout); !r && !stopped(r)) return fail("play", r.error().message);
   const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
-  c->close();
+  const bool interrupted = g_interrupted.load();
+  if (!interrupted) c->close();
   if (g.json) {
     print_json({{"trace", p.trace}, {"passes", passes}, {"commands", commands}, {"register_writes", frames},
-                {"swaps", swaps}, {"seconds", seconds}, {"reads", reads}, {"interrupted", g_interrupted.load()}});
+                {"swaps", swaps}, {"seconds", seconds}, {"reads", reads}, {"interrupted", interrupted}});
   } else {
     for (const auto& rd : reads)
       std::printf("%s = 0x%016llx\n", rd["register"].get<std::string>().c_str(),
                   static_cast<unsigned long long>(rd["value"].get<std::uint64_t>()));
-    std::printf("played %s: %llu register writes, %llu swaps in %.3f s\n", p.trace.c_str(),
-                static_cast<unsigned long long>(frames), static_cast<unsigned long long>(swaps), seconds);
+    std::printf("%s %s: %llu register writes, %llu swaps in %.3f s\n", interrupted ? "stopped (Ctrl-C) after playing" : "played",
+                p.trace.c_str(), static_cast<unsigned long long>(frames), static_cast<unsigned long long>(swaps), seconds);
   }
   return 0;
 }

@@ -1,6 +1,6 @@
 #include "gpubridge/dmc1/palette.hpp"
 
-#include "gpubridge/common/file_read.hpp"
+#include "gpubridge/common/regular_file.hpp"
 
 namespace gpubridge::dmc1 {
 
@@ -35,7 +35,7 @@ std::array<std::uint8_t, Palette::kFileBytes> Palette::to_bytes() const {
 }
 
 Result<Palette> load_palette(const std::filesystem::path& path) {
-  auto data = read_small_file(path, Palette::kFileBytes, "palette");
+  auto data = read_regular_file(path, Palette::kFileBytes, "palette");
   if (!data) return make_error(data.error().message + " (a DMC-1 palette is 768 bytes: R6, G6, B6 per entry)");
   return Palette::from_bytes({reinterpret_cast<const std::uint8_t*>(data->data()), data->size()}, path.string());
 }

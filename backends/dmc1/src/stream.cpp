@@ -4,7 +4,7 @@
 #include <cstdio>
 #include <fstream>
 
-#include "gpubridge/common/file_read.hpp"
+#include "gpubridge/common/regular_file.hpp"
 
 namespace gpubridge::dmc1 {
 namespace {
@@ -195,7 +195,7 @@ std::string format_line_stream(std::span<const std::uint64_t> words) {
 }
 
 Result<LoadedStream> load_stream(const std::filesystem::path& path) {
-  auto data = read_small_file(path, kMaxStreamFileBytes, "DMC-1 stream");
+  auto data = read_regular_file(path, kMaxStreamFileBytes, "DMC-1 stream");
   if (!data) return data.error();
   if (data->starts_with(std::string_view("GBTRACE\0", 8)))
     return make_error(path.string() + ": is a gpubridge binary trace; DMC-1 streams are .dmc1 text or tinygpus .nfo lines");

@@ -9,7 +9,7 @@
 
 #include <zlib.h>
 
-#include "gpubridge/common/file_read.hpp"
+#include "gpubridge/common/regular_file.hpp"
 
 namespace gpubridge::dmc1 {
 namespace {
@@ -82,7 +82,7 @@ TextureBinding TextureMemory::binding(unsigned tid) const {
 }
 
 Result<std::vector<std::uint8_t>> read_texture_image(const std::filesystem::path& path) {
-  auto text = read_small_file(path, TextureMemory::kMaxImageBytes, "texture image");
+  auto text = read_regular_file(path, TextureMemory::kMaxImageBytes, "texture image");
   if (!text) {
     return make_error(text.error().message +
                       " (a DMC-1 texture image is at most 14 MiB: it is mapped at 0x200000 in a 24-bit address space)");

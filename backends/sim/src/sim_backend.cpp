@@ -31,7 +31,20 @@ Result<void> SimBackend::write_frames(protocol::FrameView frames) {
   if (const std::size_t i = protocol::first_read_frame(frames); i < frames.size())
     return make_error("write_frames: frame " + std::to_string(i) + " is a read frame; use read_register",
                       backends::kBadRequest);
-  device_->write(frames);
+  if (!cancel_) {
+    device_->write(frames);
+    return {};
+  }
+  // Executing frame by frame in slices changes nothing on the device; between slices the daemon
+  // can stop a batch that would run for minutes (shutdown, client gone).
+  const std::size_t slice = kCancelCheckFrames * protocol::kFrameBytes;
+  for (std::size_t at = 0; at < frames.bytes.size(); at += slice) {
+    if (cancel_->load(std::memory_order_relaxed))
+      return make_error("write_frames: cancelled after " + std::to_string(at / protocol::kFrameBytes) + " of " +
+                            std::to_string(frames.size()) + " frames",
+                        backends::kCancelled);
+    device_->write(protocol::FrameView{frames.bytes.subspan(at, std::min(slice, frames.bytes.size() - at))});
+  }
   return {};
 }
 

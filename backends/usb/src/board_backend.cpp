@@ -278,6 +278,10 @@ Result<void> BoardBackend::send_frames(std::span<const Frame> frames) {
   std::string last_problem;
   const std::size_t batch_limit = std::max<std::size_t>(kGroupFrames, bridge_->preferred_batch_bytes() / kFrameBytes);
   while (done < frames.size()) {
+    if (cancel_ && cancel_->load(std::memory_order_relaxed))
+      return make_error("board '" + profile_.name + "': write batch cancelled after " + std::to_string(done) + " of " +
+                            std::to_string(frames.size()) + " frames",
+                        backends::kCancelled);
     if (failures > opts_.max_link_retries)
       return make_error("board '" + profile_.name + "': gave up after " + std::to_string(failures) +
                             " failed attempts to deliver a batch (" + last_problem + ")",

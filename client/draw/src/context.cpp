@@ -144,7 +144,8 @@ bool Context::release_texture(Texture& texture) {
 }
 
 Result<Texture> Context::load_texture(const std::filesystem::path& png, const TextureOptions& options) {
-  auto img = load_png(png);
+  // Refused from the PNG's header when larger than any texture (1024 texels per side).
+  auto img = load_png(png, PngLimits{1u << protocol::kMaxTextureLog2, 0, "a texture"});
   if (!img) return img.error();
   auto t = create_texture(*img, options);
   if (!t) return make_error(fmt::format("{}: {}", png.string(), t.error().message));

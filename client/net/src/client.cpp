@@ -14,6 +14,8 @@
 #include <cerrno>
 #include <cstring>
 
+#include "gpubridge/client/daemon_owner.hpp"
+
 namespace gpubridge::client {
 namespace {
 
@@ -57,17 +59,20 @@ Result<int> open_unix(const Address& a, Clock::time_point deadline) {
   std::memcpy(sa.sun_path, a.path.c_str(), a.path.size() + 1);
   const int fd = ::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC | SOCK_NONBLOCK, 0);
   if (fd < 0) return io_error("socket(): " + errno_text(errno));
-  if (::connect(fd, reinterpret_cast<const sockaddr*>(&sa), sizeof sa) != 0) {
+  // A Unix connect completes at once or fails; EAGAIN means the daemon's listen queue is full (it
+  // is busy accepting), not "in progress": the socket is not connected, so try again.
+  while (::connect(fd, reinterpret_cast<const sockaddr*>(&sa), sizeof sa) != 0) {
     const int err = errno;
-    if (err != EINPROGRESS && err != EAGAIN) {
-      ::close(fd);
-      std::string hint = (err == ENOENT || err == ECONNREFUSED) ? "; is gpubridged running?" : "";
-      return io_error("cannot connect to " + where + ": " + errno_text(err) + hint);
+    if (err == EINTR) continue;
+    if (err == EAGAIN && Clock::now() < deadline) {
+      ::usleep(2000);
+      continue;
     }
-    if (auto r = finish_connect(fd, deadline, where); !r) {
-      ::close(fd);
-      return r.error();
-    }
+    ::close(fd);
+    if (err == EAGAIN)
+      return make_error("cannot connect to " + where + ": timed out (the daemon's listen queue stayed full)", kTimeoutError);
+    std::string hint = (err == ENOENT || err == ECONNREFUSED) ? "; is gpubridged running?" : "";
+    return io_error("cannot connect to " + where + ": " + errno_text(err) + hint);
   }
   return fd;
 }
@@ -109,6 +114,8 @@ Result<int> open_tcp(const Address& a, Clock::time_point deadline) {
   return last;
 }
 
+Error interrupted_error() { return make_error("interrupted", kInterrupted); }
+
 Error from_error_msg(const protocol::ErrorMsg& e) {
   return make_error(std::string(protocol::to_string(e.code)) + ": " + e.text,
                     kProtocolErrorBase + static_cast<int>(e.code));
@@ -130,6 +137,8 @@ Client& Client::operator=(Client&& o) noexcept {
     latest_frame_ = std::move(o.latest_frame_);
     events_ = std::move(o.events_);
     async_error_ = std::move(o.async_error_);
+    pongs_ = std::move(o.pongs_);
+    interrupt_ = o.interrupt_;
   }
   return *this;
 }
@@ -143,6 +152,12 @@ Result<Client> Client::connect(std::string_view address, Timeout timeout) {
   const auto deadline = Clock::now() + timeout;
   auto fd = addr->kind == Address::Kind::Unix ? open_unix(*addr, deadline) : open_tcp(*addr, deadline);
   if (!fd) return fd.error();
+  if (addr->kind == Address::Kind::Unix) {
+    if (auto r = check_daemon_owner(*fd, addr->to_string()); !r) {
+      ::close(*fd);
+      return r.error();
+    }
+  }
   Client c;
   c.fd_ = *fd;
   c.address_ = *addr;
@@ -163,9 +178,25 @@ Result<void> Client::send_message(const Message& m, Timeout timeout) {
 }
 
 Result<void> Client::send_raw(std::span<const std::uint8_t> a, std::span<const std::uint8_t> b, Timeout timeout) {
+  if (auto r = send_pongs(timeout); !r) return r;
+  return write_all(a, b, timeout);
+}
+
+Result<void> Client::send_pongs(Timeout timeout) {
+  // Called only between messages: a PONG never lands inside another message on the wire.
+  while (!pongs_.empty()) {
+    const auto bytes = protocol::encode(Message{0, protocol::Pong{std::move(pongs_.front())}});
+    pongs_.erase(pongs_.begin());
+    if (auto r = write_all(bytes, {}, timeout); !r) return r;
+  }
+  return {};
+}
+
+Result<void> Client::write_all(std::span<const std::uint8_t> a, std::span<const std::uint8_t> b, Timeout timeout) {
   if (fd_ < 0) return io_error("not connected");
   const auto deadline = Clock::now() + timeout;
   while (!a.empty() || !b.empty()) {
+    if (interrupted()) return interrupted_error();
     iovec iov[2];
     int n_iov = 0;
     if (!a.empty()) iov[n_iov++] = {const_cast<std::uint8_t*>(a.data()), a.size()};
@@ -256,6 +287,9 @@ Result<void> Client::pump(Clock::time_point deadline, bool block) {
       latest_frame_ = std::move(rf);  // newest wins, like the daemon
     } else if (auto* ev = std::get_if<protocol::DeviceEvent>(&m.payload)) {
       if (events_.size() < 1024) events_.push_back(ev->json);
+    } else if (auto* ping = std::get_if<protocol::Ping>(&m.payload)) {
+      // The daemon's keepalive: answered by the next send_pongs() (never from inside a message).
+      if (pongs_.size() < 16) pongs_.push_back(ping->data);
     } else if (auto* rd = std::get_if<protocol::ReadbackData>(&m.payload)) {
       // The span points into the parser buffer: keep an owning copy.
       readback_chunks_.push_back(ReadbackChunk{m.request_id, rd->last, {rd->data.begin(), rd->data.end()}});
@@ -298,10 +332,12 @@ Result<Message> Client::wait_for(std::uint32_t request_id, MsgType type, Timeout
         return m;
       }
     }
+    if (interrupted()) return interrupted_error();
     if (Clock::now() >= deadline)
       return make_error("timed out waiting for " + std::string(protocol::to_string(type)) + " from " + address_.to_string(),
                         kTimeoutError);
     if (auto r = pump(deadline, true); !r) return r.error();
+    if (auto r = send_pongs(timeout); !r) return r.error();
   }
 }
 
@@ -314,6 +350,10 @@ Result<SessionInfo> Client::handshake(std::string_view name, std::string_view to
   auto reply = wait_for(id, MsgType::Welcome, timeout);
   if (!reply) return reply.error();
   const auto& w = std::get<protocol::Welcome>(reply->payload);
+  if (w.max_payload < protocol::kMinMaxPayload || w.max_payload > protocol::kMaxPayload)
+    return io_error("the daemon at " + address_.to_string() + " announced max_payload " + std::to_string(w.max_payload) +
+                    ", outside the protocol's " + std::to_string(protocol::kMinMaxPayload) + ".." +
+                    std::to_string(protocol::kMaxPayload) + " bytes (docs/protocol.md 17.1); is it a gpubridged?");
   session_ = SessionInfo{w.session_id, w.max_payload, w.json};
   return session_;
 }
@@ -404,8 +444,10 @@ Result<std::vector<std::uint8_t>> Client::readback(std::uint32_t address, std::u
             inbox_.erase(it);
             return err;
           }
+        if (interrupted()) return interrupted_error();
         if (Clock::now() >= deadline) return make_error("timed out waiting for readback data", kTimeoutError);
         if (auto r = pump(deadline, true); !r) return r.error();
+        if (auto r = send_pongs(timeout); !r) return r.error();
         continue;
       }
       ReadbackChunk chunk = std::move(readback_chunks_.front());
@@ -479,8 +521,10 @@ Result<ReceivedFrame> Client::next_frame(Timeout timeout) {
         return err;
       }
     }
+    if (interrupted()) return interrupted_error();
     if (Clock::now() >= deadline) return make_error("no frame from " + address_.to_string() + " within the timeout", kTimeoutError);
     if (auto r = pump(deadline, true); !r) return r.error();
+    if (auto r = send_pongs(timeout); !r) return r.error();
   }
 }
 

@@ -124,6 +124,9 @@ class Parser {
     return {};
   }
 
+  // Textures are at most 1024 texels per side: a larger PNG is refused from its header.
+  static PngLimits texture_png_limits() { return PngLimits{1u << protocol::kMaxTextureLog2, 0, "a texture"}; }
+
   Result<Image> texture_image(const json& j, const std::string& p) {
     const int sources = j.contains("png") + j.contains("png_base64") + j.contains("rgba");
     if (sources != 1) return r_.error(p, "give exactly one of \"png\" (file), \"png_base64\" or \"rgba\" (inline bytes)");
@@ -131,7 +134,7 @@ class Parser {
       auto f = r_.string(j["png"], R::child(p, "png"));
       if (!f) return f.error();
       const std::filesystem::path path = std::filesystem::path(*f).is_absolute() ? std::filesystem::path(*f) : base_ / *f;
-      auto img = load_png(path);
+      auto img = load_png(path, texture_png_limits());
       if (!img) return r_.error(R::child(p, "png"), img.error().message);
       return img;
     }
@@ -140,7 +143,7 @@ class Parser {
       if (!t) return t.error();
       auto bytes = decode_base64(*t);
       if (!bytes) return r_.error(R::child(p, "png_base64"), "not valid base64");
-      auto img = decode_png(*bytes, "inline PNG");
+      auto img = decode_png(*bytes, "inline PNG", texture_png_limits());
       if (!img) return r_.error(R::child(p, "png_base64"), img.error().message);
       return img;
     }

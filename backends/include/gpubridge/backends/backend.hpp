@@ -2,6 +2,7 @@
 // The one interface every device sits behind: the simulator (default, sigrok-`demo` style) and
 // real boards reached through USB-SPI bridges. The daemon, the CLI's `render` and the tests only
 // talk to this interface.
+#include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <functional>
@@ -48,6 +49,7 @@ enum BackendError : int {
   kDeviceTimeout = 101,   // bridge or flow-control timeout; device state unknown
   kDeviceProtocol = 102,  // bad response (not configured, stuck MISO, link CRC failure after retries)
   kBadRequest = 103,      // caller error (address out of range, read frame in a write batch, ...)
+  kCancelled = 104,       // stopped early because the cancel flag was set (set_cancel_flag)
 };
 
 class Backend {
@@ -69,6 +71,10 @@ class Backend {
   virtual Result<void> reset() = 0;
   // Called for every scanned-out frame, on the thread that caused the swap.
   virtual void set_scanout_callback(ScanoutCallback cb) = 0;
+  // A long write_frames may stop between frames once *flag is true (the daemon is stopping, or the
+  // client whose batch it is went away) and then returns kCancelled; the frames before that point
+  // have executed. The flag outlives the backend. Default: never checked (the batch runs to its end).
+  virtual void set_cancel_flag(const std::atomic<bool>* flag) { (void)flag; }
 };
 
 }  // namespace gpubridge::backends

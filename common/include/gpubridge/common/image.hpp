@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "gpubridge/common/result.hpp"
@@ -21,8 +22,17 @@ struct Image {
 
 inline constexpr unsigned kMaxImageDim = 16384;  // refuse larger PNGs before allocating
 
-Result<Image> load_png(const std::filesystem::path& path);
-Result<Image> decode_png(std::span<const std::uint8_t> bytes, const std::string& name_for_errors);
+// What a caller accepts, checked against the PNG's header before any pixel is decoded (a 1 MB
+// PNG can claim 1 GiB of pixels).
+struct PngLimits {
+  unsigned max_side = kMaxImageDim;  // pixels per side
+  std::uint64_t max_pixels = 0;      // width x height; 0: only max_side applies
+  std::string purpose;               // what the limit is for, in the error ("a texture", "an upload")
+};
+
+Result<Image> load_png(const std::filesystem::path& path, const PngLimits& limits = {});
+Result<Image> decode_png(std::span<const std::uint8_t> bytes, const std::string& name_for_errors,
+                         const PngLimits& limits = {});
 Result<void> save_png(const std::filesystem::path& path, const Image& img);
 Result<std::vector<std::uint8_t>> encode_png(const Image& img);
 

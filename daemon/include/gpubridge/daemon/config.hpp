@@ -14,15 +14,18 @@ namespace gpubridge::daemon {
 
 struct Limits {
   std::uint32_t max_message_bytes = 16u << 20;  // largest accepted message payload (≤ protocol::kMaxPayload)
-  unsigned max_clients = 64;                    // connections beyond this get SERVER_FULL
+  unsigned max_clients = 64;                    // handshaken sessions beyond this get SERVER_FULL at HELLO
+  unsigned max_pending_handshakes = 16;         // per transport: connections waiting for HELLO (oldest gives way)
   unsigned handshake_timeout_ms = 10000;        // HELLO must arrive within this
-  unsigned idle_timeout_ms = 300000;            // no bytes at all (subscribers exempt); 0 = off
+  unsigned idle_timeout_ms = 300000;            // no bytes at all (subscribers: no answer to a keepalive); 0 = off
   unsigned trickle_window_ms = 5000;            // an unfinished message must grow by ...
   unsigned min_bytes_per_sec = 256;             // ... at least this rate over each window
-  std::uint64_t queue_bytes = 64ull << 20;      // outgoing bytes queued per session before reading pauses
+  std::uint64_t queue_bytes = 8ull << 20;       // replies queued per session before reading and dispatching pause
 };
 
 inline constexpr unsigned kMaxReattachIntervalMs = 3600000;  // one hour
+inline constexpr std::uint64_t kMaxConfigFileBytes = 1u << 20;
+inline constexpr std::uint64_t kMaxTokenFileBytes = 4096;
 
 struct DaemonConfig {
   std::vector<std::string> listen;  // "unix:PATH" | "tcp:HOST:PORT"; empty = the default Unix socket

@@ -43,6 +43,7 @@ class MirrorBackend final : public backends::Backend {
   Result<void> flush() override;
   Result<void> reset() override;
   void set_scanout_callback(backends::ScanoutCallback cb) override;
+  void set_cancel_flag(const std::atomic<bool>* flag) override;  // both sides
 
   MirrorCounters counters() const;  // safe from any thread (STATUS reads it on the network thread)
   backends::Backend& board() { return *board_; }

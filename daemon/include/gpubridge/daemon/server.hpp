@@ -1,8 +1,11 @@
 #pragma once
-// Server: the listening sockets. Unix sockets live in a private directory (0700 when the daemon
-// creates it), are created 0600 and are guarded by a lock file (flock) so two daemons never
-// serve the same path; a stale socket is removed only while holding the lock. TCP listeners
-// set TCP_NODELAY on every connection. Over the connection cap a client gets SERVER_FULL.
+// Server: the listening sockets. A Unix socket lives in a directory no other user can write to
+// (socket_dir.hpp: the default runtime directory must be ours and 0700), is created 0600 and is
+// guarded by a lock file (flock, never through a symlink) held until the process ends, so two
+// daemons never serve the same path; a stale socket is removed only while holding the lock. TCP
+// listeners set TCP_NODELAY and keepalive on every connection. Admission (docs/daemon.md
+// "Limits"): connections still waiting for their HELLO have a budget per transport in which the
+// oldest gives way to a new one; the cap on clients applies at HELLO (Hub::may_handshake).
 #include <memory>
 #include <string>
 #include <vector>
@@ -24,7 +27,10 @@ class Server {
 
   // Binds and starts accepting. Returns the bound address (TCP port 0 is resolved).
   Result<client::Address> listen(const client::Address& address);
-  // Stops accepting, removes socket and lock files. Idempotent.
+  // Stops accepting; the socket and lock files stay until stop() (shutdown: nothing can connect,
+  // and no second daemon can start on the path while this one still runs). Idempotent.
+  void stop_accepting();
+  // Stops accepting, removes socket and lock files and releases the lock. Idempotent.
   void stop();
   std::size_t refused() const { return refused_; }
 
@@ -41,6 +47,7 @@ class Server {
   std::vector<std::unique_ptr<UnixListener>> unix_;
   std::vector<std::unique_ptr<TcpListener>> tcp_;
   std::size_t refused_ = 0;
+  bool accepting_ = true;
   bool stopped_ = false;
 };
 

@@ -1,14 +1,18 @@
 #pragma once
-// Session: one client connection. Reads bytes, feeds the MessageParser, dispatches messages,
-// and enforces the per-session limits (handshake deadline, idle and trickle timeouts, message
-// size, outgoing queue). Socket reads land directly in the parser's buffer. Device work pauses
-// reading until it completes, so a WRITE_FRAMES batch is handed to the backend as a FrameView
-// into that buffer (no per-write copy) and a client can never queue unbounded work.
-// Subscribers hold at most one pending frame (newest wins).
+// Session: one client connection, shaped like the Asio/Beast examples' connection: it reads bytes
+// straight into the MessageParser's buffer, hands each message to its RequestHandler, writes
+// replies (OutgoingQueue) and frames (FrameSubscription), and enforces the per-connection limits
+// (docs/daemon.md "Limits"): handshake deadline, idle and trickle timeouts, keepalive of idle
+// subscribers, a client that stops reading, the outgoing byte bound, a peer that went away while
+// its request runs. One thread (the network executor) runs everything of a session.
+//
+// Input stops while the handler has a message "live" (device work or a lease wait: pause/resume),
+// so a WRITE_FRAMES batch is handed to the device as a view into the parser's buffer and a client
+// can never queue unbounded work; it also stops while the outgoing queue is over its bound, per
+// message, and a burst of small messages yields the thread to other sessions every few dozen.
 #include <chrono>
 #include <cstdint>
-#include <deque>
-#include <fstream>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -16,7 +20,11 @@
 #include <utility>  // before Asio: Boost 1.74's awaitable.hpp uses std::exchange without it
 #include <boost/asio.hpp>
 
+#include "gpubridge/daemon/device_worker.hpp"
+#include "gpubridge/daemon/frame_subscription.hpp"
 #include "gpubridge/daemon/hub.hpp"
+#include "gpubridge/daemon/outgoing_queue.hpp"
+#include "gpubridge/daemon/request_handler.hpp"
 #include "gpubridge/daemon/stream.hpp"
 #include "gpubridge/protocol/messages.hpp"
 
@@ -25,98 +33,102 @@ namespace gpubridge::daemon {
 class Session : public std::enable_shared_from_this<Session> {
  public:
   using Clock = std::chrono::steady_clock;
-  using Buffer = std::shared_ptr<const std::vector<std::uint8_t>>;
+  using Buffer = OutgoingQueue::Buffer;
 
   Session(Hub& hub, std::unique_ptr<Stream> stream, boost::asio::any_io_executor executor);
   ~Session();
   void start();
 
-  // Sends ERROR(code, text) and closes once it is flushed (or after a short grace period).
-  void fail(protocol::ErrorCode code, const std::string& text, std::uint32_t ref = 0);
-  void offer_frame(FrameFanout& frame);
-  void on_lease_granted();
+  // --- to the client ---
+  void reply(std::uint32_t request_id, protocol::Payload payload);
+  void reply_error(std::uint32_t ref, protocol::ErrorCode code, const std::string& text);
+  // Sends ERROR(code, text) and closes once it is flushed (or after a short grace period). `quiet`:
+  // no log line of its own (the caller logs through a rate limiter).
+  void fail(protocol::ErrorCode code, const std::string& text, std::uint32_t ref = 0, bool quiet = false);
+  void close_after_flush();  // BYE: no more input; closes once everything queued is written
   void send_event(const std::string& json) { reply(0, protocol::DeviceEvent{json}); }
+  void offer_frame(std::shared_ptr<FrameFanout> swap);
 
+  // --- for the handler ---
+  // The current message stays live (device work, lease wait): nothing else is read or parsed.
+  void pause();
+  void resume();
+  // Runs `then` once `bytes` more fit in the outgoing queue (a streamed reply's next step).
+  void when_room(std::uint64_t bytes, std::function<void()> then);
+  // HELLO accepted: post-handshake limits (message size, read size) apply from now on.
+  void handshake_done(const std::string& name);
+  const std::shared_ptr<DeviceWorker::CancelFlag>& cancel_flag() const { return cancel_; }
+  FrameSubscription& subscription() { return subscription_; }
+  RequestHandler& handler() { return handler_; }
+  const OutgoingQueue& outgoing() const { return out_; }
+  void on_lease_granted();
+
+  // --- for the hub and status ---
   std::uint32_t id() const { return id_; }
   const std::string& name() const { return name_; }
   std::string transport() const { return stream_->transport(); }
   std::string peer() const { return stream_->peer(); }
   bool handshaken() const { return handshaken_; }
-  bool subscribed() const { return subscribed_; }
-  protocol::FrameSource frame_source() const { return frame_source_; }
+  bool closed() const { return closing_ || terminated_; }
+  bool subscribed() const { return subscription_.active(); }
+  protocol::FrameSource frame_source() const { return subscription_.source(); }
   std::uint64_t bytes_in() const { return bytes_in_; }
 
  private:
   void do_read();
   void on_read(const boost::system::error_code& ec, std::size_t n);
   void process();  // dispatches parsed messages until it needs bytes or must wait
-  void dispatch(protocol::Message& m);
-  void handle_hello(const protocol::Message& m);
-  void handle_write_frames(const protocol::Message& m);
-  void handle_read_reg(const protocol::Message& m);
-  void handle_upload(const protocol::Message& m);
-  void handle_readback(const protocol::Message& m);
-  void handle_fence(const protocol::Message& m);
-  void handle_lease_acquire(const protocol::Message& m);
-  bool require_lease(const protocol::Message& m);
-  void record(const protocol::Message& m);
-  void resume();  // device work or lease wait finished: continue with the next message
-
-  void reply(std::uint32_t request_id, protocol::Payload payload);
-  void reply_error(std::uint32_t ref, protocol::ErrorCode code, const std::string& text);
   void send(Buffer bytes);
   void do_write();
   void on_write(const boost::system::error_code& ec);
-  void terminate(const char* why);  // closes the stream now and leaves the hub
+  void arm_frame_timer(Clock::time_point due);
+  void terminate(const char* why);  // closes the stream now, cancels device work, leaves the hub
 
   void arm_tick();
   void on_tick();
+  void check_peer(Clock::time_point now);  // while a request is live: has the client gone?
 
   Hub& hub_;
   std::unique_ptr<Stream> stream_;
   boost::asio::steady_timer tick_;
-  boost::asio::steady_timer frame_timer_;  // releases a rate-limited frame when its interval ends
-  protocol::MessageParser parser_;  // socket reads land directly in its buffer
-  std::size_t read_bytes_ = 0;      // largest read: a page before the handshake, 1 MiB after
+  boost::asio::steady_timer frame_timer_;  // sends a rate-limited frame when its interval ends
+  protocol::MessageParser parser_;         // socket reads land directly in its buffer
+  RequestHandler handler_;
+  std::shared_ptr<DeviceWorker::CancelFlag> cancel_ = std::make_shared<DeviceWorker::CancelFlag>(false);
+  std::size_t read_bytes_ = 0;  // largest read: a page before the handshake, 1 MiB after
 
   std::uint32_t id_ = 0;
   std::string name_;
   bool handshaken_ = false;
-  bool reading_ = false;       // an async read is outstanding
-  bool paused_ = false;        // waiting for the device or the lease; the current message is live
-  bool waiting_lease_ = false;
-  std::uint32_t lease_request_id_ = 0;
-  bool closing_ = false;       // no more input is processed; closing after the output flushes
+  bool reading_ = false;     // an async read is outstanding
+  bool paused_ = false;      // the handler has a live message (device work, lease wait)
+  bool blocked_ = false;     // input stopped because the outgoing queue is over its bound
+  bool continuing_ = false;  // a turn of process() was posted to let other sessions run
+  bool closing_ = false;     // no more input is processed; closing after the output flushes
   bool terminated_ = false;
 
-  // Outgoing: queued replies (byte-capped; reading pauses above the cap) and one frame slot.
-  std::deque<Buffer> queue_;
-  std::uint64_t queued_bytes_ = 0;
-  Buffer pending_frame_;
+  // Outgoing: replies and events (bounded), frames (one pending swap), the write in flight.
+  OutgoingQueue out_;
+  FrameSubscription subscription_;
   std::vector<Buffer> in_flight_;
-  std::uint64_t in_flight_queue_bytes_ = 0;  // the part of in_flight_ counted in queued_bytes_
+  std::size_t in_flight_queued_ = 0;  // the part of in_flight_ counted in out_
   bool writing_ = false;
-
-  bool subscribed_ = false;
-  protocol::FrameFormat frame_format_ = protocol::FrameFormat::Native;
-  protocol::FrameSource frame_source_ = protocol::FrameSource::Board;
-  std::uint16_t max_fps_ = 0;
-  Clock::time_point last_frame_sent_{};
-  Buffer held_frame_;  // newest frame that arrived too early for max_fps; sent when the interval ends
+  Clock::time_point write_started_{};
   bool frame_timer_armed_ = false;
+  std::uint64_t room_wanted_ = 0;
+  std::function<void()> on_room_;
 
   // Timeouts.
+  Clock::time_point next_tick_{};
   Clock::time_point accepted_at_ = Clock::now();
   Clock::time_point last_rx_ = Clock::now();
   Clock::time_point close_deadline_{};
   Clock::time_point window_start_ = Clock::now();
   std::uint64_t window_bytes_ = 0;
   bool partial_at_window_start_ = false;
+  bool keepalive_sent_ = false;  // a PING went out since the client last sent anything
+  bool probed_ = false;          // a half-closed TCP peer was sent a probe during the live request
   std::uint64_t bytes_in_ = 0;
-
-  std::unique_ptr<std::ofstream> recording_;
-  std::uint64_t records_ = 0;
-  Clock::time_point record_start_{};
 };
 
 }  // namespace gpubridge::daemon

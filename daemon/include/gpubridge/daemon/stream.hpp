@@ -1,6 +1,8 @@
 #pragma once
 // The byte stream a Session talks over. AsioStream wraps a real socket (Unix or TCP); tests and
 // the fuzzer use an in-memory implementation, so the same session dispatch runs everywhere.
+#include <poll.h>
+
 #include <functional>
 #include <string>
 #include <vector>
@@ -19,6 +21,11 @@ class Stream {
   // Writes every byte of bufs (like asio::async_write).
   virtual void async_write(const std::vector<boost::asio::const_buffer>& bufs, Handler handler) = 0;
   virtual void close() = 0;
+  // Whether the client is still there, without reading: Gone when its socket is closed or reset,
+  // HalfClosed when it shut down its sending side (a closed TCP peer also looks like this until
+  // something is sent to it). The session asks while it does not read (a request is live).
+  enum class PeerState { Open, HalfClosed, Gone };
+  virtual PeerState peer_state() const { return PeerState::Open; }
   virtual std::string transport() const = 0;  // "unix" | "tcp" | "memory"
   virtual std::string peer() const = 0;       // for logs and status
 };
@@ -38,6 +45,14 @@ class AsioStream final : public Stream {
     boost::system::error_code ignored;
     socket_.shutdown(Socket::shutdown_both, ignored);
     socket_.close(ignored);
+  }
+  PeerState peer_state() const override {
+    // POLLRDHUP is set once the peer's FIN arrived, whatever unread data precedes it; POLLHUP or
+    // POLLERR once both directions are down (a closed Unix peer, a reset TCP connection).
+    pollfd p{const_cast<Socket&>(socket_).native_handle(), POLLRDHUP, 0};
+    if (p.fd < 0 || ::poll(&p, 1, 0) <= 0) return PeerState::Open;
+    if (p.revents & (POLLHUP | POLLERR | POLLNVAL)) return PeerState::Gone;
+    return (p.revents & POLLRDHUP) ? PeerState::HalfClosed : PeerState::Open;
   }
   std::string transport() const override { return transport_; }
   std::string peer() const override { return peer_; }

@@ -23,6 +23,7 @@ inline constexpr std::uint8_t kMagic1 = 'B';
 inline constexpr std::uint8_t kSocketVersion = 1;
 inline constexpr std::size_t kHeaderBytes = 12;
 inline constexpr std::uint32_t kMaxPayload = 16u << 20;        // hard ceiling (16 MiB)
+inline constexpr std::uint32_t kMinMaxPayload = 4096;          // the smallest max_payload a server may announce
 inline constexpr std::uint32_t kMaxReadbackChunk = 64u << 10;  // READBACK_DATA payload data ≤ 64 KiB
 inline constexpr std::size_t kMaxNameBytes = 64;
 inline constexpr std::size_t kMaxTokenBytes = 128;

@@ -23,12 +23,16 @@ class SimBackend final : public backends::Backend {
   Result<void> flush() override;
   Result<void> reset() override;
   void set_scanout_callback(backends::ScanoutCallback cb) override;
+  // Checked every kCancelCheckFrames frames of a write batch.
+  void set_cancel_flag(const std::atomic<bool>* flag) override { cancel_ = flag; }
+  static constexpr std::size_t kCancelCheckFrames = 64;
 
   Device& device() { return *device_; }
 
  private:
   explicit SimBackend(std::unique_ptr<Device> device) : device_(std::move(device)) {}
   std::unique_ptr<Device> device_;
+  const std::atomic<bool>* cancel_ = nullptr;
 };
 
 }  // namespace gpubridge::sim

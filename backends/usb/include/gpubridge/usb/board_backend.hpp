@@ -43,6 +43,8 @@ class BoardBackend final : public backends::Backend {
   Result<void> flush() override;
   Result<void> reset() override;
   void set_scanout_callback(backends::ScanoutCallback cb) override;
+  // Checked between the SPI transfers of a write batch.
+  void set_cancel_flag(const std::atomic<bool>* flag) override { cancel_ = flag; }
 
   SpiBridge& bridge() { return *bridge_; }
   const BoardProfile& profile() const { return profile_; }
@@ -76,6 +78,7 @@ class BoardBackend final : public backends::Backend {
   BoardOptions opts_;
   mutable std::mutex mu_;
   backends::ScanoutCallback scanout_cb_;
+  const std::atomic<bool>* cancel_ = nullptr;
   std::uint64_t id_ = 0, caps_ = 0;
   unsigned fifo_depth_ = 0;
   std::uint32_t vram_bytes_ = 0;

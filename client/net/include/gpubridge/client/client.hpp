@@ -6,6 +6,7 @@
 // Errors: protocol ERROR replies become Error{code = 1000 + ErrorCode, message = "<CODE>: text"}.
 // WRITE_FRAMES is fire-and-forget: a failure the daemon reports for it is kept and returned by
 // the next fence() (or any later call that waits for a reply).
+#include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <deque>
@@ -28,6 +29,7 @@ inline constexpr Timeout kDefaultTimeout{10000};
 inline constexpr int kProtocolErrorBase = 1000;  // Error::code = kProtocolErrorBase + ErrorCode
 inline constexpr int kTimeoutError = 2;          // Error::code of a client-side timeout
 inline constexpr int kConnectionError = 3;       // socket closed / I/O error
+inline constexpr int kInterrupted = 4;           // the interrupt flag was set (set_interrupt_flag)
 
 struct SessionInfo {
   std::uint32_t session_id = 0;
@@ -55,6 +57,7 @@ class Client {
   ~Client();
 
   // Connects (no handshake yet). address: "unix:PATH" | "tcp:HOST:PORT" | "" (the default socket).
+  // On a Unix socket the daemon must run as this user or root (daemon_owner.hpp).
   static Result<Client> connect(std::string_view address, Timeout timeout = kDefaultTimeout);
 
   Result<SessionInfo> handshake(std::string_view name, std::string_view token = {}, Timeout timeout = kDefaultTimeout);
@@ -91,11 +94,21 @@ class Client {
   // Says BYE and closes. The destructor closes without BYE.
   void close();
   int native_handle() const { return fd_; }
+  // A flag the program sets from its SIGINT handler: every call that waits returns an error with
+  // code kInterrupted soon after it is set, instead of waiting out its timeout.
+  void set_interrupt_flag(const std::atomic<bool>* flag) { interrupt_ = flag; }
+
+  // The daemon's keepalive PINGs (sent to subscribers that have been silent for a while) are
+  // answered with PONG while the client reads, between messages it sends.
 
  private:
   Client() = default;
   Result<void> send_message(const protocol::Message& m, Timeout timeout);
+  // One message (split in two spans), after any PONGs owed to the daemon.
   Result<void> send_raw(std::span<const std::uint8_t> a, std::span<const std::uint8_t> b, Timeout timeout);
+  Result<void> write_all(std::span<const std::uint8_t> a, std::span<const std::uint8_t> b, Timeout timeout);
+  Result<void> send_pongs(Timeout timeout);
+  bool interrupted() const { return interrupt_ && interrupt_->load(); }
   // Reads until a message for which `want` returns true arrives (ERROR replies with a matching
   // ref end the wait with an error). Frames and events are stored on the way.
   Result<protocol::Message> wait_for(std::uint32_t request_id, protocol::MsgType type, Timeout timeout);
@@ -122,6 +135,8 @@ class Client {
   std::optional<ReceivedFrame> latest_frame_;
   std::vector<std::string> events_;
   std::optional<Error> async_error_;  // first unanswered ERROR (e.g. for a WRITE_FRAMES)
+  std::vector<std::vector<std::uint8_t>> pongs_;  // owed for the daemon's PINGs, sent between messages
+  const std::atomic<bool>* interrupt_ = nullptr;
 };
 
 // Accumulates register writes and flushes them as large WRITE_FRAMES messages.

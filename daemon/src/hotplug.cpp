@@ -1,10 +1,10 @@
-// Board hot-plug (issue 4): notice an unplugged board, switch to the fallback (Hub::on_device_gone)
-// and pick the board up again when it reappears.
+// Board hot-plug (issue 4): notice an unplugged board, switch to the fallback (on_device_gone) and
+// pick the board up again when it reappears.
 //
 // One steady timer on the network executor drives everything; each expiry posts one step to the
 // device executor and re-arms only after that step finished, so at most one probe or attempt is
 // in flight and the network thread never waits for USB. A libusb hot-plug notification
-// (hotplug_event) re-arms the timer to expire at once, or, while a step runs, makes that step
+// (event()) re-arms the timer to expire at once, or, while a step runs, makes that step
 // re-arm it at once, so an event is never lost and never starts a second step:
 // - attached board: a presence probe (ID register read). An unplug is thereby noticed even when no
 //   client is sending commands; a probe that finds NO_DEVICE takes the normal device-gone path.
@@ -19,86 +19,100 @@
 // survives either way. Waiting for the lease to be released could postpone the board forever. The
 // holder keeps its lease and learns from the device_back event ("state": "reset") that it must
 // redraw; any other client sees the same event.
+#include "gpubridge/daemon/hotplug.hpp"
+
 #include <utility>
 
 #include "gpubridge/common/log.hpp"
-#include "gpubridge/daemon/hub.hpp"
 
 namespace gpubridge::daemon {
 
-void Hub::enable_hotplug(BackendFactory reattach, std::chrono::milliseconds interval) {
+Hotplug::Hotplug(Executor net, Executor device, DeviceWorker& worker, BackendFactory fallback, Hooks hooks)
+    : net_(std::move(net)), device_(std::move(device)), worker_(worker), fallback_(std::move(fallback)),
+      hooks_(std::move(hooks)) {}
+
+void Hotplug::enable(BackendFactory reattach, std::chrono::milliseconds interval, bool serving_board) {
   reattach_ = std::move(reattach);
-  hotplug_interval_ = interval;
+  interval_ = interval;
   if (!reattach_ || interval.count() <= 0) return;
   // A re-attach factory exists only for board configurations; serving anything but a board now
   // means `auto` found none at start and fell back to the simulator. Set before the loops run,
   // so the device thread sees it through the post below.
-  awaiting_first_board_ = info_.backend != "board";
-  first_board_pending_ = awaiting_first_board_;
-  attached_ = !awaiting_first_board_;
-  boost::asio::post(net_, [this] { arm_hotplug_timer(hotplug_interval_); });
+  awaiting_first_ = !serving_board;
+  first_board_pending_ = awaiting_first_;
+  attached_ = !awaiting_first_;
+  boost::asio::post(net_, [this] { arm(interval_); });
 }
 
-void Hub::stop_hotplug() {
-  hotplug_stopped_ = true;
-  hotplug_timer_.cancel();
+void Hotplug::stop() {
+  stopped_ = true;
+  timer_.cancel();
 }
 
-void Hub::arm_hotplug_timer(std::chrono::milliseconds delay) {
-  if (hotplug_stopped_) return;
+void Hotplug::arm(std::chrono::milliseconds delay) {
+  if (stopped_) return;
   // Re-arming cancels the pending wait, but its handler may already be queued with success: the
   // generation tells it that it was superseded.
-  const std::uint64_t generation = ++hotplug_timer_generation_;
-  hotplug_timer_.expires_after(delay);
-  hotplug_timer_.async_wait([this, generation](const boost::system::error_code& ec) {
-    if (ec || hotplug_stopped_ || generation != hotplug_timer_generation_) return;
-    hotplug_step_running_ = true;
+  const std::uint64_t generation = ++generation_;
+  timer_.expires_after(delay);
+  timer_.async_wait([this, generation](const boost::system::error_code& ec) {
+    if (ec || stopped_ || generation != generation_) return;
+    step_running_ = true;
     boost::asio::post(device_, [this] {
-      hotplug_tick();
+      if (!worker_.stopping()) step();
       boost::asio::post(net_, [this] {
-        hotplug_step_running_ = false;
-        arm_hotplug_timer(std::exchange(hotplug_poke_, false) ? std::chrono::milliseconds(0) : hotplug_interval_);
+        step_running_ = false;
+        arm(std::exchange(poke_, false) ? std::chrono::milliseconds(0) : interval_);
       });
     });
   });
 }
 
-void Hub::hotplug_event() {
+void Hotplug::event() {
   boost::asio::post(net_, [this] {
-    ++hotplug_events_;
-    if (hotplug_stopped_ || !reattach_ || hotplug_interval_.count() <= 0) return;
-    if (hotplug_step_running_)
-      hotplug_poke_ = true;  // that step re-arms at once when it is done
+    ++events_;
+    if (stopped_ || !reattach_ || interval_.count() <= 0) return;
+    if (step_running_)
+      poke_ = true;  // that step re-arms at once when it is done
     else
-      arm_hotplug_timer(std::chrono::milliseconds(0));
+      arm(std::chrono::milliseconds(0));
   });
 }
 
-void Hub::install_backend(std::unique_ptr<backends::Backend> backend) {
-  if (backend_) backend_->set_scanout_callback({});
-  std::unique_ptr<backends::Backend> old;
-  {
-    // STATUS reads the mirror's counters from the network thread: swap under the lock and keep
-    // what the outgoing mirror counted, so the totals survive an unplug.
-    std::lock_guard lock(backend_swap_mu_);
-    if (const auto* mirror = dynamic_cast<const MirrorBackend*>(backend_.get()))
-      retired_mirror_counters_ += mirror->counters();
-    old = std::exchange(backend_, std::move(backend));
+void Hotplug::on_device_gone(const Error& e) {
+  // Reported once per disappearance: without a fallback the dead board stays in place and every
+  // later command fails with DEVICE_GONE too (each caller gets that in its error reply).
+  if (lost_) return;
+  lost_ = true;
+  logger("daemon")->error("device gone: {}", e.message);
+  nlohmann::json event{{"event", "device_gone"}, {"message", e.message}};
+  if (fallback_) {
+    if (auto sim = fallback_(); sim) {
+      worker_.install(std::move(*sim));
+      const auto info = worker_.backend().info();
+      event["fallback"] = info.backend;
+      boost::asio::post(net_, [this, info] { hooks_.backend_changed(info); });
+    }
   }
-  old.reset();  // closing a board may take a while: outside the lock
-  backend_->set_scanout_callback([this](std::shared_ptr<const backends::ScanoutFrame> f) { on_scanout(std::move(f)); });
+  if (reattach_ && interval_.count() > 0) event["reattach_interval_ms"] = interval_.count();
+  boost::asio::post(net_, [this, event] {
+    ++detaches_;
+    attached_ = false;
+    hooks_.broadcast(event);
+  });
 }
 
-void Hub::hotplug_tick() {
+void Hotplug::step() {
   auto log = logger("daemon");
-  if (!device_lost_ && !awaiting_first_board_) {
-    // Only boards can vanish (a fallback simulator is only ever in place while device_lost_).
-    if (backend_->info().backend != "board") return;
-    auto r = backend_->read_register(protocol::index_of(protocol::Reg::ID));
+  if (!lost_ && !awaiting_first_) {
+    // Only boards can vanish (a fallback simulator is only ever in place while lost_).
+    auto& backend = worker_.backend();
+    if (backend.info().backend != "board") return;
+    auto r = backend.read_register(protocol::index_of(protocol::Reg::ID));
     if (!r && r.error().code == backends::kDeviceGone) on_device_gone(r.error());
     return;
   }
-  const bool first = awaiting_first_board_;
+  const bool first = awaiting_first_;
   auto board = reattach_();
   if (!board) {
     log->debug("{}: {}", first ? "auto: still no board" : "re-attach: not back yet", board.error().message);
@@ -111,9 +125,9 @@ void Hub::hotplug_tick() {
     return;
   }
   const auto info = (*board)->info();
-  install_backend(std::move(*board));
-  device_lost_ = false;
-  awaiting_first_board_ = false;
+  worker_.install(std::move(*board));
+  lost_ = false;
+  awaiting_first_ = false;
   if (first)
     log->info("auto: board {} ({}) plugged in; reset, it replaces the simulator", info.board, info.bridge);
   else
@@ -132,17 +146,17 @@ void Hub::hotplug_tick() {
                              {"message", what + ": registers, FIFO and memory are in their power-on/reset state; "
                                                 "the lease holder keeps the lease and should redraw"}};
   boost::asio::post(net_, [this, info, event, first] {
-    info_ = info;
+    hooks_.backend_changed(info);
     if (first) first_board_pending_ = false;
     else ++reattaches_;
     attached_ = true;
-    broadcast_event(event);
+    hooks_.broadcast(event);
   });
 }
 
-nlohmann::json Hub::hotplug_json() const {
-  return {{"enabled", static_cast<bool>(reattach_) && hotplug_interval_.count() > 0},
-          {"interval_ms", hotplug_interval_.count()},
+nlohmann::json Hotplug::status_json() const {
+  return {{"enabled", static_cast<bool>(reattach_) && interval_.count() > 0},
+          {"interval_ms", interval_.count()},
           {"attached", attached_},
           // `auto` started on the simulator and no board was plugged in yet (attached is false, but
           // nothing was ever detached).
@@ -151,8 +165,8 @@ nlohmann::json Hub::hotplug_json() const {
           {"reattaches", reattaches_},
           // libusb hot-plug notifications: whether they arrive, and how many did (plugs and unplugs
           // of the boards' USB ids, whether or not they changed anything).
-          {"usb_notifications", hotplug_notifications_},
-          {"usb_events", hotplug_events_}};
+          {"usb_notifications", notifications_},
+          {"usb_events", events_}};
 }
 
 }  // namespace gpubridge::daemon

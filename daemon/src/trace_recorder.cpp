@@ -1,0 +1,39 @@
+#include "gpubridge/daemon/trace_recorder.hpp"
+
+#include <cctype>
+
+#include <nlohmann/json.hpp>
+
+#include "gpubridge/common/json_text.hpp"
+#include "gpubridge/protocol/command_stream.hpp"
+#include "gpubridge/protocol/trace.hpp"
+
+namespace gpubridge::daemon {
+
+Result<std::unique_ptr<TraceRecorder>> TraceRecorder::open(const std::filesystem::path& dir, std::uint32_t session,
+                                                          const std::string& client_name) {
+  std::string safe = client_name;
+  for (char& c : safe)
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_') c = '_';
+  const auto path = dir / ("session-" + std::to_string(session) + (safe.empty() ? "" : "-" + safe) + ".gbtrace");
+  std::unique_ptr<TraceRecorder> r(new TraceRecorder);
+  r->out_.open(path, std::ios::binary | std::ios::trunc);
+  std::vector<std::uint8_t> header;
+  const std::string meta = json_text(nlohmann::json{{"source", "gpubridged"}, {"client", client_name}, {"session", session}});
+  if (!r->out_ || !protocol::append_trace_header(meta, header)) return make_error("cannot record to " + path.string());
+  r->out_.write(reinterpret_cast<const char*>(header.data()), static_cast<std::streamsize>(header.size()));
+  return r;
+}
+
+void TraceRecorder::record(const protocol::Message& m) {
+  auto cmd = protocol::command_from_message(m);
+  if (!cmd) return;
+  const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - start_).count();
+  std::vector<std::uint8_t> bytes;
+  if (!protocol::append_trace_record(protocol::TimedCommand{static_cast<std::uint64_t>(ns), std::move(*cmd)}, ++records_,
+                                     bytes))
+    return;
+  out_.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+}
+
+}  // namespace gpubridge::daemon
