@@ -113,6 +113,9 @@ std::vector<Example> make() {
   all.push_back({"README.md", "Testing", 0, "README_Testing", {
       skip("ctest --test-dir build -L daemon", "runs part of this suite (CTest inside CTest)"),
       skip("scripts/fuzz-smoke.sh 600", "10 minutes per fuzz target, by hand; scripts/test.sh runs the 5-second smoke"),
+      skip("scripts/soak-daemon.sh --minutes 10",
+           "a 10-minute soak, by hand (docs/daemon.md \"Hostile soak\"); each of its scenarios runs in CTest "
+           "daemon_tests (DaemonLimits.*, DaemonIsolation.*, CarelessInput.*)"),
       skip("build/examples/gpubridge-demo goldens --dir examples/golden --write",
            "rewrites the committed goldens; the comparing form runs in docs/examples.md"),
       skip("build/examples/dmc1/gpubridge-dmc1-demo goldens --write",
