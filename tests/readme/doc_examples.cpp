@@ -54,7 +54,7 @@ std::vector<Example> make() {
       run("build/tools/gpubridge screenshot --out next-frame.png")
           .prints(R"(frame #\d+ \(160x120, board\) written to next-frame\.png)")
           .leaves("next-frame.png"),
-      run("build/tools/gpubridge reg read STATUS").prints(R"(STATUS = 0x[0-9a-f]{16})"),
+      run("build/tools/gpubridge reg read CAPS").prints(R"(CAPS = 0x[0-9a-f]{16})"),
       // The global --connect before the command (CLI11 refused it before issue 15).
       run("build/tools/gpubridge --connect unix:$XDG_RUNTIME_DIR/gpubridge/gpubridge.sock status")
           .prints("daemon: +gpubridged .* at " + kDefaultSocket),
