@@ -1,13 +1,34 @@
 #include "gpubridge/draw/client_sink.hpp"
 
+#include <type_traits>
+
 #include <nlohmann/json.hpp>
 
 namespace gpubridge::draw {
 
 ClientSink::ClientSink(client::Client& c) : client_(&c) {
+  device_.vram_bytes = 8u << 20;
   const auto j = nlohmann::json::parse(c.session().device_json, nullptr, false);
-  if (j.is_object() && j.contains("vram_bytes") && j["vram_bytes"].is_number_unsigned() && j["vram_bytes"].get<std::uint64_t>() > 0)
-    vram_ = j["vram_bytes"].get<std::uint64_t>();
+  if (!j.is_object()) return;
+  // Only well-typed values are taken; anything else keeps the default.
+  const auto number = [&](const char* key, auto& field, std::uint64_t lo, std::uint64_t hi) {
+    const auto it = j.find(key);
+    if (it == j.end() || !it->is_number_unsigned()) return;
+    const auto v = it->get<std::uint64_t>();
+    if (v >= lo && v <= hi) field = static_cast<std::remove_reference_t<decltype(field)>>(v);
+  };
+  const auto text = [&](const char* key, std::string& field) {
+    const auto it = j.find(key);
+    if (it != j.end() && it->is_string()) field = it->get<std::string>();
+  };
+  number("vram_bytes", device_.vram_bytes, 1, ~std::uint64_t{0});
+  number("max_width", device_.max_width, 1, protocol::kMaxFramebufferDim);
+  number("max_height", device_.max_height, 1, protocol::kMaxFramebufferDim);
+  number("caps", device_.caps, 0, ~std::uint64_t{0});
+  number("id", device_.id, 0, ~std::uint64_t{0});
+  text("backend", device_.backend);
+  text("board", device_.board);
+  text("bridge", device_.bridge);
 }
 
 Result<std::unique_ptr<ClientSink>> ClientSink::connect(std::string_view address, std::string_view name,

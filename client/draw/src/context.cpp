@@ -39,6 +39,10 @@ Result<Context> Context::create(CommandSink& sink, const ContextOptions& options
   Context c(sink, options);
   auto fb = geometry::fb_format_word(options.width, options.height, options.format);
   if (!fb) return fb.error();
+  // The device would clamp the size and raise ERR_BAD_VALUE (docs/protocol.md, FB_FORMAT).
+  if (const auto d = sink.device(); options.width > d.max_width || options.height > d.max_height)
+    return make_error(fmt::format("framebuffer {}x{} is larger than the device's largest, {}x{}: use a smaller size",
+                                  options.width, options.height, d.max_width, d.max_height));
   const std::uint64_t color_bytes = std::uint64_t{options.width} * options.height * protocol::bytes_per_pixel(options.format);
   for (int i = 0; i < (options.double_buffer ? 2 : 1); ++i) {
     auto a = c.allocate(color_bytes, "colour buffer");

@@ -14,9 +14,9 @@ Result<void> RecordingSink::write_frames(protocol::FrameView frames) {
 
 Result<void> RecordingSink::upload(std::uint32_t address, std::span<const std::uint8_t> bytes) {
   if (bytes.empty()) return {};
-  if (std::uint64_t{address} + bytes.size() > vram_)
+  if (std::uint64_t{address} + bytes.size() > device_.vram_bytes)
     return make_error(fmt::format("upload of {} bytes at 0x{:x} runs past the end of video memory ({} bytes)", bytes.size(),
-                                  address, vram_));
+                                  address, device_.vram_bytes));
   stream_.commands.push_back({0, protocol::UploadCmd{address, {bytes.begin(), bytes.end()}}});
   return {};
 }

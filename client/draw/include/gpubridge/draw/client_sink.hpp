@@ -27,15 +27,16 @@ class ClientSink final : public CommandSink {
     return client_->readback(address, length);
   }
   Result<void> flush() override { return client_->fence(); }
-  // From the daemon's WELCOME device description ("vram_bytes"); 8 MiB if it does not say.
-  std::uint64_t vram_bytes() const override { return vram_; }
+  // From the daemon's WELCOME device description (backend, board, limits, "vram_bytes", "caps",
+  // "id"); what it does not say keeps DeviceInfo's defaults, and 8 MiB of video memory.
+  backends::DeviceInfo device() const override { return device_; }
 
   client::Client& client() { return *client_; }
 
  private:
   std::unique_ptr<client::Client> owned_;
   client::Client* client_;
-  std::uint64_t vram_ = 8u << 20;
+  backends::DeviceInfo device_;
 };
 
 }  // namespace gpubridge::draw

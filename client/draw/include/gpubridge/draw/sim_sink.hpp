@@ -21,7 +21,7 @@ class SimulatorSink final : public CommandSink {
     return backend_->readback(address, length);
   }
   Result<void> flush() override { return backend_->flush(); }
-  std::uint64_t vram_bytes() const override { return backend_->info().vram_bytes; }
+  backends::DeviceInfo device() const override { return backend_->info(); }
 
   // The most recent frame scanned out by a swap (nullptr before the first swap).
   std::shared_ptr<const backends::ScanoutFrame> latest_frame() const { return *latest_; }

@@ -22,8 +22,11 @@ class CommandSink {
   virtual Result<std::vector<std::uint8_t>> readback(std::uint32_t address, std::uint32_t length) = 0;
   // Returns once every earlier command has executed.
   virtual Result<void> flush() = 0;
+  // The device behind the sink: video memory, largest framebuffer and the CAPS register (a
+  // program can fit itself to it, as the examples do).
+  virtual backends::DeviceInfo device() const = 0;
   // Size of the device's video memory (bytes), used to place buffers and textures.
-  virtual std::uint64_t vram_bytes() const = 0;
+  std::uint64_t vram_bytes() const { return device().vram_bytes; }
 };
 
 // Any backends::Backend: the simulator in-process, or a board through a USB-SPI bridge.
@@ -38,28 +41,30 @@ class BackendSink final : public CommandSink {
     return backend_.readback(address, length);
   }
   Result<void> flush() override { return backend_.flush(); }
-  std::uint64_t vram_bytes() const override { return backend_.info().vram_bytes; }
+  backends::DeviceInfo device() const override { return backend_.info(); }
 
  private:
   backends::Backend& backend_;
 };
 
 // Records commands into a CommandStream (nothing executes; readback is an error). Use it to
-// write a trace of a drawing program or to inspect what the API sends.
+// write a trace of a drawing program or to inspect what the API sends. Its device is whatever it
+// is told (CAPS 0: not stated).
 class RecordingSink final : public CommandSink {
  public:
-  explicit RecordingSink(std::uint64_t vram_bytes = 8u << 20) : vram_(vram_bytes) {}
+  explicit RecordingSink(std::uint64_t vram_bytes = 8u << 20) { device_.vram_bytes = vram_bytes; }
+  explicit RecordingSink(const backends::DeviceInfo& device) : device_(device) {}
   Result<void> write_frames(protocol::FrameView frames) override;
   Result<void> upload(std::uint32_t address, std::span<const std::uint8_t> bytes) override;
   Result<std::vector<std::uint8_t>> readback(std::uint32_t address, std::uint32_t length) override;
   Result<void> flush() override { return {}; }
-  std::uint64_t vram_bytes() const override { return vram_; }
+  backends::DeviceInfo device() const override { return device_; }
 
   const protocol::CommandStream& stream() const { return stream_; }
   protocol::CommandStream take() { return std::move(stream_); }
 
  private:
-  std::uint64_t vram_;
+  backends::DeviceInfo device_;
   protocol::CommandStream stream_;
 };
 
