@@ -39,7 +39,8 @@ int run_boards(const GlobalOptions& g, const std::string& dir) {
                        {"cs_pin", p.cs_pin},
                        {"busy_pin", p.busy_pin}}},
                      {"device",
-                      {{"vram_kib", p.vram_kib}, {"max_width", p.max_width}, {"max_height", p.max_height}, {"fifo_depth", p.fifo_depth}}},
+                      {{"vram_kib", p.vram_kib}, {"max_width", p.max_width}, {"max_height", p.max_height}, {"fifo_depth", p.fifo_depth},
+                       {"clock_mhz", p.clock_mhz}}},
                      {"strict_link", p.strict_link}});
     std::puts(json_text(out, 2).c_str());
     return 0;

@@ -201,6 +201,7 @@ Result<BoardProfile> parse_board_profile(std::string_view text, const std::strin
   TRY_SET(p.max_width, d.uint("max_width", 1, protocol::kMaxFramebufferDim));
   TRY_SET(p.max_height, d.uint("max_height", 1, protocol::kMaxFramebufferDim));
   TRY_SET(p.fifo_depth, d.uint("fifo_depth", 33, 1023));
+  TRY_SET(p.clock_mhz, d.uint("clock_mhz", 1, 1000, 50));
   if (auto r = d.no_unknown_keys(); !r) return r.error();
 
   if (const json* link = top.get("link")) {

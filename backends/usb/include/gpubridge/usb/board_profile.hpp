@@ -37,6 +37,7 @@ struct BoardProfile {
   // FPGA design.
   std::uint32_t vram_kib = 0;
   unsigned max_width = 0, max_height = 0, fifo_depth = 0;
+  unsigned clock_mhz = 50;    // core clock of the design, for the timing model (not sent anywhere)
   bool strict_link = true;
   ScanoutMode scanout = ScanoutMode::Readback;
 };
