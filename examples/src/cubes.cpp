@@ -2,6 +2,7 @@
 #include <cmath>
 
 #include "examples_internal.hpp"
+#include "fallbacks.hpp"
 #include "mesh.hpp"
 
 namespace gpubridge::examples {
@@ -53,22 +54,36 @@ class Cubes final : public Example {
     return img;
   }
 
+  Wants wants(std::uint16_t) const override {
+    Wants w;
+    w.textures = {{"label", 32, 32, protocol::PixelFormat::RGBA8888, true}};
+    w.without_depth = "the two cubes one after the other (each convex, back faces culled; they do not overlap)";
+    w.without_feature = {{kBilinear, "the label sampled nearest"},
+                         {kTexturing, "the label baked into the cube's vertex colours every frame"}};
+    return w;
+  }
+
   Result<void> setup(draw::Context& ctx) override {
-    auto t = ctx.create_texture(label(0), {.bilinear = true});
-    if (!t) return t.error();
-    texture_ = *t;
+    texture_ = {};
+    if (config().texturing()) {
+      auto t = ctx.create_texture(config().texture(0).shrink(label(0)), config().texture(0).options());
+      if (!t) return t.error();
+      texture_ = *t;
+    }
     gouraud_ = cube_mesh(true);
     textured_ = cube_mesh(false);
     return {};
   }
 
   Result<void> frame(draw::Context& ctx, unsigned n) override {
-    // The textured cube's label is streamed: a new image every frame, uploaded in place.
-    if (auto r = ctx.update_texture(texture_, label(n)); !r) return r;
-    if (auto r = ctx.clear({0.12, 0.1, 0.16, 1}); !r) return r;
-    if (auto r = ctx.clear_depth(1.0); !r) return r;
-    ctx.state() = {};
-    ctx.state().z_test = ctx.state().z_write = true;
+    // The textured cube's label is streamed: a new image every frame, uploaded in place (baked
+    // into the cube's colours without a texture unit).
+    if (config().texturing()) {
+      if (auto r = ctx.update_texture(texture_, config().texture(0).shrink(label(n))); !r) return r;
+    } else {
+      baked_ = bake_texture(textured_, label(n), 8);
+    }
+    if (auto r = begin_frame(ctx, config(), {0.12, 0.1, 0.16, 1}); !r) return r;
     ctx.set_cull(geometry::CullMode::Back);
     const double t = n * 0.08;
     const auto vp = projection(ctx, 0.8, 0.5, 30) * geometry::look_at({0, 1.2, 7}, {0, 0, 0}, {0, 1, 0});
@@ -76,13 +91,14 @@ class Cubes final : public Example {
     ctx.unbind_texture();
     if (auto r = ctx.draw_indexed(gouraud_.vertices, gouraud_.indices); !r) return r;
     ctx.set_transform(vp * geometry::translate({1.7, 0, 0}) * geometry::rotate_y(-t * 0.8) * geometry::rotate_z(t * 0.5));
+    if (!config().texturing()) return ctx.draw_indexed(baked_.vertices, baked_.indices);
     if (auto r = ctx.bind_texture(texture_); !r) return r;
     return ctx.draw_indexed(textured_.vertices, textured_.indices);
   }
 
  private:
   draw::Texture texture_;
-  Mesh gouraud_, textured_;
+  Mesh gouraud_, textured_, baked_;
 };
 
 }  // namespace

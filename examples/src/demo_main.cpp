@@ -1,5 +1,7 @@
 // gpubridge-demo: the example scenes. Renders them on the in-process simulator to PNG files, or
-// streams them to a running gpubridged, or checks/regenerates their golden images.
+// streams them to a running gpubridged, or checks/regenerates their golden images, or shows how
+// each fits each board profile and what frame rate it would reach there. Every example fits
+// itself to the device it is given (fit.hpp); the choice is printed.
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -8,40 +10,22 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include "demo_fit.hpp"
 #include "gpubridge/common/image.hpp"
+#include "gpubridge/common/json_text.hpp"
 #include "gpubridge/common/log.hpp"
 #include "gpubridge/draw/sim_sink.hpp"
 #include "gpubridge/examples/example.hpp"
 #include "gpubridge/examples/golden.hpp"
 #if GPUBRIDGE_DRAW_HAS_CLIENT
 #include "gpubridge/draw/client_sink.hpp"
-#include "gpubridge/common/json_text.hpp"
 #endif
 
 namespace {
 
 using namespace gpubridge;
+using namespace gpubridge::demo;
 namespace fs = std::filesystem;
-
-int fail(const std::string& msg) {
-  std::fprintf(stderr, "gpubridge-demo: %s\n", msg.c_str());
-  return 1;
-}
-
-Result<std::vector<std::unique_ptr<examples::Example>>> select(const std::vector<std::string>& names) {
-  std::vector<std::unique_ptr<examples::Example>> out;
-  if (names.empty() || (names.size() == 1 && names[0] == "all")) return examples::make_examples();
-  for (const auto& n : names) {
-    auto e = examples::make_example(n);
-    if (!e) {
-      std::string list;
-      for (const auto& k : examples::example_names()) list += " " + k;
-      return make_error("unknown example \"" + n + "\"; the examples are:" + list + " (or all)");
-    }
-    out.push_back(std::move(e));
-  }
-  return out;
-}
 
 int run_list(bool json) {
   nlohmann::json out = nlohmann::json::array();
@@ -56,17 +40,24 @@ int run_list(bool json) {
   return 0;
 }
 
-int run_render(const std::vector<std::string>& names, const std::string& out_dir, unsigned first, unsigned frames,
-               bool json) {
+int run_render(const std::vector<std::string>& names, const FitOptions& fit_options, const std::string& board,
+               const std::string& out_dir, unsigned first, unsigned frames, bool json) {
   auto list = select(names);
   if (!list) return fail(list.error().message);
+  auto request = fit_options.request();
+  if (!request) return fail(request.error().message, 2);
+  auto device = board.empty() ? Result<examples::DeviceCaps>(examples::DeviceCaps{}) : board_device(board);
+  if (!device) return fail(device.error().message, 2);
   std::error_code ec;
   fs::create_directories(out_dir, ec);
   if (ec) return fail(out_dir + ": cannot create the directory: " + ec.message());
   nlohmann::json written = nlohmann::json::array();
   for (auto& ex : *list) {
     const std::string name = ex->info().name;
-    auto sink = draw::SimulatorSink::create();
+    auto fitted = examples::configure(*ex, *device, *request);
+    if (!fitted) return fail(fitted.error().message);
+    if (!json) print_fit(name, *fitted);
+    auto sink = draw::SimulatorSink::create(device->simulator_options());
     if (!sink) return fail(sink.error().message);
     auto ctx = draw::Context::create(**sink, ex->options());
     if (!ctx) return fail(name + ": " + ctx.error().message);
@@ -77,7 +68,7 @@ int run_render(const std::vector<std::string>& names, const std::string& out_dir
       std::snprintf(file, sizeof file, "%s-%04u.png", name.c_str(), n);
       const fs::path path = fs::path(out_dir) / file;
       if (auto s = save_png(path, image_from_device(f->format, f->width, f->height, f->pixels)); !s) return s;
-      written.push_back({{"example", name}, {"frame", n}, {"path", path.string()}, {"crc", f->crc}});
+      written.push_back({{"example", name}, {"frame", n}, {"path", path.string()}, {"crc", f->crc}, {"config", fit_json(*fitted)}});
       if (!json) std::printf("%s\n", path.string().c_str());
       return {};
     });
@@ -87,16 +78,22 @@ int run_render(const std::vector<std::string>& names, const std::string& out_dir
   return 0;
 }
 
-int run_stream(const std::vector<std::string>& names, const std::string& address, unsigned frames, double fps,
-               bool json) {
+int run_stream(const std::vector<std::string>& names, const FitOptions& fit_options, const std::string& address,
+               unsigned frames, double fps, bool json) {
 #if GPUBRIDGE_DRAW_HAS_CLIENT
   auto list = select(names);
   if (!list) return fail(list.error().message);
+  auto request = fit_options.request();
+  if (!request) return fail(request.error().message, 2);
   auto sink = draw::ClientSink::connect(address, "gpubridge-demo");
   if (!sink) return fail("cannot stream to the daemon: " + sink.error().message);
+  const auto device = examples::DeviceCaps::from((*sink)->device());
   nlohmann::json summary = nlohmann::json::array();
   for (auto& ex : *list) {
     const std::string name = ex->info().name;
+    auto fitted = examples::configure(*ex, device, *request);
+    if (!fitted) return fail(fitted.error().message);
+    if (!json) print_fit(name, *fitted);
     auto ctx = draw::Context::create(**sink, ex->options());
     if (!ctx) return fail(name + ": " + ctx.error().message);
     const auto start = std::chrono::steady_clock::now();
@@ -107,47 +104,74 @@ int run_stream(const std::vector<std::string>& names, const std::string& address
     if (!r) return fail(r.error().message);
     if (auto f = ctx->flush(); !f) return fail(name + ": " + f.error().message);
     const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    summary.push_back({{"example", name}, {"frames", frames}, {"seconds", secs}, {"triangles", ctx->stats().emitted}});
+    summary.push_back({{"example", name}, {"frames", frames}, {"seconds", secs}, {"triangles", ctx->stats().emitted},
+                       {"config", fit_json(*fitted)}});
     if (!json) std::printf("%-12s %u frames in %.2f s (%zu triangles sent)\n", name.c_str(), frames, secs, ctx->stats().emitted);
   }
   if (json) std::puts(json_text(summary, 2).c_str());
   return 0;
 #else
-  (void)names, (void)address, (void)frames, (void)fps, (void)json;
+  (void)names, (void)fit_options, (void)address, (void)frames, (void)fps, (void)json;
   return fail("this build has no daemon client library (gpubridge_client); use `render`");
 #endif
 }
 
-int run_goldens(const std::string& dir, bool write, bool json) {
+int run_goldens(const std::string& dir, const std::vector<std::string>& class_names, bool write, bool json) {
+  std::vector<const examples::GoldenClass*> classes;
+  for (const auto& n : class_names) {
+    const auto* c = examples::find_golden_class(n);
+    if (!c) {
+      std::string known;
+      for (const auto& k : examples::golden_classes()) known += " " + k.name;
+      return fail("unknown class \"" + n + "\"; the classes are:" + known, 2);
+    }
+    classes.push_back(c);
+  }
+  if (classes.empty())
+    for (const auto& c : examples::golden_classes()) classes.push_back(&c);
   nlohmann::json report = nlohmann::json::array();
   int failures = 0;
-  for (auto& ex : examples::make_examples()) {
-    const std::string name = ex->info().name;
-    auto img = examples::render_golden_frame(*ex);
-    if (!img) return fail(img.error().message);
-    const fs::path path = examples::golden_path(dir, name);
-    if (write) {
-      if (auto s = save_png(path, *img); !s) return fail(s.error().message);
-      if (!json) std::printf("wrote %s\n", path.string().c_str());
-      report.push_back({{"example", name}, {"path", path.string()}, {"written", true}});
-      continue;
+  for (const auto* cls : classes)
+    for (auto& ex : examples::make_examples()) {
+      const std::string name = ex->info().name;
+      auto img = examples::render_golden_frame(*ex, *cls);
+      if (!img) return fail(cls->name + ": " + img.error().message);
+      const fs::path path = examples::golden_path(dir, *cls, name);
+      if (write) {
+        std::error_code ec;
+        fs::create_directories(path.parent_path(), ec);
+        if (auto s = save_png(path, *img); !s) return fail(s.error().message);
+        if (!json) std::printf("wrote %s\n", path.string().c_str());
+        report.push_back({{"class", cls->name}, {"example", name}, {"path", path.string()}, {"written", true}});
+        continue;
+      }
+      auto golden = load_png(path);
+      if (!golden)
+        return fail(golden.error().message + " (create the goldens with: gpubridge-demo goldens --dir " + dir + " --write)");
+      const auto diff = examples::compare_images(*golden, *img);
+      if (!diff.identical()) ++failures;
+      if (!json) std::printf("%-9s %-12s %s\n", cls->name.c_str(), name.c_str(), diff.summary().c_str());
+      report.push_back({{"class", cls->name}, {"example", name}, {"path", path.string()},
+                        {"differing_pixels", diff.differing_pixels}, {"max_difference", diff.max_difference}});
     }
-    auto golden = load_png(path);
-    if (!golden) return fail(golden.error().message + " (create the goldens with: gpubridge-demo goldens --write " + dir + ")");
-    const auto diff = examples::compare_images(*golden, *img);
-    if (!diff.identical()) ++failures;
-    if (!json) std::printf("%-12s %s\n", name.c_str(), diff.summary().c_str());
-    report.push_back({{"example", name}, {"path", path.string()}, {"differing_pixels", diff.differing_pixels},
-                      {"max_difference", diff.max_difference}});
-  }
   if (json) std::puts(json_text(report, 2).c_str());
   return failures ? 1 : 0;
+}
+
+// --size, --format, --no-depth, --without on a subcommand.
+void add_fit_options(CLI::App* sub, FitOptions& o) {
+  sub->add_option("--size", o.size, "force the framebuffer size, WIDTHxHEIGHT (default: the largest that fits)");
+  sub->add_option("--format", o.format, "force the framebuffer format: RGBA8888, RGB565 or RGBA2222");
+  sub->add_flag("--no-depth", o.no_depth, "draw without a depth buffer (each example's painter's order)");
+  sub->add_option("--without", o.without, "do not use these device features: bilinear, blend, dither, rgb565, rgba2222, texture")
+      ->delimiter(',');
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"gpubridge-demo: the example scenes (one per seed), rendered on the simulator or streamed to gpubridged"};
+  CLI::App app{"gpubridge-demo: the example scenes (one per seed), rendered on the simulator or streamed to gpubridged; "
+               "each fits itself to the device it is given"};
   bool json = false;
   app.add_flag("--json", json, "machine-readable output");
   app.require_subcommand(1);
@@ -155,13 +179,17 @@ int main(int argc, char** argv) {
   auto* list = app.add_subcommand("list", "list the examples");
 
   std::vector<std::string> names;
-  std::string out_dir = "demo-frames";
+  FitOptions fit_options;
+  std::string out_dir = "demo-frames", board;
   unsigned frames = 1, first = examples::kGoldenFrame;
   auto* render = app.add_subcommand("render", "render examples on the in-process simulator and write PNG frames");
   render->add_option("EXAMPLES", names, "example names, or all (default)");
   render->add_option("--out", out_dir, "output directory (created)")->capture_default_str();
   render->add_option("--frames", frames, "frames per example")->check(CLI::Range(1u, 100000u))->capture_default_str();
   render->add_option("--first", first, "first frame number")->capture_default_str();
+  render->add_option("--board", board, "render on a simulator with this board profile's device (configs/boards; default: the "
+                                       "plain simulator)");
+  add_fit_options(render, fit_options);
 
   std::string address;
   unsigned stream_frames = 120;
@@ -171,18 +199,32 @@ int main(int argc, char** argv) {
   stream->add_option("--connect", address, "daemon address: unix:PATH or tcp:HOST:PORT (default: the default socket)");
   stream->add_option("--frames", stream_frames, "frames per example")->check(CLI::Range(1u, 1000000u))->capture_default_str();
   stream->add_option("--fps", fps, "frames per second (0 = as fast as possible)")->check(CLI::Range(0.0, 1000.0))->capture_default_str();
+  add_fit_options(stream, fit_options);
 
   std::string golden_dir;
+  std::vector<std::string> classes;
   bool write = false;
-  auto* goldens = app.add_subcommand("goldens", "compare each example's golden frame with its committed PNG, or rewrite them");
+  auto* goldens = app.add_subcommand("goldens", "compare each example's golden frames with the committed PNGs, or rewrite them");
   goldens->add_option("--dir", golden_dir, "directory of the golden PNGs (examples/golden in the source tree)")->required();
+  goldens->add_option("--class", classes, "device classes: large, up5k, up5k-min (default: all)")->delimiter(',');
   goldens->add_flag("--write", write, "render and overwrite the goldens (when the renderer legitimately changed)");
 
-  for (auto* sub : {list, render, stream, goldens}) sub->add_flag("--json", json, "machine-readable output");
+  std::vector<std::string> boards;
+  bool timing = false, markdown = false;
+  auto* fit = app.add_subcommand("fit", "show the configuration each example picks on each board profile (--timing: the "
+                                        "predicted frame rate there)");
+  fit->add_option("EXAMPLES", names, "example names, or all (default)");
+  fit->add_option("--board", boards, "board profiles (configs/boards; default: every one)")->delimiter(',');
+  fit->add_flag("--timing", timing, "predict each frame rate from the board's SPI and core clocks (docs/protocol.md section 19)");
+  fit->add_flag("--markdown", markdown, "print Markdown tables (docs/examples.md)");
+  add_fit_options(fit, fit_options);
+
+  for (auto* sub : {list, render, stream, goldens, fit}) sub->add_flag("--json", json, "machine-readable output");
   CLI11_PARSE(app, argc, argv);
   gpubridge::init_logging("warn");
   if (*list) return run_list(json);
-  if (*render) return run_render(names, out_dir, first, frames, json);
-  if (*stream) return run_stream(names, address, stream_frames, fps, json);
-  return run_goldens(golden_dir, write, json);
+  if (*render) return run_render(names, fit_options, board, out_dir, first, frames, json);
+  if (*stream) return run_stream(names, fit_options, address, stream_frames, fps, json);
+  if (*fit) return run_fit(names, boards, fit_options, timing, markdown, json);
+  return run_goldens(golden_dir, classes, write, json);
 }

@@ -2,11 +2,45 @@
 
 namespace gpubridge::examples {
 
-draw::ContextOptions Example::options() const {
-  draw::ContextOptions o;
-  o.width = 320;
-  o.height = 240;
-  return o;
+const Fit& Example::config() const {
+  if (!fit_) {
+    const DeviceCaps large;
+    auto f = fit(wants(large.features), large);
+    if (f) {
+      fit_ = std::move(*f);
+    } else {
+      // Only an example wanting more than the default simulator holds gets here; its context
+      // creation then says what did not fit.
+      Fit wanted;
+      const auto w = wants(large.features);
+      wanted.device = large;
+      wanted.features = large.features;
+      wanted.context.width = w.width;
+      wanted.context.height = w.height;
+      wanted.context.format = w.format;
+      fit_ = std::move(wanted);
+    }
+  }
+  return *fit_;
+}
+
+Result<void> begin_frame(draw::Context& ctx, const Fit& fit, geometry::Vec4 clear_color) {
+  if (auto r = ctx.clear(clear_color); !r) return r;
+  ctx.state() = {};
+  if (!fit.painter()) {
+    if (auto r = ctx.clear_depth(1.0); !r) return r;
+    ctx.state().z_test = ctx.state().z_write = true;
+  }
+  ctx.state().dither = fit.dither;
+  return {};
+}
+
+Result<Fit> configure(Example& ex, const DeviceCaps& device, const FitRequest& request) {
+  const std::uint16_t features = device.features & static_cast<std::uint16_t>(~request.without);
+  auto f = fit(ex.wants(features), device, request);
+  if (!f) return make_error(ex.info().name + ": " + f.error().message);
+  ex.configure(*f);
+  return f;
 }
 
 std::vector<std::unique_ptr<Example>> make_examples() {

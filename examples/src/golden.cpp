@@ -26,6 +26,42 @@ std::filesystem::path golden_path(const std::filesystem::path& dir, const std::s
   return dir / (name + ".png");
 }
 
+const std::vector<GoldenClass>& golden_classes() {
+  static const std::vector<GoldenClass> classes = [] {
+    DeviceCaps up5k;
+    up5k.name = "up5k";
+    up5k.vram_bytes = 128 * 1024;
+    up5k.max_width = 320;
+    up5k.max_height = 240;
+    DeviceCaps up5k_min = up5k;
+    up5k_min.name = "up5k-min";
+    up5k_min.features = kDither | kStrictLink | kRgba2222 | kTexturing;
+    return std::vector<GoldenClass>{
+        {"large", "the default simulator: 8 MiB, 1024x1024, every feature", DeviceCaps{}},
+        {"up5k", "128 KiB, 320x240, every feature (iCEBreaker and the 128 KiB board profiles)", up5k},
+        {"up5k-min", "128 KiB, 320x240, RGBA2222 and the dither only (no RGB565, bilinear or blending)", up5k_min},
+    };
+  }();
+  return classes;
+}
+
+const GoldenClass* find_golden_class(std::string_view name) {
+  for (const auto& c : golden_classes())
+    if (c.name == name) return &c;
+  return nullptr;
+}
+
+Result<Image> render_golden_frame(Example& ex, const GoldenClass& cls, unsigned threads) {
+  if (auto f = configure(ex, cls.device); !f) return f.error();
+  auto options = cls.device.simulator_options();
+  options.threads = threads;
+  return render_golden_frame(ex, options);
+}
+
+std::filesystem::path golden_path(const std::filesystem::path& dir, const GoldenClass& cls, const std::string& name) {
+  return cls.name == "large" ? golden_path(dir, name) : golden_path(dir / cls.name, name);
+}
+
 ImageDiff compare_images(const Image& expected, const Image& actual) {
   ImageDiff d;
   if (expected.width != actual.width || expected.height != actual.height) {

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "examples_internal.hpp"
+#include "fallbacks.hpp"
 #include "mesh.hpp"
 
 namespace gpubridge::examples {
@@ -11,6 +12,7 @@ namespace {
 constexpr int kGrid = 64;        // vertices per side
 constexpr double kCell = 1.0;    // world units per cell
 constexpr double kSize = (kGrid - 1) * kCell;
+constexpr unsigned kTex = 256;   // colour map texels per side
 
 double height_at(double x, double z) {
   return 7.0 * value_noise(x / 9.0, z / 9.0, 11) + 2.5 * value_noise(x / 3.5, z / 3.5, 12) - 2.0;
@@ -21,16 +23,21 @@ class Terrain final : public Example {
   ExampleInfo info() const override {
     return {"terrain", "DMC-1 (Comanche)", "a height-map terrain fly-over with a planar perspective-correct colour map"};
   }
-  draw::ContextOptions options() const override {
-    auto o = Example::options();
-    o.format = protocol::PixelFormat::RGB565;
-    return o;
+  Wants wants(std::uint16_t) const override {
+    Wants w;
+    w.format = protocol::PixelFormat::RGB565;
+    w.textures = {{"colour map", kTex, kTex, protocol::PixelFormat::RGB565}};
+    // The colour map is what the fly-over shows: its detail outlasts the framebuffer's bits.
+    w.keep = {Knob::Size, Knob::Textures, Knob::Format, Knob::DoubleBuffer, Knob::Depth};
+    w.without_depth = "cells drawn far to near (exact for a height field)";
+    w.without_feature = {{kTexturing, "the colour map baked into the vertex colours"}};
+    return w;
   }
 
   Result<void> setup(draw::Context& ctx) override {
     mesh_ = {};
+    texture_ = {};
     // The colour map: height bands shaded by the slope towards the light, like Comanche's voxel map.
-    constexpr unsigned kTex = 256;
     Image map = make_image(kTex, kTex);
     for (unsigned j = 0; j < kTex; ++j)
       for (unsigned i = 0; i < kTex; ++i) {
@@ -45,11 +52,11 @@ class Terrain final : public Example {
         else c = {0.95, 0.95, 0.97};
         put(map, i, j, c.x * shade, c.y * shade, c.z * shade);
       }
-    auto t = ctx.create_texture(map, {.format = protocol::PixelFormat::RGB565,
-                                      .wrap_s = protocol::Wrap::Clamp,
-                                      .wrap_t = protocol::Wrap::Clamp});
-    if (!t) return t.error();
-    texture_ = *t;
+    if (config().texturing()) {
+      auto t = ctx.create_texture(config().texture(0).shrink(map), config().texture(0).options(protocol::Wrap::Clamp, protocol::Wrap::Clamp));
+      if (!t) return t.error();
+      texture_ = *t;
+    }
     for (int j = 0; j < kGrid; ++j)
       for (int i = 0; i < kGrid; ++i) {
         const double x = i * kCell, z = j * kCell;
@@ -62,14 +69,12 @@ class Terrain final : public Example {
         // Counter-clockwise seen from above (+y).
         for (std::uint32_t k : {a, c, b, b, c, d}) mesh_.indices.push_back(k);
       }
+    if (!config().texturing()) mesh_ = bake_texture(mesh_, map, 1, false, protocol::Wrap::Clamp, protocol::Wrap::Clamp);
     return {};
   }
 
   Result<void> frame(draw::Context& ctx, unsigned n) override {
-    if (auto r = ctx.clear({0.55, 0.72, 0.95, 1}); !r) return r;
-    if (auto r = ctx.clear_depth(1.0); !r) return r;
-    ctx.state() = {};
-    ctx.state().z_test = ctx.state().z_write = true;
+    if (auto r = begin_frame(ctx, config(), {0.55, 0.72, 0.95, 1}); !r) return r;
     ctx.set_cull(geometry::CullMode::Back);
     // Fly north along a gentle curve, keeping above the ground.
     const double t = n * 0.35;
@@ -77,11 +82,45 @@ class Terrain final : public Example {
     const double cy = std::max(height_at(cx, cz), 0.2) + 4.0;
     const geometry::Vec3 eye{cx, cy, cz}, target{cx + 2 * std::sin(t * 0.08 + 0.3), cy - 1.6, cz - 6};
     ctx.set_transform(projection(ctx, 1.0, 0.3, 80) * geometry::look_at(eye, target, {0, 1, 0}));
-    if (auto r = ctx.bind_texture(texture_); !r) return r;
-    return ctx.draw_indexed(mesh_.vertices, mesh_.indices);
+    if (config().texturing()) {
+      if (auto r = ctx.bind_texture(texture_); !r) return r;
+    } else {
+      ctx.unbind_texture();
+    }
+    if (!config().painter()) return ctx.draw_indexed(mesh_.vertices, mesh_.indices);
+    return ctx.draw_indexed(mesh_.vertices, painter_order(eye));
   }
 
  private:
+  // The cells far to near from the eye (by the distance of their centres across the ground: the
+  // cells are the Voronoi regions of those centres, so no cell can hide a farther one), and in
+  // each cell the triangle beyond the diagonal from the eye first. Six indices per cell, as
+  // setup() lists them (a c b, b c d; the diagonal b-c), baked or not (one cut keeps them).
+  std::vector<std::uint32_t> painter_order(geometry::Vec3 eye) const {
+    struct Cell {
+      double distance;
+      std::uint32_t first;  // index of its first index
+      bool near_side_d;     // the eye is on corner d's side of the diagonal
+    };
+    std::vector<Cell> cells;
+    cells.reserve(mesh_.indices.size() / 6);
+    for (int j = 0; j + 1 < kGrid; ++j)
+      for (int i = 0; i + 1 < kGrid; ++i) {
+        const double dx = (i + 0.5) * kCell - eye.x, dz = (j + 0.5) * kCell - eye.z;
+        const bool d_side = eye.x + eye.z > (i + j + 1) * kCell;
+        cells.push_back({dx * dx + dz * dz, static_cast<std::uint32_t>((j * (kGrid - 1) + i) * 6), d_side});
+      }
+    std::stable_sort(cells.begin(), cells.end(), [](const Cell& a, const Cell& b) { return a.distance > b.distance; });
+    std::vector<std::uint32_t> out;
+    out.reserve(mesh_.indices.size());
+    for (const auto& c : cells) {
+      const std::uint32_t far = c.near_side_d ? c.first : c.first + 3, near = c.near_side_d ? c.first + 3 : c.first;
+      out.insert(out.end(), mesh_.indices.begin() + far, mesh_.indices.begin() + far + 3);
+      out.insert(out.end(), mesh_.indices.begin() + near, mesh_.indices.begin() + near + 3);
+    }
+    return out;
+  }
+
   draw::Texture texture_;
   Mesh mesh_;
 };

@@ -3,6 +3,7 @@
 #include <numbers>
 
 #include "examples_internal.hpp"
+#include "fallbacks.hpp"
 #include "mesh.hpp"
 
 namespace gpubridge::examples {
@@ -13,14 +14,20 @@ class Tetrahedron final : public Example {
   ExampleInfo info() const override {
     return {"tetrahedron", "DMC-1", "a rotating tetrahedron with a perspective-correct procedural texture on each face"};
   }
-  draw::ContextOptions options() const override {
-    auto o = Example::options();
-    o.format = protocol::PixelFormat::RGB565;
-    return o;
+  Wants wants(std::uint16_t) const override {
+    Wants w;
+    w.format = protocol::PixelFormat::RGB565;
+    w.textures = {{"checker", 64, 64, protocol::PixelFormat::RGB565}};
+    // The perspective-correct texture is the idea: its detail outlasts the framebuffer's bits.
+    w.keep = {Knob::Size, Knob::Textures, Knob::Format, Knob::DoubleBuffer, Knob::Depth};
+    w.without_depth = "nothing: a convex solid with its back faces culled needs no depth test";
+    w.without_feature = {{kTexturing, "the texture's colours baked into faces cut 4 x 4 (its fine checker averages out)"}};
+    return w;
   }
 
   Result<void> setup(draw::Context& ctx) override {
     mesh_ = {};
+    texture_ = {};
     // A 64x64 texture: a checkerboard with a diagonal stripe, so perspective errors would show.
     Image img = make_image(64, 64);
     for (unsigned y = 0; y < 64; ++y)
@@ -30,9 +37,11 @@ class Tetrahedron final : public Example {
         const double v = stripe ? 1.0 : check ? 0.85 : 0.35;
         put(img, x, y, v, v * (stripe ? 0.9 : 1.0), stripe ? 0.2 : v);
       }
-    auto t = ctx.create_texture(img, {.format = protocol::PixelFormat::RGB565});
-    if (!t) return t.error();
-    texture_ = *t;
+    if (config().texturing()) {
+      auto t = ctx.create_texture(config().texture(0).shrink(img), config().texture(0).options());
+      if (!t) return t.error();
+      texture_ = *t;
+    }
     // Regular tetrahedron: every face counter-clockwise from outside, one colour tint each.
     const geometry::Vec3 p[4] = {{1, 1, 1}, {1, -1, -1}, {-1, 1, -1}, {-1, -1, 1}};
     const int faces[4][3] = {{0, 1, 2}, {0, 3, 1}, {0, 2, 3}, {1, 3, 2}};
@@ -47,19 +56,21 @@ class Tetrahedron final : public Example {
       mesh_.vertices.emplace_back(c, tint[f], geometry::Vec2{1, 2});
       for (std::uint32_t k = 0; k < 3; ++k) mesh_.indices.push_back(base + k);
     }
+    if (!config().texturing()) mesh_ = bake_texture(mesh_, img, 4);
     return {};
   }
 
   Result<void> frame(draw::Context& ctx, unsigned n) override {
-    if (auto r = ctx.clear({0.08, 0.08, 0.12, 1}); !r) return r;
-    if (auto r = ctx.clear_depth(1.0); !r) return r;
-    ctx.state() = {};
-    ctx.state().z_test = ctx.state().z_write = true;
+    if (auto r = begin_frame(ctx, config(), {0.08, 0.08, 0.12, 1}); !r) return r;
     ctx.set_cull(geometry::CullMode::Back);
     const double t = n * 0.06;
     const auto model = geometry::rotate_y(0.7 + t * 1.3) * geometry::rotate_x(0.5 + t * 0.7);
     ctx.set_transform(projection(ctx, 0.9, 0.5, 20) * geometry::look_at({0, 0, 4.2}, {0, 0, 0}, {0, 1, 0}) * model);
-    if (auto r = ctx.bind_texture(texture_); !r) return r;
+    if (config().texturing()) {
+      if (auto r = ctx.bind_texture(texture_); !r) return r;
+    } else {
+      ctx.unbind_texture();
+    }
     return ctx.draw_indexed(mesh_.vertices, mesh_.indices);
   }
 

@@ -3,6 +3,7 @@
 #include <numbers>
 
 #include "examples_internal.hpp"
+#include "fallbacks.hpp"
 #include "mesh.hpp"
 
 namespace gpubridge::examples {
@@ -16,10 +17,15 @@ class Torus final : public Example {
   ExampleInfo info() const override {
     return {"torus", "donut ASIC", "a spinning torus lit per vertex, ordered-dithered to RGBA2222"};
   }
-  draw::ContextOptions options() const override {
-    auto o = Example::options();
-    o.format = protocol::PixelFormat::RGBA2222;
-    return o;
+  Wants wants(std::uint16_t) const override {
+    Wants w;
+    w.format = protocol::PixelFormat::RGBA2222;
+    w.dither = true;
+    // Two bits per channel, dithered, is the idea: the format is held longest.
+    w.keep = {Knob::Format, Knob::Size, Knob::Textures, Knob::DoubleBuffer, Knob::Depth};
+    w.without_depth = "triangles drawn far to near by their centres (back faces culled)";
+    w.without_feature = {{kDither, "colour bands instead of the ordered dither"}};
+    return w;
   }
 
   Result<void> setup(draw::Context&) override {
@@ -44,11 +50,7 @@ class Torus final : public Example {
   }
 
   Result<void> frame(draw::Context& ctx, unsigned n) override {
-    if (auto r = ctx.clear({0, 0, 0, 1}); !r) return r;
-    if (auto r = ctx.clear_depth(1.0); !r) return r;
-    ctx.state() = {};
-    ctx.state().z_test = ctx.state().z_write = true;
-    ctx.state().dither = true;
+    if (auto r = begin_frame(ctx, config(), {0, 0, 0, 1}); !r) return r;
     ctx.set_cull(geometry::CullMode::Back);
     const double t = n * 0.07;
     const auto model = geometry::rotate_x(0.9 + t) * geometry::rotate_z(t * 0.6);
@@ -62,9 +64,11 @@ class Torus final : public Example {
       const double l = 0.12 + 0.88 * diffuse;
       v[i] = draw::Vertex(positions_[i], {clamp01(1.0 * l + spec), clamp01(0.62 * l + spec), clamp01(0.25 * l + spec), 1});
     }
-    ctx.set_transform(projection(ctx, 0.8, 0.5, 20) * geometry::look_at({0, 0, 4}, {0, 0, 0}, {0, 1, 0}) * model);
+    const auto mvp = projection(ctx, 0.8, 0.5, 20) * geometry::look_at({0, 0, 4}, {0, 0, 0}, {0, 1, 0}) * model;
+    ctx.set_transform(mvp);
     ctx.unbind_texture();
-    return ctx.draw_indexed(v, indices_);
+    if (!config().painter()) return ctx.draw_indexed(v, indices_);
+    return ctx.draw_indexed(v, far_to_near(indices_, centroid_depths(v, indices_, mvp)));
   }
 
  private:

@@ -1,6 +1,7 @@
-// Each example's golden frame, rendered on the exact simulator, matches the committed PNG bit
-// for bit. On a mismatch the test writes the actual frame and a diff summary naming the pixels.
-// Regenerate (only when the renderer legitimately changed):
+// Each example's golden frame, rendered on the exact simulator for each class of device it fits
+// itself to (large, up5k, up5k-min), matches the committed PNG bit for bit. On a mismatch the test
+// writes the actual frame and a diff summary naming the pixels. Regenerate (only when the
+// renderer legitimately changed):
 //   gpubridge-demo goldens --dir examples/golden --write
 #include <gtest/gtest.h>
 
@@ -12,38 +13,80 @@
 namespace gpubridge::examples {
 namespace {
 
-class ExampleGolden : public ::testing::TestWithParam<std::string> {};
+struct Case {
+  std::string cls, example;
+};
+
+std::vector<Case> all_cases() {
+  std::vector<Case> out;
+  for (const auto& c : golden_classes())
+    for (const auto& e : example_names()) out.push_back({c.name, e});
+  return out;
+}
+
+class ExampleGolden : public ::testing::TestWithParam<Case> {};
 
 TEST_P(ExampleGolden, MatchesCommittedPng) {
-  auto ex = make_example(GetParam());
+  const auto& [cls_name, name] = GetParam();
+  const GoldenClass* cls = find_golden_class(cls_name);
+  ASSERT_NE(cls, nullptr);
+  auto ex = make_example(name);
   ASSERT_NE(ex, nullptr);
-  auto actual = render_golden_frame(*ex);
+  auto actual = render_golden_frame(*ex, *cls);
   ASSERT_TRUE(actual) << actual.error().message;
-  auto golden = load_png(golden_path(GPUBRIDGE_GOLDEN_DIR, GetParam()));
+  auto golden = load_png(golden_path(GPUBRIDGE_GOLDEN_DIR, *cls, name));
   ASSERT_TRUE(golden) << golden.error().message;
   const auto diff = compare_images(*golden, *actual);
   if (!diff.identical()) {
-    std::filesystem::create_directories(GPUBRIDGE_GOLDEN_OUT);
-    const auto out = golden_path(GPUBRIDGE_GOLDEN_OUT, GetParam());
+    const auto out = golden_path(GPUBRIDGE_GOLDEN_OUT, *cls, name);
+    std::filesystem::create_directories(out.parent_path());
     (void)save_png(out, *actual);
-    ADD_FAILURE() << GetParam() << ": " << diff.summary() << "\nactual frame written to " << out.string()
+    ADD_FAILURE() << cls_name << " " << name << ": " << diff.summary() << "\nactual frame written to " << out.string()
                   << "\nif the renderer legitimately changed: gpubridge-demo goldens --dir examples/golden --write";
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(AllExamples, ExampleGolden, ::testing::ValuesIn(example_names()),
-                         [](const auto& p) { return p.param; });
+INSTANTIATE_TEST_SUITE_P(AllExamples, ExampleGolden, ::testing::ValuesIn(all_cases()), [](const auto& p) {
+  std::string n = p.param.cls + "_" + p.param.example;
+  for (auto& c : n)
+    if (c == '-') c = '_';
+  return n;
+});
+
+TEST(ExampleGolden, LargeClassIsWhatEveryExampleWants) {
+  // The large goldens are the examples as written: nothing given up on the default simulator,
+  // and a freshly made example is configured that way before anyone fits it.
+  const GoldenClass* large = find_golden_class("large");
+  ASSERT_NE(large, nullptr);
+  for (auto& ex : make_examples()) {
+    auto f = configure(*ex, large->device);
+    ASSERT_TRUE(f) << f.error().message;
+    EXPECT_TRUE(f->gave_up.empty()) << ex->info().name << " gave up " << f->gave_up.front();
+    EXPECT_EQ(make_example(ex->info().name)->config().summary(), f->summary());
+  }
+}
+
+TEST(ExampleGolden, SmallClassesGiveSomethingUp) {
+  // The up5k goldens show a different configuration from the large ones for every example
+  // (otherwise they would not cover the small device).
+  for (const char* cls : {"up5k", "up5k-min"})
+    for (auto& ex : make_examples()) {
+      auto f = configure(*ex, find_golden_class(cls)->device);
+      ASSERT_TRUE(f) << f.error().message;
+      EXPECT_FALSE(f->gave_up.empty()) << cls << " " << ex->info().name << ": " << f->summary();
+      EXPECT_LE(f->vram_bytes, 128u * 1024) << cls << " " << ex->info().name;
+    }
+}
 
 TEST(ExampleFrames, IdenticalWithSeveralRasteriserThreads) {
   // The goldens are rendered with one thread; banded rendering must give the same bytes.
-  sim::DeviceOptions threaded;
-  threaded.threads = 3;
-  for (const auto& name : example_names()) {
-    auto a = make_example(name), b = make_example(name);
-    auto ia = render_golden_frame(*a), ib = render_golden_frame(*b, threaded);
-    ASSERT_TRUE(ia && ib);
-    EXPECT_TRUE(compare_images(*ia, *ib).identical()) << name << ": " << compare_images(*ia, *ib).summary();
-  }
+  for (const auto& cls : golden_classes())
+    for (const auto& name : example_names()) {
+      auto a = make_example(name), b = make_example(name);
+      auto ia = render_golden_frame(*a, cls), ib = render_golden_frame(*b, cls, 3);
+      ASSERT_TRUE(ia && ib);
+      EXPECT_TRUE(compare_images(*ia, *ib).identical()) << cls.name << " " << name << ": " << compare_images(*ia, *ib).summary();
+    }
 }
 
 TEST(ImageDiff, ReportsDifferingPixels) {

@@ -3,12 +3,14 @@
 // drawing API, so the same code renders on the in-process simulator or streams to a daemon.
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "gpubridge/common/result.hpp"
 #include "gpubridge/draw/context.hpp"
+#include "gpubridge/examples/fit.hpp"
 
 namespace gpubridge::examples {
 
@@ -22,13 +24,26 @@ class Example {
  public:
   virtual ~Example() = default;
   virtual ExampleInfo info() const = 0;
-  // Framebuffer size/format and buffers the example wants.
-  virtual draw::ContextOptions options() const;
+  // What the example would like from a device that has `features` (fit.hpp: kBlend, ...), and
+  // what it holds on to longest when video memory is short.
+  virtual Wants wants(std::uint16_t features) const = 0;
+  // The configuration setup() and frame() follow: the one configure() chose, or, until then, the
+  // large one (everything the example wants, on the default simulator).
+  const Fit& config() const;
+  void configure(Fit fit) { fit_ = std::move(fit); }
+  // Framebuffer size/format and buffers of the configuration.
+  draw::ContextOptions options() const { return config().context; }
   // Once per context: textures and meshes (calling it again starts over, for a new context).
   virtual Result<void> setup(draw::Context& ctx) = 0;
   // Draws frame `n` (clears included), without swapping. Frame n is a pure function of n.
   virtual Result<void> frame(draw::Context& ctx, unsigned n) = 0;
+
+ private:
+  mutable std::optional<Fit> fit_;
 };
+
+// Fits the example to `device` (honouring `request`) and configures it with the result.
+Result<Fit> configure(Example& ex, const DeviceCaps& device, const FitRequest& request = {});
 
 // Every example, in presentation order.
 std::vector<std::unique_ptr<Example>> make_examples();

@@ -1,5 +1,6 @@
 #pragma once
-// Golden images of the examples: the frame kGoldenFrame of each, rendered on the exact simulator.
+// Golden images of the examples: the frame kGoldenFrame of each, rendered on the exact simulator,
+// for each class of device the examples fit themselves to (fit.hpp).
 #include <filesystem>
 #include <string>
 
@@ -10,9 +11,27 @@
 
 namespace gpubridge::examples {
 
-// Renders frames 0..kGoldenFrame on a fresh simulator and returns the last scanned-out frame.
+// Renders frames 0..kGoldenFrame of the example as configured on a fresh simulator and returns
+// the last scanned-out frame; any device error flag is an error.
 Result<Image> render_golden_frame(Example& ex, const sim::DeviceOptions& device = {});
 std::filesystem::path golden_path(const std::filesystem::path& dir, const std::string& name);
+
+// A class of device with golden images of every example.
+struct GoldenClass {
+  std::string name;         // "large", "up5k", "up5k-min"
+  std::string description;  // one line
+  DeviceCaps device;
+};
+// large: the default simulator (what every example wants); up5k: 128 KiB and 320x240 at most,
+// every feature (iCEBreaker and the other 128 KiB board profiles); up5k-min: the same with only
+// RGBA2222 and the dither (no RGB565, bilinear filtering or blending: the least a UP5K design offers).
+const std::vector<GoldenClass>& golden_classes();
+const GoldenClass* find_golden_class(std::string_view name);
+// Configures the example for the class, then renders its golden frame there (threads: the
+// simulator's rasteriser threads; the output does not depend on them).
+Result<Image> render_golden_frame(Example& ex, const GoldenClass& cls, unsigned threads = 1);
+// DIR/NAME.png for the large class, DIR/CLASS/NAME.png for the others.
+std::filesystem::path golden_path(const std::filesystem::path& dir, const GoldenClass& cls, const std::string& name);
 
 struct ImageDiff {
   bool size_mismatch = false;
