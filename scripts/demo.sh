@@ -4,7 +4,8 @@
 # the window or press Q to finish); without one, a few frames of every scene are written as PNG
 # files and their paths printed.
 # Environment: GPUBRIDGE_SKIP_DEPS=1 skips the package install; DEMO_FRAMES (default 240 with a
-# display, 3 without) frames per scene; DEMO_FPS (default 30); DEMO_OUT (default out/demo).
+# display, 3 without) frames per scene; DEMO_FPS (default 30); DEMO_OUT (default out/demo);
+# DEMO_BACKEND (default sim): a board profile (emulated:icebreaker without the board), mirrored.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
