@@ -41,6 +41,8 @@ nlohmann::json prediction_json(const examples::FramePrediction& p) {
   return {{"spi_frames", p.work.frames_received},
           {"triangles", p.work.triangles_rasterised},
           {"pixels", p.work.pixels_depth_passed},
+          {"pipeline_cycles", p.estimate.pipeline_cycles},
+          {"memory_bytes", p.estimate.memory_bytes},
           {"board_cycles", p.estimate.board_cycles},
           {"board_ms", p.estimate.board_ms},
           {"spi_ms", p.estimate.spi_ms},
@@ -175,7 +177,7 @@ int run_fit(const std::vector<std::string>& names, const std::vector<std::string
       if (markdown) {
         if (configs.find(name) == configs.end()) example_order.push_back(name);
         auto& rows = configs[name];
-        std::string text = fitted.summary();
+        std::string text = fitted.choice() + "; " + fmt::format("{:.0f} KiB", fitted.vram_bytes / 1024.0);
         for (const auto& g : fitted.gave_up) text += "<br>gave up: " + g;
         auto it = std::find_if(rows.begin(), rows.end(), [&](const auto& r) { return r.first == text; });
         if (it == rows.end()) rows.push_back({text, {board.name}});

@@ -176,6 +176,10 @@ draw::TextureOptions TextureFit::options(protocol::Wrap wrap_s, protocol::Wrap w
 }
 
 std::string Fit::summary() const {
+  return choice() + fmt::format("; {} of {} bytes", thousands(vram_bytes), thousands(device.vram_bytes));
+}
+
+std::string Fit::choice() const {
   std::string s = fmt::format("{}x{} {}{}, {}, {}", context.width, context.height, format_label(context.format),
                               dither ? " dithered" : "", context.double_buffer ? "double-buffered" : "single buffer",
                               context.depth_buffer ? "depth buffer" : "painter's order");
@@ -183,7 +187,7 @@ std::string Fit::summary() const {
     s += "; textures";
     for (std::size_t i = 0; i < textures.size(); ++i) s += (i ? ", " : " ") + texture_label(textures[i]);
   }
-  return s + fmt::format("; {} of {} bytes", thousands(vram_bytes), thousands(device.vram_bytes));
+  return s;
 }
 
 Result<Fit> fit(const Wants& wants, const DeviceCaps& device, const FitRequest& request) {

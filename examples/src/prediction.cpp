@@ -32,7 +32,7 @@ Result<FramePrediction> predict_frame(Example& ex, const DeviceCaps& device, con
   timing.clock_mhz = board.clock_mhz;
   timing.spi_clock_mhz = board.spi_clock_mhz;
   const unsigned bpp = protocol::bytes_per_pixel(p.fit.context.format);
-  p.estimate = sim::estimate_timing(p.work, timing, bpp);
+  p.estimate = sim::estimate_timing(p.work, timing, bpp, p.fit.context.depth_buffer);
   if (board.readback) {
     // MEM_DATA reads: one 72-bit frame per 8 bytes, in bursts like the writes.
     const double frames = std::ceil(double(p.fit.context.width) * p.fit.context.height * bpp / 8);

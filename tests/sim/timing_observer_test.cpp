@@ -32,6 +32,8 @@ TEST(SimTiming, FormulasOnHandComputedCounters) {
   // SPI: 20·72 bits at 40 MHz + one CS gap of 1 µs
   EXPECT_NEAR(e.spi_ms, 20 * 72 / 40e3 + 1e-3, 1e-12);
   EXPECT_NEAR(e.frame_ms, e.spi_ms, 1e-12);
+  // Without a depth buffer (painter's order) covered pixels move no depth bytes: 200 + 800.
+  EXPECT_EQ(estimate_timing(w, b, 4, /*depth_buffer=*/false).memory_bytes, 1000u);
   BoardTiming slow;
   ASSERT_TRUE(apply_timing_setting(slow, "clock_mhz=0.01").ok());
   EXPECT_GT(estimate_timing(w, slow, 4).frame_ms, e.frame_ms);

@@ -120,6 +120,8 @@ struct Fit {
   const TextureFit& texture(std::size_t i) const { return textures.at(i); }
   // "320x240 RGBA2222 dithered, single buffer, painter's order; textures 64x64 RGB565; 81,920 of 131,072 bytes".
   std::string summary() const;
+  // The same without the memory figures (equal on devices that differ only in memory size).
+  std::string choice() const;
 };
 
 // The closest configuration to `wants` that fits `device`, honouring `request`. Errors: a forced

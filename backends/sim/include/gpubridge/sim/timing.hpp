@@ -38,8 +38,10 @@ struct TimingEstimate {
 };
 
 // Counters of `work` (e.g. the difference of two DeviceStats snapshots) under profile `board`;
-// colour_bpp (bytes per pixel of the colour buffer) sizes the colour traffic.
-TimingEstimate estimate_timing(const DeviceStats& work, const BoardTiming& board, unsigned colour_bpp);
+// colour_bpp (bytes per pixel of the colour buffer) sizes the colour traffic; without a depth
+// buffer (depth_buffer false: a program drawing in painter's order) covered pixels move no depth bytes.
+TimingEstimate estimate_timing(const DeviceStats& work, const BoardTiming& board, unsigned colour_bpp,
+                               bool depth_buffer = true);
 // a − b, field by field.
 DeviceStats stats_difference(const DeviceStats& a, const DeviceStats& b);
 // "clock_mhz=25 spi_clock_mhz=10 ..." settings applied to a profile (errors name the key).
