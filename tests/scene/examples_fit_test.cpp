@@ -8,6 +8,7 @@
 #include "gpubridge/draw/sim_sink.hpp"
 #include "gpubridge/examples/example.hpp"
 #include "gpubridge/examples/golden.hpp"
+#include "gpubridge/examples/prediction.hpp"
 
 namespace gpubridge::examples {
 namespace {
@@ -199,6 +200,25 @@ TEST(Examples, EveryExampleFitsEveryGoldenClassWithinItsMemory) {
       EXPECT_EQ(f->features & ~cls.device.features, 0) << "uses a feature the device lacks";
       EXPECT_EQ(ex->options().width, f->context.width) << "configure() is what options() follows";
     }
+}
+
+TEST(Prediction, TextureUploadsInTheFrameTravelTheLink) {
+  // cubes re-uploads its 32x32 RGBA8888 label every frame: 4 KiB is 1 MEM_ADDR + 512 MEM_DATA
+  // frames on a board, which the simulator (taking uploads straight into memory) does not count.
+  const BoardLink link{"test", 50, 30, false};
+  auto cubes = make_example("cubes");
+  auto p = predict_frame(*cubes, DeviceCaps{}, link);
+  ASSERT_TRUE(p) << p.error().message;
+  EXPECT_GE(p->work.frames_received, 513u);
+  EXPECT_GE(p->work.mem_data_writes, 512u);
+  EXPECT_NEAR(p->estimate.spi_ms, p->work.frames_received * 72 / 30e3, 0.1);
+  // The tetrahedron uploads its texture once, in setup: the frame itself is a few dozen frames.
+  auto tetra = make_example("tetrahedron");
+  auto q = predict_frame(*tetra, DeviceCaps{}, link);
+  ASSERT_TRUE(q) << q.error().message;
+  EXPECT_LT(q->work.frames_received, 100u);
+  EXPECT_EQ(q->work.mem_data_writes, 0u);
+  EXPECT_GT(q->fps, 0);
 }
 
 TEST(Painter, FarToNearKeepsTrianglesWholeAndOrdersThemByDistance) {
