@@ -163,8 +163,8 @@ void add_fit_options(CLI::App* sub, FitOptions& o) {
   sub->add_option("--size", o.size, "force the framebuffer size, WIDTHxHEIGHT (default: the largest that fits)");
   sub->add_option("--format", o.format, "force the framebuffer format: RGBA8888, RGB565 or RGBA2222");
   sub->add_flag("--no-depth", o.no_depth, "draw without a depth buffer (each example's painter's order)");
-  sub->add_option("--without", o.without, "do not use these device features: bilinear, blend, dither, rgb565, rgba2222, texture")
-      ->delimiter(',');
+  sub->add_option("--without", o.without, "do not use these device features: bilinear, blend, dither, rgb565, rgba2222, texture (comma-separated)")
+      ->delimiter(',')->allow_extra_args(false);
 }
 
 }  // namespace
@@ -206,7 +206,7 @@ int main(int argc, char** argv) {
   bool write = false;
   auto* goldens = app.add_subcommand("goldens", "compare each example's golden frames with the committed PNGs, or rewrite them");
   goldens->add_option("--dir", golden_dir, "directory of the golden PNGs (examples/golden in the source tree)")->required();
-  goldens->add_option("--class", classes, "device classes: large, up5k, up5k-min (default: all)")->delimiter(',');
+  goldens->add_option("--class", classes, "device classes, comma-separated: large, up5k, up5k-min (default: all)")->delimiter(',')->allow_extra_args(false);
   goldens->add_flag("--write", write, "render and overwrite the goldens (when the renderer legitimately changed)");
 
   std::vector<std::string> boards;
@@ -214,7 +214,7 @@ int main(int argc, char** argv) {
   auto* fit = app.add_subcommand("fit", "show the configuration each example picks on each board profile (--timing: the "
                                         "predicted frame rate there)");
   fit->add_option("EXAMPLES", names, "example names, or all (default)");
-  fit->add_option("--board", boards, "board profiles (configs/boards; default: every one)")->delimiter(',');
+  fit->add_option("--board", boards, "board profiles (configs/boards, comma-separated; default: every one)")->delimiter(',')->allow_extra_args(false);
   fit->add_flag("--timing", timing, "predict each frame rate from the board's SPI and core clocks (docs/protocol.md section 19)");
   fit->add_flag("--markdown", markdown, "print Markdown tables (docs/examples.md)");
   add_fit_options(fit, fit_options);

@@ -23,6 +23,11 @@ std::vector<Example> make() {
   all.push_back({"README.md", "Two commands (fresh Debian 12)", 1, "README_TwoCommands_Test",
                  {skip("./scripts/test.sh", "is the whole test suite, this test included")}});
 
+  all.push_back({"README.md", "The demo scenes", 0, "README_DemoScenes_OnABoard",
+                 {skip("DEMO_BACKEND=emulated:icebreaker ./scripts/demo.sh",
+                       "installs Debian packages (root) and rebuilds, like ./scripts/demo.sh; its main job on every "
+                       "emulated board profile runs as CTest demo.boards (scripts/demo-run.sh on this build)")}});
+
   all.push_back({"README.md", "Using it", 0, "README_UsingIt", {
       run("build/tools/gpubridge render examples/scenes/gouraud-triangle.json --out frame.png")
           .prints(R"(1 frame\(s\) scanned out, 1 triangles)")
@@ -179,6 +184,24 @@ std::vector<Example> make() {
           .within(120),
       skip("build/examples/gpubridge-demo goldens --dir examples/golden --write",
            "rewrites the committed goldens (the line above compares with them)"),
+  }});
+
+  all.push_back({"docs/examples.md", "On every board", 0, "docs_examples_OnEveryBoard", {
+      run("build/examples/gpubridge-demo fit --board icebreaker")
+          .prints(R"(icebreaker \(iCE40 UP5K; 128 KiB, 320x240 at most)")
+          .prints(R"(voxels +256x192 RGBA2222 dithered, double-buffered, painter's order)")
+          .prints(R"(gave up: framebuffer 320x240 -> 256x192 \(video memory\))"),
+      run("build/examples/gpubridge-demo render tetrahedron --board icebreaker --out small")
+          .prints(R"(tetrahedron on icebreaker: 320x240 RGBA2222 dithered, single buffer, painter's order)")
+          .leaves("small/tetrahedron-0012.png"),
+      run("build/examples/gpubridge-demo render torus --size 160x120 --no-depth --without dither --out forced")
+          .prints(R"(gave up: framebuffer 320x240 -> 160x120 \(--size\))")
+          .prints(R"(gave up: dither: colour bands instead of the ordered dither \(--without dither\))")
+          .leaves("forced/torus-0012.png"),
+      run("build/examples/gpubridge-demo fit --timing --markdown")
+          .prints(R"(\| example \| ch341a-generic \|)")
+          .prints(R"(\| terrain \| 0\.5 \|)")
+          .within(120),
   }});
 
   all.push_back({"docs/viewer.md", "gpubridge-view", 0, "docs_viewer_Start", {
