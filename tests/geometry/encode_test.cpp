@@ -60,6 +60,8 @@ TEST(Encode, TriModeFields) {
   s.blend = protocol::BlendMode::Multiply;
   s.mask_g = true;
   s.tex_decal = true;
+  s.dither = s.temporal = true;
+  s.dither_phase = 21;  // the frame number: its low four bits are sent
   const auto w = tri_mode_word(s);
   EXPECT_EQ(protocol::check_write(protocol::index_of(Reg::TRI_MODE), w).errors, 0);
   EXPECT_EQ(field(Reg::TRI_MODE, "GOURAUD", w), 0);
@@ -71,6 +73,9 @@ TEST(Encode, TriModeFields) {
   EXPECT_EQ(field(Reg::TRI_MODE, "MASK_G", w), 1);
   EXPECT_EQ(field(Reg::TRI_MODE, "MASK_R", w), 0);
   EXPECT_EQ(field(Reg::TRI_MODE, "TEX_DECAL", w), 1);
+  EXPECT_EQ(field(Reg::TRI_MODE, "DITHER", w), 1);
+  EXPECT_EQ(field(Reg::TRI_MODE, "TEMPORAL", w), 1);
+  EXPECT_EQ(field(Reg::TRI_MODE, "DITHER_PHASE", w), 5);
 }
 
 TEST(Encode, TexFmtValidatesSizes) {

@@ -55,7 +55,7 @@ TEST(SceneParse, MinimalSceneValues) {
 TEST(SceneParse, DrawStateAndDepthBuffer) {
   auto s = parse(R"({"framebuffer": {"width": 8, "height": 8},
     "draws": [{"gouraud": false, "z_test": true, "z_func": "lequal", "z_write": true, "blend": "ALPHA",
-               "dither": true, "write_mask": "rg", "cull": "back", "scissor": [1, 2, 3, 4], "color": [0, 0, 1],
+               "dither": true, "temporal": true, "dither_phase": 13, "write_mask": "rg", "cull": "back", "scissor": [1, 2, 3, 4], "color": [0, 0, 1],
                "vertices": [[0,0],[1,0],[0,1]]}]})");
   ASSERT_TRUE(s) << s.error().message;
   const auto& d = s->draws[0];
@@ -64,6 +64,8 @@ TEST(SceneParse, DrawStateAndDepthBuffer) {
   EXPECT_EQ(d.state.z_func, protocol::DepthFunc::LessEqual);
   EXPECT_EQ(d.state.blend, protocol::BlendMode::Alpha);
   EXPECT_TRUE(d.state.dither);
+  EXPECT_TRUE(d.state.temporal);
+  EXPECT_EQ(d.state.dither_phase, 13u);
   EXPECT_FALSE(d.state.mask_r);
   EXPECT_FALSE(d.state.mask_g);
   EXPECT_TRUE(d.state.mask_b);
@@ -151,6 +153,7 @@ TEST(SceneParse, ErrorsNameFilePathAndProblem) {
       {"{" + fb + R"(, "draws": [{"texture": "nope", "vertices": []}]})", "draws[0].texture: no texture named \"nope\""},
       {"{" + fb + R"(, "draws": [{"blend": "SCREEN", "vertices": []}]})", "draws[0].blend: \"SCREEN\" is not one of: OFF, ALPHA, ADD, MULTIPLY"},
       {"{" + fb + R"(, "draws": [{"write_mask": "xyz", "vertices": []}]})", "draws[0].write_mask: use the letters"},
+      {"{" + fb + R"(, "draws": [{"dither_phase": 16, "vertices": []}]})", "draws[0].dither_phase: 16 is outside 0..15"},
       {"{" + fb + R"(, "textures": [{"name": "t", "width": 12, "height": 8, "rgba": []}]})", "textures[0].rgba: expected 384 numbers"},
       {"{" + fb + R"(, "textures": [{"name": "t", "width": 8, "height": 8, "rgba": [1]}]})", "expected 256 numbers"},
       {"{" + fb + R"(, "textures": [{"name": "t", "png": "missing.png"}]})", "textures[0].png:"},

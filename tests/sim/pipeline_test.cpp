@@ -17,6 +17,15 @@ unsigned ref_dither(unsigned v, unsigned n, int x, int y) {
   return (t > 255 ? 255 : t) >> (8 - n);
 }
 
+// Temporal dither (TEMPORAL = 1): threshold B ^ reverse4(phase), levels scaled to 0..2^n - 1.
+unsigned ref_temporal(unsigned v, unsigned n, int x, int y, unsigned phase) {
+  const unsigned rev = ((phase & 1) << 3) | ((phase & 2) << 1) | ((phase & 4) >> 1) | ((phase & 8) >> 3);
+  const unsigned t = unsigned(kBayer[y & 3][x & 3]) ^ rev;
+  const unsigned m = (1u << n) - 1;
+  return (m * v + ((m * v) >> 8) + 16 * t + 8) >> 8;
+}
+std::uint64_t temporal_mode(unsigned phase) { return (1u << 9) | (1u << 15) | (std::uint64_t{phase} << 16); }
+
 // A flat full-canvas quad (two triangles) with colour c and depth z.
 void quad(Canvas& c, std::uint32_t rgba, std::uint32_t z = 0) {
   const int W = static_cast<int>(c.width) * 16, H = static_cast<int>(c.height) * 16;
@@ -114,6 +123,58 @@ TEST(SimPipeline, DitherRgb565FollowsBayerFormula) {
     for (int x = 0; x < 8; ++x) {
       const unsigned expect = (ref_dither(0x83, 5, x, y) << 11) | (ref_dither(0x41, 6, x, y) << 5) | ref_dither(0x7E, 5, x, y);
       EXPECT_EQ((unsigned{c.px(x, y)[0]} << 8) | c.px(x, y)[1], expect) << x << "," << y;
+    }
+}
+
+TEST(SimPipeline, TemporalDitherRgba2222FollowsFormula) {
+  for (unsigned phase = 0; phase < 16; ++phase)
+    for (std::uint32_t v : {0x00u, 0x01u, 0x2Au, 0x55u, 0x80u, 0xAAu, 0xFEu, 0xFFu}) {
+      Canvas c(8, 8, 2);
+      w(*c.dev, Reg::TRI_MODE, temporal_mode(phase));
+      quad(c, (v << 24) | ((255 - v) << 16) | (v << 8) | (v ^ 0x5A));
+      for (int y = 0; y < 8; ++y)
+        for (int x = 0; x < 8; ++x) {
+          const unsigned expect = (ref_temporal(v, 2, x, y, phase) << 6) | (ref_temporal(255 - v, 2, x, y, phase) << 4) |
+                                  (ref_temporal(v, 2, x, y, phase) << 2) | ref_temporal(v ^ 0x5A, 2, x, y, phase);
+          ASSERT_EQ(c.px(x, y)[0], expect) << "v " << v << " phase " << phase << " at " << x << "," << y;
+        }
+    }
+  // The end points are fixed in every phase: 0 stays 0 and 255 stays 3 (no saturation needed).
+  for (unsigned phase = 0; phase < 16; ++phase)
+    for (int y = 0; y < 4; ++y)
+      for (int x = 0; x < 4; ++x) {
+        EXPECT_EQ(ref_temporal(0, 2, x, y, phase), 0u);
+        EXPECT_EQ(ref_temporal(255, 2, x, y, phase), 3u);
+      }
+}
+
+TEST(SimPipeline, TemporalDitherRgb565FollowsFormula) {
+  for (unsigned phase : {0u, 1u, 6u, 15u}) {
+    Canvas c(8, 8, 1);
+    w(*c.dev, Reg::TRI_MODE, temporal_mode(phase));
+    quad(c, 0x83417EFF);
+    for (int y = 0; y < 8; ++y)
+      for (int x = 0; x < 8; ++x) {
+        const unsigned expect = (ref_temporal(0x83, 5, x, y, phase) << 11) | (ref_temporal(0x41, 6, x, y, phase) << 5) |
+                                ref_temporal(0x7E, 5, x, y, phase);
+        EXPECT_EQ((unsigned{c.px(x, y)[0]} << 8) | c.px(x, y)[1], expect) << phase << " at " << x << "," << y;
+      }
+  }
+}
+
+// TEMPORAL without DITHER has no effect (truncation), and the phase alone changes nothing.
+TEST(SimPipeline, TemporalWithoutDitherTruncates) {
+  Canvas c(8, 8, 2), ordered(8, 8, 2);
+  w(*c.dev, Reg::TRI_MODE, temporal_mode(9) & ~std::uint64_t{1u << 9});
+  quad(c, 0x80808080);
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 8; ++x) EXPECT_EQ(c.px(x, y)[0], 0xAA) << x << "," << y;
+  w(*ordered.dev, Reg::TRI_MODE, (1u << 9) | (std::uint64_t{9} << 16));  // DITHER + phase, TEMPORAL = 0
+  quad(ordered, 0x80808080);
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 8; ++x) {
+      const unsigned q = ref_dither(0x80, 2, x, y);
+      EXPECT_EQ(ordered.px(x, y)[0], (q << 6) | (q << 4) | (q << 2) | q) << x << "," << y;
     }
 }
 

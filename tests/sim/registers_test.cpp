@@ -17,13 +17,13 @@ TEST(SimRegisters, ResetValuesIdAndCaps) {
   o.max_width = 320;
   o.max_height = 240;
   auto d = make_device(o);
-  EXPECT_EQ(rd(*d, Reg::ID), 0x5350475501000007ull);
+  EXPECT_EQ(rd(*d, Reg::ID), 0x5350475501010007ull);  // protocol 1.1
   const std::uint64_t caps = rd(*d, Reg::CAPS);
   EXPECT_EQ(caps & 0xFFFFFF, 2048u);                // VRAM_KIB
   EXPECT_EQ((caps >> 24) & 0x7FF, 320u);            // MAX_WIDTH
   EXPECT_EQ((caps >> 35) & 0x7FF, 240u);            // MAX_HEIGHT
   EXPECT_EQ((caps >> 46) & 0x3FF, 100u);            // FIFO_DEPTH
-  EXPECT_EQ(caps >> 56, 0x3Fu);                     // FEATURES
+  EXPECT_EQ(caps >> 56, 0x7Fu);                     // FEATURES (bit 6: temporal dither)
   for (const auto& r : register_table()) {
     if (r.access != Access::ReadWrite || r.path != Path::Queued) continue;
     EXPECT_EQ(d->read(r.index), r.reset) << r.name;
@@ -98,6 +98,29 @@ TEST(SimRegisters, MissingFeatureFallsBack) {
   w(*d, Reg::TRI_MODE, 1u << 7);  // BLEND = ALPHA
   EXPECT_EQ(rd(*d, Reg::TRI_MODE), 0u);
   EXPECT_EQ(errors_of(*d), ERR_BAD_VALUE);
+}
+
+// Section 5 rule 5 for the protocol 1.1 fields: a device without CAPS.FEATURES bit 6 replaces
+// TEMPORAL and DITHER_PHASE by 0 (ERR_BAD_VALUE) and keeps the ordered dither; one with it keeps them.
+TEST(SimRegisters, TemporalDitherNeedsItsFeatureBit) {
+  const std::uint64_t mode = (1u << 9) | (1u << 15) | (std::uint64_t{11} << 16) | 1;  // DITHER, TEMPORAL, phase 11
+  DeviceOptions o;
+  o.features = kAllFeatures & ~FEATURE_TEMPORAL_DITHER;
+  auto d = make_device(o);
+  w(*d, Reg::TRI_MODE, mode);
+  EXPECT_EQ(rd(*d, Reg::TRI_MODE), (1u << 9) | 1u);
+  EXPECT_EQ(errors_of(*d), ERR_BAD_VALUE);
+  w(*d, Reg::ERR_CLEAR, 0xFFFF);
+  w(*d, Reg::TRI_MODE, std::uint64_t{5} << 16);  // a phase alone is refused too
+  EXPECT_EQ(rd(*d, Reg::TRI_MODE), 0u);
+  EXPECT_EQ(errors_of(*d), ERR_BAD_VALUE);
+
+  auto full = make_device();
+  w(*full, Reg::TRI_MODE, mode);
+  EXPECT_EQ(rd(*full, Reg::TRI_MODE), mode);
+  EXPECT_EQ(errors_of(*full), 0);
+  w(*full, Reg::TRI_MODE, std::uint64_t{1} << 20);  // bit 20 stays reserved
+  EXPECT_EQ(errors_of(*full), ERR_RESERVED_BITS);
 }
 
 TEST(SimRegisters, ResetNeedsMagicAndKeepsMemory) {

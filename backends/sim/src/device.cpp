@@ -194,6 +194,7 @@ struct Device::State {
       case Reg::TRI_MODE:
         need(FEATURE_BLEND, 3ull << 7);
         need(FEATURE_DITHER, 1ull << 9);
+        need(FEATURE_TEMPORAL_DITHER, (1ull << 15) | (15ull << 16));  // TEMPORAL, DITHER_PHASE
         break;
       case Reg::LINK_CTRL: need(FEATURE_STRICT_LINK, 1); break;
       default: break;

@@ -15,9 +15,14 @@ DrawState decode_draw_state(const RegisterValues& r, std::uint64_t vram_bytes) {
   s.z_func = static_cast<DepthFunc>((m >> 3) & 7);
   s.z_write = (m >> 6) & 1;
   s.blend = static_cast<BlendMode>((m >> 7) & 3);
-  s.dither = (m >> 9) & 1;
+  s.dither.on = (m >> 9) & 1;
   s.keep_mask = static_cast<std::uint8_t>((m >> 10) & 15);
   s.decal = (m >> 14) & 1;
+  s.dither.temporal = s.dither.on && ((m >> 15) & 1);
+  if (s.dither.temporal) {
+    const unsigned p = (m >> 16) & 15;
+    s.dither.phase_xor = static_cast<std::uint8_t>(((p & 1) << 3) | ((p & 2) << 1) | ((p & 4) >> 1) | ((p & 8) >> 3));
+  }
 
   s.fb_format = static_cast<PixelFormat>((r.fb_format >> 32) & 3);
   s.fb_width = std::max<unsigned>(1, r.fb_format & 0x7FF);

@@ -13,6 +13,13 @@ struct ClipRect {
   bool empty() const { return x1 <= x0 || y1 <= y0; }
 };
 
+// TRI_MODE.DITHER, TEMPORAL and DITHER_PHASE as the quantiser uses them (pixel.hpp, section 11).
+struct DitherMode {
+  bool on = false;              // DITHER
+  bool temporal = false;        // DITHER and TEMPORAL: thresholds B ^ phase_xor, levels scaled to 0..2^n - 1
+  std::uint8_t phase_xor = 0;   // temporal: DITHER_PHASE with its four bits reversed; 0 otherwise
+};
+
 struct TextureState {
   std::uint32_t base = 0;
   unsigned wl = 3, hl = 3;  // log2 width / height
@@ -24,7 +31,8 @@ struct TextureState {
 
 struct DrawState {
   // TRI_MODE
-  bool gouraud = false, textured = false, z_test = false, z_write = false, dither = false, decal = false;
+  bool gouraud = false, textured = false, z_test = false, z_write = false, decal = false;
+  DitherMode dither;
   protocol::DepthFunc z_func = protocol::DepthFunc::Never;
   protocol::BlendMode blend = protocol::BlendMode::Off;
   std::uint8_t keep_mask = 0;  // bit 0 R, 1 G, 2 B, 3 A: 1 = channel keeps its stored bits

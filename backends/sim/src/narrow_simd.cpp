@@ -68,7 +68,7 @@ template <bool kTextured, unsigned kFormat>
     if constexpr (kFormat != 0) {
       u32x8 bayer;
       GB_LOAD8(bayer, t.bayer[row & 3]);
-      simd::write_packed8<kFormat>(cp, 8, word, pass, true, t.blend, bayer, t.keep_packed, true);
+      simd::write_packed8<kFormat>(cp, 8, word, pass, true, t.blend, bayer, t.temporal, t.keep_packed, true);
     } else {
       u32x8 cold;
       GB_LOAD8(cold, cp);

@@ -37,7 +37,8 @@ struct NarrowTriangle {
   std::size_t colour_pitch = 0;    // bytes per colour row (4, 2 or 1 per pixel)
   unsigned format = 0;             // protocol::PixelFormat of the colour buffer
   std::uint32_t keep_packed = 0;   // packed formats: the stored bits the write mask keeps
-  std::uint32_t bayer[4][8] = {};  // packed formats with dither: Bayer value of row (first + j) % 4, lane k
+  std::uint32_t bayer[4][8] = {};  // packed formats with dither: threshold index of row (first + j) % 4, lane k
+  bool temporal = false;           // packed formats: the temporal quantiser (section 11) on `bayer`
   unsigned z_func = 0;             // protocol::DepthFunc
   unsigned blend = 0;              // protocol::BlendMode (0 = off)
   std::uint32_t keep = 0;          // bytes of the colour word the write mask keeps

@@ -1,8 +1,8 @@
 #pragma once
 // Section 11 for eight pixels of a packed colour buffer (RGB565 big-endian halfwords, RGBA2222
 // bytes), shared by both vector routines (span_simd.cpp, narrow_simd.cpp): blend against the
-// stored pixels expanded by bit replication, quantise with the lanes' ordered dither, keep the
-// bits the write mask protects, store the passing lanes. Byte for byte what pixel.hpp's
+// stored pixels expanded by bit replication, quantise with the lanes' ordered or temporal dither,
+// keep the bits the write mask protects, store the passing lanes. Byte for byte what pixel.hpp's
 // store_colour() does per pixel (the vector equivalence tests compare them). Internal to those
 // routines' .cpp files: it is inlined into their target clones.
 #include <cstdint>
@@ -69,10 +69,28 @@ template <unsigned kFormat>
   return v >> (8 - n);
 }
 
-// Colour words to packed pixels; `bayer` holds each lane's 4x4 Bayer value (0 without dither),
-// scaled per channel width as (bayer << (8 - n)) >> 4.
+// Temporal quantiser of channel c (pixel.hpp's quantise_temporal): `t16` holds each lane's 16t + 8.
+template <unsigned kBits>
+[[gnu::always_inline]] inline u32x8 quantise_temporal8(u32x8 word, unsigned c, u32x8 t16) {
+  const u32x8 v = (word >> c) & 255u;
+  const u32x8 a = (v << kBits) - v;
+  return (a + (a >> 8) + t16) >> 8;
+}
+
+// Colour words to packed pixels. `bayer` holds each lane's threshold index t (0 without dither).
+// Ordered dither: t scaled per channel width as (t << (8 - n)) >> 4, saturating add, truncate.
+// Temporal (`temporal`): the scaled quantiser with the centred threshold 16t + 8.
 template <unsigned kFormat>
-[[gnu::always_inline]] inline u32x8 pack_colour(u32x8 word, u32x8 bayer) {
+[[gnu::always_inline]] inline u32x8 pack_colour(u32x8 word, u32x8 bayer, bool temporal) {
+  if (temporal) {
+    const u32x8 t16 = (bayer << 4) + 8u;
+    if constexpr (kFormat == 1)
+      return (quantise_temporal8<5>(word, 0, t16) << 11) | (quantise_temporal8<6>(word, 8, t16) << 5) |
+             quantise_temporal8<5>(word, 16, t16);
+    else
+      return (quantise_temporal8<2>(word, 0, t16) << 6) | (quantise_temporal8<2>(word, 8, t16) << 4) |
+             (quantise_temporal8<2>(word, 16, t16) << 2) | quantise_temporal8<2>(word, 24, t16);
+  }
   if constexpr (kFormat == 1) {
     const u32x8 add5 = bayer >> 1, add6 = bayer >> 2;
     return (quantise8(word, 0, 5, add5) << 11) | (quantise8(word, 8, 6, add6) << 5) | quantise8(word, 16, 5, add5);
@@ -87,10 +105,11 @@ template <unsigned kFormat>
 // mask, or lanes that do not pass); without it nothing is read. `whole`: as for load_packed.
 template <unsigned kFormat>
 [[gnu::always_inline]] inline void write_packed8(std::uint8_t* p, unsigned n, u32x8 word, u32x8 pass, bool need_old,
-                                                 unsigned blend, u32x8 bayer, std::uint32_t keep_bits, bool whole) {
+                                                 unsigned blend, u32x8 bayer, bool temporal, std::uint32_t keep_bits,
+                                                 bool whole) {
   const u32x8 old = need_old ? load_packed<kFormat>(p, n, whole) : u32x8{};
   if (blend != 0) word = GB_BLEND8(blend, word, expand_packed<kFormat>(old));
-  u32x8 out = pack_colour<kFormat>(word, bayer);
+  u32x8 out = pack_colour<kFormat>(word, bayer, temporal);
   out = (out & ~keep_bits) | (old & keep_bits);
   out = (out & pass) | (old & ~pass);
   store_packed<kFormat>(p, out, n);

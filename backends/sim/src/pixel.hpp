@@ -3,6 +3,7 @@
 // quantise + dither, write mask. The rasteriser calls them in section 11's order.
 #include <cstdint>
 
+#include "draw_state.hpp"
 #include "fixed_point.hpp"
 #include "gpubridge/protocol/pixel.hpp"
 
@@ -37,19 +38,33 @@ inline protocol::Rgba8 blend(protocol::BlendMode m, protocol::Rgba8 src, protoco
 
 inline constexpr std::uint8_t kBayer4[4][4] = {{0, 8, 2, 10}, {12, 4, 14, 6}, {3, 11, 1, 9}, {15, 7, 13, 5}};
 
+// Dither threshold index t (0..15) of screen position (x, y): the Bayer value, XOR the reversed
+// phase in temporal mode. XOR with a constant permutes the 16 values, so every aligned 4x4 block
+// of every frame still holds each threshold once.
+inline unsigned dither_threshold(const DitherMode& d, int x, int y) { return kBayer4[y & 3][x & 3] ^ d.phase_xor; }
+
+// Temporal quantiser: v scaled to the n-bit levels 0..M (M = 2^n - 1, g = M·v + (M·v >> 8), which
+// is 256·M·v/255 within one unit and at most 256·M - 1), plus the centred threshold 16t + 8, over
+// 256. Never above M, so no saturation; the mean over the 16 thresholds is g/256 within 1/32.
+inline unsigned quantise_temporal(unsigned v, unsigned n, unsigned t) {
+  const unsigned a = (v << n) - v;
+  return (a + (a >> 8) + (t << 4) + 8) >> 8;
+}
+
 // 8-bit value v to an n-bit channel (n < 8), optionally dithered at screen position (x, y).
-inline unsigned quantise(unsigned v, unsigned n, bool dither, int x, int y) {
-  if (dither) {
-    const unsigned add = (unsigned{kBayer4[y & 3][x & 3]} << (8 - n)) >> 4;
-    v = v + add > 255 ? 255 : v + add;
-  }
+inline unsigned quantise(unsigned v, unsigned n, const DitherMode& d, int x, int y) {
+  if (!d.on) return v >> (8 - n);
+  const unsigned t = dither_threshold(d, x, y);
+  if (d.temporal) return quantise_temporal(v, n, t);
+  const unsigned add = (t << (8 - n)) >> 4;
+  v = v + add > 255 ? 255 : v + add;
   return v >> (8 - n);
 }
 
 // Quantises (and dithers) c and stores it at p honouring the write mask (keep bit 0 R .. 3 A:
 // 1 = keep the stored channel).
-inline void store_colour(protocol::PixelFormat f, std::uint8_t* p, protocol::Rgba8 c, bool dither, std::uint8_t keep,
-                         int x, int y) {
+inline void store_colour(protocol::PixelFormat f, std::uint8_t* p, protocol::Rgba8 c, const DitherMode& dither,
+                         std::uint8_t keep, int x, int y) {
   using protocol::PixelFormat;
   switch (f) {
     case PixelFormat::RGB565: {

@@ -252,6 +252,7 @@ class Kernel {
     simd_tpl_.keep = keep_bytes(st_.keep_mask);
     simd_tpl_.format = static_cast<unsigned>(st_.fb_format);
     simd_tpl_.keep_packed = keep_packed_bits(st_.fb_format, st_.keep_mask);
+    simd_tpl_.temporal = st_.dither.temporal && st_.fb_format != protocol::PixelFormat::RGBA8888;
     if (kTextured) simd_tpl_.texture = {&tex_, &ctx_.recip, q_const_, const_rc_, st_.tex.wl, st_.tex.hl, st_.decal};
     simd_ = true;
   }
@@ -275,8 +276,8 @@ class Kernel {
     }
     const std::size_t pix = static_cast<std::size_t>(y) * width_ + static_cast<std::size_t>(x);
     sp.colour = color_ + pix * st_.bpp;
-    if (st_.dither && st_.fb_format != protocol::PixelFormat::RGBA8888)
-      for (unsigned k = 0; k < 8; ++k) sp.bayer[k] = kBayer4[y & 3][(static_cast<unsigned>(x) + k) & 3];
+    if (st_.dither.on && st_.fb_format != protocol::PixelFormat::RGBA8888)
+      for (unsigned k = 0; k < 8; ++k) sp.bayer[k] = dither_threshold(st_.dither, x + static_cast<int>(k), y);
     sp.depth = kDepth ? zbuf_ + pix * 4 : nullptr;
     sp.count = count;
     sp.room = width_ - static_cast<unsigned>(x);
@@ -454,10 +455,10 @@ bool draw_narrow(const Triangle& t, const DrawState& st, RasterContext& ctx, int
   n.colour_pitch = std::size_t{st.fb_width} * st.bpp;
   n.format = static_cast<unsigned>(st.fb_format);
   n.keep_packed = keep_packed_bits(st.fb_format, st.keep_mask);
-  if (st.dither && st.fb_format != protocol::PixelFormat::RGBA8888)
-    for (unsigned j = 0; j < 4; ++j)
-      for (unsigned lane = 0; lane < 8; ++lane)
-        n.bayer[j][lane] = kBayer4[(static_cast<unsigned>(ya) + j) & 3][(static_cast<unsigned>(t.x0) + lane) & 3];
+  if (st.dither.on && st.fb_format != protocol::PixelFormat::RGBA8888)
+    for (int j = 0; j < 4; ++j)
+      for (int lane = 0; lane < 8; ++lane) n.bayer[j][lane] = dither_threshold(st.dither, t.x0 + lane, ya + j);
+  n.temporal = st.dither.temporal && st.fb_format != protocol::PixelFormat::RGBA8888;
   n.z_func = static_cast<unsigned>(st.z_func);
   n.gouraud = gouraud;
   n.z_test = st.z_test;

@@ -90,7 +90,8 @@ template <bool kTextured, unsigned kFormat>
       if (s.gouraud) word = (q[0] & 255u) | ((q[1] & 255u) << 8) | ((q[2] & 255u) << 16) | (q[3] << 24);
       if constexpr (kTextured) word = texture8(s.texture, q[5], q[6], q[7], pass, n, word);
       if constexpr (kFormat != 0) {
-        simd::write_packed8<kFormat>(cp, n, word, pass, reads_colour || !all, s.blend, bayer, s.keep_packed, whole);
+        simd::write_packed8<kFormat>(cp, n, word, pass, reads_colour || !all, s.blend, bayer, s.temporal, s.keep_packed,
+                                    whole);
       } else if (reads_colour || !all) {
         u32x8 cold;
         GB_LOAD_N(cold, cp, n, whole);

@@ -1,6 +1,6 @@
 #pragma once
 // The vectorised span routine for draws into an RGBA8888, RGB565 or RGBA2222 buffer (packed formats
-// quantised with the optional ordered dither, section 11): optional depth test/write,
+// quantised with the optional ordered or temporal dither, section 11): optional depth test/write,
 // optional texture (any format inside VRAM, nearest or bilinear, modulate or decal; the texture
 // disjoint from both buffers), optional blend (ALPHA, ADD, MULTIPLY) and write mask, both buffers
 // inside VRAM and disjoint. Eight pixels per step: lanes k = 0..7
@@ -30,8 +30,9 @@ struct SimdSpan {
   std::uint32_t keep = 0;                  // bytes of the colour word the write mask keeps
   unsigned format = 0;                     // protocol::PixelFormat of the colour buffer
   std::uint32_t keep_packed = 0;           // packed formats: the stored bits the write mask keeps
-  std::uint32_t bayer[8] = {};             // packed formats with dither: 4x4 Bayer value of lane k's pixel
+  std::uint32_t bayer[8] = {};             // packed formats with dither: threshold index of lane k's pixel
                                            // (the pattern repeats every 4 pixels, so every chunk of 8 shares it)
+  bool temporal = false;                   // packed formats: the temporal quantiser (section 11) on `bayer`
   bool gouraud = false, z_test = false, z_write = false;
   // Texture stage (texture.tex == nullptr: untextured). Texels are fetched lane by lane (the
   // texel coordinates need 64-bit products and a table lookup); filter and combine run in lanes.

@@ -38,6 +38,8 @@ std::uint64_t tri_mode_word(const RenderState& s) {
   w = put(Reg::TRI_MODE, "MASK_B", w, s.mask_b);
   w = put(Reg::TRI_MODE, "MASK_A", w, s.mask_a);
   w = put(Reg::TRI_MODE, "TEX_DECAL", w, s.tex_decal);
+  w = put(Reg::TRI_MODE, "TEMPORAL", w, s.temporal);
+  w = put(Reg::TRI_MODE, "DITHER_PHASE", w, s.dither_phase & 15);
   return w;
 }
 

@@ -244,8 +244,8 @@ class Parser {
 
   Result<Draw> draw(const json& j, const std::string& p, Scene& s) {
     if (auto o = r_.object(j, p); !o) return o.error();
-    if (auto k = r_.only_keys(j, p, {"comment", "gouraud", "z_test", "z_func", "z_write", "blend", "dither", "write_mask",
-                                     "texture", "texture_mode", "wrap", "wrap_s", "wrap_t", "filter", "cull", "scissor",
+    if (auto k = r_.only_keys(j, p, {"comment", "gouraud", "z_test", "z_func", "z_write", "blend", "dither", "temporal",
+                                     "dither_phase", "write_mask", "texture", "texture_mode", "wrap", "wrap_s", "wrap_t", "filter", "cull", "scissor",
                                      "color", "vertices"});
         !k)
       return k.error();
@@ -263,6 +263,14 @@ class Parser {
     auto di = flag(j, p, "dither", false);
     if (!di) return di.error();
     st.dither = *di;
+    auto te = flag(j, p, "temporal", false);
+    if (!te) return te.error();
+    st.temporal = *te;
+    if (j.contains("dither_phase")) {
+      auto ph = r_.uint_in(j["dither_phase"], R::child(p, "dither_phase"), 0, 15);
+      if (!ph) return ph.error();
+      st.dither_phase = *ph;
+    }
     if (j.contains("z_func")) {
       auto f = r_.choice(j["z_func"], R::child(p, "z_func"), kDepthFuncs);
       if (!f) return f.error();

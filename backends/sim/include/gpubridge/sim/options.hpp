@@ -42,8 +42,9 @@ enum Feature : std::uint8_t {
   FEATURE_STRICT_LINK = 1u << 3,
   FEATURE_RGB565 = 1u << 4,
   FEATURE_RGBA2222 = 1u << 5,
+  FEATURE_TEMPORAL_DITHER = 1u << 6,  // TRI_MODE.TEMPORAL and DITHER_PHASE (protocol 1.1)
 };
-inline constexpr std::uint8_t kAllFeatures = 0x3F;
+inline constexpr std::uint8_t kAllFeatures = 0x7F;
 
 inline constexpr std::uint64_t kMaxVramBytes = 1ull << 32;  // addresses are 32-bit
 inline constexpr unsigned kMaxThreads = 64;
