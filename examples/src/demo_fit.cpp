@@ -60,11 +60,12 @@ int fail(const std::string& msg, int code) {
   return code;
 }
 
-Result<std::vector<std::unique_ptr<examples::Example>>> select(const std::vector<std::string>& names) {
+Result<std::vector<std::unique_ptr<examples::Example>>> select(const std::vector<std::string>& names,
+                                                               const examples::ExampleParams& params) {
   std::vector<std::unique_ptr<examples::Example>> out;
-  if (names.empty() || (names.size() == 1 && names[0] == "all")) return examples::make_examples();
+  if (names.empty() || (names.size() == 1 && names[0] == "all")) return examples::make_examples(params);
   for (const auto& n : names) {
-    auto e = examples::make_example(n);
+    auto e = examples::make_example(n, params);
     if (!e) {
       std::string list;
       for (const auto& k : examples::example_names()) list += " " + k;

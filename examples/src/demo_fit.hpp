@@ -17,7 +17,8 @@ namespace gpubridge::demo {
 int fail(const std::string& msg, int code = 1);
 
 // The named examples (all for none or "all"); an unknown name is an error listing the known ones.
-Result<std::vector<std::unique_ptr<examples::Example>>> select(const std::vector<std::string>& names);
+Result<std::vector<std::unique_ptr<examples::Example>>> select(const std::vector<std::string>& names,
+                                                               const examples::ExampleParams& params = {});
 
 // --size, --format, --no-depth, --without as given.
 struct FitOptions {

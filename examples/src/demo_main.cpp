@@ -17,6 +17,8 @@
 #include "gpubridge/draw/sim_sink.hpp"
 #include "gpubridge/examples/example.hpp"
 #include "gpubridge/examples/golden.hpp"
+#include "gpubridge/examples/cordic.hpp"
+#include "gpubridge/examples/figures.hpp"
 #if GPUBRIDGE_DRAW_HAS_CLIENT
 #include "gpubridge/draw/client_sink.hpp"
 #endif
@@ -40,9 +42,10 @@ int run_list(bool json) {
   return 0;
 }
 
-int run_render(const std::vector<std::string>& names, const FitOptions& fit_options, const std::string& board,
-               const std::string& out_dir, unsigned first, unsigned frames, bool json) {
-  auto list = select(names);
+int run_render(const std::vector<std::string>& names, const examples::ExampleParams& params,
+               const FitOptions& fit_options, const std::string& board, const std::string& out_dir, unsigned first,
+               unsigned frames, bool json) {
+  auto list = select(names, params);
   if (!list) return fail(list.error().message);
   auto request = fit_options.request();
   if (!request) return fail(request.error().message, 2);
@@ -78,10 +81,11 @@ int run_render(const std::vector<std::string>& names, const FitOptions& fit_opti
   return 0;
 }
 
-int run_stream(const std::vector<std::string>& names, const FitOptions& fit_options, const std::string& address,
+int run_stream(const std::vector<std::string>& names, const examples::ExampleParams& params, const FitOptions& fit_options,
+               const std::string& address,
                unsigned frames, double fps, bool json) {
 #if GPUBRIDGE_DRAW_HAS_CLIENT
-  auto list = select(names);
+  auto list = select(names, params);
   if (!list) return fail(list.error().message);
   auto request = fit_options.request();
   if (!request) return fail(request.error().message, 2);
@@ -111,7 +115,7 @@ int run_stream(const std::vector<std::string>& names, const FitOptions& fit_opti
   if (json) std::puts(json_text(summary, 2).c_str());
   return 0;
 #else
-  (void)names, (void)fit_options, (void)address, (void)frames, (void)fps, (void)json;
+  (void)names, (void)params, (void)fit_options, (void)address, (void)frames, (void)fps, (void)json;
   return fail("this build has no daemon client library (gpubridge_client); use `render`");
 #endif
 }
@@ -134,25 +138,30 @@ int run_goldens(const std::string& dir, const std::vector<std::string>& class_na
   for (const auto* cls : classes)
     for (auto& ex : examples::make_examples()) {
       const std::string name = ex->info().name;
-      auto img = examples::render_golden_frame(*ex, *cls);
-      if (!img) return fail(cls->name + ": " + img.error().message);
-      const fs::path path = examples::golden_path(dir, *cls, name);
-      if (write) {
-        std::error_code ec;
-        fs::create_directories(path.parent_path(), ec);
-        if (auto s = save_png(path, *img); !s) return fail(s.error().message);
-        if (!json) std::printf("wrote %s\n", path.string().c_str());
-        report.push_back({{"class", cls->name}, {"example", name}, {"path", path.string()}, {"written", true}});
+      auto frames = examples::render_golden_frames(*ex, *cls);
+      if (!frames) return fail(cls->name + ": " + frames.error().message);
+      for (const auto& [frame, img] : *frames) {
+        const fs::path path = examples::golden_path(dir, *cls, name, frame);
+        if (write) {
+          std::error_code ec;
+          fs::create_directories(path.parent_path(), ec);
+          if (auto s = save_png(path, img); !s) return fail(s.error().message);
+          if (!json) std::printf("wrote %s\n", path.string().c_str());
+          report.push_back({{"class", cls->name}, {"example", name}, {"frame", frame}, {"path", path.string()},
+                            {"written", true}});
         continue;
       }
       auto golden = load_png(path);
       if (!golden)
         return fail(golden.error().message + " (create the goldens with: gpubridge-demo goldens --dir " + dir + " --write)");
-      const auto diff = examples::compare_images(*golden, *img);
-      if (!diff.identical()) ++failures;
-      if (!json) std::printf("%-9s %-12s %s\n", cls->name.c_str(), name.c_str(), diff.summary().c_str());
-      report.push_back({{"class", cls->name}, {"example", name}, {"path", path.string()},
-                        {"differing_pixels", diff.differing_pixels}, {"max_difference", diff.max_difference}});
+        const auto diff = examples::compare_images(*golden, img);
+        if (!diff.identical()) ++failures;
+        // The first golden frame is named alone, later ones with their number.
+        const std::string label = frame == examples::kGoldenFrame ? name : name + " frame " + std::to_string(frame);
+        if (!json) std::printf("%-9s %-26s %s\n", cls->name.c_str(), label.c_str(), diff.summary().c_str());
+        report.push_back({{"class", cls->name}, {"example", name}, {"frame", frame}, {"path", path.string()},
+                          {"differing_pixels", diff.differing_pixels}, {"max_difference", diff.max_difference}});
+      }
     }
   if (json) std::puts(json_text(report, 2).c_str());
   return failures ? 1 : 0;
@@ -163,8 +172,27 @@ void add_fit_options(CLI::App* sub, FitOptions& o) {
   sub->add_option("--size", o.size, "force the framebuffer size, WIDTHxHEIGHT (default: the largest that fits)");
   sub->add_option("--format", o.format, "force the framebuffer format: RGBA8888, RGB565 or RGBA2222");
   sub->add_flag("--no-depth", o.no_depth, "draw without a depth buffer (each example's painter's order)");
-  sub->add_option("--without", o.without, "do not use these device features: bilinear, blend, dither, rgb565, rgba2222, texture (comma-separated)")
+  sub->add_option("--without", o.without, "do not use these device features: bilinear, blend, dither, rgb565, rgba2222, temporal, texture (comma-separated)")
       ->delimiter(',')->allow_extra_args(false);
+}
+
+int run_figures(const std::string& dir, bool json) {
+  auto figures = examples::write_figures(dir);
+  if (!figures) return fail(figures.error().message);
+  nlohmann::json report = nlohmann::json::array();
+  for (const auto& f : *figures) {
+    const std::string path = (fs::path(dir) / f.file).string();
+    nlohmann::json j{{"path", path}, {"what", f.what}};
+    if (f.has_error) j["mean_error_lsb"] = f.mean_error;
+    report.push_back(j);
+    if (json) continue;
+    if (f.has_error)
+      std::printf("%-44s %s (mean error %.2f LSB)\n", path.c_str(), f.what.c_str(), f.mean_error);
+    else
+      std::printf("%-44s %s\n", path.c_str(), f.what.c_str());
+  }
+  if (json) std::puts(json_text(report, 2).c_str());
+  return 0;
 }
 
 }  // namespace
@@ -191,6 +219,14 @@ int main(int argc, char** argv) {
                                        "plain simulator)");
   add_fit_options(render, fit_options);
 
+  examples::ExampleParams params;
+  const std::string iterations_help = "shift-and-add steps per rotation of torus-cordic (" +
+                                      std::to_string(examples::cordic::kMinIterations) + ".." +
+                                      std::to_string(examples::cordic::kMaxIterations) + ")";
+  render->add_option("--cordic-iterations", params.cordic_iterations, iterations_help)
+      ->check(CLI::Range(examples::cordic::kMinIterations, examples::cordic::kMaxIterations))
+      ->capture_default_str();
+
   std::string address;
   unsigned stream_frames = 120;
   double fps = 30;
@@ -200,6 +236,9 @@ int main(int argc, char** argv) {
   stream->add_option("--frames", stream_frames, "frames per example")->check(CLI::Range(1u, 1000000u))->capture_default_str();
   stream->add_option("--fps", fps, "frames per second (0 = as fast as possible)")->check(CLI::Range(0.0, 1000.0))->capture_default_str();
   add_fit_options(stream, fit_options);
+  stream->add_option("--cordic-iterations", params.cordic_iterations, iterations_help)
+      ->check(CLI::Range(examples::cordic::kMinIterations, examples::cordic::kMaxIterations))
+      ->capture_default_str();
 
   std::string golden_dir;
   std::vector<std::string> classes;
@@ -219,12 +258,18 @@ int main(int argc, char** argv) {
   fit->add_flag("--markdown", markdown, "print Markdown tables (docs/examples.md)");
   add_fit_options(fit, fit_options);
 
-  for (auto* sub : {list, render, stream, goldens, fit}) sub->add_flag("--json", json, "machine-readable output");
+  std::string figures_dir;
+  auto* figures = app.add_subcommand(
+      "figures", "render the temporal-dither and CORDIC figures of docs/examples.md (the torus held at its golden pose)");
+  figures->add_option("--dir", figures_dir, "output directory (created; docs/screenshots in the source tree)")->required();
+
+  for (auto* sub : {list, render, stream, goldens, fit, figures}) sub->add_flag("--json", json, "machine-readable output");
   CLI11_PARSE(app, argc, argv);
   gpubridge::init_logging("warn");
   if (*list) return run_list(json);
-  if (*render) return run_render(names, fit_options, board, out_dir, first, frames, json);
-  if (*stream) return run_stream(names, fit_options, address, stream_frames, fps, json);
+  if (*render) return run_render(names, params, fit_options, board, out_dir, first, frames, json);
+  if (*stream) return run_stream(names, params, fit_options, address, stream_frames, fps, json);
+  if (*figures) return run_figures(figures_dir, json);
   if (*fit) return run_fit(names, boards, fit_options, timing, markdown, json);
   return run_goldens(golden_dir, classes, write, json);
 }

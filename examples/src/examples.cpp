@@ -43,11 +43,15 @@ Result<Fit> configure(Example& ex, const DeviceCaps& device, const FitRequest& r
   return f;
 }
 
-std::vector<std::unique_ptr<Example>> make_examples() {
+std::vector<unsigned> Example::golden_frames() const { return {kGoldenFrame}; }
+
+std::vector<std::unique_ptr<Example>> make_examples(const ExampleParams& params) {
   std::vector<std::unique_ptr<Example>> all;
   all.push_back(make_tetrahedron());
   all.push_back(make_terrain());
   all.push_back(make_torus());
+  all.push_back(make_torus({.temporal = true}));
+  all.push_back(make_torus({.cordic_iterations = params.cordic_iterations}));
   all.push_back(make_voxels());
   all.push_back(make_room());
   all.push_back(make_cubes());
@@ -55,8 +59,8 @@ std::vector<std::unique_ptr<Example>> make_examples() {
   return all;
 }
 
-std::unique_ptr<Example> make_example(std::string_view name) {
-  for (auto& e : make_examples())
+std::unique_ptr<Example> make_example(std::string_view name, const ExampleParams& params) {
+  for (auto& e : make_examples(params))
     if (e->info().name == name) return std::move(e);
   return nullptr;
 }

@@ -3,13 +3,13 @@
 #include <memory>
 
 #include "gpubridge/examples/example.hpp"
+#include "gpubridge/examples/torus.hpp"
 #include "gpubridge/geometry/math.hpp"
 
 namespace gpubridge::examples {
 
 std::unique_ptr<Example> make_tetrahedron();
 std::unique_ptr<Example> make_terrain();
-std::unique_ptr<Example> make_torus();
 std::unique_ptr<Example> make_voxels();
 std::unique_ptr<Example> make_room();
 std::unique_ptr<Example> make_cubes();

@@ -18,7 +18,8 @@ struct FeatureName {
   std::string_view name;
 };
 constexpr FeatureName kFeatureNames[] = {{kBilinear, "bilinear"}, {kBlend, "blend"},       {kDither, "dither"},
-                                         {kRgb565, "rgb565"},     {kRgba2222, "rgba2222"}, {kTexturing, "texture"}};
+                                         {kRgb565, "rgb565"},     {kRgba2222, "rgba2222"}, {kTemporalDither, "temporal"},
+                                         {kTexturing, "texture"}};
 
 bool format_available(PixelFormat f, std::uint16_t features) {
   if (f == PixelFormat::RGB565) return (features & kRgb565) != 0;

@@ -9,21 +9,29 @@
 
 namespace gpubridge::examples {
 
-Result<Image> render_golden_frame(Example& ex, const sim::DeviceOptions& device) {
+Result<std::vector<GoldenFrame>> render_golden_frames(Example& ex, const sim::DeviceOptions& device) {
+  const auto wanted = ex.golden_frames();
+  if (wanted.empty()) return make_error(ex.info().name + ": no golden frames");
   auto sink = draw::SimulatorSink::create(device);
   if (!sink) return sink.error();
   auto ctx = draw::Context::create(**sink, ex.options());
   if (!ctx) return make_error(ex.info().name + ": " + ctx.error().message);
-  if (auto r = run_frames(ex, *ctx, 0, kGoldenFrame + 1); !r) return r.error();
-  const auto f = (*sink)->latest_frame();
-  if (!f) return make_error(ex.info().name + ": no frame was scanned out");
+  std::vector<GoldenFrame> out;
+  auto keep = [&](unsigned n) -> Result<void> {
+    if (std::find(wanted.begin(), wanted.end(), n) == wanted.end()) return {};
+    const auto f = (*sink)->latest_frame();
+    if (!f) return make_error(ex.info().name + ": no frame was scanned out");
+    out.push_back({n, image_from_device(f->format, f->width, f->height, f->pixels)});
+    return {};
+  };
+  if (auto r = run_frames(ex, *ctx, 0, wanted.back() + 1, keep); !r) return r.error();
   if (const auto errors = (*sink)->backend().device().errors())
     return make_error(fmt::format("{}: the device reported errors: {}", ex.info().name, protocol::describe_errors(errors)));
-  return image_from_device(f->format, f->width, f->height, f->pixels);
+  return out;
 }
 
-std::filesystem::path golden_path(const std::filesystem::path& dir, const std::string& name) {
-  return dir / (name + ".png");
+std::filesystem::path golden_path(const std::filesystem::path& dir, const std::string& name, unsigned frame) {
+  return dir / (frame == kGoldenFrame ? name + ".png" : fmt::format("{}-f{}.png", name, frame));
 }
 
 const std::vector<GoldenClass>& golden_classes() {
@@ -51,15 +59,24 @@ const GoldenClass* find_golden_class(std::string_view name) {
   return nullptr;
 }
 
-Result<Image> render_golden_frame(Example& ex, const GoldenClass& cls, unsigned threads) {
+Result<std::vector<GoldenFrame>> render_golden_frames(Example& ex, const GoldenClass& cls, unsigned threads) {
   if (auto f = configure(ex, cls.device); !f) return f.error();
   auto options = cls.device.simulator_options();
   options.threads = threads;
-  return render_golden_frame(ex, options);
+  return render_golden_frames(ex, options);
 }
 
-std::filesystem::path golden_path(const std::filesystem::path& dir, const GoldenClass& cls, const std::string& name) {
-  return cls.name == "large" ? golden_path(dir, name) : golden_path(dir / cls.name, name);
+Result<Image> render_golden_frame(Example& ex, const GoldenClass& cls, unsigned threads) {
+  auto frames = render_golden_frames(ex, cls, threads);
+  if (!frames) return frames.error();
+  for (auto& f : *frames)
+    if (f.frame == kGoldenFrame) return std::move(f.image);
+  return make_error(ex.info().name + ": frame " + std::to_string(kGoldenFrame) + " is not among its golden frames");
+}
+
+std::filesystem::path golden_path(const std::filesystem::path& dir, const GoldenClass& cls, const std::string& name,
+                                  unsigned frame) {
+  return golden_path(cls.name == "large" ? dir : dir / cls.name, name, frame);
 }
 
 ImageDiff compare_images(const Image& expected, const Image& actual) {

@@ -5,6 +5,7 @@
 //   gpubridge-demo goldens --dir examples/golden --write
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 
 #include "gpubridge/examples/example.hpp"
@@ -32,17 +33,21 @@ TEST_P(ExampleGolden, MatchesCommittedPng) {
   ASSERT_NE(cls, nullptr);
   auto ex = make_example(name);
   ASSERT_NE(ex, nullptr);
-  auto actual = render_golden_frame(*ex, *cls);
-  ASSERT_TRUE(actual) << actual.error().message;
-  auto golden = load_png(golden_path(GPUBRIDGE_GOLDEN_DIR, *cls, name));
-  ASSERT_TRUE(golden) << golden.error().message;
-  const auto diff = compare_images(*golden, *actual);
-  if (!diff.identical()) {
-    const auto out = golden_path(GPUBRIDGE_GOLDEN_OUT, *cls, name);
-    std::filesystem::create_directories(out.parent_path());
-    (void)save_png(out, *actual);
-    ADD_FAILURE() << cls_name << " " << name << ": " << diff.summary() << "\nactual frame written to " << out.string()
-                  << "\nif the renderer legitimately changed: gpubridge-demo goldens --dir examples/golden --write";
+  auto frames = render_golden_frames(*ex, *cls);
+  ASSERT_TRUE(frames) << frames.error().message;
+  ASSERT_EQ(frames->size(), ex->golden_frames().size());
+  for (const auto& [frame, actual] : *frames) {
+    auto golden = load_png(golden_path(GPUBRIDGE_GOLDEN_DIR, *cls, name, frame));
+    ASSERT_TRUE(golden) << golden.error().message;
+    const auto diff = compare_images(*golden, actual);
+    if (!diff.identical()) {
+      const auto out = golden_path(GPUBRIDGE_GOLDEN_OUT, *cls, name, frame);
+      std::filesystem::create_directories(out.parent_path());
+      (void)save_png(out, actual);
+      ADD_FAILURE() << cls_name << " " << name << " frame " << frame << ": " << diff.summary()
+                    << "\nactual frame written to " << out.string()
+                    << "\nif the renderer legitimately changed: gpubridge-demo goldens --dir examples/golden --write";
+    }
   }
 }
 
@@ -52,6 +57,22 @@ INSTANTIATE_TEST_SUITE_P(AllExamples, ExampleGolden, ::testing::ValuesIn(all_cas
     if (c == '-') c = '_';
   return n;
 });
+
+// The temporal dither's golden frames differ from each other (the pattern moves every frame) and
+// from the ordered dither's frame.
+TEST(ExampleFrames, TemporalDitherFramesDifferFromEachOtherAndFromTheOrderedDither) {
+  auto temporal = make_example("torus-temporal"), ordered = make_example("torus");
+  ASSERT_TRUE(temporal && ordered);
+  const GoldenClass* large = find_golden_class("large");
+  ASSERT_NE(large, nullptr);
+  auto frames = render_golden_frames(*temporal, *large);
+  auto still = render_golden_frame(*ordered, *large);
+  ASSERT_TRUE(frames && still);
+  ASSERT_EQ(frames->size(), 4u);
+  EXPECT_FALSE(compare_images(*still, frames->front().image).identical());
+  for (std::size_t i = 1; i < frames->size(); ++i)
+    EXPECT_FALSE(compare_images((*frames)[i - 1].image, (*frames)[i].image).identical()) << (*frames)[i].frame;
+}
 
 TEST(ExampleGolden, LargeClassIsWhatEveryExampleWants) {
   // The large goldens are the examples as written: nothing given up on the default simulator,
@@ -83,9 +104,13 @@ TEST(ExampleFrames, IdenticalWithSeveralRasteriserThreads) {
   for (const auto& cls : golden_classes())
     for (const auto& name : example_names()) {
       auto a = make_example(name), b = make_example(name);
-      auto ia = render_golden_frame(*a, cls), ib = render_golden_frame(*b, cls, 3);
-      ASSERT_TRUE(ia && ib);
-      EXPECT_TRUE(compare_images(*ia, *ib).identical()) << cls.name << " " << name << ": " << compare_images(*ia, *ib).summary();
+      auto fa = render_golden_frames(*a, cls), fb = render_golden_frames(*b, cls, 3);
+      ASSERT_TRUE(fa && fb);
+      ASSERT_EQ(fa->size(), fb->size());
+      for (std::size_t i = 0; i < fa->size(); ++i)
+        EXPECT_TRUE(compare_images((*fa)[i].image, (*fb)[i].image).identical())
+            << cls.name << " " << name << " frame " << (*fa)[i].frame << ": "
+            << compare_images((*fa)[i].image, (*fb)[i].image).summary();
     }
 }
 

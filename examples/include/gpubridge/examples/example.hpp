@@ -37,18 +37,26 @@ class Example {
   virtual Result<void> setup(draw::Context& ctx) = 0;
   // Draws frame `n` (clears included), without swapping. Frame n is a pure function of n.
   virtual Result<void> frame(draw::Context& ctx, unsigned n) = 0;
+  // The frames with golden images, ascending; kGoldenFrame first (examples that change from frame
+  // to frame by design, like the temporal dither, add the following ones).
+  virtual std::vector<unsigned> golden_frames() const;
 
  private:
   mutable std::optional<Fit> fit_;
+};
+
+// Parameters of the examples that take one (gpubridge-demo --cordic-iterations).
+struct ExampleParams {
+  unsigned cordic_iterations = 8;  // torus-cordic: shift-and-add steps per rotation, 4..16
 };
 
 // Fits the example to `device` (honouring `request`) and configures it with the result.
 Result<Fit> configure(Example& ex, const DeviceCaps& device, const FitRequest& request = {});
 
 // Every example, in presentation order.
-std::vector<std::unique_ptr<Example>> make_examples();
+std::vector<std::unique_ptr<Example>> make_examples(const ExampleParams& params = {});
 // nullptr for an unknown name.
-std::unique_ptr<Example> make_example(std::string_view name);
+std::unique_ptr<Example> make_example(std::string_view name, const ExampleParams& params = {});
 std::vector<std::string> example_names();
 
 // The frame each example's golden image shows.

@@ -35,8 +35,9 @@ inline constexpr std::uint16_t kDither = sim::FEATURE_DITHER;
 inline constexpr std::uint16_t kStrictLink = sim::FEATURE_STRICT_LINK;
 inline constexpr std::uint16_t kRgb565 = sim::FEATURE_RGB565;
 inline constexpr std::uint16_t kRgba2222 = sim::FEATURE_RGBA2222;
+inline constexpr std::uint16_t kTemporalDither = sim::FEATURE_TEMPORAL_DITHER;
 inline constexpr std::uint16_t kTexturing = 1u << 8;
-// "bilinear", "blend", "dither", "rgb565", "rgba2222", "texture".
+// "bilinear", "blend", "dither", "rgb565", "rgba2222", "temporal", "texture".
 std::string_view feature_name(std::uint16_t bit);
 std::optional<std::uint16_t> parse_feature(std::string_view name);
 // "bilinear blend ..." for a mask (the known bits only).

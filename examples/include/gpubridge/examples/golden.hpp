@@ -11,10 +11,15 @@
 
 namespace gpubridge::examples {
 
-// Renders frames 0..kGoldenFrame of the example as configured on a fresh simulator and returns
-// the last scanned-out frame; any device error flag is an error.
-Result<Image> render_golden_frame(Example& ex, const sim::DeviceOptions& device = {});
-std::filesystem::path golden_path(const std::filesystem::path& dir, const std::string& name);
+// Renders frames 0..last of ex.golden_frames() of the example as configured, on a fresh simulator,
+// and returns those frames, in that order; any device error flag is an error.
+struct GoldenFrame {
+  unsigned frame = 0;
+  Image image;
+};
+Result<std::vector<GoldenFrame>> render_golden_frames(Example& ex, const sim::DeviceOptions& device = {});
+// DIR/NAME.png for kGoldenFrame, DIR/NAME-fN.png for a later golden frame N.
+std::filesystem::path golden_path(const std::filesystem::path& dir, const std::string& name, unsigned frame = kGoldenFrame);
 
 // A class of device with golden images of every example.
 struct GoldenClass {
@@ -27,11 +32,14 @@ struct GoldenClass {
 // RGBA2222 and the dither (no RGB565, bilinear filtering or blending: the least a UP5K design offers).
 const std::vector<GoldenClass>& golden_classes();
 const GoldenClass* find_golden_class(std::string_view name);
-// Configures the example for the class, then renders its golden frame there (threads: the
+// Configures the example for the class, then renders its golden frames there (threads: the
 // simulator's rasteriser threads; the output does not depend on them).
+Result<std::vector<GoldenFrame>> render_golden_frames(Example& ex, const GoldenClass& cls, unsigned threads = 1);
+// The same, frame kGoldenFrame only.
 Result<Image> render_golden_frame(Example& ex, const GoldenClass& cls, unsigned threads = 1);
-// DIR/NAME.png for the large class, DIR/CLASS/NAME.png for the others.
-std::filesystem::path golden_path(const std::filesystem::path& dir, const GoldenClass& cls, const std::string& name);
+// golden_path(DIR, NAME, FRAME) for the large class, the same in DIR/CLASS for the others.
+std::filesystem::path golden_path(const std::filesystem::path& dir, const GoldenClass& cls, const std::string& name,
+                                  unsigned frame = kGoldenFrame);
 
 struct ImageDiff {
   bool size_mismatch = false;
