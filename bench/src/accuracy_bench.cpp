@@ -15,6 +15,18 @@
 namespace gpubridge::bench {
 namespace {
 
+sim::AccuracyKnobs knobs(unsigned recip, unsigned nr, unsigned sub, unsigned zb, bool fast) {
+  sim::AccuracyKnobs k;
+  k.recip_bits = recip;
+  k.nr_steps = nr;
+  k.subpixel_bits = sub;
+  k.z_bits = zb;
+  k.fast = fast;
+  return k;
+}
+
+}  // namespace
+
 std::string machine_description() {
   std::string cpu = "unknown CPU";
   std::ifstream info("/proc/cpuinfo");
@@ -31,18 +43,6 @@ std::string machine_description() {
     << load.substr(0, load.find(' ', load.find(' ', load.find(' ') + 1) + 1));
   return o.str();
 }
-
-sim::AccuracyKnobs knobs(unsigned recip, unsigned nr, unsigned sub, unsigned zb, bool fast) {
-  sim::AccuracyKnobs k;
-  k.recip_bits = recip;
-  k.nr_steps = nr;
-  k.subpixel_bits = sub;
-  k.z_bits = zb;
-  k.fast = fast;
-  return k;
-}
-
-}  // namespace
 
 std::vector<sim::AccuracyKnobs> bench_configs() {
   return {
@@ -194,6 +194,11 @@ Result<Report> run_accuracy_bench(const AccuracyBenchOptions& opt, const std::fu
   }
   for (auto& s : rep.scenes) rep.scene_triangles.push_back(s.triangles.size());
   for (auto& s : rep.scenes) s.triangles.clear();  // descriptions only from here on
+  if (opt.cordic) {
+    auto front = run_cordic_front({.runs = 4 * runs, .quick = opt.quick}, progress);
+    if (!front) return front.error();
+    rep.cordic = std::move(front).value();
+  }
   return rep;
 }
 

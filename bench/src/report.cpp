@@ -59,6 +59,7 @@ std::string report_markdown(const Report& r, const std::string& command) {
       << error_cells(row.error) << "\n";
   }
   o << "\n![speed/error front](accuracy-front.svg)\n";
+  if (r.cordic) o << "\n" << cordic_front_markdown(*r.cordic, command);
   return o.str();
 }
 
@@ -87,6 +88,7 @@ nlohmann::json report_json(const Report& r) {
     }
     j["rows"].push_back(jr);
   }
+  if (r.cordic) j["cordic_front"] = cordic_front_json(*r.cordic);
   return j;
 }
 

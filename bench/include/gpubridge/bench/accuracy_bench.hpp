@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "gpubridge/bench/cordic_front.hpp"
 #include "gpubridge/bench/scenes.hpp"
 #include "gpubridge/common/result.hpp"
 #include "gpubridge/sim/options.hpp"
@@ -23,6 +24,7 @@ struct AccuracyBenchOptions {
   std::vector<unsigned> threads{1, 2};
   std::vector<std::string> scenes;  // only these scenes (by name); empty = all
   bool exact_only = false;          // only the exact configuration (no other accuracy knobs)
+  bool cordic = true;               // the CORDIC front of the torus example (cordic_front.hpp)
 };
 
 // Error of one renderer on one scene against the double-precision reference (the leading
@@ -57,7 +59,11 @@ struct Report {
   std::vector<std::size_t> scene_triangles;  // triangles per frame
   std::vector<Row> rows;
   std::vector<std::string> goals;  // the speed goals with their measured ratios
+  std::optional<CordicFront> cordic;  // its own section (cordic_front.hpp)
 };
+
+// "CPU model, N hardware threads, load average at start: a b c" (figures on a shared machine need it).
+std::string machine_description();
 
 // The simulator configurations measured: the exact default first.
 std::vector<sim::AccuracyKnobs> bench_configs();
