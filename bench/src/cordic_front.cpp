@@ -111,6 +111,63 @@ std::pair<double, double> to_screen(const geometry::Mat4& pvm, geometry::Vec3 p,
   return {(c.x / c.w * 0.5 + 0.5) * w, (0.5 - c.y / c.w * 0.5) * h};
 }
 
+// Screen distance of every vertex from its floating-point position, max and mean over all frames.
+void measure_shift(const examples::TorusGeometry& geo, const std::vector<examples::TorusGeometry::Frame>& float_frames,
+                   const geometry::Mat4& pv, unsigned width, unsigned height, CordicRow& row) {
+  examples::TorusGeometry::Frame f;
+  double sum = 0;
+  std::size_t count = 0;
+  for (unsigned n = 0; n < float_frames.size(); ++n) {
+    geo.frame(n, f);
+    const auto& ref = float_frames[n];
+    const geometry::Mat4 ref_pvm = pv * ref.model, pvm = pv * f.model;
+    for (std::size_t i = 0; i < f.vertices.size(); ++i) {
+      const auto a = to_screen(ref_pvm, ref.vertices[i].position, width, height);
+      const auto b = to_screen(pvm, f.vertices[i].position, width, height);
+      const double d = std::hypot(a.first - b.first, a.second - b.second);
+      row.shift_max_px = std::max(row.shift_max_px, d);
+      sum += d;
+      ++count;
+    }
+  }
+  row.shift_mean_px = count ? sum / double(count) : 0;
+}
+
+// Image error of RGBA8888 frames against the floating-point ones. The background is black and
+// every lit torus pixel is not: pixels covered in only one of the two frames are edge pixels
+// (coverage moved with the vertices); colour is compared where both frames show the torus.
+void measure_image(const std::vector<std::vector<std::uint8_t>>& reference,
+                   const std::vector<std::vector<std::uint8_t>>& frames, CordicRow& row) {
+  double sum = 0;
+  std::uint64_t torus = 0, both = 0, channels = 0, differing = 0;
+  for (std::size_t n = 0; n < std::min(reference.size(), frames.size()); ++n) {
+    const auto& a = reference[n];
+    const auto& b = frames[n];
+    for (std::size_t p = 0; p + 3 < std::min(a.size(), b.size()); p += 4) {
+      const bool in_a = (a[p] | a[p + 1] | a[p + 2]) != 0, in_b = (b[p] | b[p + 1] | b[p + 2]) != 0;
+      if (!in_a && !in_b) continue;
+      ++torus;
+      if (in_a != in_b) {
+        ++row.edge_pixels;
+        continue;
+      }
+      ++both;
+      bool differs = false;
+      for (std::size_t c = 0; c < 3; ++c) {
+        const int d = std::abs(int(a[p + c]) - int(b[p + c]));
+        row.colour_max = std::max(row.colour_max, double(d));
+        sum += d;
+        ++channels;
+        differs |= d != 0;
+      }
+      differing += differs;
+    }
+  }
+  row.colour_mean = channels ? sum / double(channels) : 0;
+  row.differing_pct = both ? 100.0 * double(differing) / double(both) : 0;
+  row.edge_pct = torus ? 100.0 * double(row.edge_pixels) / double(torus) : 0;
+}
+
 }  // namespace
 
 Result<CordicFront> run_cordic_front(const CordicFrontOptions& opt, const std::function<void(const std::string&)>& progress) {
@@ -137,58 +194,11 @@ Result<CordicFront> run_cordic_front(const CordicFrontOptions& opt, const std::f
     if (k != 0) {
       progress(fmt::format("CORDIC front: {} iterations, error", k));
       const examples::TorusGeometry geo(k);
-      examples::TorusGeometry::Frame f;
-      // Vertex displacement on screen against the floating-point vertices of the same frame.
-      double shift_sum = 0;
-      std::size_t shift_count = 0;
-      for (unsigned n = 0; n < front.frames; ++n) {
-        geo.frame(n, f);
-        const auto& ref = float_frames[n];
-        const geometry::Mat4 ref_pvm = pv * ref.model, pvm = pv * f.model;
-        for (std::size_t i = 0; i < f.vertices.size(); ++i) {
-          const auto a = to_screen(ref_pvm, ref.vertices[i].position, front.width, front.height);
-          const auto b = to_screen(pvm, f.vertices[i].position, front.width, front.height);
-          const double d = std::hypot(a.first - b.first, a.second - b.second);
-          row.shift_max_px = std::max(row.shift_max_px, d);
-          shift_sum += d;
-          ++shift_count;
-        }
-      }
-      row.shift_mean_px = shift_count ? shift_sum / double(shift_count) : 0;
-      // Image error. The background is black and every lit torus pixel is not: pixels covered in
-      // only one of the two frames are edge pixels (coverage moved with the vertices); colour is
-      // compared where both frames show the torus.
+      measure_shift(geo, float_frames, pv, front.width, front.height, row);
       unsigned w = 0, h = 0;
       auto frames = render_rgba(k, front.frames, w, h);
       if (!frames) return frames.error();
-      double sum = 0;
-      std::uint64_t torus = 0, both = 0, channels = 0, differing = 0;
-      for (unsigned n = 0; n < front.frames; ++n) {
-        const auto& a = (*reference)[n];
-        const auto& b = (*frames)[n];
-        for (std::size_t p = 0; p + 3 < std::min(a.size(), b.size()); p += 4) {
-          const bool in_a = (a[p] | a[p + 1] | a[p + 2]) != 0, in_b = (b[p] | b[p + 1] | b[p + 2]) != 0;
-          if (!in_a && !in_b) continue;
-          ++torus;
-          if (in_a != in_b) {
-            ++row.edge_pixels;
-            continue;
-          }
-          ++both;
-          bool differs = false;
-          for (std::size_t c = 0; c < 3; ++c) {
-            const int d = std::abs(int(a[p + c]) - int(b[p + c]));
-            row.colour_max = std::max(row.colour_max, double(d));
-            sum += d;
-            ++channels;
-            differs |= d != 0;
-          }
-          differing += differs;
-        }
-      }
-      row.colour_mean = channels ? sum / double(channels) : 0;
-      row.differing_pct = both ? 100.0 * double(differing) / double(both) : 0;
-      row.edge_pct = torus ? 100.0 * double(row.edge_pixels) / double(torus) : 0;
+      measure_image(*reference, *frames, row);
       if (!front.knee && row.shift_max_px < kVertexGrid) front.knee = k;
     }
     front.rows.push_back(row);

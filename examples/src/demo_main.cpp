@@ -36,7 +36,7 @@ int run_list(bool json) {
     if (json)
       out.push_back({{"name", i.name}, {"seed", i.seed}, {"description", i.description}});
     else
-      std::printf("%-12s %-18s %s\n", i.name.c_str(), i.seed.c_str(), i.description.c_str());
+      std::printf("%-16s %-18s %s\n", i.name.c_str(), i.seed.c_str(), i.description.c_str());
   }
   if (json) std::puts(json_text(out, 2).c_str());
   return 0;

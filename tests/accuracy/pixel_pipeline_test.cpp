@@ -169,7 +169,8 @@ TEST(PixelPipeline, DitherAllValues_ExactFormula) {
 }
 
 // Bound: identical bytes for a dithered Gouraud mesh drawn forwards, backwards and with 1 or 3
-// threads (dither depends on the screen position only), and DITHER has no effect on RGBA8888.
+// threads (the ordered dither depends on the screen position only, the temporal one on the phase
+// as well), in RGB565 and RGBA2222; neither dither has an effect on RGBA8888.
 TEST(PixelPipeline, DitherIndependentOfOrderAndBands_Identical) {
   std::mt19937 rng(24);
   std::vector<DeviceTriangle> mesh;
@@ -181,28 +182,39 @@ TEST(PixelPipeline, DitherIndependentOfOrderAndBands_Identical) {
       mesh.push_back({v(x0, y0), v(x1, y0), v(x1, y1)});
       mesh.push_back({v(x0, y0), v(x1, y1), v(x0, y1)});
     }
-  std::vector<std::uint8_t> reference;
-  for (unsigned threads : {1u, 3u})
-    for (bool reversed : {false, true}) {
-      SimHarness h({.width = 64, .height = 64, .format = protocol::PixelFormat::RGB565, .threads = threads});
-      geometry::RenderState st;
-      st.dither = true;
-      h.state(st);
-      auto tris = mesh;
-      if (reversed) std::reverse(tris.begin(), tris.end());
-      h.draw(tris);
-      if (reference.empty()) reference = h.color_bytes();
-      else EXPECT_TRUE(h.color_bytes() == reference) << threads << " threads, reversed " << reversed;
-    }
-  std::vector<std::uint8_t> without;
-  for (bool dither : {false, true}) {
-    SimHarness h;
+  struct Mode {
+    bool temporal;
+    unsigned phase;
+  };
+  for (const Mode mode : {Mode{false, 0}, Mode{true, 0}, Mode{true, 5}, Mode{true, 15}}) {
     geometry::RenderState st;
-    st.dither = dither;
-    h.state(st);
-    h.draw(mesh);
-    if (!dither) without = h.color_bytes();
-    else EXPECT_TRUE(h.color_bytes() == without);
+    st.dither = true;
+    st.temporal = mode.temporal;
+    st.dither_phase = mode.phase;
+    for (auto fmt : {protocol::PixelFormat::RGB565, protocol::PixelFormat::RGBA2222}) {
+      std::vector<std::uint8_t> reference;
+      for (unsigned threads : {1u, 3u})
+        for (bool reversed : {false, true}) {
+          SimHarness h({.width = 64, .height = 64, .format = fmt, .threads = threads});
+          h.state(st);
+          auto tris = mesh;
+          if (reversed) std::reverse(tris.begin(), tris.end());
+          h.draw(tris);
+          if (reference.empty()) reference = h.color_bytes();
+          else EXPECT_TRUE(h.color_bytes() == reference) << "temporal " << mode.temporal << " phase " << mode.phase << ", "
+                                                         << threads << " threads, reversed " << reversed;
+        }
+    }
+    std::vector<std::uint8_t> without;
+    for (bool dither : {false, true}) {
+      SimHarness h;
+      geometry::RenderState s8 = st;
+      s8.dither = dither;
+      h.state(s8);
+      h.draw(mesh);
+      if (!dither) without = h.color_bytes();
+      else EXPECT_TRUE(h.color_bytes() == without) << "temporal " << mode.temporal << " phase " << mode.phase;
+    }
   }
 }
 

@@ -1,14 +1,13 @@
 // Hard case 25: the temporal dither (TRI_MODE.TEMPORAL, DITHER_PHASE; docs/protocol.md section
 // 11.1). Every frame is bit-exact against the document's integer formula, written here
 // independently; the mean of N frames of a flat colour on RGBA2222 lies within the bound the
-// document proves, per pixel and channel; the dither depends on the screen position and the phase
-// only (draw order and bands change nothing).
+// document proves, per pixel and channel. (Independence of draw order and bands: pixel_pipeline_test's
+// DitherIndependentOfOrderAndBands covers both dithers.)
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <array>
 #include <cstdlib>
-#include <random>
 
 #include "sim_harness.hpp"
 
@@ -149,48 +148,6 @@ TEST(TemporalDither, MeanOfFramesOfAFlatColour_WithinProvenBound) {
   const double bound16 = 85.0 * (1.0 / 16 - 1.0 / 32 + 1.0 / 256);
   EXPECT_GT(worst16, bound16 - 0.4) << "the N = 16 bound is not tight any more";
   EXPECT_GT(ordered_worst16, bound16) << "the ordered dither met the temporal bound: the check cannot fail";
-}
-
-// Bound: identical bytes for a temporally dithered Gouraud mesh drawn forwards, backwards and
-// with 1 or 3 threads, in every phase tried (the threshold depends on the screen position and
-// the phase only); TEMPORAL and the phase have no effect on RGBA8888.
-TEST(TemporalDither, IndependentOfOrderAndBands_Identical) {
-  std::mt19937 rng(25);
-  std::vector<DeviceTriangle> mesh;
-  for (int j = 0; j < 8; ++j)
-    for (int i = 0; i < 8; ++i) {
-      const int x0 = i * 128, y0 = j * 128, x1 = x0 + 128, y1 = y0 + 128;
-      auto v = [&](int x, int y) { return dv(x, y, 0, rng()); };
-      mesh.push_back({v(x0, y0), v(x1, y0), v(x1, y1)});
-      mesh.push_back({v(x0, y0), v(x1, y1), v(x0, y1)});
-    }
-  for (int phase : {0, 5, 15}) {
-    geometry::RenderState st = temporal_state(phase);
-    st.gouraud = true;
-    for (auto fmt : {PixelFormat::RGB565, PixelFormat::RGBA2222}) {
-      std::vector<std::uint8_t> reference;
-      for (unsigned threads : {1u, 3u})
-        for (bool reversed : {false, true}) {
-          SimHarness h({.width = 64, .height = 64, .format = fmt, .threads = threads});
-          h.state(st);
-          auto tris = mesh;
-          if (reversed) std::reverse(tris.begin(), tris.end());
-          h.draw(tris);
-          if (reference.empty()) reference = h.color_bytes();
-          else EXPECT_TRUE(h.color_bytes() == reference) << "phase " << phase << ", " << threads << " threads, reversed " << reversed;
-        }
-    }
-    std::vector<std::uint8_t> plain;
-    for (bool temporal : {false, true}) {
-      SimHarness h;
-      geometry::RenderState s8 = st;
-      s8.dither = s8.temporal = temporal;
-      h.state(s8);
-      h.draw(mesh);
-      if (!temporal) plain = h.color_bytes();
-      else EXPECT_TRUE(h.color_bytes() == plain) << "phase " << phase;
-    }
-  }
 }
 
 }  // namespace

@@ -118,6 +118,7 @@ TEST(TextTrace, BadLinesReportLineAndColumn) {
       {"TRI_MODE GOURAUD=2", "3:10: GOURAUD=2 is not a flag value; use 0 or 1"},
       {"TRI_MODE GOURAUD", "3:10: 'GOURAUD' is not a value for TRI_MODE"},
       {"TRI_MODE GOURAUD=1 Z_TEST", "3:20: expected FIELD=value, found 'Z_TEST'"},
+      {"TRI_MODE DITHER_PHASE=16", "3:10: DITHER_PHASE=16 is out of range 0..15"},
       {"PRIM 3", "3:6: value 0x3 is not valid for PRIM"},
       {"CLEAR 1", "3:7: value 0x1 is not valid for CLEAR"},
       {"STATUS 0", "3:1: STATUS is read-only"},
@@ -173,6 +174,7 @@ TEST(TextTrace, CanonicalTextIsStable) {
   const std::string text =
       "VERTEX X=1.5 Y=-2 Z=0x10\n"
       "TRI_MODE GOURAUD=1 Z_FUNC=lequal Z_TEST=1\n"
+      "TRI_MODE DITHER=1 TEMPORAL=1 DITHER_PHASE=9\n"
       ".upload 0 hex x.hex\n"
       "COLOR R=1 Q=0.25\n";
   AssetLoader loader = [](const TraceAsset&) -> Result<std::vector<std::uint8_t>> {
@@ -188,6 +190,7 @@ TEST(TextTrace, CanonicalTextIsStable) {
   EXPECT_EQ(write_text_trace(*back), canonical);
   EXPECT_NE(canonical.find("VERTEX Z=0x10 Y=-2 X=1.5\n"), std::string::npos) << canonical;
   EXPECT_NE(canonical.find("TRI_MODE Z_FUNC=LEQUAL Z_TEST=1 GOURAUD=1\n"), std::string::npos) << canonical;
+  EXPECT_NE(canonical.find("TRI_MODE DITHER_PHASE=9 TEMPORAL=1 DITHER=1\n"), std::string::npos) << canonical;
   EXPECT_NE(canonical.find(".mem 0x00000000 010203\n"), std::string::npos) << canonical;
 }
 
