@@ -103,6 +103,9 @@ std::vector<Example> make() {
 
       skip("build/tools/gpubridge bench accuracy --out-dir docs",
            "rewrites docs/accuracy-report.* and runs for minutes; CTest bench_accuracy_quick_smoke runs it with --quick"),
+      skip("build/tools/gpubridge bench accuracy --cordic-only --out-dir docs",
+           "rewrites the CORDIC section of docs/accuracy-report.*; CTest bench_accuracy_quick_smoke runs it with --quick "
+           "on a copy of a report"),
       skip("build/tools/gpubridge bench dmc1",
            "measures for seconds per stream on a machine shared with the rest of the suite; CTest "
            "dmc1_bench_smoke runs it with one short round"),
@@ -127,6 +130,8 @@ std::vector<Example> make() {
            "rewrites the committed goldens; CTest dmc1_level_goldens runs the comparing form"),
       skip("build/tools/gpubridge bench accuracy --out-dir docs",
            "rewrites docs/accuracy-report.*; CTest bench_accuracy_quick_smoke runs it with --quick"),
+      skip("build/examples/gpubridge-demo figures --dir docs/screenshots",
+           "rewrites the committed figures; docs/examples.md's block runs it into another directory"),
   }});
 
   all.push_back({"docs/dmc1.md", "Quick start", 0, "docs_dmc1_QuickStart", {
@@ -184,6 +189,22 @@ std::vector<Example> make() {
           .within(120),
       skip("build/examples/gpubridge-demo goldens --dir examples/golden --write",
            "rewrites the committed goldens (the line above compares with them)"),
+  }});
+
+  all.push_back({"docs/examples.md", "Shift-and-add rotation (CORDIC)", 0, "docs_examples_DonutIdeas", {
+      run("build/examples/gpubridge-demo figures --dir docs/screenshots")
+          .instead("build/examples/gpubridge-demo figures --dir figures",
+                   "the committed figures are not rewritten: the same pictures into a directory of the checkout")
+          .prints(R"(dither-temporal-mean16\.png +RGBA2222, temporal dither, mean of 16 frames .*\(mean error [0-9.]+ LSB\))")
+          .leaves("figures/dither-temporal-mean16.png")
+          .leaves("figures/cordic-4.png")
+          .within(180),
+      run("build/examples/gpubridge-demo render torus-cordic --cordic-iterations 5 --out frames")
+          .prints(R"(frames/torus-cordic-0012\.png)")
+          .leaves("frames/torus-cordic-0012.png"),
+      skip("build/tools/gpubridge bench accuracy --cordic-only --out-dir docs",
+           "rewrites the CORDIC section of docs/accuracy-report.*; CTest bench_accuracy_quick_smoke runs it with --quick "
+           "on a copy of a report"),
   }});
 
   all.push_back({"docs/examples.md", "On every board", 0, "docs_examples_OnEveryBoard", {
