@@ -39,7 +39,13 @@ class DiscardSink final : public draw::CommandSink {
     return make_error("the bench's discarding sink has no memory to read");
   }
   Result<void> flush() override { return {}; }
-  std::uint64_t vram_bytes() const override { return 8u << 20; }
+  // The default simulator's memory; CAPS 0 reads as every feature (the example is not fitted).
+  backends::DeviceInfo device() const override {
+    backends::DeviceInfo info;
+    info.backend = "discard";
+    info.vram_bytes = 8u << 20;
+    return info;
+  }
 };
 
 // One vertex-stage configuration under timing: its geometry alone (vertex stage), and the whole

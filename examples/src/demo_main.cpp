@@ -149,11 +149,11 @@ int run_goldens(const std::string& dir, const std::vector<std::string>& class_na
           if (!json) std::printf("wrote %s\n", path.string().c_str());
           report.push_back({{"class", cls->name}, {"example", name}, {"frame", frame}, {"path", path.string()},
                             {"written", true}});
-        continue;
-      }
-      auto golden = load_png(path);
-      if (!golden)
-        return fail(golden.error().message + " (create the goldens with: gpubridge-demo goldens --dir " + dir + " --write)");
+          continue;
+        }
+        auto golden = load_png(path);
+        if (!golden)
+          return fail(golden.error().message + " (create the goldens with: gpubridge-demo goldens --dir " + dir + " --write)");
         const auto diff = examples::compare_images(*golden, img);
         if (!diff.identical()) ++failures;
         // The first golden frame is named alone, later ones with their number.
