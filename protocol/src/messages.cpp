@@ -1,11 +1,15 @@
 // Socket protocol v1: message encoder and payload decoder (the incremental parser is message_parser.cpp).
-// Every decode problem becomes a DecodeError naming the message type, the field and its byte
-// offset in the payload; the parser adds the stream offset of the message.
+// Each payload's fields are described once, by its layout() below; the decoder (FieldReader) and
+// the encoder (FieldWriter) both walk that description. Every decode problem becomes a
+// DecodeError naming the message type, the field and its byte offset in the payload; the parser
+// adds the stream offset of the message.
 #include "gpubridge/protocol/messages.hpp"
 
 #include <algorithm>
-#include <bit>
-#include <cstring>
+#include <array>
+#include <cassert>
+#include <concepts>
+#include <cstdio>
 #include <type_traits>
 #include <utility>
 
@@ -27,76 +31,7 @@ T get_le(const std::uint8_t* p) {
   return static_cast<T>(v);
 }
 
-void put_bytes(std::vector<std::uint8_t>& out, std::span<const std::uint8_t> b) { out.insert(out.end(), b.begin(), b.end()); }
-void put_string(std::vector<std::uint8_t>& out, std::string_view s) { out.insert(out.end(), s.begin(), s.end()); }
-
-// ---- payload reader with field names for error messages ---------------------------------
-
-class PayloadReader {
- public:
-  PayloadReader(MsgType type, std::span<const std::uint8_t> p) : type_(type), p_(p) {}
-
-  std::size_t pos() const { return pos_; }
-  std::size_t remaining() const { return p_.size() - pos_; }
-  bool failed() const { return error_.has_value(); }
-  std::optional<DecodeError> take_error() { return std::move(error_); }
-
-  template <class T>
-  T get(const char* field) {
-    if (!need(sizeof(T), field)) return T{};
-    T v = get_le<T>(p_.data() + pos_);
-    pos_ += sizeof(T);
-    return v;
-  }
-  std::span<const std::uint8_t> bytes(std::size_t n, const char* field) {
-    if (!need(n, field)) return {};
-    auto s = p_.subspan(pos_, n);
-    pos_ += n;
-    return s;
-  }
-  std::span<const std::uint8_t> rest() {
-    auto s = p_.subspan(pos_);
-    pos_ = p_.size();
-    return s;
-  }
-  void expect_end() {
-    if (!failed() && pos_ != p_.size())
-      fail(ErrorCode::Malformed, std::to_string(p_.size() - pos_) + " unexpected trailing bytes at payload byte " +
-                                     std::to_string(pos_));
-  }
-  void fail(ErrorCode code, const std::string& what) {
-    if (!error_) error_ = DecodeError{code, std::string(to_string(type_)) + " " + what};
-  }
-  // Field value problem: "<TYPE> <field> <what> (payload byte N)".
-  void bad_field(const char* field, std::size_t at, const std::string& what) {
-    fail(ErrorCode::Malformed, std::string(field) + " " + what + " (payload byte " + std::to_string(at) + ")");
-  }
-
- private:
-  bool need(std::size_t n, const char* field) {
-    if (failed()) return false;
-    if (remaining() < n) {
-      fail(ErrorCode::Malformed, "payload of " + std::to_string(p_.size()) + " bytes is too short: " + field +
-                                     " needs " + std::to_string(n) + " bytes at payload byte " + std::to_string(pos_));
-      return false;
-    }
-    return true;
-  }
-
-  MsgType type_;
-  std::span<const std::uint8_t> p_;
-  std::size_t pos_ = 0;
-  std::optional<DecodeError> error_;
-};
-
 std::string as_string(std::span<const std::uint8_t> b) { return std::string(b.begin(), b.end()); }
-
-void read_json(PayloadReader& r, const char* field, std::string& out) {
-  const std::size_t at = r.pos();
-  out = as_string(r.rest());
-  if (r.failed()) return;
-  if (auto problem = json_object_problem(out); !problem.empty()) r.bad_field(field, at, problem);
-}
 
 bool valid_utf8(std::string_view s) {
   std::size_t i = 0;
@@ -123,355 +58,336 @@ bool valid_utf8(std::string_view s) {
   return true;
 }
 
-void read_text(PayloadReader& r, const char* field, std::string& out) {
-  const std::size_t at = r.pos();
-  out = as_string(r.rest());
-  if (!r.failed() && !valid_utf8(out)) r.bad_field(field, at, "is not valid UTF-8");
-}
+// ---- field vocabulary --------------------------------------------------------------------
 
-void decode_into(const Header& h, PayloadReader& r, Payload& out) {
-  switch (h.type) {
-    case MsgType::Hello: {
-      Hello m;
-      m.version = r.get<std::uint16_t>("version");
-      const std::size_t name_at = r.pos();
-      const auto name_len = r.get<std::uint8_t>("name_len");
-      if (!r.failed() && name_len > kMaxNameBytes)
-        r.bad_field("name_len", name_at, std::to_string(name_len) + " exceeds " + std::to_string(kMaxNameBytes) + " bytes");
-      m.name = as_string(r.bytes(name_len, "name"));
-      const std::size_t token_at = r.pos();
-      const auto token_len = r.get<std::uint8_t>("token_len");
-      if (!r.failed() && token_len > kMaxTokenBytes)
-        r.bad_field("token_len", token_at,
-                    std::to_string(token_len) + " exceeds " + std::to_string(kMaxTokenBytes) + " bytes");
-      m.token = as_string(r.bytes(token_len, "token"));
-      r.expect_end();
-      if (!r.failed() && !valid_utf8(m.name)) r.bad_field("name", name_at + 1, "is not valid UTF-8");
-      out = std::move(m);
-      return;
-    }
-    case MsgType::Welcome: {
-      Welcome m;
-      m.version = r.get<std::uint16_t>("version");
-      m.max_payload = r.get<std::uint32_t>("max_payload");
-      m.session_id = r.get<std::uint32_t>("session_id");
-      read_json(r, "device description", m.json);
-      out = std::move(m);
-      return;
-    }
-    case MsgType::Error: {
-      ErrorMsg m;
-      m.code = static_cast<ErrorCode>(r.get<std::uint16_t>("code"));
-      m.ref = r.get<std::uint32_t>("ref");
-      read_text(r, "text", m.text);
-      out = std::move(m);
-      return;
-    }
-    case MsgType::Ping:
-    case MsgType::Pong: {
-      auto data = r.rest();
-      if (data.size() > 64) r.bad_field("data", 0, "of " + std::to_string(data.size()) + " bytes exceeds 64 bytes");
-      std::vector<std::uint8_t> copy(data.begin(), data.end());
-      if (h.type == MsgType::Ping)
-        out = Ping{std::move(copy)};
-      else
-        out = Pong{std::move(copy)};
-      return;
-    }
-    case MsgType::Bye: r.expect_end(); out = Bye{}; return;
-    case MsgType::WriteFrames: {
-      auto data = r.rest();
-      if (data.empty()) {
-        r.fail(ErrorCode::Malformed, "payload is empty; send at least one 9-byte frame");
-      } else if (data.size() % kFrameBytes != 0) {
-        r.fail(ErrorCode::Malformed, "payload of " + std::to_string(data.size()) + " bytes is not a multiple of 9");
-      } else {
-        if (const std::size_t f = first_read_frame(FrameView{data}); f * kFrameBytes < data.size())
-          r.fail(ErrorCode::BadFrame, "frame " + std::to_string(f) + " (payload byte " +
-                                          std::to_string(f * kFrameBytes) + ") has the read bit set; use READ_REG");
-      }
-      out = WriteFrames{FrameView{data}};
-      return;
-    }
-    case MsgType::ReadReg: {
-      ReadReg m;
-      m.index = r.get<std::uint8_t>("index");
-      if (!r.failed() && m.index >= kRegisterCount)
-        r.bad_field("index", 0, std::to_string(m.index) + " exceeds the 7-bit register index range 0..127");
-      r.expect_end();
-      out = m;
-      return;
-    }
-    case MsgType::RegValue: {
-      RegValue m;
-      m.index = r.get<std::uint8_t>("index");
-      if (!r.failed() && m.index >= kRegisterCount)
-        r.bad_field("index", 0, std::to_string(m.index) + " exceeds the 7-bit register index range 0..127");
-      m.value = r.get<std::uint64_t>("value");
-      r.expect_end();
-      out = m;
-      return;
-    }
-    case MsgType::Upload: {
-      Upload m;
-      m.address = r.get<std::uint32_t>("address");
-      m.data = r.rest();
-      if (!r.failed() && m.data.empty()) r.bad_field("data", 4, "is empty; an UPLOAD carries at least 1 byte");
-      // Device addresses are 32-bit: a range that wraps past 4 GiB is malformed, whoever sends it
-      // (socket, binary trace) — the text trace reader refuses the same range.
-      if (!r.failed() && std::uint64_t{m.address} + m.data.size() > (std::uint64_t{1} << 32))
-        r.bad_field("data", 4, std::to_string(m.data.size()) + " bytes at address " + std::to_string(m.address) +
-                                   " run past the 4 GiB address space");
-      out = m;
-      return;
-    }
-    case MsgType::UploadAck: {
-      UploadAck m;
-      m.address = r.get<std::uint32_t>("address");
-      m.length = r.get<std::uint32_t>("length");
-      r.expect_end();
-      out = m;
-      return;
-    }
-    case MsgType::Readback: {
-      Readback m;
-      m.address = r.get<std::uint32_t>("address");
-      m.length = r.get<std::uint32_t>("length");
-      if (!r.failed() && (m.length == 0 || m.length > (64u << 20)))
-        r.bad_field("length", 4, std::to_string(m.length) + " is outside 1..67108864 (64 MiB)");
-      if (!r.failed() && std::uint64_t{m.address} + m.length > (std::uint64_t{1} << 32))
-        r.bad_field("length", 4, std::to_string(m.length) + " bytes at address " + std::to_string(m.address) +
-                                     " run past the 4 GiB address space");
-      r.expect_end();
-      out = m;
-      return;
-    }
-    case MsgType::ReadbackData: {
-      ReadbackData m;
-      m.address = r.get<std::uint32_t>("address");
-      const auto last = r.get<std::uint8_t>("last");
-      if (!r.failed() && last > 1) r.bad_field("last", 4, std::to_string(last) + " is not 0 or 1");
-      m.last = last == 1;
-      m.data = r.rest();
-      if (!r.failed() && m.data.size() > kMaxReadbackChunk)
-        r.bad_field("data", 5, "of " + std::to_string(m.data.size()) + " bytes exceeds the 65536-byte chunk limit");
-      out = m;
-      return;
-    }
-    case MsgType::Fence: {
-      FenceMsg m;
-      m.id = r.get<std::uint64_t>("id");
-      r.expect_end();
-      out = m;
-      return;
-    }
-    case MsgType::FenceDone: {
-      FenceDone m;
-      m.id = r.get<std::uint64_t>("id");
-      r.expect_end();
-      out = m;
-      return;
-    }
-    case MsgType::StatusReq: r.expect_end(); out = StatusReq{}; return;
-    case MsgType::StatusReply: {
-      StatusReply m;
-      read_json(r, "status", m.json);
-      out = std::move(m);
-      return;
-    }
-    case MsgType::Subscribe: {
-      Subscribe m;
-      const auto format = r.get<std::uint8_t>("format");
-      if (!r.failed() && format > 3) r.bad_field("format", 0, std::to_string(format) + " is not 0..3");
-      m.format = static_cast<FrameFormat>(format);
-      m.max_fps = r.get<std::uint16_t>("max_fps");
-      // Optional trailing source byte (absent in the original 3-byte form = board).
-      if (!r.failed() && r.remaining() > 0) {
-        const auto source = r.get<std::uint8_t>("source");
-        if (source > 2) r.bad_field("source", 3, std::to_string(source) + " is not 0 (board), 1 (sim) or 2 (diff)");
-        m.source = static_cast<FrameSource>(source);
-      }
-      r.expect_end();
-      out = m;
-      return;
-    }
-    case MsgType::Unsubscribe: r.expect_end(); out = Unsubscribe{}; return;
-    case MsgType::FrameMsg: {
-      FrameData m;
-      m.number = r.get<std::uint32_t>("number");
-      m.width = r.get<std::uint16_t>("width");
-      m.height = r.get<std::uint16_t>("height");
-      const auto format = r.get<std::uint8_t>("format");
-      if (!r.failed() && format > 2) r.bad_field("format", 8, std::to_string(format) + " is not a pixel format (0..2)");
-      m.format = static_cast<PixelFormat>(format);
-      const auto source = r.get<std::uint8_t>("source");
-      if (!r.failed() && source > 2) r.bad_field("source", 9, std::to_string(source) + " is not 0 (board), 1 (sim) or 2 (diff)");
-      m.source = static_cast<FrameSource>(source);
-      m.crc = r.get<std::uint32_t>("crc");
-      m.swap_ns = r.get<std::uint64_t>("swap_ns");
-      m.pixels = r.rest();
-      if (!r.failed()) {
-        const std::uint64_t expect = std::uint64_t{m.width} * m.height * bytes_per_pixel(m.format);
-        if (m.pixels.size() != expect)
-          r.bad_field("pixels", 22, "of " + std::to_string(m.pixels.size()) + " bytes do not match " +
-                                        std::to_string(m.width) + "x" + std::to_string(m.height) + " " +
-                                        std::string(to_string(m.format)) + " (" + std::to_string(expect) + " bytes)");
-      }
-      out = m;
-      return;
-    }
-    case MsgType::LeaseAcquire: {
-      LeaseAcquire m;
-      const auto mode = r.get<std::uint8_t>("mode");
-      if (!r.failed() && mode > 1) r.bad_field("mode", 0, std::to_string(mode) + " is not 0 (wait) or 1 (fail if busy)");
-      m.mode = static_cast<LeaseMode>(mode);
-      r.expect_end();
-      out = m;
-      return;
-    }
-    case MsgType::LeaseGranted: {
-      LeaseGranted m;
-      m.session_id = r.get<std::uint32_t>("session_id");
-      r.expect_end();
-      out = m;
-      return;
-    }
-    case MsgType::LeaseRelease: r.expect_end(); out = LeaseRelease{}; return;
-    case MsgType::LeaseReleased: r.expect_end(); out = LeaseReleased{}; return;
-    case MsgType::DeviceEvent: {
-      DeviceEvent m;
-      read_json(r, "event", m.json);
-      out = std::move(m);
-      return;
-    }
-  }
-  r.fail(ErrorCode::UnknownType, "has no decoder");
-}
+// The values a field may hold; `what` completes "<field> <value> ..." in the decode error.
+struct Range {
+  std::uint64_t lo, hi;
+  const char* what;
+};
+// A trailing byte field's size limit; `what` completes "<field> of <n> bytes ...". The encoder
+// clips to the limit only where `clip` says so (it never writes what the decoder refuses there).
+struct MaxBytes {
+  std::size_t max;
+  const char* what;
+  bool clip = false;
+};
+enum class Text : std::uint8_t { Bytes, Utf8 };
 
-// ---- encoder ----------------------------------------------------------------------------
+// Decoder side: reads each field the layout names, in order, and checks it. After the first
+// problem every later read yields a zero value and no new error, so the first problem is the one
+// reported. Text checks (UTF-8, JSON) run after the whole layout has been read.
+class FieldReader {
+ public:
+  FieldReader(std::string_view type_name, std::span<const std::uint8_t> p) : type_name_(type_name), p_(p) {}
 
-struct PayloadEncoder {
-  std::vector<std::uint8_t>& o;
+  template <std::unsigned_integral T>
+  void num(const char* field, T& v) {
+    if (!start(sizeof(T), field)) return;
+    v = get_le<T>(p_.data() + pos_);
+    pos_ += sizeof(T);
+  }
+  template <std::unsigned_integral T>
+  void num(const char* field, T& v, Range r) {
+    num(field, v);
+    if (!failed() && (v < r.lo || v > r.hi)) bad_field(field, at_, std::to_string(v) + " " + r.what);
+  }
+  // An enumeration carried as the unsigned integer Wire.
+  template <std::unsigned_integral Wire, class E>
+  void code(const char* field, E& v, std::optional<Range> r = std::nullopt) {
+    Wire w = 0;
+    if (r) num(field, w, *r);
+    else num(field, w);
+    v = static_cast<E>(w);
+  }
+  template <std::unsigned_integral Wire, class E>
+  void optional_code(const char* field, std::optional<E>& v, Range r) {
+    if (failed() || remaining() == 0) return;
+    E e{};
+    code<Wire>(field, e, r);
+    v = e;
+  }
+  void flag(const char* field, bool& v) {
+    std::uint8_t w = 0;
+    num(field, w, Range{0, 1, "is not 0 or 1"});
+    v = w == 1;
+  }
+  // u8 length (the field `len_field`, at most `max`), then that many bytes.
+  void counted(const char* len_field, const char* field, std::string& s, std::size_t max, Text text) {
+    std::uint8_t n = 0;
+    num(len_field, n);
+    if (!failed() && n > max) bad_field(len_field, at_, std::to_string(n) + " exceeds " + std::to_string(max) + " bytes");
+    if (!start(n, field)) return;
+    s = as_string(p_.subspan(pos_, n));
+    pos_ += n;
+    if (text == Text::Utf8) defer_check(field, &s, false);
+  }
+  // The rest of the payload.
+  [[gnu::always_inline]] void rest(const char* field, std::span<const std::uint8_t>& data,
+                                   std::optional<MaxBytes> limit = std::nullopt) {
+    start(0, field);
+    data = p_.subspan(pos_);
+    pos_ = p_.size();
+    if (!failed() && limit && data.size() > limit->max)
+      bad_field(field, at_, "of " + std::to_string(data.size()) + " bytes " + limit->what);
+  }
+  void rest(const char* field, std::vector<std::uint8_t>& data, MaxBytes limit) {
+    std::span<const std::uint8_t> s;
+    rest(field, s, limit);
+    data.assign(s.begin(), s.end());
+  }
+  void rest_text(const char* field, std::string& s) {
+    std::span<const std::uint8_t> b;
+    rest(field, b);
+    s = as_string(b);
+    defer_check(field, &s, false);
+  }
+  void rest_json(const char* field, std::string& s) {
+    std::span<const std::uint8_t> b;
+    rest(field, b);
+    s = as_string(b);
+    defer_check(field, &s, true);
+  }
+  // WRITE_FRAMES: whole 9-byte write frames, at least one.
+  void frames(FrameView& v) {
+    std::span<const std::uint8_t> data;
+    rest("frames", data);
+    v = FrameView{data};
+    if (data.empty()) {
+      fail(ErrorCode::Malformed, "payload is empty; send at least one 9-byte frame");
+    } else if (data.size() % kFrameBytes != 0) {
+      fail(ErrorCode::Malformed, "payload of " + std::to_string(data.size()) + " bytes is not a multiple of 9");
+    } else if (const std::size_t f = first_read_frame(v); f * kFrameBytes < data.size()) {
+      fail(ErrorCode::BadFrame, "frame " + std::to_string(f) + " (payload byte " + std::to_string(f * kFrameBytes) +
+                                    ") has the read bit set; use READ_REG");
+    }
+  }
+  // A check across fields, reported against the last field read: `problem()` returns what is
+  // wrong, or an empty string.
+  template <class F>
+  void check(F&& problem) {
+    if (failed()) return;
+    if (std::string what = problem(); !what.empty()) bad_field(field_, at_, what);
+  }
 
-  void operator()(const Hello& m) {
-    const auto name = std::string_view(m.name).substr(0, kMaxNameBytes);
-    const auto token = std::string_view(m.token).substr(0, kMaxTokenBytes);
-    put_le(o, m.version);
-    put_le(o, static_cast<std::uint8_t>(name.size()));
-    put_string(o, name);
-    put_le(o, static_cast<std::uint8_t>(token.size()));
-    put_string(o, token);
+  // After the layout: no trailing bytes, then the deferred text checks.
+  [[gnu::always_inline]] std::optional<DecodeError> finish() {
+    if (!failed() && pos_ != p_.size())
+      fail(ErrorCode::Malformed, std::to_string(p_.size() - pos_) + " unexpected trailing bytes at payload byte " +
+                                     std::to_string(pos_));
+    if (text_.text && !failed()) {
+      const std::string problem = text_.json ? json_object_problem(*text_.text)
+                                  : valid_utf8(*text_.text) ? std::string()
+                                                            : std::string("is not valid UTF-8");
+      if (!problem.empty()) bad_field(text_.field, text_.at, problem);
+    }
+    return std::move(error_);
   }
-  void operator()(const Welcome& m) {
-    put_le(o, m.version);
-    put_le(o, m.max_payload);
-    put_le(o, m.session_id);
-    put_string(o, m.json);
+
+ private:
+  // A payload has at most one text field that needs a content check.
+  struct TextCheck {
+    const char* field = "";
+    std::size_t at = 0;
+    const std::string* text = nullptr;
+    bool json = false;  // a JSON object, else UTF-8 text
+  };
+  void defer_check(const char* field, const std::string* text, bool json) {
+    assert(!text_.text && "one checked text field per payload");
+    text_ = TextCheck{field, at_, text, json};
   }
-  void operator()(const ErrorMsg& m) {
-    put_le(o, static_cast<std::uint16_t>(m.code));
-    put_le(o, m.ref);
-    put_string(o, m.text);
+  bool failed() const { return error_.has_value(); }
+  std::size_t remaining() const { return p_.size() - pos_; }
+  // Begins field `field` of n bytes at the current position.
+  // The reads are inlined into each message's decoder; building an error is the cold path.
+  [[gnu::always_inline]] bool start(std::size_t n, const char* field) {
+    field_ = field;
+    at_ = pos_;
+    if (failed()) return false;
+    if (remaining() < n) [[unlikely]] {
+      too_short(n, field);
+      return false;
+    }
+    return true;
   }
-  void operator()(const Ping& m) { put_bytes(o, std::span(m.data).first(std::min<std::size_t>(m.data.size(), 64))); }
-  void operator()(const Pong& m) { put_bytes(o, std::span(m.data).first(std::min<std::size_t>(m.data.size(), 64))); }
-  void operator()(const Bye&) {}
-  void operator()(const WriteFrames& m) { put_bytes(o, m.frames.bytes); }
-  void operator()(const ReadReg& m) { put_le(o, m.index); }
-  void operator()(const RegValue& m) {
-    put_le(o, m.index);
-    put_le(o, m.value);
+  [[gnu::cold, gnu::noinline]] void too_short(std::size_t n, const char* field) {
+    fail(ErrorCode::Malformed, "payload of " + std::to_string(p_.size()) + " bytes is too short: " + field + " needs " +
+                                   std::to_string(n) + " bytes at payload byte " + std::to_string(pos_));
   }
-  void operator()(const Upload& m) {
-    put_le(o, m.address);
-    put_bytes(o, m.data);
+  [[gnu::cold, gnu::noinline]] void fail(ErrorCode code, const std::string& what) {
+    if (!error_) error_ = DecodeError{code, std::string(type_name_) + " " + what};
   }
-  void operator()(const UploadAck& m) {
-    put_le(o, m.address);
-    put_le(o, m.length);
+  // Field value problem: "<TYPE> <field> <what> (payload byte N)".
+  [[gnu::cold, gnu::noinline]] void bad_field(const char* field, std::size_t at, const std::string& what) {
+    fail(ErrorCode::Malformed, std::string(field) + " " + what + " (payload byte " + std::to_string(at) + ")");
   }
-  void operator()(const Readback& m) {
-    put_le(o, m.address);
-    put_le(o, m.length);
-  }
-  void operator()(const ReadbackData& m) {
-    put_le(o, m.address);
-    put_le(o, static_cast<std::uint8_t>(m.last ? 1 : 0));
-    put_bytes(o, m.data);
-  }
-  void operator()(const FenceMsg& m) { put_le(o, m.id); }
-  void operator()(const FenceDone& m) { put_le(o, m.id); }
-  void operator()(const StatusReq&) {}
-  void operator()(const StatusReply& m) { put_string(o, m.json); }
-  void operator()(const Subscribe& m) {
-    put_le(o, static_cast<std::uint8_t>(m.format));
-    put_le(o, m.max_fps);
-    if (m.source) put_le(o, static_cast<std::uint8_t>(*m.source));
-  }
-  void operator()(const Unsubscribe&) {}
-  void operator()(const FrameData& m) {
-    put_le(o, m.number);
-    put_le(o, m.width);
-    put_le(o, m.height);
-    put_le(o, static_cast<std::uint8_t>(m.format));
-    put_le(o, static_cast<std::uint8_t>(m.source));
-    put_le(o, m.crc);
-    put_le(o, m.swap_ns);
-    put_bytes(o, m.pixels);
-  }
-  void operator()(const LeaseAcquire& m) { put_le(o, static_cast<std::uint8_t>(m.mode)); }
-  void operator()(const LeaseGranted& m) { put_le(o, m.session_id); }
-  void operator()(const LeaseRelease&) {}
-  void operator()(const LeaseReleased&) {}
-  void operator()(const DeviceEvent& m) { put_string(o, m.json); }
+
+  std::string_view type_name_;
+  std::span<const std::uint8_t> p_;
+  std::size_t pos_ = 0;
+  const char* field_ = "";  // the field being read, and where it starts
+  std::size_t at_ = 0;
+  TextCheck text_;
+  std::optional<DecodeError> error_;
 };
 
-constexpr MsgType kTypeOfIndex[] = {
-    MsgType::Hello,       MsgType::Welcome,      MsgType::Error,        MsgType::Ping,        MsgType::Pong,
-    MsgType::Bye,         MsgType::WriteFrames,  MsgType::ReadReg,      MsgType::RegValue,    MsgType::Upload,
-    MsgType::UploadAck,   MsgType::Readback,     MsgType::ReadbackData, MsgType::Fence,       MsgType::FenceDone,
-    MsgType::StatusReq,   MsgType::StatusReply,  MsgType::Subscribe,    MsgType::Unsubscribe, MsgType::FrameMsg,
-    MsgType::LeaseAcquire, MsgType::LeaseGranted, MsgType::LeaseRelease, MsgType::LeaseReleased, MsgType::DeviceEvent,
+// Encoder side: appends each field the layout names. Checks are the decoder's business.
+class FieldWriter {
+ public:
+  explicit FieldWriter(std::vector<std::uint8_t>& out) : o_(out) {}
+
+  template <std::unsigned_integral T>
+  void num(const char*, T v, std::optional<Range> = std::nullopt) { put_le(o_, v); }
+  template <std::unsigned_integral Wire, class E>
+  void code(const char*, E v, std::optional<Range> = std::nullopt) { put_le(o_, static_cast<Wire>(v)); }
+  template <std::unsigned_integral Wire, class E>
+  void optional_code(const char*, const std::optional<E>& v, Range) {
+    if (v) put_le(o_, static_cast<Wire>(*v));
+  }
+  void flag(const char*, bool v) { put_le(o_, static_cast<std::uint8_t>(v ? 1 : 0)); }
+  void counted(const char*, const char*, std::string_view s, std::size_t max, Text) {
+    s = s.substr(0, max);
+    put_le(o_, static_cast<std::uint8_t>(s.size()));
+    o_.insert(o_.end(), s.begin(), s.end());
+  }
+  void rest(const char*, std::span<const std::uint8_t> data, std::optional<MaxBytes> limit = std::nullopt) {
+    if (limit && limit->clip) data = data.first(std::min(data.size(), limit->max));
+    o_.insert(o_.end(), data.begin(), data.end());
+  }
+  void rest_text(const char*, std::string_view s) { o_.insert(o_.end(), s.begin(), s.end()); }
+  void rest_json(const char*, std::string_view s) { o_.insert(o_.end(), s.begin(), s.end()); }
+  void frames(const FrameView& v) { rest("frames", v.bytes); }
+  template <class F>
+  void check(F&&) {}
+
+ private:
+  std::vector<std::uint8_t>& o_;
 };
-static_assert(std::size(kTypeOfIndex) == std::variant_size_v<Payload>, "one MsgType per payload alternative");
+
+// ---- payload layouts: one per message, in wire order (docs/protocol.md "Socket protocol") ----
+
+// `M` is the message type, const when encoding.
+template <class M, class... T>
+concept OneOf = (std::same_as<std::remove_const_t<M>, T> || ...);
+
+constexpr Range kRegisterIndex{0, kRegisterCount - 1, "exceeds the 7-bit register index range 0..127"};
+constexpr Range kSource{0, 2, "is not 0 (board), 1 (sim) or 2 (diff)"};
+
+std::string address_space_problem(std::uint32_t address, std::uint64_t length) {
+  if (std::uint64_t{address} + length <= (std::uint64_t{1} << 32)) return {};
+  return std::to_string(length) + " bytes at address " + std::to_string(address) + " run past the 4 GiB address space";
+}
+
+void layout(auto& io, OneOf<Hello> auto& m) {
+  io.num("version", m.version);
+  io.counted("name_len", "name", m.name, kMaxNameBytes, Text::Utf8);
+  io.counted("token_len", "token", m.token, kMaxTokenBytes, Text::Bytes);
+}
+void layout(auto& io, OneOf<Welcome> auto& m) {
+  io.num("version", m.version);
+  io.num("max_payload", m.max_payload);
+  io.num("session_id", m.session_id);
+  io.rest_json("device description", m.json);
+}
+void layout(auto& io, OneOf<ErrorMsg> auto& m) {
+  io.template code<std::uint16_t>("code", m.code);
+  io.num("ref", m.ref);
+  io.rest_text("text", m.text);
+}
+void layout(auto& io, OneOf<Ping, Pong> auto& m) { io.rest("data", m.data, MaxBytes{64, "exceeds 64 bytes", true}); }
+void layout(auto&, OneOf<Bye, StatusReq, Unsubscribe, LeaseRelease, LeaseReleased> auto&) {}
+void layout(auto& io, OneOf<WriteFrames> auto& m) { io.frames(m.frames); }
+void layout(auto& io, OneOf<ReadReg> auto& m) { io.num("index", m.index, kRegisterIndex); }
+void layout(auto& io, OneOf<RegValue> auto& m) {
+  io.num("index", m.index, kRegisterIndex);
+  io.num("value", m.value);
+}
+void layout(auto& io, OneOf<Upload> auto& m) {
+  io.num("address", m.address);
+  io.rest("data", m.data);
+  io.check([&] { return m.data.empty() ? std::string("is empty; an UPLOAD carries at least 1 byte") : std::string(); });
+  // Device addresses are 32-bit: a range that wraps past 4 GiB is malformed, whoever sends it
+  // (socket, binary trace) — the text trace reader refuses the same range.
+  io.check([&] { return address_space_problem(m.address, m.data.size()); });
+}
+void layout(auto& io, OneOf<UploadAck> auto& m) {
+  io.num("address", m.address);
+  io.num("length", m.length);
+}
+void layout(auto& io, OneOf<Readback> auto& m) {
+  io.num("address", m.address);
+  io.num("length", m.length, Range{1, 64u << 20, "is outside 1..67108864 (64 MiB)"});
+  io.check([&] { return address_space_problem(m.address, m.length); });
+}
+void layout(auto& io, OneOf<ReadbackData> auto& m) {
+  io.num("address", m.address);
+  io.flag("last", m.last);
+  io.rest("data", m.data, MaxBytes{kMaxReadbackChunk, "exceeds the 65536-byte chunk limit"});
+}
+void layout(auto& io, OneOf<FenceMsg, FenceDone> auto& m) { io.num("id", m.id); }
+void layout(auto& io, OneOf<StatusReply> auto& m) { io.rest_json("status", m.json); }
+void layout(auto& io, OneOf<Subscribe> auto& m) {
+  io.template code<std::uint8_t>("format", m.format, Range{0, 3, "is not 0..3"});
+  io.num("max_fps", m.max_fps);
+  io.template optional_code<std::uint8_t>("source", m.source, kSource);  // absent in the original 3-byte form
+}
+void layout(auto& io, OneOf<FrameData> auto& m) {
+  io.num("number", m.number);
+  io.num("width", m.width);
+  io.num("height", m.height);
+  io.template code<std::uint8_t>("format", m.format, Range{0, 2, "is not a pixel format (0..2)"});
+  io.template code<std::uint8_t>("source", m.source, kSource);
+  io.num("crc", m.crc);
+  io.num("swap_ns", m.swap_ns);
+  io.rest("pixels", m.pixels);
+  io.check([&] {
+    const std::uint64_t expect = std::uint64_t{m.width} * m.height * bytes_per_pixel(m.format);
+    if (m.pixels.size() == expect) return std::string();
+    return "of " + std::to_string(m.pixels.size()) + " bytes do not match " + std::to_string(m.width) + "x" +
+           std::to_string(m.height) + " " + std::string(to_string(m.format)) + " (" + std::to_string(expect) + " bytes)";
+  });
+}
+void layout(auto& io, OneOf<LeaseAcquire> auto& m) {
+  io.template code<std::uint8_t>("mode", m.mode, Range{0, 1, "is not 0 (wait) or 1 (fail if busy)"});
+}
+void layout(auto& io, OneOf<LeaseGranted> auto& m) { io.num("session_id", m.session_id); }
+void layout(auto& io, OneOf<DeviceEvent> auto& m) { io.rest_json("event", m.json); }
+
+// ---- the message table, derived from the Payload variant ----------------------------------
+
+template <class T>
+std::optional<DecodeError> decode_as(std::span<const std::uint8_t> payload, Payload& out) {
+  T m;
+  FieldReader r(T::kName, payload);
+  layout(r, m);
+  auto error = r.finish();
+  out = std::move(m);
+  return error;
+}
+
+using Decoder = std::optional<DecodeError> (*)(std::span<const std::uint8_t>, Payload&);
+struct TypeEntry {
+  std::string_view name;
+  Decoder decode = nullptr;  // nullptr: not a message type
+};
+
+// Indexed by the type byte.
+constexpr std::array<TypeEntry, 256> kTypes = []<std::size_t... I>(std::index_sequence<I...>) {
+  std::array<TypeEntry, 256> t{};
+  ((t[static_cast<std::uint8_t>(std::variant_alternative_t<I, Payload>::kType)] =
+        TypeEntry{std::variant_alternative_t<I, Payload>::kName, &decode_as<std::variant_alternative_t<I, Payload>>}),
+   ...);
+  return t;
+}(std::make_index_sequence<std::variant_size_v<Payload>>{});
 
 }  // namespace
 
 std::string_view to_string(MsgType t) {
-  switch (t) {
-    case MsgType::Hello: return "HELLO";
-    case MsgType::Welcome: return "WELCOME";
-    case MsgType::Error: return "ERROR";
-    case MsgType::Ping: return "PING";
-    case MsgType::Pong: return "PONG";
-    case MsgType::Bye: return "BYE";
-    case MsgType::WriteFrames: return "WRITE_FRAMES";
-    case MsgType::ReadReg: return "READ_REG";
-    case MsgType::RegValue: return "REG_VALUE";
-    case MsgType::Upload: return "UPLOAD";
-    case MsgType::UploadAck: return "UPLOAD_ACK";
-    case MsgType::Readback: return "READBACK";
-    case MsgType::ReadbackData: return "READBACK_DATA";
-    case MsgType::Fence: return "FENCE";
-    case MsgType::FenceDone: return "FENCE_DONE";
-    case MsgType::StatusReq: return "STATUS_REQ";
-    case MsgType::StatusReply: return "STATUS_REPLY";
-    case MsgType::Subscribe: return "SUBSCRIBE";
-    case MsgType::Unsubscribe: return "UNSUBSCRIBE";
-    case MsgType::FrameMsg: return "FRAME";
-    case MsgType::LeaseAcquire: return "LEASE_ACQUIRE";
-    case MsgType::LeaseGranted: return "LEASE_GRANTED";
-    case MsgType::LeaseRelease: return "LEASE_RELEASE";
-    case MsgType::LeaseReleased: return "LEASE_RELEASED";
-    case MsgType::DeviceEvent: return "DEVICE_EVENT";
-  }
-  return "UNKNOWN";
+  const auto& e = kTypes[static_cast<std::uint8_t>(t)];
+  return e.decode ? e.name : "UNKNOWN";
 }
 
-bool is_known_type(std::uint8_t t) {
-  return std::any_of(std::begin(kTypeOfIndex), std::end(kTypeOfIndex),
-                     [t](MsgType k) { return static_cast<std::uint8_t>(k) == t; });
-}
+bool is_known_type(std::uint8_t t) { return kTypes[t].decode != nullptr; }
 
 std::string_view to_string(ErrorCode c) {
   switch (c) {
@@ -513,7 +429,9 @@ std::optional<FrameSource> parse_frame_source(std::string_view s) {
   return std::nullopt;
 }
 
-MsgType type_of(const Payload& p) { return kTypeOfIndex[p.index()]; }
+MsgType type_of(const Payload& p) {
+  return std::visit([](const auto& m) { return std::remove_cvref_t<decltype(m)>::kType; }, p);
+}
 
 std::string json_object_problem(std::string_view text) {
   // Bound the nesting first: deep nesting costs stack in consumers that walk the tree.
@@ -550,7 +468,8 @@ void encode_header(MsgType type, std::uint32_t length, std::uint32_t request_id,
 void encode(const Message& m, std::vector<std::uint8_t>& out) {
   const std::size_t start = out.size();
   out.resize(start + kHeaderBytes);
-  std::visit(PayloadEncoder{out}, m.payload);
+  FieldWriter w(out);
+  std::visit([&w](const auto& payload) { layout(w, payload); }, m.payload);
   const auto length = static_cast<std::uint32_t>(out.size() - start - kHeaderBytes);
   encode_header(type_of(m.payload), length, m.request_id, out.data() + start);
 }
@@ -561,8 +480,18 @@ std::vector<std::uint8_t> encode(const Message& m) {
   return out;
 }
 
-std::optional<DecodeError> decode_header(std::span<const std::uint8_t, kHeaderBytes> b, std::uint32_t max_payload,
-                                         Header& out) {
+namespace {
+
+void read_header(std::span<const std::uint8_t, kHeaderBytes> b, Header& out) {
+  out.version = b[2];
+  out.type = static_cast<MsgType>(b[3]);
+  out.length = get_le<std::uint32_t>(b.data() + 4);
+  out.request_id = get_le<std::uint32_t>(b.data() + 8);
+}
+
+// The first problem of a header, in the order decode_header checks them (off the hot path).
+[[gnu::cold, gnu::noinline]] DecodeError header_problem(std::span<const std::uint8_t, kHeaderBytes> b,
+                                                        std::uint32_t max_payload, Header& out) {
   if (b[0] != kMagic0 || b[1] != kMagic1) {
     char buf[96];
     std::snprintf(buf, sizeof buf, "bad magic 0x%02X 0x%02X (expected 'G' 'B'); is this a gpubridge client?", b[0], b[1]);
@@ -576,22 +505,29 @@ std::optional<DecodeError> decode_header(std::span<const std::uint8_t, kHeaderBy
     std::snprintf(buf, sizeof buf, "unknown message type 0x%02X", b[3]);
     return DecodeError{ErrorCode::UnknownType, buf};
   }
-  out.version = b[2];
-  out.type = static_cast<MsgType>(b[3]);
-  out.length = get_le<std::uint32_t>(b.data() + 4);
-  out.request_id = get_le<std::uint32_t>(b.data() + 8);
-  if (out.length > max_payload)
-    return DecodeError{ErrorCode::TooLarge, std::string(to_string(out.type)) + " payload length " +
-                                                std::to_string(out.length) + " exceeds the maximum of " +
-                                                std::to_string(max_payload) + " bytes; split it into smaller messages"};
-  return std::nullopt;
+  read_header(b, out);
+  return DecodeError{ErrorCode::TooLarge, std::string(to_string(out.type)) + " payload length " + std::to_string(out.length) +
+                                              " exceeds the maximum of " + std::to_string(max_payload) +
+                                              " bytes; split it into smaller messages"};
+}
+
+}  // namespace
+
+std::optional<DecodeError> decode_header(std::span<const std::uint8_t, kHeaderBytes> b, std::uint32_t max_payload,
+                                         Header& out) {
+  if (b[0] == kMagic0 && b[1] == kMagic1 && b[2] == kSocketVersion && kTypes[b[3]].decode &&
+      get_le<std::uint32_t>(b.data() + 4) <= max_payload) [[likely]] {
+    read_header(b, out);
+    return std::nullopt;
+  }
+  return header_problem(b, max_payload, out);
 }
 
 std::optional<DecodeError> decode_payload(const Header& h, std::span<const std::uint8_t> payload, Message& out) {
-  PayloadReader r(h.type, payload);
   out.request_id = h.request_id;
-  decode_into(h, r, out.payload);
-  return r.take_error();
+  const auto& entry = kTypes[static_cast<std::uint8_t>(h.type)];
+  if (!entry.decode) return DecodeError{ErrorCode::UnknownType, std::string(to_string(h.type)) + " has no decoder"};
+  return entry.decode(payload, out.payload);
 }
 
 }  // namespace gpubridge::protocol

@@ -28,32 +28,35 @@ inline constexpr std::uint32_t kMaxReadbackChunk = 64u << 10;  // READBACK_DATA 
 inline constexpr std::size_t kMaxNameBytes = 64;
 inline constexpr std::size_t kMaxTokenBytes = 128;
 
+// Message types and directions. Each payload's fields are described once, in wire order, by its
+// layout() in messages.cpp (the encoder and the decoder are derived from it); docs/protocol.md
+// "Socket protocol" is the normative description.
 enum class MsgType : std::uint8_t {
-  Hello = 0x01,         // c→s  u16 version, u8 name_len, name, u8 token_len, token
-  Welcome = 0x02,       // s→c  u16 version, u32 max_payload, u32 session_id, JSON device description
-  Error = 0x03,         // s→c  u16 code, u32 ref (request id it answers, 0 = none), UTF-8 text
-  Ping = 0x04,          // c→s  ≤ 64 opaque bytes
-  Pong = 0x05,          // s→c  the same bytes
-  Bye = 0x06,           // both: empty; the server answers Bye and closes
-  WriteFrames = 0x10,   // c→s  N × 9-byte device write frames, N ≥ 1 (lease required)
-  ReadReg = 0x11,       // c→s  u8 index
-  RegValue = 0x12,      // s→c  u8 index, u64 value
-  Upload = 0x13,        // c→s  u32 address, ≥ 1 data bytes (lease required)
-  UploadAck = 0x14,     // s→c  u32 address, u32 length applied
-  Readback = 0x15,      // c→s  u32 address, u32 length (1 .. 64 MiB) (lease required)
-  ReadbackData = 0x16,  // s→c  u32 address, u8 last (0/1), data (≤ 64 KiB)
-  Fence = 0x20,         // c→s  u64 id
-  FenceDone = 0x21,     // s→c  u64 id: every earlier command of this client has executed
-  StatusReq = 0x22,     // c→s  empty
-  StatusReply = 0x23,   // s→c  JSON
-  Subscribe = 0x30,     // c→s  u8 format (FrameFormat), u16 max_fps (0 = every frame) [, u8 source (FrameSource)]
-  Unsubscribe = 0x31,   // c→s  empty
-  FrameMsg = 0x32,      // s→c  u32 number, u16 width, u16 height, u8 format, u8 source, u32 crc, u64 swap_ns, pixels
-  LeaseAcquire = 0x40,  // c→s  u8 mode (LeaseMode)
-  LeaseGranted = 0x41,  // s→c  u32 session_id
-  LeaseRelease = 0x42,  // c→s  empty
-  LeaseReleased = 0x43, // s→c  empty
-  DeviceEvent = 0x50,   // s→c  JSON {"event": "...", ...}
+  Hello = 0x01,         // c→s
+  Welcome = 0x02,       // s→c
+  Error = 0x03,         // s→c
+  Ping = 0x04,          // c→s
+  Pong = 0x05,          // s→c
+  Bye = 0x06,           // both: the server answers Bye and closes
+  WriteFrames = 0x10,   // c→s (lease required)
+  ReadReg = 0x11,       // c→s
+  RegValue = 0x12,      // s→c
+  Upload = 0x13,        // c→s (lease required)
+  UploadAck = 0x14,     // s→c
+  Readback = 0x15,      // c→s (lease required)
+  ReadbackData = 0x16,  // s→c
+  Fence = 0x20,         // c→s
+  FenceDone = 0x21,     // s→c: every earlier command of this client has executed
+  StatusReq = 0x22,     // c→s
+  StatusReply = 0x23,   // s→c
+  Subscribe = 0x30,     // c→s
+  Unsubscribe = 0x31,   // c→s
+  FrameMsg = 0x32,      // s→c
+  LeaseAcquire = 0x40,  // c→s
+  LeaseGranted = 0x41,  // s→c
+  LeaseRelease = 0x42,  // c→s
+  LeaseReleased = 0x43, // s→c
+  DeviceEvent = 0x50,   // s→c
 };
 std::string_view to_string(MsgType t);
 bool is_known_type(std::uint8_t t);
@@ -96,34 +99,51 @@ struct Header {
   std::uint32_t request_id = 0;
 };
 
-// Typed payloads. Byte spans point into the parser's buffer and are valid until the next
-// call to MessageParser::next(), feed() or prepare(); copy what you keep.
-struct Hello { std::uint16_t version = kSocketVersion; std::string name; std::string token; };
-struct Welcome { std::uint16_t version = kSocketVersion; std::uint32_t max_payload = kMaxPayload; std::uint32_t session_id = 0; std::string json; };
-struct ErrorMsg { ErrorCode code = ErrorCode::Internal; std::uint32_t ref = 0; std::string text; };
-struct Ping { std::vector<std::uint8_t> data; };
-struct Pong { std::vector<std::uint8_t> data; };
-struct Bye {};
-struct WriteFrames { FrameView frames; };
-struct ReadReg { std::uint8_t index = 0; };
-struct RegValue { std::uint8_t index = 0; std::uint64_t value = 0; };
-struct Upload { std::uint32_t address = 0; std::span<const std::uint8_t> data; };
-struct UploadAck { std::uint32_t address = 0; std::uint32_t length = 0; };
-struct Readback { std::uint32_t address = 0; std::uint32_t length = 0; };
-struct ReadbackData { std::uint32_t address = 0; bool last = false; std::span<const std::uint8_t> data; };
-struct FenceMsg { std::uint64_t id = 0; };
-struct FenceDone { std::uint64_t id = 0; };
-struct StatusReq {};
-struct StatusReply { std::string json; };
+// Typed payloads, one struct per message type: kType is its type byte, kName its name in
+// docs/protocol.md and in error messages. Byte spans point into the parser's buffer and are valid
+// until the next call to MessageParser::next(), feed() or prepare(); copy what you keep.
+#define GPUBRIDGE_MESSAGE(T, NAME)                 \
+  static constexpr MsgType kType = MsgType::T;     \
+  static constexpr std::string_view kName = NAME
+struct Hello { GPUBRIDGE_MESSAGE(Hello, "HELLO"); std::uint16_t version = kSocketVersion; std::string name; std::string token; };
+struct Welcome {
+  GPUBRIDGE_MESSAGE(Welcome, "WELCOME");
+  std::uint16_t version = kSocketVersion;
+  std::uint32_t max_payload = kMaxPayload;
+  std::uint32_t session_id = 0;
+  std::string json;  // device description
+};
+struct ErrorMsg { GPUBRIDGE_MESSAGE(Error, "ERROR"); ErrorCode code = ErrorCode::Internal; std::uint32_t ref = 0; std::string text; };
+struct Ping { GPUBRIDGE_MESSAGE(Ping, "PING"); std::vector<std::uint8_t> data; };
+struct Pong { GPUBRIDGE_MESSAGE(Pong, "PONG"); std::vector<std::uint8_t> data; };
+struct Bye { GPUBRIDGE_MESSAGE(Bye, "BYE"); };
+struct WriteFrames { GPUBRIDGE_MESSAGE(WriteFrames, "WRITE_FRAMES"); FrameView frames; };
+struct ReadReg { GPUBRIDGE_MESSAGE(ReadReg, "READ_REG"); std::uint8_t index = 0; };
+struct RegValue { GPUBRIDGE_MESSAGE(RegValue, "REG_VALUE"); std::uint8_t index = 0; std::uint64_t value = 0; };
+struct Upload { GPUBRIDGE_MESSAGE(Upload, "UPLOAD"); std::uint32_t address = 0; std::span<const std::uint8_t> data; };
+struct UploadAck { GPUBRIDGE_MESSAGE(UploadAck, "UPLOAD_ACK"); std::uint32_t address = 0; std::uint32_t length = 0; };
+struct Readback { GPUBRIDGE_MESSAGE(Readback, "READBACK"); std::uint32_t address = 0; std::uint32_t length = 0; };
+struct ReadbackData {
+  GPUBRIDGE_MESSAGE(ReadbackData, "READBACK_DATA");
+  std::uint32_t address = 0;
+  bool last = false;
+  std::span<const std::uint8_t> data;
+};
+struct FenceMsg { GPUBRIDGE_MESSAGE(Fence, "FENCE"); std::uint64_t id = 0; };
+struct FenceDone { GPUBRIDGE_MESSAGE(FenceDone, "FENCE_DONE"); std::uint64_t id = 0; };
+struct StatusReq { GPUBRIDGE_MESSAGE(StatusReq, "STATUS_REQ"); };
+struct StatusReply { GPUBRIDGE_MESSAGE(StatusReply, "STATUS_REPLY"); std::string json; };
 // Without a source, SUBSCRIBE is encoded in the original 3-byte form (board; old daemons accept it).
 // An explicit source is a 4th byte, kept as decoded so that re-encoding gives the same bytes.
 struct Subscribe {
+  GPUBRIDGE_MESSAGE(Subscribe, "SUBSCRIBE");
   FrameFormat format = FrameFormat::Native;
-  std::uint16_t max_fps = 0;
+  std::uint16_t max_fps = 0;  // 0 = every frame
   std::optional<FrameSource> source = std::nullopt;  // absent = FrameSource::Board
 };
-struct Unsubscribe {};
+struct Unsubscribe { GPUBRIDGE_MESSAGE(Unsubscribe, "UNSUBSCRIBE"); };
 struct FrameData {
+  GPUBRIDGE_MESSAGE(FrameMsg, "FRAME");
   std::uint32_t number = 0;
   std::uint16_t width = 0, height = 0;
   PixelFormat format = PixelFormat::RGBA8888;
@@ -132,12 +152,14 @@ struct FrameData {
   std::span<const std::uint8_t> pixels;  // width * height * bpp(format)
   FrameSource source = FrameSource::Board;  // payload byte 9 (was reserved 0: board frames are unchanged)
 };
-struct LeaseAcquire { LeaseMode mode = LeaseMode::Wait; };
-struct LeaseGranted { std::uint32_t session_id = 0; };
-struct LeaseRelease {};
-struct LeaseReleased {};
-struct DeviceEvent { std::string json; };
+struct LeaseAcquire { GPUBRIDGE_MESSAGE(LeaseAcquire, "LEASE_ACQUIRE"); LeaseMode mode = LeaseMode::Wait; };
+struct LeaseGranted { GPUBRIDGE_MESSAGE(LeaseGranted, "LEASE_GRANTED"); std::uint32_t session_id = 0; };
+struct LeaseRelease { GPUBRIDGE_MESSAGE(LeaseRelease, "LEASE_RELEASE"); };
+struct LeaseReleased { GPUBRIDGE_MESSAGE(LeaseReleased, "LEASE_RELEASED"); };
+struct DeviceEvent { GPUBRIDGE_MESSAGE(DeviceEvent, "DEVICE_EVENT"); std::string json; };  // {"event": "...", ...}
+#undef GPUBRIDGE_MESSAGE
 
+// Every message type: the decoder, to_string(MsgType) and is_known_type() are derived from this list.
 using Payload = std::variant<Hello, Welcome, ErrorMsg, Ping, Pong, Bye, WriteFrames, ReadReg, RegValue, Upload,
                              UploadAck, Readback, ReadbackData, FenceMsg, FenceDone, StatusReq, StatusReply, Subscribe,
                              Unsubscribe, FrameData, LeaseAcquire, LeaseGranted, LeaseRelease, LeaseReleased,
