@@ -10,6 +10,7 @@
 #include "gpubridge/client/address.hpp"
 #include "gpubridge/common/regular_file.hpp"
 #include "gpubridge/common/log.hpp"
+#include "gpubridge/common/try.hpp"
 #include "gpubridge/protocol/messages.hpp"
 
 namespace gpubridge::daemon {
@@ -94,12 +95,6 @@ void for_each_limit(Limits_& lim, F&& f) {
 std::string log_level_problem(const std::string& level) {
   return "expected one of " + log_levels_text() + ", got " + Reader::shown(json(level));
 }
-
-#define GPUBRIDGE_TRY(expr) \
-  do {                      \
-    auto r_ = (expr);       \
-    if (!r_) return r_.error(); \
-  } while (0)
 
 }  // namespace
 

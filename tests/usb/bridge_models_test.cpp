@@ -9,6 +9,7 @@
 #include "gpubridge/usb/emu/emulated_stack.hpp"
 #include "gpubridge/usb/emu/mcp2210_model.hpp"
 #include "gpubridge/usb/emu/reference_target.hpp"
+#include "gpubridge/usb/emu/spi_slave.hpp"
 #include "gpubridge/usb/mcp2210.hpp"
 #include "test_profiles.hpp"
 

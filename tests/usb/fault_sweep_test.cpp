@@ -49,7 +49,7 @@ Outcome run_session(BridgeChip chip, Arm arm) {
     return o;
   };
   const auto profile = test::profile_for(chip);
-  auto bridge = emu::open_bridge(profile, s->usb(), s->hid());
+  auto bridge = open_bridge(profile, s->transport());
   if (!bridge) return finish(bridge.error());
   BoardOptions bo;
   bo.max_status_polls = 200;

@@ -7,6 +7,7 @@
 #include "gpubridge/usb/emu/emulated_stack.hpp"
 #include "gpubridge/usb/emu/mpsse_model.hpp"
 #include "gpubridge/usb/emu/reference_target.hpp"
+#include "gpubridge/usb/emu/spi_slave.hpp"
 #include "gpubridge/usb/ftdi_mpsse.hpp"
 #include "forwarding_usb_device.hpp"
 #include "test_profiles.hpp"

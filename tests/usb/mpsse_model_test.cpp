@@ -3,6 +3,7 @@
 
 #include "gpubridge/usb/emu/mpsse_model.hpp"
 #include "gpubridge/usb/emu/reference_target.hpp"
+#include "gpubridge/usb/emu/spi_slave.hpp"
 
 namespace gpubridge::usb::emu {
 namespace {

@@ -12,6 +12,7 @@
 #include "gpubridge/usb/emu/mcp2210_model.hpp"
 #include "gpubridge/usb/emu/mpsse_model.hpp"
 #include "gpubridge/usb/emu/reference_target.hpp"
+#include "gpubridge/usb/emu/spi_slave.hpp"
 #include "gpubridge/usb/ftdi_mpsse.hpp"
 #include "gpubridge/usb/mcp2210.hpp"
 #include "forwarding_usb_device.hpp"

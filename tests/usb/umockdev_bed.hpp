@@ -16,6 +16,7 @@
 
 #include "gpubridge/usb/emu/mpsse_model.hpp"
 #include "gpubridge/usb/emu/reference_target.hpp"
+#include "gpubridge/usb/emu/spi_slave.hpp"
 #include "gpubridge/usb/usb_device.hpp"
 #include "umockdev_urbs.hpp"
 

@@ -18,6 +18,7 @@
 #include "gpubridge/usb/board_factory.hpp"
 #include "gpubridge/usb/emu/mcp2210_model.hpp"
 #include "gpubridge/usb/emu/reference_target.hpp"
+#include "gpubridge/usb/emu/spi_slave.hpp"
 #include "gpubridge/usb/hidapi_transport.hpp"
 #include "test_profiles.hpp"
 #include "umockdev_urbs.hpp"

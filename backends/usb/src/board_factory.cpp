@@ -21,16 +21,17 @@ Result<std::unique_ptr<BoardBackend>> open_board(const BoardProfile& profile, co
   if (opts.emulate) {
     emu::EmulationOptions eo;
     eo.presence_file = opts.emulated_presence_file;
+    eo.pins = opts.emulated_pins;
     auto stack = emu::EmulatedStack::create(profile, eo);
     if (!stack) return stack.error();
     std::shared_ptr<emu::EmulatedStack> s = std::move(*stack);
-    s->spi_faults().max_reliable_hz = opts.emulated_max_reliable_hz;
-    auto bridge = emu::open_bridge(profile, s->usb(), s->hid());
+    if (opts.emulated_max_reliable_hz) s->spi_faults().max_reliable_hz = opts.emulated_max_reliable_hz;
+    auto bridge = open_bridge(profile, s->transport());
     if (!bridge) return bridge.error();
     return BoardBackend::attach(profile, s, std::move(*bridge), opts.board);
   }
   auto lower = std::make_shared<RealLower>();
-  if (profile.chip == BridgeChip::MCP2210) {
+  if (chip_info(profile.chip).api == UsbApi::Hidapi) {
     auto ctx = HidapiContext::create();
     if (!ctx) return ctx.error();
     lower->hid_ctx = *ctx;
@@ -45,7 +46,7 @@ Result<std::unique_ptr<BoardBackend>> open_board(const BoardProfile& profile, co
     if (!dev) return dev.error();
     lower->usb = std::move(*dev);
   }
-  auto bridge = emu::open_bridge(profile, lower->usb.get(), lower->hid.get());
+  auto bridge = open_bridge(profile, {lower->usb.get(), lower->hid.get()});
   if (!bridge) return bridge.error();
   return BoardBackend::attach(profile, lower, std::move(*bridge), opts.board);
 }

@@ -6,7 +6,7 @@
 
 namespace gpubridge::usb::emu {
 
-Ch341aModel::Ch341aModel(SpiSlave* slave, std::string serial) : slave_(slave) {
+Ch341aModel::Ch341aModel(SpiPins* pins, std::string serial) : UsbChipModel(pins) {
   info_.vid = 0x1a86;
   info_.pid = 0x5512;
   info_.bcd_device = 0x0304;
@@ -15,43 +15,29 @@ Ch341aModel::Ch341aModel(SpiSlave* slave, std::string serial) : slave_(slave) {
   info_.port_path = "1-3";
 }
 
-UsbStatus Ch341aModel::detach_kernel_driver(int) {
-  return faults_.next() == UsbFault::NoDevice ? UsbStatus::NoDevice : UsbStatus::NotFound;
-}
-UsbStatus Ch341aModel::claim_interface(int interface) {
-  if (faults_.next() == UsbFault::NoDevice) return UsbStatus::NoDevice;
-  if (interface != 0) return UsbStatus::NotFound;
-  claimed_ = true;
-  return UsbStatus::Ok;
-}
-UsbStatus Ch341aModel::release_interface(int) {
-  claimed_ = false;
-  return faults_.unplugged ? UsbStatus::NoDevice : UsbStatus::Ok;
-}
 UsbIo Ch341aModel::control_out(std::uint8_t, std::uint8_t, std::uint16_t, std::uint16_t, std::span<const std::uint8_t>, unsigned) {
-  violations_.push_back("the CH341A SPI path uses no control requests");
+  violation("the CH341A SPI path uses no control requests");
   return {UsbStatus::Pipe, 0};
 }
 UsbIo Ch341aModel::control_in(std::uint8_t, std::uint8_t, std::uint16_t, std::uint16_t, std::span<std::uint8_t>, unsigned) {
-  violations_.push_back("the CH341A SPI path uses no control requests");
+  violation("the CH341A SPI path uses no control requests");
   return {UsbStatus::Pipe, 0};
 }
-UsbStatus Ch341aModel::clear_halt(std::uint8_t) { return faults_.unplugged ? UsbStatus::NoDevice : UsbStatus::Ok; }
 std::uint16_t Ch341aModel::max_packet_size(std::uint8_t ep) const { return (ep == 0x02 || ep == 0x82) ? 32 : 0; }
 
 void Ch341aModel::update_cs() {
-  if (!slave_) return;
-  const bool low = (dir_ & 1) && !(pins_ & 1);
-  if (low != slave_->cs_asserted()) slave_->set_cs(low);
+  if (!pins_) return;
+  const bool low = (dir_ & 1) && !(uio_ & 1);
+  if (low != pins_->cs_asserted()) pins_->set_cs(low);
 }
 
 void Ch341aModel::packet(std::span<const std::uint8_t> p) {
   switch (p[0]) {
     case 0xA8:
-      if ((dir_ & 0x29) != 0x29) violations_.push_back("A8 SPI stream before CS/SCK/DOUT were enabled as outputs");
+      if ((dir_ & 0x29) != 0x29) violation("A8 SPI stream before CS/SCK/DOUT were enabled as outputs");
       for (std::size_t i = 1; i < p.size(); ++i) {
         const std::uint8_t wire = reverse_bits(p[i]);  // the chip shifts LSB first
-        const std::uint8_t got = slave_ ? slave_->shift_byte(wire) : 0xFF;
+        const std::uint8_t got = pins_ ? pins_->shift_byte(wire) : 0xFF;
         in_.push_back(reverse_bits(got));
       }
       break;
@@ -59,20 +45,20 @@ void Ch341aModel::packet(std::span<const std::uint8_t> p) {
       for (std::size_t i = 1; i < p.size(); ++i) {
         const std::uint8_t c = p[i];
         if (c == 0x20) return;  // end of UIO stream: rest of the packet ignored
-        if ((c & 0xC0) == 0x80) pins_ = c & 0x3F;
+        if ((c & 0xC0) == 0x80) uio_ = c & 0x3F;
         else if ((c & 0xC0) == 0x40) dir_ = c & 0x3F;
         else if ((c & 0xC0) == 0xC0) continue;  // delay
-        else if (c == 0x00) in_.push_back(pins_);
-        else violations_.push_back("unknown UIO sub-command");
+        else if (c == 0x00) in_.push_back(uio_);
+        else violation("unknown UIO sub-command");
         update_cs();
       }
-      violations_.push_back("UIO stream without 0x20 end marker");
+      violation("UIO stream without 0x20 end marker");
       break;
     case 0xAA:
-      if (p.size() < 3 || (p[1] & 0xF0) != 0x60 || p[2] != 0x00) violations_.push_back("malformed AA configuration stream");
+      if (p.size() < 3 || (p[1] & 0xF0) != 0x60 || p[2] != 0x00) violation("malformed AA configuration stream");
       break;
     default:
-      violations_.push_back("unknown CH341A command byte");
+      violation("unknown CH341A command byte");
   }
 }
 

@@ -4,7 +4,7 @@
 
 namespace gpubridge::usb::emu {
 
-Cp2130Model::Cp2130Model(SpiSlave* slave, std::string serial) : slave_(slave) {
+Cp2130Model::Cp2130Model(SpiPins* pins, std::string serial) : UsbChipModel(pins) {
   info_.vid = 0x10c4;
   info_.pid = 0x87a0;
   info_.bcd_device = 0x0100;
@@ -13,20 +13,6 @@ Cp2130Model::Cp2130Model(SpiSlave* slave, std::string serial) : slave_(slave) {
   info_.port_path = "1-4";
 }
 
-UsbStatus Cp2130Model::detach_kernel_driver(int) {
-  return faults_.next() == UsbFault::NoDevice ? UsbStatus::NoDevice : UsbStatus::NotFound;
-}
-UsbStatus Cp2130Model::claim_interface(int i) {
-  if (faults_.next() == UsbFault::NoDevice) return UsbStatus::NoDevice;
-  if (i != 0) return UsbStatus::NotFound;
-  claimed_ = true;
-  return UsbStatus::Ok;
-}
-UsbStatus Cp2130Model::release_interface(int) {
-  claimed_ = false;
-  return faults_.unplugged ? UsbStatus::NoDevice : UsbStatus::Ok;
-}
-UsbStatus Cp2130Model::clear_halt(std::uint8_t) { return faults_.unplugged ? UsbStatus::NoDevice : UsbStatus::Ok; }
 std::uint16_t Cp2130Model::max_packet_size(std::uint8_t ep) const {
   return (ep == 0x01 || ep == 0x02 || ep == 0x81 || ep == 0x82) ? 64 : 0;
 }
@@ -38,30 +24,30 @@ UsbIo Cp2130Model::control_out(std::uint8_t rt, std::uint8_t req, std::uint16_t 
   if (f == UsbFault::Stall) return {UsbStatus::Pipe, 0};
   if (f == UsbFault::TimeoutPartial) return {UsbStatus::Timeout, 0};
   if (rt != kRequestTypeVendorOut || value != 0 || index != 0) {
-    violations_.push_back("CP2130 control request with wrong bmRequestType/wValue/wIndex");
+    violation("CP2130 control request with wrong bmRequestType/wValue/wIndex");
     return {UsbStatus::Pipe, 0};
   }
   switch (req) {
     case 0x25:
       if (data.size() != 2 || data[0] > 10 || data[1] > 2) {
-        violations_.push_back("Set_GPIO_Chip_Select needs [channel 0..10, mode 0..2]");
+        violation("Set_GPIO_Chip_Select needs [channel 0..10, mode 0..2]");
         return {UsbStatus::Pipe, 0};
       }
       cs_channel_ = data[1] == 0 ? -1 : data[0];
       return {UsbStatus::Ok, 2};
     case 0x31:
       if (data.size() != 2 || data[0] > 10) {
-        violations_.push_back("Set_SPI_Word needs [channel 0..10, word]");
+        violation("Set_SPI_Word needs [channel 0..10, word]");
         return {UsbStatus::Pipe, 0};
       }
       spi_word_[data[0]] = data[1];
       return {UsbStatus::Ok, 2};
     case 0x60: case 0x61: case 0x62: case 0x63: case 0x64: case 0x65: case 0x66: case 0x67: case 0x68: case 0x69:
     case 0x6A: case 0x6B: case 0x6C: case 0x6D: case 0x6E: case 0x6F: case 0x70: case 0x71:
-      violations_.push_back("one-time-programmable configuration request: never write these");
+      violation("one-time-programmable configuration request: never write these");
       return {UsbStatus::Pipe, 0};
     default:
-      violations_.push_back("unsupported CP2130 request");
+      violation("unsupported CP2130 request");
       return {UsbStatus::Pipe, 0};
   }
 }
@@ -82,23 +68,23 @@ UsbIo Cp2130Model::bulk_out(std::uint8_t ep, std::span<const std::uint8_t> data,
   const std::uint8_t cmd = data[2];
   const std::size_t len = std::size_t{data[4]} | std::size_t{data[5]} << 8 | std::size_t{data[6]} << 16 | std::size_t{data[7]} << 24;
   if (data[0] != 0 || data[1] != 0 || data[3] != 0 || (cmd != 0x00 && cmd != 0x01 && cmd != 0x02 && cmd != 0x04)) {
-    violations_.push_back("malformed CP2130 bulk command header");
+    violation("malformed CP2130 bulk command header");
     return {UsbStatus::Pipe, 0};
   }
   if ((cmd == 0x01 || cmd == 0x02) && data.size() != 8 + len) {
-    violations_.push_back("bulk command length field does not match the data sent");
+    violation("bulk command length field does not match the data sent");
     return {UsbStatus::Pipe, 0};
   }
-  if (cmd == 0x02 && len > 56) violations_.push_back("WriteRead over 56 bytes stalls the synchronous API (single-buffered IN)");
-  if (cs_channel_ < 0) violations_.push_back("SPI command with no chip select enabled");
-  if (cs_channel_ >= 0 && (spi_word_[cs_channel_] & 0x30) != 0) violations_.push_back("CS channel not in SPI mode 0");
-  if (slave_) slave_->set_cs(true);
+  if (cmd == 0x02 && len > 56) violation("WriteRead over 56 bytes stalls the synchronous API (single-buffered IN)");
+  if (cs_channel_ < 0) violation("SPI command with no chip select enabled");
+  if (cs_channel_ >= 0 && (spi_word_[cs_channel_] & 0x30) != 0) violation("CS channel not in SPI mode 0");
+  if (pins_) pins_->set_cs(true);
   const std::size_t clocked = std::min(len, accepted - 8);
   for (std::size_t i = 0; i < clocked; ++i) {
-    const std::uint8_t got = slave_ ? slave_->shift_byte(data[8 + i]) : 0xFF;
+    const std::uint8_t got = pins_ ? pins_->shift_byte(data[8 + i]) : 0xFF;
     if (cmd == 0x02) in_.push_back(got);
   }
-  if (slave_) slave_->set_cs(false);
+  if (pins_) pins_->set_cs(false);
   if (f == UsbFault::TimeoutPartial) return {UsbStatus::Timeout, accepted};
   return {UsbStatus::Ok, data.size()};
 }

@@ -1,20 +1,14 @@
 #include "gpubridge/usb/emu/emulated_stack.hpp"
 
 #include <cstdio>
+#include <stdexcept>
 
 #include "gpubridge/backends/backend.hpp"
-#include "gpubridge/usb/ch341a.hpp"
-#include "gpubridge/usb/cp2130.hpp"
-#include "gpubridge/usb/emu/ch341a_model.hpp"
-#include "gpubridge/usb/emu/cp2130_model.hpp"
-#include "gpubridge/usb/emu/mcp2210_model.hpp"
-#include "gpubridge/usb/emu/mpsse_model.hpp"
-#include "gpubridge/usb/mcp2210.hpp"
-#include "gpubridge/usb/emu/reference_target.hpp"
-#include "gpubridge/usb/ftdi_mpsse.hpp"
-#if GPUBRIDGE_HAVE_SIM
 #include "gpubridge/sim/device.hpp"
-#endif
+#include "gpubridge/usb/bridge_chips.hpp"
+#include "gpubridge/usb/emu/chip_model.hpp"
+#include "gpubridge/usb/emu/mcp2210_model.hpp"
+#include "gpubridge/usb/emu/reference_target.hpp"
 
 namespace gpubridge::usb::emu {
 namespace {
@@ -35,17 +29,17 @@ class SwitchableTarget final : public backends::SpiTarget {
 struct EmulatedStack::Impl {
   BoardProfile profile;
   EmulationOptions opts;
+  // The SPI pins: the C++ SPI slave driving a device model (simulator or reference target), or
+  // whatever EmulationOptions::pins built (then `slave` is null).
   SwitchableTarget target;
   bool simulator = false;
   std::unique_ptr<SpiSlave> slave;
-  std::unique_ptr<MpsseModel> mpsse;
-  std::unique_ptr<Ch341aModel> ch341a;
-  std::unique_ptr<Mcp2210Model> mcp2210;
-  std::unique_ptr<Cp2130Model> cp2130;
-  FaultPlan no_faults;
+  std::unique_ptr<SpiPins> custom_pins;
+  std::unique_ptr<ChipModel> chip;
+
+  SpiPins* pins() { return slave ? static_cast<SpiPins*>(slave.get()) : custom_pins.get(); }
 
   Result<std::unique_ptr<backends::SpiTarget>> make_target() {
-#if GPUBRIDGE_HAVE_SIM
     if (opts.use_simulator) {
       sim::DeviceOptions o;
       o.vram_bytes = std::uint64_t{profile.vram_kib} * 1024;
@@ -58,7 +52,6 @@ struct EmulatedStack::Impl {
       simulator = true;
       return std::unique_ptr<backends::SpiTarget>(std::move(*d));
     }
-#endif
     ReferenceTargetConfig c;
     c.vram_kib = profile.vram_kib;
     c.fifo_depth = profile.fifo_depth;
@@ -69,17 +62,16 @@ struct EmulatedStack::Impl {
     return std::unique_ptr<backends::SpiTarget>(std::make_unique<ReferenceTarget>(c));
   }
   void tick() {
-#if GPUBRIDGE_HAVE_SIM
-    if (simulator) {
-      static_cast<sim::Device*>(target.t_.get())->step(1);
-      return;
-    }
-#endif
-    static_cast<ReferenceTarget*>(target.t_.get())->tick();
+    if (simulator) static_cast<sim::Device*>(target.t_.get())->step(1);
+    else static_cast<ReferenceTarget*>(target.t_.get())->tick();
   }
   void power_cycle() {
     auto t = make_target();
     if (t) target.t_ = std::move(*t);  // same options as before, so creation cannot newly fail
+  }
+  SpiSlave& builtin_slave() {
+    if (!slave) throw std::logic_error("emulated board '" + profile.name + "': no C++ SPI slave (EmulationOptions::pins replaced it)");
+    return *slave;
   }
 };
 
@@ -101,108 +93,48 @@ Result<std::unique_ptr<EmulatedStack>> EmulatedStack::create(const BoardProfile&
   auto impl = std::make_unique<Impl>();
   impl->profile = profile;
   impl->opts = opts;
-  auto t = impl->make_target();
-  if (!t) return make_error("emulated board '" + profile.name + "': " + t.error().message, backends::kBadRequest);
-  impl->target.t_ = std::move(*t);
-  Impl* raw = impl.get();
-  impl->slave = std::make_unique<SpiSlave>(impl->target, [raw] { raw->power_cycle(); }, [raw] { raw->tick(); });
-  switch (profile.chip) {
-    case BridgeChip::FT232H:
-    case BridgeChip::FT2232H:
-    case BridgeChip::FT4232H: {
-      MpsseModelConfig c;
-      c.chip = profile.chip == BridgeChip::FT232H    ? FtdiChip::FT232H
-               : profile.chip == BridgeChip::FT2232H ? FtdiChip::FT2232H
-                                                     : FtdiChip::FT4232H;
-      c.high_speed = opts.high_speed;
-      c.serial = opts.serial;
-      c.cs_pin = profile.cs_pin;
-      c.busy_wired = profile.busy_pin;
-      impl->mpsse = std::make_unique<MpsseModel>(c, impl->slave.get());
-      break;
-    }
-    case BridgeChip::CH341A: impl->ch341a = std::make_unique<Ch341aModel>(impl->slave.get(), opts.serial); break;
-    case BridgeChip::MCP2210: impl->mcp2210 = std::make_unique<Mcp2210Model>(impl->slave.get(), opts.serial); break;
-    case BridgeChip::CP2130: impl->cp2130 = std::make_unique<Cp2130Model>(impl->slave.get(), opts.serial); break;
+  if (opts.pins) {
+    auto pins = opts.pins(profile);
+    if (!pins) return make_error("emulated board '" + profile.name + "': " + pins.error().message, pins.error().code);
+    impl->custom_pins = std::move(*pins);
+  } else {
+    auto t = impl->make_target();
+    if (!t) return make_error("emulated board '" + profile.name + "': " + t.error().message, backends::kBadRequest);
+    impl->target.t_ = std::move(*t);
+    Impl* raw = impl.get();
+    impl->slave = std::make_unique<SpiSlave>(impl->target, [raw] { raw->power_cycle(); }, [raw] { raw->tick(); });
   }
+  impl->chip = chip_info(profile.chip).make_model(profile, opts, impl->pins());
   std::unique_ptr<EmulatedStack> stack(new EmulatedStack(std::move(impl)));
   stack->usb_faults().presence_file = opts.presence_file;
   return stack;
 }
 
-UsbDevice* EmulatedStack::usb() {
-  if (impl_->mpsse) return impl_->mpsse.get();
-  if (impl_->ch341a) return impl_->ch341a.get();
-  if (impl_->cp2130) return impl_->cp2130.get();
-  return nullptr;
+UsbDevice* EmulatedStack::usb() { return impl_->chip->usb(); }
+HidDevice* EmulatedStack::hid() { return impl_->chip->hid(); }
+BridgeTransport EmulatedStack::transport() { return {usb(), hid()}; }
+ChipModel& EmulatedStack::chip() { return *impl_->chip; }
+Mcp2210Model* EmulatedStack::mcp2210() { return dynamic_cast<Mcp2210Model*>(impl_->chip.get()); }
+FaultPlan& EmulatedStack::usb_faults() { return impl_->chip->faults(); }
+std::vector<std::string> EmulatedStack::violations() const { return impl_->chip->violations(); }
+SpiPins& EmulatedStack::pins() { return *impl_->pins(); }
+SpiFaults& EmulatedStack::spi_faults() { return impl_->builtin_slave().faults(); }
+SpiSlave& EmulatedStack::slave() { return impl_->builtin_slave(); }
+backends::SpiTarget& EmulatedStack::target() {
+  impl_->builtin_slave();
+  return *impl_->target.t_;
 }
-HidDevice* EmulatedStack::hid() { return impl_->mcp2210.get(); }
-Mcp2210Model* EmulatedStack::mcp2210() { return impl_->mcp2210.get(); }
-FaultPlan& EmulatedStack::usb_faults() {
-  if (impl_->mpsse) return impl_->mpsse->faults();
-  if (impl_->ch341a) return impl_->ch341a->faults();
-  if (impl_->cp2130) return impl_->cp2130->faults();
-  if (impl_->mcp2210) return impl_->mcp2210->faults();
-  return impl_->no_faults;
-}
-SpiFaults& EmulatedStack::spi_faults() { return impl_->slave->faults(); }
-SpiSlave& EmulatedStack::slave() { return *impl_->slave; }
-backends::SpiTarget& EmulatedStack::target() { return *impl_->target.t_; }
-bool EmulatedStack::target_is_simulator() const { return impl_->simulator; }
-void EmulatedStack::power_cycle() { impl_->power_cycle(); }
-std::vector<std::string> EmulatedStack::violations() const {
-  if (impl_->mpsse) return impl_->mpsse->violations();
-  if (impl_->ch341a) return impl_->ch341a->violations();
-  if (impl_->cp2130) return impl_->cp2130->violations();
-  if (impl_->mcp2210) return impl_->mcp2210->violations();
-  return {};
-}
-
-Result<std::unique_ptr<SpiBridge>> open_bridge(const BoardProfile& p, UsbDevice* usb, HidDevice* hid) {
-  switch (p.chip) {
-    case BridgeChip::FT232H:
-    case BridgeChip::FT2232H:
-    case BridgeChip::FT4232H: {
-      if (!usb) return make_error("FTDI driver needs a USB device", backends::kBadRequest);
-      FtdiConfig c;
-      c.channel = p.interface;
-      c.cs_pin = p.cs_pin;
-      c.busy_pin = p.busy_pin;
-      c.read_edge = p.read_edge;
-      c.latency_ms = p.latency_ms;
-      c.clock_hz = p.spi_clock_hz;
-      c.stream_reads = p.stream_reads;
-      auto b = FtdiMpsseBridge::open(*usb, c);
-      if (!b) return b.error();
-      return std::unique_ptr<SpiBridge>(std::move(*b));
-    }
-    case BridgeChip::CH341A: {
-      if (!usb) return make_error("CH341A driver needs a USB device", backends::kBadRequest);
-      auto b = Ch341aBridge::open(*usb);
-      if (!b) return b.error();
-      return std::unique_ptr<SpiBridge>(std::move(*b));
-    }
-    case BridgeChip::CP2130: {
-      if (!usb) return make_error("CP2130 driver needs a USB device", backends::kBadRequest);
-      auto b = Cp2130Bridge::open(*usb, p.cs_pin, p.spi_clock_hz);
-      if (!b) return b.error();
-      return std::unique_ptr<SpiBridge>(std::move(*b));
-    }
-    case BridgeChip::MCP2210: {
-      if (!hid) return make_error("MCP2210 driver needs a HID device", backends::kBadRequest);
-      auto b = Mcp2210Bridge::open(*hid, p.cs_pin, p.spi_clock_hz);
-      if (!b) return b.error();
-      return std::unique_ptr<SpiBridge>(std::move(*b));
-    }
-  }
-  return make_error("no driver for bridge chip " + std::string(to_string(p.chip)), backends::kBadRequest);
+bool EmulatedStack::target_is_simulator() const { return impl_->slave && impl_->simulator; }
+void EmulatedStack::power_cycle() {
+  impl_->builtin_slave();
+  impl_->power_cycle();
 }
 
 Result<EmulatedBoard> open_emulated_board(const BoardProfile& profile, EmulationOptions opts, BoardOptions board) {
   auto stack = EmulatedStack::create(profile, opts);
   if (!stack) return stack.error();
   std::shared_ptr<EmulatedStack> shared = std::move(*stack);
-  auto bridge = open_bridge(profile, shared->usb(), shared->hid());
+  auto bridge = open_bridge(profile, shared->transport());
   if (!bridge) return bridge.error();
   auto backend = BoardBackend::attach(profile, shared, std::move(*bridge), board);
   if (!backend) return backend.error();

@@ -4,7 +4,7 @@
 
 namespace gpubridge::usb::emu {
 
-Mcp2210Model::Mcp2210Model(SpiSlave* slave, std::string serial) : slave_(slave) {
+Mcp2210Model::Mcp2210Model(SpiPins* pins, std::string serial) : ChipModel(pins) {
   info_.vid = 0x04d8;
   info_.pid = 0x00de;
   info_.path = "/dev/hidraw-model";
@@ -23,7 +23,7 @@ int Mcp2210Model::write(std::span<const std::uint8_t> data) {
     return -1;
   }
   if (data.size() != 65 || data[0] != 0x00) {
-    violations_.push_back("HID write of " + std::to_string(data.size()) + " bytes (must be report id 0x00 + 64 bytes)");
+    violation("HID write of " + std::to_string(data.size()) + " bytes (must be report id 0x00 + 64 bytes)");
     last_error_ = "bad report";
     return -1;
   }
@@ -57,7 +57,7 @@ std::array<std::uint8_t, 64> Mcp2210Model::handle(std::span<const std::uint8_t, 
       in_transaction_ = false;
       rx_.clear();
       remaining_ = 0;
-      if (slave_ && slave_->cs_asserted()) slave_->set_cs(false);
+      if (pins_ && pins_->cs_asserted()) pins_->set_cs(false);
       break;
     case 0x20:
       std::copy(chip_settings_.begin() + 4, chip_settings_.end(), out.begin() + 4);
@@ -68,7 +68,7 @@ std::array<std::uint8_t, 64> Mcp2210Model::handle(std::span<const std::uint8_t, 
       break;
     case 0x40:
       if (in_transaction_) { out[1] = 0xF8; break; }
-      if (r[20] > 3) violations_.push_back("SPI mode " + std::to_string(r[20]) + " (valid 0..3)");
+      if (r[20] > 3) violation("SPI mode " + std::to_string(r[20]) + " (valid 0..3)");
       std::copy(r.begin(), r.end(), spi_settings_.begin());
       break;
     case 0x41:
@@ -79,31 +79,31 @@ std::array<std::uint8_t, 64> Mcp2210Model::handle(std::span<const std::uint8_t, 
       if (inject_busy) { --inject_busy; out[1] = 0xF8; break; }
       const std::size_t n = r[1];
       if (n > 60) {
-        violations_.push_back("transfer of " + std::to_string(n) + " bytes in one report (max 60)");
+        violation("transfer of " + std::to_string(n) + " bytes in one report (max 60)");
         out[1] = 0xF8;
         break;
       }
       const bool first = !in_transaction_;
       if (first) {
         remaining_ = std::size_t{spi_settings_[18]} | std::size_t{spi_settings_[19]} << 8;
-        if (spi_settings_[20] != 0) violations_.push_back("SPI mode is not 0");
+        if (spi_settings_[20] != 0) violation("SPI mode is not 0");
         const std::uint16_t active = static_cast<std::uint16_t>(spi_settings_[10] | spi_settings_[11] << 8);
         unsigned cs = 9;
         for (unsigned p = 0; p < 9; ++p)
           if (chip_settings_[4 + p] == 1 && !(active & (1u << p))) cs = p;
-        if (cs == 9) violations_.push_back("transfer without a GP pin designated as chip select and driven low");
+        if (cs == 9) violation("transfer without a GP pin designated as chip select and driven low");
         if (n == 0 || remaining_ == 0) {
-          violations_.push_back("transfer started with no data or zero transaction length");
+          violation("transfer started with no data or zero transaction length");
           out[1] = 0x00;
           out[3] = 0x10;
           break;
         }
         in_transaction_ = true;
-        if (slave_) slave_->set_cs(true);
+        if (pins_) pins_->set_cs(true);
       }
-      if (n > remaining_) violations_.push_back("more bytes than the configured transaction length");
-      for (std::size_t i = 0; i < n && remaining_ > 0; ++i, --remaining_) rx_.push_back(slave_ ? slave_->shift_byte(r[4 + i]) : 0xFF);
-      if (remaining_ == 0 && slave_ && slave_->cs_asserted()) slave_->set_cs(false);
+      if (n > remaining_) violation("more bytes than the configured transaction length");
+      for (std::size_t i = 0; i < n && remaining_ > 0; ++i, --remaining_) rx_.push_back(pins_ ? pins_->shift_byte(r[4 + i]) : 0xFF);
+      if (remaining_ == 0 && pins_ && pins_->cs_asserted()) pins_->set_cs(false);
       if (first) {
         out[3] = 0x20;  // started, data not yet available
         break;
@@ -123,7 +123,7 @@ std::array<std::uint8_t, 64> Mcp2210Model::handle(std::span<const std::uint8_t, 
       break;
     }
     default:
-      violations_.push_back("unknown MCP2210 command");
+      violation("unknown MCP2210 command");
       out[1] = 0xF9;
   }
   return out;

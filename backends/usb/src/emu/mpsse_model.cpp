@@ -23,7 +23,7 @@ std::string hex(unsigned v) {
 
 }  // namespace
 
-MpsseModel::MpsseModel(MpsseModelConfig cfg, SpiSlave* slave) : cfg_(std::move(cfg)), slave_(slave) {
+MpsseModel::MpsseModel(MpsseModelConfig cfg, SpiPins* pins) : ChipModel(pins), cfg_(std::move(cfg)) {
   info_.vid = 0x0403;
   switch (cfg_.chip) {
     case FtdiChip::FT232H: info_.pid = 0x6014; info_.bcd_device = 0x0900; info_.product = "FT232H (model)"; break;
@@ -47,7 +47,6 @@ std::size_t MpsseModel::tx_fifo_bytes() const {
   return 1024;
 }
 
-void MpsseModel::violation(std::string what) { violations_.push_back(std::move(what)); }
 
 int MpsseModel::channel_of_endpoint(std::uint8_t ep, bool in) const {
   const int channels = cfg_.chip == FtdiChip::FT232H ? 1 : 2;
@@ -343,10 +342,10 @@ std::uint32_t MpsseModel::sck_hz() const {
 }
 
 void MpsseModel::update_cs(Channel& c) {
-  if (&c != &ch_[0] || !slave_) return;
+  if (&c != &ch_[0] || !pins_) return;
   const std::uint8_t bit = static_cast<std::uint8_t>(1u << cfg_.cs_pin);
   const bool driven_low = (c.low_dir & bit) && !(c.low_value & bit);
-  if (driven_low != slave_->cs_asserted()) slave_->set_cs(driven_low);
+  if (driven_low != pins_->cs_asserted()) pins_->set_cs(driven_low);
 }
 
 std::uint8_t MpsseModel::shift(Channel& c, std::uint8_t mosi, bool write, unsigned bits) {
@@ -356,7 +355,7 @@ std::uint8_t MpsseModel::shift(Channel& c, std::uint8_t mosi, bool write, unsign
     const bool out_bit = (mosi >> (7 - i)) & 1u;
     bool miso_bit = true;  // DI pulled up with nothing attached
     if (c.loopback) miso_bit = out_bit;
-    else if (&c == &ch_[0] && slave_) miso_bit = slave_->shift_bit(out_bit);
+    else if (&c == &ch_[0] && pins_) miso_bit = pins_->shift_bit(out_bit);
     in = static_cast<std::uint8_t>(in << 1 | (miso_bit ? 1 : 0));
     if (write) c.low_value = static_cast<std::uint8_t>((c.low_value & ~0x02) | (out_bit ? 0x02 : 0));
   }
@@ -388,7 +387,7 @@ std::size_t MpsseModel::execute(int ch, std::span<const std::uint8_t> cmd, bool&
     if (write && !(op & 0x01)) violation("opcode " + hex(op) + " writes on the rising edge: SPI mode 0 needs the falling edge");
     if (!(c.low_dir & 0x01) || (write && !(c.low_dir & 0x02)))
       violation("data command " + hex(op) + " while SK/DO are not outputs (send 0x80 first)");
-    if (slave_ && ch == 0) slave_->set_clock_hz(sck_hz());
+    if (pins_ && ch == 0) pins_->set_clock_hz(sck_hz());
     const bool lsb = op & 0x08;
     if (bit_mode) {
       const std::size_t need = write ? 3 : 2;
@@ -433,7 +432,7 @@ std::size_t MpsseModel::execute(int ch, std::span<const std::uint8_t> cmd, bool&
     case 0x81:
     case 0x83: {
       std::uint8_t v = op == 0x81 ? c.low_value : c.high_value;
-      if (op == 0x81 && ch == 0 && slave_ && cfg_.busy_wired) v = static_cast<std::uint8_t>((v & ~0x20) | (slave_->busy_pin() ? 0x20 : 0));
+      if (op == 0x81 && ch == 0 && pins_ && cfg_.busy_wired) v = static_cast<std::uint8_t>((v & ~0x20) | (pins_->busy_pin() ? 0x20 : 0));
       c.in.push_back(v);
       return 1;
     }
@@ -447,13 +446,13 @@ std::size_t MpsseModel::execute(int ch, std::span<const std::uint8_t> cmd, bool&
     case 0x88:
     case 0x89: {
       const bool want_high = op == 0x88;
-      auto pin_high = [&] { return ch == 0 && slave_ && cfg_.busy_wired && slave_->busy_pin(); };
+      auto pin_high = [&] { return ch == 0 && pins_ && cfg_.busy_wired && pins_->busy_pin(); };
       for (unsigned t = 0; pin_high() != want_high; ++t) {
-        if (t >= cfg_.max_wait_ticks || !slave_ || !cfg_.busy_wired) {
+        if (t >= cfg_.max_wait_ticks || !pins_ || !cfg_.busy_wired) {
           stalled = true;  // waits until the host's timeout: the pin never changes
           return 0;
         }
-        slave_->idle_tick();
+        pins_->idle_tick();
       }
       return 1;
     }

@@ -6,6 +6,7 @@
 
 #include "gpubridge/usb/board_backend.hpp"
 #include "gpubridge/usb/board_profile.hpp"
+#include "gpubridge/usb/emu/emulated_stack.hpp"
 
 namespace gpubridge::usb {
 
@@ -13,6 +14,7 @@ struct BoardOpenOptions {
   bool emulate = false;
   std::uint32_t emulated_max_reliable_hz = 0;  // emulation only: MISO errors above this SCK (0 = none)
   std::string emulated_presence_file;          // emulation only: plugged in while this file exists ("" = always)
+  emu::PinsFactory emulated_pins;              // emulation only: what drives the SPI pins (empty = SpiSlave + simulator)
   BoardOptions board;
 };
 

@@ -1,7 +1,8 @@
 #pragma once
 // Board profiles are data (configs/boards/*.json): which bridge chip, how it is wired, how fast
-// the SPI link may run and what the FPGA design offers. Cable descriptions (configs/cables/*.json)
-// list the bridge chips `gpubridge probe` looks for.
+// the SPI link may run and what the FPGA design offers; each is checked against its chip's row in
+// the chip table (bridge_chips.hpp). Cable descriptions (configs/cables/*.json) list the bridge
+// chips `gpubridge probe` looks for, checked against the same table.
 #include <cstdint>
 #include <filesystem>
 #include <optional>
@@ -9,13 +10,10 @@
 #include <vector>
 
 #include "gpubridge/common/result.hpp"
+#include "gpubridge/usb/bridge_chips.hpp"
 #include "gpubridge/usb/ftdi_mpsse.hpp"
 
 namespace gpubridge::usb {
-
-enum class BridgeChip : std::uint8_t { FT232H, FT2232H, FT4232H, CH341A, MCP2210, CP2130 };
-std::string_view to_string(BridgeChip c);
-std::optional<BridgeChip> parse_bridge_chip(std::string_view s);  // "ft232h", "ch341a", ...
 
 enum class ScanoutMode : std::uint8_t { Readback, CrcOnly, Off };
 
@@ -43,7 +41,7 @@ struct BoardProfile {
 };
 
 struct CableInfo {
-  std::string name, chip, description, api;
+  std::string name, chip, description, api;  // chip: a chip table name; api: that chip's ("libusb", "hidapi")
   std::uint16_t vid = 0, pid = 0;
   std::uint32_t max_spi_hz = 0;
   std::vector<std::string> interfaces;

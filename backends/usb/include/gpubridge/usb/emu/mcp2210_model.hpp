@@ -9,31 +9,25 @@
 #include <string>
 #include <vector>
 
-#include "gpubridge/usb/emu/fault_plan.hpp"
-#include "gpubridge/usb/emu/spi_slave.hpp"
-#include "gpubridge/usb/hid_device.hpp"
+#include "gpubridge/usb/emu/chip_model.hpp"
 
 namespace gpubridge::usb::emu {
 
-class Mcp2210Model final : public HidDevice {
+class Mcp2210Model final : public ChipModel, public HidDevice {
  public:
-  Mcp2210Model(SpiSlave* slave, std::string serial);
+  Mcp2210Model(SpiPins* pins, std::string serial);
+  HidDevice* hid() override { return this; }
   const HidDeviceInfo& info() const override { return info_; }
   int write(std::span<const std::uint8_t> data) override;
   int read(std::span<std::uint8_t> data, int timeout_ms) override;
   std::string last_error() const override { return last_error_; }
 
-  FaultPlan& faults() { return faults_; }
-  const std::vector<std::string>& violations() const { return violations_; }
   unsigned inject_busy = 0;        // the next N transfer commands answer 0xF8
   bool external_master = false;    // transfer commands answer 0xF7
 
  private:
   std::array<std::uint8_t, 64> handle(std::span<const std::uint8_t, 64> r);
-  SpiSlave* slave_;
   HidDeviceInfo info_;
-  FaultPlan faults_;
-  std::vector<std::string> violations_;
   std::string last_error_;
   std::deque<std::array<std::uint8_t, 64>> responses_;
   std::array<std::uint8_t, 64> chip_settings_{}, spi_settings_{};

@@ -10,9 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "gpubridge/usb/emu/fault_plan.hpp"
-#include "gpubridge/usb/emu/spi_slave.hpp"
-#include "gpubridge/usb/usb_device.hpp"
+#include "gpubridge/usb/emu/chip_model.hpp"
 
 namespace gpubridge::usb::emu {
 
@@ -28,10 +26,13 @@ struct MpsseModelConfig {
   unsigned max_wait_ticks = 100000;  // device time a wait-on-I/O may take before the MPSSE stalls
 };
 
-class MpsseModel final : public UsbDevice {
+// Two channels, each its own interface with ftdi_sio bound until detached: claim and release are
+// this model's own, not UsbChipModel's single-interface ones.
+class MpsseModel final : public ChipModel, public UsbDevice {
  public:
-  // slave: the SPI device on channel A (channel B has nothing attached).
-  MpsseModel(MpsseModelConfig cfg, SpiSlave* slave);
+  // pins: the SPI device on channel A (channel B has nothing attached).
+  MpsseModel(MpsseModelConfig cfg, SpiPins* pins);
+  UsbDevice* usb() override { return this; }
 
   const UsbDeviceInfo& info() const override { return info_; }
   UsbStatus detach_kernel_driver(int interface) override;
@@ -47,8 +48,6 @@ class MpsseModel final : public UsbDevice {
   std::uint16_t max_packet_size(std::uint8_t endpoint) const override;
   BulkStreamResult bulk_stream(const BulkStream& s, const InSink& on_in) override;
 
-  FaultPlan& faults() { return faults_; }
-  const std::vector<std::string>& violations() const { return violations_; }
   std::uint32_t sck_hz() const;
   std::size_t tx_fifo_bytes() const;
   std::size_t rx_fifo_bytes() const { return tx_fifo_bytes(); }
@@ -68,7 +67,6 @@ class MpsseModel final : public UsbDevice {
   };
   int channel_of_endpoint(std::uint8_t ep, bool in) const;
   Channel* channel_of_index(std::uint16_t windex);
-  void violation(std::string what);
   // Moves waiting IN bytes into `data` as packets, each led by the two modem-status bytes, up to
   // `limit` bytes and ending at a short packet; nullopt when not even one packet fits (babble).
   std::optional<std::size_t> pack_in(Channel& c, std::span<std::uint8_t> data, std::size_t limit);
@@ -78,11 +76,8 @@ class MpsseModel final : public UsbDevice {
   std::uint8_t shift(Channel& c, std::uint8_t mosi, bool write, unsigned bits);
 
   MpsseModelConfig cfg_;
-  SpiSlave* slave_;
   UsbDeviceInfo info_;
   Channel ch_[2];
-  FaultPlan faults_;
-  std::vector<std::string> violations_;
   std::vector<std::vector<std::uint8_t>> out_log_;
 };
 

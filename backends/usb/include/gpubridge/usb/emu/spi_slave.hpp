@@ -1,5 +1,6 @@
 #pragma once
-// SPI-slave model: the FPGA's SPI front end as the bridge chip models see it. It assembles
+// SPI-slave model: the FPGA's SPI front end behind the SPI pins the bridge chip models drive
+// (SpiPins). It assembles
 // 72-bit frames per chip-select window (SPI mode 0, MSB first), shifts the status byte and read
 // values out on MISO exactly as docs/protocol.md "SPI link" defines, and drives a SpiTarget.
 // Wire-level faults (stuck MISO, bit flips, power cycle, marginal clock) are injected here.
@@ -8,6 +9,7 @@
 #include <optional>
 
 #include "gpubridge/backends/spi_target.hpp"
+#include "gpubridge/usb/emu/spi_pins.hpp"
 
 namespace gpubridge::usb::emu {
 
@@ -20,19 +22,19 @@ struct SpiFaults {
   std::uint32_t max_reliable_hz = 0;           // above this SCK, every 61st MISO bit is wrong (0 = no limit)
 };
 
-class SpiSlave {
+class SpiSlave final : public SpiPins {
  public:
   // power_cycle: resets the target to its power-on state (called for the power-cycle fault).
   // idle_tick: lets device time pass while the bridge waits (executes queued commands).
   SpiSlave(backends::SpiTarget& target, std::function<void()> power_cycle, std::function<void()> idle_tick);
 
-  void set_cs(bool asserted);  // asserted = CS line low
-  bool cs_asserted() const { return cs_; }
-  bool shift_bit(bool mosi);   // one SCK cycle; returns the MISO bit sampled on the rising edge
-  std::uint8_t shift_byte(std::uint8_t mosi);
-  bool busy_pin() const;
-  void idle_tick();
-  void set_clock_hz(std::uint32_t hz) { clock_hz_ = hz; }
+  void set_cs(bool asserted) override;
+  bool cs_asserted() const override { return cs_; }
+  bool shift_bit(bool mosi) override;
+  std::uint8_t shift_byte(std::uint8_t mosi) override;
+  bool busy_pin() const override;
+  void idle_tick() override;
+  void set_clock_hz(std::uint32_t hz) override { clock_hz_ = hz; }
 
   SpiFaults& faults() { return faults_; }
   std::uint64_t frames_completed() const { return frames_; }
