@@ -54,7 +54,16 @@ class BoardBackend final : public backends::Backend {
  private:
   BoardBackend(BoardProfile profile, std::shared_ptr<void> lower, std::unique_ptr<SpiBridge> bridge, BoardOptions opts);
   Result<void> attach_locked();
+  // Link layer (board_link.cpp).
+  struct Batch;
+  struct BatchStatus;
+  struct SendProgress;
   Result<void> send_frames(std::span<const protocol::Frame> frames);  // writes, link + flow control
+  Result<std::size_t> batch_room(std::size_t batch_limit, SendProgress& p);
+  Batch build_batch(std::span<const protocol::Frame> rest, std::size_t max_frames, bool readdress) const;
+  Result<BatchStatus> batch_status(const Result<std::vector<std::uint8_t>>& reply, SendProgress& p);
+  Result<void> account_batch(const Batch& b, BatchStatus s, bool transfer_ok, std::span<const protocol::Frame> frames,
+                             SendProgress& p);
   Result<std::vector<std::uint64_t>> read_frames(std::span<const std::uint8_t> indices);
   Result<std::vector<std::uint8_t>> exchange(std::span<const SpiWindow> windows,
                                              std::span<const protocol::Frame> sent_in_order);
@@ -64,12 +73,15 @@ class BoardBackend final : public backends::Backend {
   Result<void> check_host_tag();
   Result<std::uint64_t> poll_status(std::uint64_t mask, std::uint64_t want, const char* waiting_for);
   Result<unsigned> fifo_credits();
-  Result<void> emit_scanout();
+  void note_sent(const protocol::Frame& f);
+  // Memory (board_memory.cpp).
   Result<std::vector<std::uint8_t>> readback_locked(std::uint32_t address, std::uint32_t length, bool verify);
   Result<std::vector<std::uint8_t>> read_memory_once(std::uint32_t start, std::size_t words);
-  void note_sent(const protocol::Frame& f);
-  void track(const protocol::Frame& f);
   void track_memory_pointer(const protocol::Frame& f);
+  // Scanout (board_scanout.cpp).
+  Result<void> emit_scanout();
+  // Attach and the Backend calls (board_backend.cpp).
+  void track(const protocol::Frame& f);
   Error gone_error() const;
 
   BoardProfile profile_;
