@@ -1,34 +1,25 @@
+// The daemon's backend kinds, one row each in kKinds: the one place that knows backend names.
+// make_backend, check_backend, is_board_backend, make_reattach_factory, watch_board_usb and
+// fallback_factory all resolve a name to its row once and ask the row.
 #include "gpubridge/daemon/backend_factory.hpp"
 
 #include <cstdio>
 
 #include "gpubridge/common/log.hpp"
 #include "gpubridge/daemon/test_backends.hpp"
-
-#ifdef GPUBRIDGE_HAVE_SIM
 #include "gpubridge/sim/sim_backend.hpp"
-#endif
-#ifdef GPUBRIDGE_HAVE_USB
 #include "gpubridge/usb/board_factory.hpp"
 #include "gpubridge/usb/board_profile.hpp"
 #include "gpubridge/usb/hotplug_monitor.hpp"
-#endif
 
 namespace gpubridge::daemon {
 
 namespace {
-constexpr std::string_view kEmulatedPrefix = "emulated:";
 
-Result<std::pair<unsigned, unsigned>> parse_fake_size(const std::string& name) {
-  unsigned w = 0, h = 0;
-  char x = 0;
-  if (std::sscanf(name.c_str() + 5, "%u%c%u", &w, &x, &h) != 3 || x != 'x' || w < 1 || h < 1 ||
-      w > protocol::kMaxFramebufferDim || h > protocol::kMaxFramebufferDim)
-    return make_error("backend \"" + name + "\": expected fake:WIDTHxHEIGHT with sizes 1..1024");
-  return std::pair{w, h};
-}
+using BackendPtr = std::unique_ptr<backends::Backend>;
 
-#ifdef GPUBRIDGE_HAVE_USB
+// ---- what the rows do --------------------------------------------------------------------
+
 // `boards_dir` may name the configuration directory (holding boards/) or the boards/ directory
 // itself; the USB library wants the former.
 std::filesystem::path config_dir_of(const DaemonConfig& cfg) {
@@ -39,6 +30,16 @@ std::filesystem::path config_dir_of(const DaemonConfig& cfg) {
   return dir.lexically_normal().parent_path();
 }
 
+Result<std::pair<unsigned, unsigned>> parse_fake_size(std::string_view size) {
+  unsigned w = 0, h = 0;
+  char x = 0;
+  const std::string text(size);
+  if (std::sscanf(text.c_str(), "%u%c%u", &w, &x, &h) != 3 || x != 'x' || w < 1 || h < 1 ||
+      w > protocol::kMaxFramebufferDim || h > protocol::kMaxFramebufferDim)
+    return make_error("backend \"fake:" + text + "\": expected fake:WIDTHxHEIGHT with sizes 1..1024");
+  return std::pair{w, h};
+}
+
 // "emulated:PROFILE?presence=PATH": options after '?' (key=value, '&'-separated) configure the
 // emulation; today only `presence` (the emulated adapter is plugged in while PATH exists).
 struct EmulatedSpec {
@@ -46,12 +47,13 @@ struct EmulatedSpec {
   std::string presence_file;
 };
 
-Result<EmulatedSpec> parse_emulated_spec(const std::string& spec) {
+Result<EmulatedSpec> parse_emulated_spec(std::string_view spec_view) {
+  const std::string spec(spec_view);
   EmulatedSpec out;
   const auto q = spec.find('?');
   out.profile = spec.substr(0, q);
   if (out.profile.empty())
-    return make_error("backend \"" + std::string(kEmulatedPrefix) + spec +
+    return make_error("backend \"emulated:" + spec +
                       "\": expected emulated:PROFILE (a board profile name or .json file), optionally ?presence=PATH");
   if (q == std::string::npos) return out;
   std::string rest = spec.substr(q + 1);
@@ -65,55 +67,44 @@ Result<EmulatedSpec> parse_emulated_spec(const std::string& spec) {
     if (key == "presence" && !value.empty()) {
       out.presence_file = value;
     } else {
-      return make_error("backend \"" + std::string(kEmulatedPrefix) + spec + "\": unknown option \"" + item +
+      return make_error("backend \"emulated:" + spec + "\": unknown option \"" + item +
                         "\" (the only option is presence=PATH: the emulated adapter is plugged in while PATH exists)");
     }
   }
   return out;
 }
 
-// The profiles a board backend name stands for: every profile for "auto", else the one it names
-// ("emulated:NAME?..." names NAME). Used where no device is opened (--check-config, the USB watch).
-Result<std::vector<usb::BoardProfile>> board_profiles_of(const DaemonConfig& cfg, const std::string& name) {
-  if (name == "auto") {
-    auto profiles = usb::load_board_profiles(config_dir_of(cfg));
-    if (!profiles) return make_error("backend \"auto\": " + profiles.error().message);
-    return profiles;
-  }
-  std::string profile_name = name;
-  if (name.starts_with(kEmulatedPrefix)) {
-    auto spec = parse_emulated_spec(name.substr(kEmulatedPrefix.size()));
-    if (!spec) return spec.error();
-    profile_name = spec->profile;
-  }
+Result<usb::BoardProfile> named_profile(const std::string& backend, const std::string& profile_name, const DaemonConfig& cfg) {
   auto profile = usb::find_board_profile(config_dir_of(cfg), profile_name);
-  if (!profile) return make_error("backend \"" + name + "\": " + profile.error().message);
-  return std::vector<usb::BoardProfile>{std::move(*profile)};
+  if (!profile) return make_error("backend \"" + backend + "\": " + profile.error().message);
+  return profile;
 }
 
-Result<std::unique_ptr<backends::Backend>> open_named_board(const std::string& name, bool emulate, const DaemonConfig& cfg,
-                                                             const std::string& presence_file = {}) {
-  auto profile = usb::find_board_profile(config_dir_of(cfg), name);
-  if (!profile) return make_error("backend \"" + std::string(emulate ? kEmulatedPrefix : "") + name + "\": " + profile.error().message);
+Result<BackendPtr> open_board(const usb::BoardProfile& profile, bool emulate, const std::string& presence_file = {}) {
   usb::BoardOpenOptions opts;
   opts.emulate = emulate;
   opts.emulated_presence_file = presence_file;
-  auto board = usb::open_board(*profile, opts);
+  auto board = usb::open_board(profile, opts);
   if (!board) {
-    std::string msg = "board \"" + profile->name + "\" (" + std::string(usb::to_string(profile->chip)) + ")" +
+    std::string msg = "board \"" + profile.name + "\" (" + std::string(usb::to_string(profile.chip)) + ")" +
                       (emulate ? " (emulated)" : "") + ": " + board.error().message;
     if (!emulate)
-      msg += "; or run without it: --backend sim (simulator) or --backend emulated:" + profile->name +
+      msg += "; or run without it: --backend sim (simulator) or --backend emulated:" + profile.name +
              " (this board's driver against an emulated bridge)";
     return make_error(msg, board.error().code);
   }
-  logger("daemon")->info("backend: board {} ({}){}", profile->name, usb::to_string(profile->chip), emulate ? ", emulated" : "");
-  return std::unique_ptr<backends::Backend>(std::move(*board));
+  logger("daemon")->info("backend: board {} ({}){}", profile.name, usb::to_string(profile.chip), emulate ? ", emulated" : "");
+  return BackendPtr(std::move(*board));
+}
+
+std::string describe_board(const usb::BoardProfile& profile, bool emulated, const DaemonConfig& cfg) {
+  return "board " + profile.name + " (" + std::string(usb::to_string(profile.chip)) + (emulated ? ", emulated" : "") +
+         ") from " + profile.file.string() + (cfg.mirror ? ", mirrored by the simulator" : "");
 }
 
 // The first board whose real bridge opens and attaches; nullptr when none does. Profiles whose
 // bridge is absent fail at the USB open (no transfers), so this stays fast without hardware.
-std::unique_ptr<backends::Backend> first_present_board(const DaemonConfig& cfg) {
+BackendPtr first_present_board(const DaemonConfig& cfg) {
   auto log = logger("daemon");
   auto profiles = usb::load_board_profiles(config_dir_of(cfg));
   if (!profiles) {
@@ -130,118 +121,193 @@ std::unique_ptr<backends::Backend> first_present_board(const DaemonConfig& cfg) 
   }
   return nullptr;
 }
-#endif
+
+// sim
+Result<BackendPtr> open_sim(std::string_view, const DaemonConfig&) { return make_simulator(); }
+Result<std::string> describe_sim(std::string_view, const DaemonConfig&) { return std::string("the simulator"); }
+
+// discard
+Result<BackendPtr> open_discard(std::string_view, const DaemonConfig&) { return BackendPtr(std::make_unique<DiscardBackend>()); }
+Result<std::string> describe_discard(std::string_view, const DaemonConfig&) {
+  return std::string("discard (accepts every command, scans out nothing)");
+}
+
+// fake, fake:WxH (frames of that size: fan-out and memory tests); `size` is "" or ":WxH"
+Result<BackendPtr> open_fake(std::string_view size, const DaemonConfig&) {
+  if (size.empty()) return BackendPtr(std::make_unique<FakeScanoutBackend>());
+  auto wh = parse_fake_size(size.substr(1));
+  if (!wh) return wh.error();
+  return BackendPtr(std::make_unique<FakeScanoutBackend>(wh->first, wh->second));
+}
+Result<std::string> describe_fake(std::string_view size, const DaemonConfig&) {
+  if (size.empty()) return std::string("fake (test backend: registers, 1 MiB of memory, 64x48 frames)");
+  auto wh = parse_fake_size(size.substr(1));
+  if (!wh) return wh.error();
+  return "fake (test backend, " + std::to_string(wh->first) + "x" + std::to_string(wh->second) + " frames)";
+}
+
+// auto: the first present board, else the simulator
+Result<std::vector<usb::BoardProfile>> profiles_auto(std::string_view, const DaemonConfig& cfg) {
+  auto profiles = usb::load_board_profiles(config_dir_of(cfg));
+  if (!profiles) return make_error("backend \"auto\": " + profiles.error().message);
+  return profiles;
+}
+Result<BackendPtr> open_auto(std::string_view, const DaemonConfig& cfg) {
+  if (auto board = first_present_board(cfg)) return board;
+  logger("daemon")->info("auto: no board attached (details at --log-level debug); using the simulator");
+  return make_simulator();
+}
+Result<BackendPtr> reopen_auto(std::string_view, const DaemonConfig& cfg) {  // never settles for the simulator
+  if (auto board = first_present_board(cfg)) return board;
+  return make_error("auto: no board attached", backends::kDeviceGone);
+}
+Result<std::string> describe_auto(std::string_view, const DaemonConfig& cfg) {
+  auto profiles = profiles_auto({}, cfg);
+  if (!profiles) return profiles.error();
+  const std::string first = "auto: the first of " + std::to_string(profiles->size()) + " board profiles in " +
+                            (config_dir_of(cfg) / "boards").string() + " whose adapter is present";
+  if (cfg.mirror) return first + ", mirrored by the simulator (with --mirror the daemon does not start when none is present)";
+  return first + ", else the simulator" + (cfg.reattach_interval_ms ? " until a board is plugged in" : "");
+}
+
+// emulated:PROFILE[?presence=PATH]: the board's driver on its bridge chip's model + the simulator
+Result<std::vector<usb::BoardProfile>> profiles_emulated(std::string_view spec, const DaemonConfig& cfg) {
+  auto s = parse_emulated_spec(spec);
+  if (!s) return s.error();
+  auto profile = named_profile("emulated:" + std::string(spec), s->profile, cfg);
+  if (!profile) return profile.error();
+  return std::vector<usb::BoardProfile>{std::move(*profile)};
+}
+Result<BackendPtr> open_emulated(std::string_view spec, const DaemonConfig& cfg) {
+  auto s = parse_emulated_spec(spec);
+  if (!s) return s.error();
+  auto profile = named_profile("emulated:" + s->profile, s->profile, cfg);
+  if (!profile) return profile.error();
+  return open_board(*profile, true, s->presence_file);
+}
+Result<std::string> describe_emulated(std::string_view spec, const DaemonConfig& cfg) {
+  auto profiles = profiles_emulated(spec, cfg);
+  if (!profiles) return profiles.error();
+  return describe_board(profiles->front(), true, cfg);
+}
+
+// BOARD: a board profile name or .json file, the real board
+Result<std::vector<usb::BoardProfile>> profiles_board(std::string_view name, const DaemonConfig& cfg) {
+  auto profile = named_profile(std::string(name), std::string(name), cfg);
+  if (!profile) return profile.error();
+  return std::vector<usb::BoardProfile>{std::move(*profile)};
+}
+Result<BackendPtr> open_real_board(std::string_view name, const DaemonConfig& cfg) {
+  auto profile = named_profile(std::string(name), std::string(name), cfg);
+  if (!profile) return profile.error();
+  return open_board(*profile, false);
+}
+Result<std::string> describe_real_board(std::string_view name, const DaemonConfig& cfg) {
+  auto profiles = profiles_board(name, cfg);
+  if (!profiles) return profiles.error();
+  return describe_board(profiles->front(), false, cfg);
+}
+
+// ---- the table ---------------------------------------------------------------------------
+
+// What follows a kind's name: nothing ("sim"), an optional ":ARG" ("fake", "fake:64x48": the row
+// gets "" or ":64x48"), a required ":ARG" ("emulated:BOARD": the row gets "BOARD"), or the whole
+// name (the last row, a board profile).
+enum class Arg : std::uint8_t { None, Optional, Required, WholeName };
+
+struct BackendKind {
+  std::string_view name;
+  Arg arg;
+  std::string_view syntax;  // for --help
+  bool board;               // names a board: can disappear (then the simulator may take over) and come back, can be mirrored
+  bool usb_watch;           // a real USB adapter: libusb hot-plug notifications apply
+  Result<BackendPtr> (*open)(std::string_view arg, const DaemonConfig& cfg);
+  // What `open` would serve, checked without opening a device (--check-config).
+  Result<std::string> (*describe)(std::string_view arg, const DaemonConfig& cfg);
+  // Board kinds with usb_watch: the profiles whose USB ids to watch.
+  Result<std::vector<usb::BoardProfile>> (*profiles)(std::string_view arg, const DaemonConfig& cfg) = nullptr;
+  // Board kinds: re-opens after an unplug (nullptr: `open` again).
+  Result<BackendPtr> (*reopen)(std::string_view arg, const DaemonConfig& cfg) = nullptr;
+};
+
+// clang-format off
+constexpr BackendKind kKinds[] = {
+  // name        arg             syntax                            board  usb_watch
+  {"sim",      Arg::None,      "sim",                            false, false, &open_sim,        &describe_sim},
+  {"auto",     Arg::None,      "auto",                           true,  true,  &open_auto,       &describe_auto,       &profiles_auto, &reopen_auto},
+  {"emulated", Arg::Required,  "emulated:BOARD[?presence=PATH]", true,  false, &open_emulated,   &describe_emulated},
+  {"fake",     Arg::Optional,  "fake[:WIDTHxHEIGHT]",            false, false, &open_fake,       &describe_fake},
+  {"discard",  Arg::None,      "discard",                        false, false, &open_discard,    &describe_discard},
+  {"",         Arg::WholeName, "BOARD",                          true,  true,  &open_real_board, &describe_real_board, &profiles_board},
+};
+// clang-format on
+static_assert(kKinds[std::size(kKinds) - 1].arg == Arg::WholeName, "the last row takes every other name");
+
+struct Resolved {
+  const BackendKind& kind;
+  std::string_view arg;
+};
+
+Resolved resolve(std::string_view name) {
+  for (const auto& k : kKinds) {
+    if (k.arg == Arg::WholeName) return {k, name};
+    if (!name.starts_with(k.name)) continue;
+    const auto rest = name.substr(k.name.size());
+    if (rest.empty() && k.arg != Arg::Required) return {k, rest};
+    if (rest.starts_with(':') && k.arg == Arg::Optional) return {k, rest};
+    if (rest.starts_with(':') && k.arg == Arg::Required) return {k, rest.substr(1)};
+  }
+  return {kKinds[std::size(kKinds) - 1], name};
+}
+
 }  // namespace
 
-bool simulator_available() {
-#ifdef GPUBRIDGE_HAVE_SIM
-  return true;
-#else
-  return false;
-#endif
+std::string backend_syntax() {
+  std::string out;
+  for (const auto& k : kKinds) out += (out.empty() ? "" : " | ") + std::string(k.syntax);
+  return out;
 }
 
-Result<std::unique_ptr<backends::Backend>> make_simulator() {
-#ifdef GPUBRIDGE_HAVE_SIM
+Result<BackendPtr> make_simulator() {
   auto sim = sim::SimBackend::create();
   if (!sim) return sim.error();
-  return std::unique_ptr<backends::Backend>(std::move(*sim));
-#else
-  return make_error("this gpubridged was built without the simulator (gpubridge_sim); use --backend fake or discard");
-#endif
+  return BackendPtr(std::move(*sim));
 }
 
-Result<std::unique_ptr<backends::Backend>> make_backend(const std::string& name, const DaemonConfig& cfg) {
-  if (name == "sim") return make_simulator();
-  if (name == "discard") return std::unique_ptr<backends::Backend>(std::make_unique<DiscardBackend>());
-  if (name == "fake") return std::unique_ptr<backends::Backend>(std::make_unique<FakeScanoutBackend>());
-  if (name.starts_with("fake:")) {  // fake:WxH, frames of that size (fan-out and memory tests)
-    auto size = parse_fake_size(name);
-    if (!size) return size.error();
-    return std::unique_ptr<backends::Backend>(std::make_unique<FakeScanoutBackend>(size->first, size->second));
-  }
-#ifdef GPUBRIDGE_HAVE_USB
-  if (name == "auto") {
-    if (auto board = first_present_board(cfg)) return board;
-    logger("daemon")->info("auto: no board attached (details at --log-level debug); using the simulator");
-    return make_simulator();
-  }
-  if (name.starts_with(kEmulatedPrefix)) {
-    auto spec = parse_emulated_spec(name.substr(kEmulatedPrefix.size()));
-    if (!spec) return spec.error();
-    return open_named_board(spec->profile, true, cfg, spec->presence_file);
-  }
-  return open_named_board(name, false, cfg);
-#else
-  (void)cfg;
-  if (name == "auto") return make_simulator();  // no USB board path: nothing to detect
-  return make_error("backend \"" + name +
-                    "\": board backends need the USB board path (gpubridge_usb), which this gpubridged was built "
-                    "without; use \"sim\", \"auto\", \"fake\" or \"discard\"");
-#endif
+Result<BackendPtr> make_backend(const std::string& name, const DaemonConfig& cfg) {
+  const auto r = resolve(name);
+  return r.kind.open(r.arg, cfg);
 }
 
 Result<std::string> check_backend(const DaemonConfig& cfg) {
-  const std::string& name = cfg.backend;
-  const bool board = is_board_backend(name);
-  if (cfg.mirror && !board)
-    return make_error("--mirror needs a board backend (a board profile name, emulated:BOARD or auto), not \"" + name +
+  const auto r = resolve(cfg.backend);
+  if (cfg.mirror && !r.kind.board)
+    return make_error("--mirror needs a board backend (a board profile name, emulated:BOARD or auto), not \"" + cfg.backend +
                       "\": mirror mode compares a board with the simulator");
-  const std::string mirrored = cfg.mirror ? ", mirrored by the simulator" : "";
-  if (name == "sim") return simulator_available() ? Result<std::string>("the simulator") : make_simulator().error();
-  if (name == "discard") return std::string("discard (accepts every command, scans out nothing)");
-  if (name == "fake") return std::string("fake (test backend: registers, 1 MiB of memory, 64x48 frames)");
-  if (name.starts_with("fake:")) {
-    auto size = parse_fake_size(name);
-    if (!size) return size.error();
-    return "fake (test backend, " + std::to_string(size->first) + "x" + std::to_string(size->second) + " frames)";
-  }
-#ifdef GPUBRIDGE_HAVE_USB
-  auto profiles = board_profiles_of(cfg, name);
-  if (!profiles) return profiles.error();
-  if (name == "auto") {
-    const std::string first = "auto: the first of " + std::to_string(profiles->size()) + " board profiles in " +
-                              (config_dir_of(cfg) / "boards").string() + " whose adapter is present";
-    if (cfg.mirror) return first + mirrored + " (with --mirror the daemon does not start when none is present)";
-    return first + ", else the simulator" + (cfg.reattach_interval_ms ? " until a board is plugged in" : "");
-  }
-  const auto& profile = profiles->front();
-  return "board " + profile.name + " (" + std::string(usb::to_string(profile.chip)) +
-         (name.starts_with(kEmulatedPrefix) ? ", emulated" : "") + ") from " + profile.file.string() + mirrored;
-#else
-  if (name == "auto") return std::string("auto: the simulator (this gpubridged has no USB board path)");
-  return make_backend(name, cfg).error();
-#endif
+  return r.kind.describe(r.arg, cfg);
 }
 
-bool is_board_backend(const std::string& name) {
-  return !(name == "sim" || name == "discard" || name == "fake" || name.starts_with("fake:"));
+bool is_board_backend(const std::string& name) { return resolve(name).kind.board; }
+
+std::function<Result<BackendPtr>()> fallback_factory(const DaemonConfig& cfg) {
+  if (!cfg.fallback_to_sim || !resolve(cfg.backend).kind.board) return {};  // only boards disappear
+  return make_simulator;
 }
 
-std::function<Result<std::unique_ptr<backends::Backend>>()> make_reattach_factory(const DaemonConfig& cfg) {
-#ifdef GPUBRIDGE_HAVE_USB
-  if (!is_board_backend(cfg.backend)) return {};
-  const std::string name = cfg.backend;
-  // A copy of the configuration: the factory runs later, on the device thread.
-  return [name, cfg]() -> Result<std::unique_ptr<backends::Backend>> {
-    if (name == "auto") {
-      if (auto board = first_present_board(cfg)) return board;
-      return make_error("auto: no board attached", backends::kDeviceGone);
-    }
-    return make_backend(name, cfg);
+std::function<Result<BackendPtr>()> make_reattach_factory(const DaemonConfig& cfg) {
+  const auto r = resolve(cfg.backend);
+  if (!r.kind.board) return {};
+  // Copies of the name and configuration: the factory runs later, on the device thread.
+  return [&kind = r.kind, name = cfg.backend, cfg]() -> Result<BackendPtr> {
+    const auto arg = resolve(name).arg;
+    return kind.reopen ? kind.reopen(arg, cfg) : kind.open(arg, cfg);
   };
-#else
-  (void)cfg;
-  return {};
-#endif
 }
 
 Result<std::shared_ptr<void>> watch_board_usb(const DaemonConfig& cfg, std::function<void()> on_event) {
-  const std::string& name = cfg.backend;
-  if (!is_board_backend(name) || name.starts_with(kEmulatedPrefix) || cfg.reattach_interval_ms == 0)
-    return std::shared_ptr<void>();
-#ifdef GPUBRIDGE_HAVE_USB
-  auto profiles = board_profiles_of(cfg, name);
+  const auto r = resolve(cfg.backend);
+  if (!r.kind.usb_watch || cfg.reattach_interval_ms == 0) return std::shared_ptr<void>();
+  auto profiles = r.kind.profiles(r.arg, cfg);
   if (!profiles) return profiles.error();
   std::vector<std::pair<std::uint16_t, std::uint16_t>> ids;
   for (const auto& p : *profiles) ids.emplace_back(p.vid, p.pid);
@@ -249,10 +315,6 @@ Result<std::shared_ptr<void>> watch_board_usb(const DaemonConfig& cfg, std::func
   auto monitor = usb::HotplugMonitor::start(ids, [on_event = std::move(on_event)](bool, std::uint16_t, std::uint16_t) { on_event(); });
   if (!monitor) return monitor.error();
   return std::shared_ptr<void>(std::move(*monitor));
-#else
-  (void)on_event;
-  return std::shared_ptr<void>();
-#endif
 }
 
 }  // namespace gpubridge::daemon

@@ -62,8 +62,7 @@ int run(daemon::DaemonConfig cfg) {
 
   daemon::HubOptions opts{cfg.limits, cfg.token, cfg.frames_dir, cfg.record_dir};
   opts.mirror = cfg.mirror;
-  daemon::Hub::BackendFactory fallback;
-  if (cfg.fallback_to_sim && cfg.backend != "sim" && daemon::simulator_available()) fallback = daemon::make_simulator;
+  const daemon::Hub::BackendFactory fallback = daemon::fallback_factory(cfg);
   int exit_code = 0;
   {
     daemon::Hub hub(net.get_executor(), device.get_executor(), std::move(*backend), opts, fallback);
@@ -185,8 +184,9 @@ int main(int argc, char** argv) {
   app.add_option("--token", token, "token TCP clients must present (required for non-loopback TCP)");
   app.add_option("--token-file", token_file, "read the token from the first line of this file");
   app.add_option("-b,--backend", backend,
-                 "sim | auto | BOARD | emulated:BOARD[?presence=PATH] | fake | discard "
-                 "(presence: the emulated adapter is plugged in while PATH exists)");
+                 gpubridge::daemon::backend_syntax() +
+                     " (BOARD: a board profile name or .json file; presence: the emulated adapter is plugged in "
+                     "while PATH exists)");
   app.add_flag("--no-fallback", no_fallback, "do not switch to the simulator when a board disappears");
   app.add_flag("--mirror", mirror,
                "board backends: also run the simulator on the same commands and compare every frame "

@@ -4,9 +4,7 @@
 
 #include "gpubridge/common/log.hpp"
 
-#ifdef GPUBRIDGE_HAVE_SIM
 #include "gpubridge/sim/sim_backend.hpp"
-#endif
 
 namespace gpubridge::daemon {
 namespace {
@@ -147,7 +145,6 @@ Result<std::unique_ptr<backends::Backend>> make_mirror(std::unique_ptr<backends:
   if (info.backend != "board")
     return make_error("--mirror needs a board backend (a board profile name or emulated:BOARD), not \"" + info.backend +
                       "\": mirror mode compares a board with the simulator");
-#ifdef GPUBRIDGE_HAVE_SIM
   sim::DeviceOptions o;
   // The model gets the board's memory and limits, so a command that does not fit the board does
   // not fit the model either (CAPS fields from the register table).
@@ -164,9 +161,6 @@ Result<std::unique_ptr<backends::Backend>> make_mirror(std::unique_ptr<backends:
   logger("daemon")->info("mirror: board {} mirrored by the simulator ({} KiB, {}x{} max)", info.board, o.vram_bytes / 1024,
                          o.max_width, o.max_height);
   return std::unique_ptr<backends::Backend>(std::make_unique<MirrorBackend>(std::move(board), std::move(*model)));
-#else
-  return make_error("--mirror needs the simulator, and this gpubridged was built without it (gpubridge_sim)");
-#endif
 }
 
 }  // namespace gpubridge::daemon

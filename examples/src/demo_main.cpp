@@ -14,14 +14,12 @@
 #include "gpubridge/common/image.hpp"
 #include "gpubridge/common/json_text.hpp"
 #include "gpubridge/common/log.hpp"
+#include "gpubridge/draw/client_sink.hpp"
 #include "gpubridge/draw/sim_sink.hpp"
 #include "gpubridge/examples/example.hpp"
 #include "gpubridge/examples/golden.hpp"
 #include "gpubridge/examples/cordic.hpp"
 #include "gpubridge/examples/figures.hpp"
-#if GPUBRIDGE_DRAW_HAS_CLIENT
-#include "gpubridge/draw/client_sink.hpp"
-#endif
 
 namespace {
 
@@ -84,7 +82,6 @@ int run_render(const std::vector<std::string>& names, const examples::ExamplePar
 int run_stream(const std::vector<std::string>& names, const examples::ExampleParams& params, const FitOptions& fit_options,
                const std::string& address,
                unsigned frames, double fps, bool json) {
-#if GPUBRIDGE_DRAW_HAS_CLIENT
   auto list = select(names, params);
   if (!list) return fail(list.error().message);
   auto request = fit_options.request();
@@ -114,10 +111,6 @@ int run_stream(const std::vector<std::string>& names, const examples::ExamplePar
   }
   if (json) std::puts(json_text(summary, 2).c_str());
   return 0;
-#else
-  (void)names, (void)params, (void)fit_options, (void)address, (void)frames, (void)fps, (void)json;
-  return fail("this build has no daemon client library (gpubridge_client); use `render`");
-#endif
 }
 
 int run_goldens(const std::string& dir, const std::vector<std::string>& class_names, bool write, bool json) {

@@ -12,7 +12,6 @@
 #include "gpubridge/client/client.hpp"
 #include "gpubridge/common/image.hpp"
 
-#if defined(GPUBRIDGE_HAVE_SIM) && defined(GPUBRIDGE_HAVE_USB)
 namespace gpubridge::test {
 namespace {
 
@@ -131,4 +130,3 @@ TEST(DaemonBoardErrors, UnknownProfileListsTheKnownOnes) {
 
 }  // namespace
 }  // namespace gpubridge::test
-#endif

@@ -450,7 +450,6 @@ TEST_F(DaemonE2E, RateLimitedSubscriberStillGetsTheLastFrame) {
 }  // namespace
 }  // namespace gpubridge::test
 
-#ifdef GPUBRIDGE_HAVE_SIM
 namespace gpubridge::test {
 namespace {
 
@@ -505,7 +504,6 @@ TEST(DaemonSim, PlayedTraceScreenshotEqualsInProcessRender) {
 
 }  // namespace
 }  // namespace gpubridge::test
-#endif
 
 namespace gpubridge::test {
 namespace {

@@ -34,7 +34,6 @@
 #include "gpubridge/protocol/crc32.hpp"
 #include "gpubridge/protocol/pixel.hpp"
 
-#if defined(GPUBRIDGE_HAVE_SIM) && defined(GPUBRIDGE_HAVE_USB)
 #include "gpubridge/sim/device.hpp"
 #include "gpubridge/sim/sim_backend.hpp"
 #include "gpubridge/usb/board_profile.hpp"
@@ -755,4 +754,3 @@ TEST(DaemonMirror, SwapsOfABoardWithoutScanoutAreCountedAsUnpaired) {
 
 }  // namespace
 }  // namespace gpubridge::test
-#endif

@@ -7,9 +7,7 @@
 #include <variant>
 
 #include "gpubridge/draw/context.hpp"
-#if GPUBRIDGE_DRAW_HAS_SIM
 #include "gpubridge/draw/sim_sink.hpp"
-#endif
 
 namespace gpubridge::draw {
 namespace {
@@ -126,7 +124,6 @@ TEST(DrawContext, VideoMemoryIsBounded) {
   EXPECT_NE(t.error().message.find("video memory full: 262144 bytes requested"), std::string::npos) << t.error().message;
 }
 
-#if GPUBRIDGE_DRAW_HAS_SIM
 
 // A unit cube with one colour per face, counter-clockwise when seen from outside.
 void cube(std::vector<Vertex>& v, std::vector<std::uint32_t>& idx) {
@@ -250,7 +247,6 @@ TEST(DrawOnSimulator, TexturedQuadSamplesTheUploadedTexture) {
     }
 }
 
-#endif  // GPUBRIDGE_DRAW_HAS_SIM
 
 }  // namespace
 }  // namespace gpubridge::draw

@@ -7,9 +7,7 @@
 #include <variant>
 
 #include "gpubridge/draw/context.hpp"
-#if GPUBRIDGE_DRAW_HAS_SIM
 #include "gpubridge/draw/sim_sink.hpp"
-#endif
 
 namespace gpubridge::draw {
 namespace {
@@ -227,7 +225,6 @@ TEST(DrawTextures, UpdateRejectsOtherSizesAndReleasedTextures) {
   EXPECT_NE(r.error().message.find("was released"), std::string::npos);
 }
 
-#if GPUBRIDGE_DRAW_HAS_SIM
 
 // A textured quad covering the whole 32x32 framebuffer (decal: the texel colour alone).
 Result<Image> draw_textured_quad(Context& ctx, const Texture& t, bool swap_and_read = true) {
@@ -299,7 +296,6 @@ TEST(DrawTexturesOnSimulator, DrawsBeforeAnUpdateOrReleaseSampleTheOldContents) 
   expect_all(*last, 255, 255, 0);
 }
 
-#endif  // GPUBRIDGE_DRAW_HAS_SIM
 
 }  // namespace
 }  // namespace gpubridge::draw

@@ -6,9 +6,7 @@
 
 #include "gpubridge/viewer/options.hpp"
 #include "gpubridge/viewer/overlay.hpp"
-#ifdef GPUBRIDGE_VIEW_HAS_CLIENT
 #include "gpubridge/viewer/daemon_frame_source.hpp"
-#endif
 
 namespace gpubridge::viewer {
 namespace {
@@ -85,7 +83,6 @@ TEST(MirrorView, HelpListsThePictureKeys) {
   EXPECT_NE(all.find("magenta"), std::string::npos);
 }
 
-#ifdef GPUBRIDGE_VIEW_HAS_CLIENT
 TEST(MirrorView, ReadsTheDaemonsMirrorFields) {
   EXPECT_TRUE(mirror_enabled(R"({"backend":"board","mirror":true})"));
   EXPECT_FALSE(mirror_enabled(R"({"backend":"sim","mirror":false})"));
@@ -99,7 +96,6 @@ TEST(MirrorView, ReadsTheDaemonsMirrorFields) {
   EXPECT_FALSE(mirror_counts(R"({"mirror":{"compared":-1,"mismatches":0}})"));
   EXPECT_FALSE(mirror_counts("["));
 }
-#endif
 
 }  // namespace
 }  // namespace gpubridge::viewer

@@ -222,7 +222,6 @@ TEST_F(ViewerGl, KeysFlipZoomAndSaveTheFrame) {
       ASSERT_TRUE(pixel_is(*img, 4 * x + 2, 4 * y + 2, expected_pixel(x, y, n3, "RGBA8888")));  // fit = 4x here
 }
 
-#ifdef GPUBRIDGE_VIEW_HAS_CLIENT
 TEST_F(ViewerGl, UnreachableDaemonGivesOneLineAndExitThree) {
   const auto shot = (dir_.path() / "never.png").string();
   const auto r = view({"--connect", "unix:" + (dir_.path() / "no-daemon.sock").string(), "--frames", "1",
@@ -232,7 +231,6 @@ TEST_F(ViewerGl, UnreachableDaemonGivesOneLineAndExitThree) {
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
   EXPECT_FALSE(std::filesystem::exists(shot));
 }
-#endif
 
 }  // namespace
 }  // namespace gpubridge::viewer::test

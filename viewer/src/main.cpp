@@ -5,13 +5,11 @@
 
 #include "exit_codes.hpp"
 #include "gpubridge/common/log.hpp"
+#include "gpubridge/viewer/daemon_frame_source.hpp"
 #include "gpubridge/viewer/options.hpp"
 #include "gpubridge/viewer/test_frame_source.hpp"
 #include "headless.hpp"
 #include "window_app.hpp"
-#ifdef GPUBRIDGE_VIEW_HAS_CLIENT
-#include "gpubridge/viewer/daemon_frame_source.hpp"
-#endif
 
 namespace {
 
@@ -31,13 +29,8 @@ gpubridge::Result<std::unique_ptr<FrameSource>> make_source(const Options& o, un
     if (!spec) return spec.error();
     return std::unique_ptr<FrameSource>(std::make_unique<TestFrameSource>(*spec));
   }
-#ifdef GPUBRIDGE_VIEW_HAS_CLIENT
   DaemonSourceConfig config{o.connect, o.token, max_fps, o.wait, o.source};
   return std::unique_ptr<FrameSource>(std::make_unique<DaemonFrameSource>(std::move(config)));
-#else
-  (void)max_fps;
-  return gpubridge::make_error("this gpubridge-view was built without the daemon client library (gpubridge_client)");
-#endif
 }
 
 }  // namespace

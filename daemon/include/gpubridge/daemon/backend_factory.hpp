@@ -1,10 +1,10 @@
 #pragma once
-// Builds the daemon's backend from its name: "sim" (the simulator, default), "discard" and
-// "fake" (test_backends.hpp), "auto" (the first board profile whose real bridge opens, else the
-// simulator), a board profile name or .json path (the real board), or "emulated:PROFILE" (that
-// board's bridge-chip model + simulator, same driver code; "emulated:PROFILE?presence=PATH" makes
-// the emulated adapter plugged in only while PATH exists). Boards need the USB board path,
-// linked in when gpubridge_usb is built.
+// Builds the daemon's backend from its name. The kinds are one table (kKinds in
+// backend_factory.cpp, the only code that knows the names): "sim" (the simulator, default),
+// "discard" and "fake[:WxH]" (test_backends.hpp), "auto" (the first board profile whose real
+// bridge opens, else the simulator), "emulated:PROFILE[?presence=PATH]" (that board's bridge-chip
+// model + simulator, same driver code; with presence the emulated adapter is plugged in only while
+// PATH exists), and any other name: a board profile name or .json path (the real board).
 #include <functional>
 #include <memory>
 #include <string>
@@ -21,13 +21,17 @@ Result<std::unique_ptr<backends::Backend>> make_backend(const std::string& name,
 Result<std::string> check_backend(const DaemonConfig& cfg);
 // The simulator with default options (fallback when a board disappears).
 Result<std::unique_ptr<backends::Backend>> make_simulator();
-bool simulator_available();
+// The backend names in --help form: "sim | auto | emulated:BOARD[?presence=PATH] | ...".
+std::string backend_syntax();
 // True for backends that name a board ("auto", a profile, "emulated:PROFILE"): those can
-// disappear and come back.
+// disappear and come back, and can be mirrored.
 bool is_board_backend(const std::string& name);
+// What replaces cfg's backend when it disappears: the simulator for boards with fallback_to_sim,
+// else nothing (empty).
+std::function<Result<std::unique_ptr<backends::Backend>>()> fallback_factory(const DaemonConfig& cfg);
 // Re-opens the configured board after it disappeared (the hub calls it on the device thread until
 // it succeeds); "auto" looks for any present board but never settles for the simulator. Empty
-// for backends that cannot disappear (sim, fake, discard) or without the USB board path.
+// for backends that cannot disappear (sim, fake, discard).
 std::function<Result<std::unique_ptr<backends::Backend>>()> make_reattach_factory(const DaemonConfig& cfg);
 // libusb hot-plug notifications for the USB ids of cfg's real board(s) (the named profile, or every
 // profile for "auto"); `on_event` runs on the watcher's thread for each plug or unplug (Hub::
