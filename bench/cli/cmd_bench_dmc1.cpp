@@ -17,9 +17,7 @@
 #include "gpubridge/dmc1/link.hpp"
 #include "gpubridge/dmc1/stream.hpp"
 #include "gpubridge/dmc1/uart.hpp"
-#ifdef GPUBRIDGE_HAVE_DMC1_LEVEL
 #include "gpubridge/examples/dmc1_level.hpp"
-#endif
 
 namespace gpubridge::cli {
 namespace {
@@ -112,12 +110,10 @@ int run(const GlobalOptions& g, const Dmc1BenchArgs& a) {
     if (!s) return fail(s.error().message);
     streams.emplace_back(name, std::move(s->words));
   }
-#ifdef GPUBRIDGE_HAVE_DMC1_LEVEL
   // The example client's frames: coherent like a recorded game frame (neighbouring columns read
   // neighbouring texels), 16 positions along its camera path.
   if (a.streams.empty() || std::find(a.streams.begin(), a.streams.end(), "level") != a.streams.end())
     streams.emplace_back("level", examples::dmc1_level::path_commands(examples::dmc1_level::hall(), 16));
-#endif
   std::vector<Row> rows;
   for (auto& [name, words] : streams) {
     Row row;

@@ -11,18 +11,12 @@
 
 #include <nlohmann/json.hpp>
 
-#include "command.hpp"
-#include "gpubridge/geometry/geometry.hpp"
-#if __has_include("bench_group.hpp")
 #include "bench_group.hpp"
-#define GPUBRIDGE_BENCH_GEOMETRY_GROUP 1
-#endif
-#if __has_include("gpubridge/examples/example.hpp")
+#include "command.hpp"
+#include "gpubridge/common/json_text.hpp"
 #include "gpubridge/draw/sim_sink.hpp"
 #include "gpubridge/examples/example.hpp"
-#include "gpubridge/common/json_text.hpp"
-#define GPUBRIDGE_BENCH_GEOMETRY_EXAMPLES 1
-#endif
+#include "gpubridge/geometry/geometry.hpp"
 
 namespace gpubridge::cli {
 namespace {
@@ -140,7 +134,6 @@ int run(const GlobalOptions& g, unsigned triangles, unsigned runs, double spi_mh
                                    {"clipped", st.clipped}, {"culled", st.culled}});
     if (!g.json) std::printf("| %s | %.2f | %.2f | %.1f | %s |\n", w.name.c_str(), mtri, ratio, fpt, w.what.c_str());
   }
-#ifdef GPUBRIDGE_BENCH_GEOMETRY_EXAMPLES
   if (!g.json)
     std::printf("\nexample scenes, per frame (frame %u; SPI fps = link limit for the frame's register bytes at %.0f MHz, "
                 "72 bits per frame)\n\n| example | triangles | frames | KiB | host ms | sim ms | SPI fps |\n"
@@ -186,7 +179,6 @@ int run(const GlobalOptions& g, unsigned triangles, unsigned runs, double spi_mh
       std::printf("| %s | %zu | %zu | %.1f | %.2f | %.2f | %.1f |\n", name.c_str(), tris, frame_count, bytes / 1024,
                   host * 1e3, sim_time * 1e3, spi_fps);
   }
-#endif
   if (g.json) std::puts(json_text(report, 2).c_str());
   return 0;
 }
@@ -204,14 +196,6 @@ void setup(CLI::App& parent, GlobalOptions& g, std::vector<std::pair<CLI::App*, 
 
 }  // namespace
 
-GPUBRIDGE_COMMAND("bench-geometry", 81, [](CLI::App& app, GlobalOptions& g, auto& runners) {
-#ifdef GPUBRIDGE_BENCH_GEOMETRY_GROUP
-  setup(*bench_group(app), g, runners);
-#else
-  auto* group = app.add_subcommand("bench", "benchmarks");
-  group->require_subcommand(1);
-  setup(*group, g, runners);
-#endif
-});
+GPUBRIDGE_COMMAND("bench-geometry", 81, [](CLI::App& app, GlobalOptions& g, auto& runners) { setup(*bench_group(app), g, runners); });
 
 }  // namespace gpubridge::cli

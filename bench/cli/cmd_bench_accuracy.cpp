@@ -10,10 +10,8 @@
 
 #include "bench_group.hpp"
 #include "command.hpp"
-#ifdef GPUBRIDGE_HAVE_BENCH_LIB
 #include "gpubridge/bench/accuracy_bench.hpp"
 #include "gpubridge/common/json_text.hpp"
-#endif
 
 namespace gpubridge::cli {
 namespace {
@@ -29,18 +27,12 @@ struct AccuracyArgs {
   bool cordic_only = false;
 };
 
-[[maybe_unused]] bool write_file(const std::filesystem::path& p, const std::string& text) {
+bool write_file(const std::filesystem::path& p, const std::string& text) {
   std::ofstream f(p, std::ios::binary);
   f << text;
   return bool(f);
 }
 
-#ifndef GPUBRIDGE_HAVE_BENCH_LIB
-int run_accuracy(const GlobalOptions&, const AccuracyArgs&) {
-  std::fprintf(stderr, "gpubridge bench accuracy: this build has no benchmarks (configure with -DGPUBRIDGE_BUILD_BENCH=ON)\n");
-  return 1;
-}
-#else
 Result<std::string> read_file(const std::filesystem::path& p) {
   std::ifstream f(p, std::ios::binary);
   if (!f) return make_error(p.string() + ": cannot read it");
@@ -146,7 +138,6 @@ int run_accuracy(const GlobalOptions& g, const AccuracyArgs& a) {
   if (!report->llvmpipe_ok) std::fprintf(stderr, "gpubridge bench accuracy: llvmpipe rows omitted: %s\n", report->llvmpipe.c_str());
   return 0;
 }
-#endif
 
 }  // namespace
 

@@ -1,6 +1,6 @@
 #pragma once
-// The `gpubridge bench` command group. Each bench lives in its own cmd_*.cpp and attaches its
-// subcommand to the group returned here (`bench accuracy`, `bench daemon`, `bench usb`, ...); the
+// The `gpubridge bench` command group. Each bench lives in its own bench/cli/cmd_bench_*.cpp and
+// attaches its subcommand to the group returned here (`bench accuracy`, `bench daemon`, `bench usb`, ...); the
 // group is created by whichever command registers first.
 #include <CLI/CLI.hpp>
 
