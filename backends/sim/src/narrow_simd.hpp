@@ -1,17 +1,20 @@
 #pragma once
 // The vector routine for small triangles (boxes at most 8 pixels wide), the commonest draw of a
-// dense mesh: RGBA8888 store with optional texture (as the span routine: texels fetched lane by
-// lane, filter and combine in lanes), blend and write mask, optional depth test/write. One row of the box is one 8-lane step: the three edge functions, the coverage mask,
-// every attribute plane and the depth compare are lane vectors, the colour and depth rows are read
+// dense mesh: a store in any pixel format (the packed ones with dither and the write mask on their
+// stored bits) with optional texture (as the span routine: texels fetched lane by lane, filter and
+// combine in lanes), blend and write mask, optional depth test/write. One row of the box is one
+// 8-lane step: the three edge functions, the coverage mask, every attribute plane and the depth
+// compare are lane vectors, the colour and depth rows are read
 // and written whole and merged under the mask. There is no branch per pixel or per row (a small
 // triangle's rows are too short for per-pixel branches to predict), and the arithmetic is the
 // exact (q, r) stepping of the scalar routine with 32-bit lanes, so the output is the same byte
 // for byte.
 //
-// The caller guarantees (narrow_simd_fits): the 8-pixel window lies inside the framebuffer row and
-// both buffers inside VRAM; colour and depth buffers do not overlap; 8·den < 2^31; every edge value
-// the walk meets fits 32 bits. Lanes outside the box or the triangle are written back unchanged;
-// those pixels are on the same row, so they belong to the same band worker.
+// The caller guarantees (draw_narrow in rasterizer.cpp checks it): the 8-pixel window lies inside
+// the framebuffer row and both buffers inside VRAM; colour and depth buffers do not overlap;
+// 8·den < 2^31; every edge value the walk meets fits 32 bits. Lanes outside the box or the
+// triangle are written back unchanged; those pixels are on the same row, so they belong to the
+// same band worker.
 #include <cstddef>
 #include <cstdint>
 

@@ -198,8 +198,8 @@ class Kernel {
     }
   }
 
-  // The span vector routine applies to stores in any pixel format (blend, dither and write mask
-  // included; the small-triangle one to RGBA8888 only) with both buffers inside VRAM and
+  // The span vector routine (and the small-triangle one, draw_narrow) applies to stores in any
+  // pixel format (blend, dither and write mask included) with both buffers inside VRAM and
   // disjoint (it tests eight depths before it writes eight colours), a
   // texture inside VRAM and disjoint from both (it samples eight texels before it writes), the
   // exact texel arithmetic (not the `fast` knob), and 2·den < 2^31 so remainders fit signed
