@@ -161,7 +161,7 @@ void measure_image(const std::vector<std::vector<std::uint8_t>>& reference,
       bool differs = false;
       for (std::size_t c = 0; c < 3; ++c) {
         const int d = std::abs(int(a[p + c]) - int(b[p + c]));
-        row.colour_max = std::max(row.colour_max, double(d));
+        row.color_max = std::max(row.color_max, double(d));
         sum += d;
         ++channels;
         differs |= d != 0;
@@ -169,7 +169,7 @@ void measure_image(const std::vector<std::vector<std::uint8_t>>& reference,
       differing += differs;
     }
   }
-  row.colour_mean = channels ? sum / double(channels) : 0;
+  row.color_mean = channels ? sum / double(channels) : 0;
   row.differing_pct = both ? 100.0 * double(differing) / double(both) : 0;
   row.edge_pct = torus ? 100.0 * double(row.edge_pixels) / double(torus) : 0;
 }
@@ -253,7 +253,7 @@ std::string cordic_front_markdown(const CordicFront& f, const std::string& comma
       o << "- | - | - | - |\n";
     else
       o << fmt::format("{:.3f} / {:.4f} | {:.2f} % | {:.0f} / {:.3f} | {:.2f} % |\n", r.shift_max_px, r.shift_mean_px,
-                       r.edge_pct, r.colour_max, r.colour_mean, r.differing_pct);
+                       r.edge_pct, r.color_max, r.color_mean, r.differing_pct);
   }
   o << "\n";
   const CordicRow *knee = nullptr, *before = nullptr;
@@ -277,10 +277,10 @@ std::string cordic_front_markdown(const CordicFront& f, const std::string& comma
         "ones (max shift {:.3f} px): the device's s12.4 vertex grid sees at most one subpixel step of "
         "difference, {:.2f} % of the torus's pixels are edge pixels and the colour error is {:.0f} LSB max, "
         "{:.3f} mean.",
-        knee->iterations, knee->shift_max_px, knee->edge_pct, knee->colour_max, knee->colour_mean);
+        knee->iterations, knee->shift_max_px, knee->edge_pct, knee->color_max, knee->color_mean);
     if (before)
       o << fmt::format(" With {} iterations vertices move up to {:.3f} px ({:.2f} % edge pixels, colour {:.3f} LSB mean).",
-                       before->iterations, before->shift_max_px, before->edge_pct, before->colour_mean);
+                       before->iterations, before->shift_max_px, before->edge_pct, before->color_mean);
     o << fmt::format(" Each iteration costs about {:.1f} µs of vertex stage per frame ({} to {} iterations: {:.2f}x to {:.2f}x "
                      "the floating-point time); past the knee it buys only sub-grid vertex motion.\n\n",
                      per_step, first.iterations, last.iterations, first.vertex_ratio, last.vertex_ratio);
@@ -309,8 +309,8 @@ nlohmann::json cordic_front_json(const CordicFront& f) {
       jr["shift_mean_px"] = r.shift_mean_px;
       jr["edge_pixels"] = r.edge_pixels;
       jr["edge_pct"] = r.edge_pct;
-      jr["colour_max_lsb"] = r.colour_max;
-      jr["colour_mean_lsb"] = r.colour_mean;
+      jr["colour_max_lsb"] = r.color_max;
+      jr["colour_mean_lsb"] = r.color_mean;
       jr["differing_pct"] = r.differing_pct;
     }
     j["rows"].push_back(jr);
@@ -344,12 +344,12 @@ std::string cordic_front_svg(const CordicFront& f) {
       o << fmt::format("<text x=\"{:.1f}\" y=\"{}\" text-anchor=\"middle\">{}</text>\n", X(ox, r->iterations), margin + ph + 14,
                        r->iterations);
   };
-  auto polyline = [&](const std::vector<std::pair<double, double>>& pts, const char* colour, const char* label, int ly) {
-    o << "<polyline fill=\"none\" stroke=\"" << colour << "\" stroke-width=\"1.8\" points=\"";
+  auto polyline = [&](const std::vector<std::pair<double, double>>& pts, const char* color, const char* label, int ly) {
+    o << "<polyline fill=\"none\" stroke=\"" << color << "\" stroke-width=\"1.8\" points=\"";
     for (const auto& [x, y] : pts) o << fmt::format("{:.1f},{:.1f} ", x, y);
     o << "\"/>\n";
-    for (const auto& [x, y] : pts) o << fmt::format("<circle cx=\"{:.1f}\" cy=\"{:.1f}\" r=\"2.5\" fill=\"{}\"/>", x, y, colour);
-    o << fmt::format("\n<text x=\"{}\" y=\"{}\" fill=\"{}\">{}</text>\n", pts.empty() ? 0.0 : pts.back().first - 120, ly, colour, label);
+    for (const auto& [x, y] : pts) o << fmt::format("<circle cx=\"{:.1f}\" cy=\"{:.1f}\" r=\"2.5\" fill=\"{}\"/>", x, y, color);
+    o << fmt::format("\n<text x=\"{}\" y=\"{}\" fill=\"{}\">{}</text>\n", pts.empty() ? 0.0 : pts.back().first - 120, ly, color, label);
   };
   // Left: shift in pixels, log10 from 1e-4 to the largest.
   const int ox0 = margin;

@@ -42,9 +42,9 @@ ReferenceFrame reference_frame(const Scene& scene) {
 
 ErrorStats measure_error(const Scene& scene, const ReferenceFrame& ref, const RenderedFrame& got) {
   ErrorStats e;
-  e.has_colour = !scene.textured;
+  e.has_color = !scene.textured;
   e.has_texel = scene.textured;
-  double colour_sum = 0, texel_sum = 0;
+  double color_sum = 0, texel_sum = 0;
   std::uint64_t judged = 0;
   for (std::size_t i = 0; i < ref.count.size(); ++i) {
     if (ref.count[i] == 0 && got.count[i] == 0) continue;
@@ -57,11 +57,11 @@ ErrorStats measure_error(const Scene& scene, const ReferenceFrame& ref, const Re
     ++judged;
     e.z_max = std::max(e.z_max, std::fabs(double(got.depth[i]) - ref.z[i]));
     const std::uint8_t* c = &got.rgba[i * 4];
-    if (e.has_colour) {
+    if (e.has_color) {
       for (int ch = 0; ch < 4; ++ch) {
         const double d = std::fabs(double(c[ch]) - ref.rgba[i][ch]);
-        e.colour_max = std::max(e.colour_max, d);
-        colour_sum += d;
+        e.color_max = std::max(e.color_max, d);
+        color_sum += d;
       }
     }
     if (e.has_texel) {
@@ -81,7 +81,7 @@ ErrorStats measure_error(const Scene& scene, const ReferenceFrame& ref, const Re
     }
   }
   if (judged > 0) {
-    e.colour_mean = colour_sum / double(judged * 4);
+    e.color_mean = color_sum / double(judged * 4);
     e.texel_mean = texel_sum / double(judged);
   }
   return e;

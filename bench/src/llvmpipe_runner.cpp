@@ -27,25 +27,25 @@ GlDrawState throughput_state(const Scene& s) {
   st.blend = s.state.blend == protocol::BlendMode::Alpha ? GlDrawState::Blend::Alpha
              : s.state.blend == protocol::BlendMode::Add ? GlDrawState::Blend::Add
                                                          : GlDrawState::Blend::Off;
-  st.output = s.textured ? GlDrawState::Output::TextureDecal : GlDrawState::Output::Colour;
+  st.output = s.textured ? GlDrawState::Output::TextureDecal : GlDrawState::Output::Color;
   return st;
 }
 
 nlohmann::json error_json(const ErrorStats& e) {
-  return {{"pixels", e.pixels}, {"coverage_mismatches", e.coverage_mismatches}, {"colour_max", e.colour_max},
-          {"colour_mean", e.colour_mean}, {"z_max", e.z_max}, {"texel_max", e.texel_max},
-          {"texel_mean", e.texel_mean}, {"has_colour", e.has_colour}, {"has_texel", e.has_texel}};
+  return {{"pixels", e.pixels}, {"coverage_mismatches", e.coverage_mismatches}, {"colour_max", e.color_max},
+          {"colour_mean", e.color_mean}, {"z_max", e.z_max}, {"texel_max", e.texel_max},
+          {"texel_mean", e.texel_mean}, {"has_colour", e.has_color}, {"has_texel", e.has_texel}};
 }
 ErrorStats error_from_json(const nlohmann::json& j) {
   ErrorStats e;
   e.pixels = j.at("pixels");
   e.coverage_mismatches = j.at("coverage_mismatches");
-  e.colour_max = j.at("colour_max");
-  e.colour_mean = j.at("colour_mean");
+  e.color_max = j.at("colour_max");
+  e.color_mean = j.at("colour_mean");
   e.z_max = j.at("z_max");
   e.texel_max = j.at("texel_max");
   e.texel_mean = j.at("texel_mean");
-  e.has_colour = j.at("has_colour");
+  e.has_color = j.at("has_colour");
   e.has_texel = j.at("has_texel");
   return e;
 }
@@ -57,14 +57,14 @@ ErrorStats llvmpipe_error(LlvmpipePeer& peer, const Scene& s, const ReferenceFra
   auto counting = verts;
   for (auto& v : counting) v.r = 1.0f / 255.0f, v.g = v.b = v.a = 0.0f;
   peer.set_vertices(counting);
-  peer.render({.depth = GlDrawState::Depth::Off, .blend = GlDrawState::Blend::Add, .output = GlDrawState::Output::Colour});
-  const auto counts = peer.read_colour();
+  peer.render({.depth = GlDrawState::Depth::Off, .blend = GlDrawState::Blend::Add, .output = GlDrawState::Output::Color});
+  const auto counts = peer.read_color();
   got.count.resize(counts.size() / 4);
   for (std::size_t i = 0; i < got.count.size(); ++i) got.count[i] = counts[i * 4];
   // Values: depth ALWAYS + write, no blending, the last triangle owns each pixel.
   peer.set_vertices(verts);
-  peer.render({.depth = GlDrawState::Depth::Always, .output = GlDrawState::Output::Colour});
-  got.rgba = peer.read_colour();
+  peer.render({.depth = GlDrawState::Depth::Always, .output = GlDrawState::Output::Color});
+  got.rgba = peer.read_color();
   got.depth = peer.read_depth24();
   if (s.textured) {
     peer.render({.depth = GlDrawState::Depth::Always, .output = GlDrawState::Output::TexelCoordinates});

@@ -13,9 +13,9 @@ namespace {
 
 std::string error_cells(const std::optional<ErrorStats>& e) {
   if (!e) return "| | | | |";
-  const std::string colour = e->has_colour ? fmt::format("{:.3f} / {:.4f}", e->colour_max, e->colour_mean) : "-";
+  const std::string color = e->has_color ? fmt::format("{:.3f} / {:.4f}", e->color_max, e->color_mean) : "-";
   const std::string texel = e->has_texel ? fmt::format("{:.2f} / {:.3f}", e->texel_max, e->texel_mean) : "-";
-  return fmt::format("| {} of {} | {} | {:.3f} | {} |", e->coverage_mismatches, e->pixels, colour, e->z_max, texel);
+  return fmt::format("| {} of {} | {} | {:.3f} | {} |", e->coverage_mismatches, e->pixels, color, e->z_max, texel);
 }
 
 }  // namespace
@@ -83,7 +83,7 @@ nlohmann::json report_json(const Report& r) {
     if (row.error) {
       const auto& e = *row.error;
       jr["error"] = {{"pixels", e.pixels}, {"coverage_mismatches", e.coverage_mismatches}, {"z_max_lsb", e.z_max}};
-      if (e.has_colour) jr["error"]["colour_max_lsb"] = e.colour_max, jr["error"]["colour_mean_lsb"] = e.colour_mean;
+      if (e.has_color) jr["error"]["colour_max_lsb"] = e.color_max, jr["error"]["colour_mean_lsb"] = e.color_mean;
       if (e.has_texel) jr["error"]["texel_max_256"] = e.texel_max, jr["error"]["texel_mean_256"] = e.texel_mean;
     }
     j["rows"].push_back(jr);

@@ -13,7 +13,7 @@ namespace {
 using protocol::Reg;
 
 struct Layout {
-  std::uint32_t colour = 0, depth = 0, texture = 0;
+  std::uint32_t color = 0, depth = 0, texture = 0;
 };
 Layout layout_of(const Scene& s) {
   Layout l;
@@ -44,7 +44,7 @@ Result<std::unique_ptr<sim::Device>> make_device(const Scene& s, const sim::Accu
     return {};
   };
   if (auto r = word(Reg::FB_FORMAT, geometry::fb_format_word(s.width, s.height, protocol::PixelFormat::RGBA8888)); !r) return r.error();
-  if (auto r = word(Reg::FB_DRAW, geometry::address16_word(l.colour)); !r) return r.error();
+  if (auto r = word(Reg::FB_DRAW, geometry::address16_word(l.color)); !r) return r.error();
   if (auto r = word(Reg::FB_Z, geometry::address16_word(l.depth)); !r) return r.error();
   if (auto r = word(Reg::SCISSOR, geometry::scissor_word(0, 0, 1024, 1024)); !r) return r.error();
   if (s.textured) {
@@ -123,7 +123,7 @@ Result<RenderedFrame> render_sim_error_pass(const Scene& scene, const sim::Accur
   dev.set_pixel_observer(nullptr);
   const auto mem = static_cast<const sim::Device&>(dev).memory();
   const Layout l = layout_of(scene);
-  out.rgba.assign(mem.begin() + l.colour, mem.begin() + l.colour + n * 4);
+  out.rgba.assign(mem.begin() + l.color, mem.begin() + l.color + n * 4);
   out.depth.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
     const std::uint8_t* p = mem.data() + l.depth + i * 4;

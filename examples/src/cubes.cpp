@@ -9,7 +9,7 @@ namespace gpubridge::examples {
 namespace {
 
 // A cube of half-size 1: 4 vertices per face (own UVs), counter-clockwise from outside.
-Mesh cube_mesh(bool corner_colours) {
+Mesh cube_mesh(bool corner_colors) {
   Mesh m;
   const geometry::Vec3 normals[6] = {{0, 0, 1}, {0, 0, -1}, {1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}};
   for (const auto& n : normals) {
@@ -20,8 +20,8 @@ Mesh cube_mesh(bool corner_colours) {
     const geometry::Vec2 t[4] = {{0, 1}, {1, 1}, {1, 0}, {0, 0}};
     const auto base = static_cast<std::uint32_t>(m.vertices.size());
     for (int k = 0; k < 4; ++k) {
-      const geometry::Vec4 c = corner_colours ? geometry::Vec4{(p[k].x + 1) / 2, (p[k].y + 1) / 2, (p[k].z + 1) / 2, 1}
-                                              : geometry::Vec4{1, 1, 1, 1};
+      const geometry::Vec4 c = corner_colors ? geometry::Vec4{(p[k].x + 1) / 2, (p[k].y + 1) / 2, (p[k].z + 1) / 2, 1}
+                                             : geometry::Vec4{1, 1, 1, 1};
       m.vertices.emplace_back(p[k], c, t[k]);
     }
     for (std::uint32_t k : {0u, 1u, 2u, 0u, 2u, 3u}) m.indices.push_back(base + k);

@@ -25,7 +25,7 @@ geometry::RenderState gouraud_z_always() {
 }
 
 struct Worst {
-  double colour = 0, z = 0;
+  double color = 0, z = 0;
   int pixels = 0;
 };
 
@@ -38,7 +38,7 @@ Worst compare_one(SimHarness& h, const DeviceTriangle& t) {
   for (const auto& s : rasterize(to_fixed(t), h.full_rect())) {
     const auto c = h.color(s.x, s.y);
     const double got[4] = {double(c.r), double(c.g), double(c.b), double(c.a)};
-    for (int k = 0; k < 4; ++k) w.colour = std::max(w.colour, std::fabs(got[k] - s.rgba[k]));
+    for (int k = 0; k < 4; ++k) w.color = std::max(w.color, std::fabs(got[k] - s.rgba[k]));
     w.z = std::max(w.z, std::fabs(double(h.depth(s.x, s.y)) - s.z));
     ++w.pixels;
   }
@@ -57,15 +57,15 @@ DeviceTriangle random_triangle(std::mt19937& rng, int lo16, int hi16) {
 TEST(Attributes, ConstantAttributes_Exact) {
   SimHarness h;
   std::mt19937 rng(11);
-  for (std::uint32_t colour : {0x00000000u, 0xFFFFFFFFu, 0x80FF017Fu}) {
+  for (std::uint32_t color : {0x00000000u, 0xFFFFFFFFu, 0x80FF017Fu}) {
     for (std::uint32_t z : {0u, 0xFFFFFFu, 0x7FFFFFu, 1u}) {
       auto t = random_triangle(rng, -100, 1100);
-      for (auto& v : t) v.rgba = colour, v.z = z;
-      h.clear(~colour, z ^ 0xFFFFFF);
+      for (auto& v : t) v.rgba = color, v.z = z;
+      h.clear(~color, z ^ 0xFFFFFF);
       h.state(gouraud_z_always());
       h.draw(t);
       for (const auto& s : rasterize(to_fixed(t), h.full_rect())) {
-        ASSERT_EQ(protocol::word_from_rgba(h.color(s.x, s.y)), colour);
+        ASSERT_EQ(protocol::word_from_rgba(h.color(s.x, s.y)), color);
         ASSERT_EQ(h.depth(s.x, s.y), z);
       }
     }
@@ -110,17 +110,17 @@ TEST(Attributes, VertexOrderInvariance_Exact) {
   for (int k = 0; k < 20; ++k) {
     const DeviceTriangle t = random_triangle(rng, 0, 1023);
     std::array<int, 3> order{0, 1, 2};
-    std::vector<std::uint8_t> colour0, depth0;
+    std::vector<std::uint8_t> color0, depth0;
     int perm = 0;
     do {
       SimHarness h;
       h.state(gouraud_z_always());
       h.draw(DeviceTriangle{t[order[0]], t[order[1]], t[order[2]]});
       if (perm++ == 0) {
-        colour0 = h.color_bytes();
+        color0 = h.color_bytes();
         depth0 = h.depth_bytes();
       } else {
-        ASSERT_TRUE(h.color_bytes() == colour0) << "triangle " << k << " permutation " << perm;
+        ASSERT_TRUE(h.color_bytes() == color0) << "triangle " << k << " permutation " << perm;
         ASSERT_TRUE(h.depth_bytes() == depth0) << "triangle " << k << " permutation " << perm;
       }
     } while (std::next_permutation(order.begin(), order.end()));
@@ -226,7 +226,7 @@ TEST(Attributes, LongSpansNoDrift_HalfLsb) {
   for (const auto& t : {wide, gentle}) {
     const Worst w = compare_one(h, t);
     EXPECT_GT(w.pixels, 100000);
-    EXPECT_LE(w.colour, kHalfLsb);
+    EXPECT_LE(w.color, kHalfLsb);
     EXPECT_LE(w.z, kHalfLsb);
   }
 }

@@ -234,7 +234,7 @@ TEST(Coverage, TJunction_MatchesReferenceGapsRecorded) {
 
 // Bound: identical colour and depth bytes for 1, 2, 3 and 4 rasteriser threads.
 TEST(Coverage, ThreadCountInvariance_IdenticalBytes) {
-  std::vector<std::uint8_t> colour1, depth1;
+  std::vector<std::uint8_t> color1, depth1;
   const auto mesh = jittered_mesh(0.0, 3, 30, 22, 20.0);
   for (unsigned threads : {1u, 2u, 3u, 4u}) {
     SimHarness h({.width = 640, .height = 480, .threads = threads});
@@ -254,10 +254,10 @@ TEST(Coverage, ThreadCountInvariance_IdenticalBytes) {
     h.draw(tris);
     h.draw(layer);
     if (threads == 1) {
-      colour1 = h.color_bytes();
+      color1 = h.color_bytes();
       depth1 = h.depth_bytes();
     } else {
-      EXPECT_TRUE(h.color_bytes() == colour1) << threads << " threads";
+      EXPECT_TRUE(h.color_bytes() == color1) << threads << " threads";
       EXPECT_TRUE(h.depth_bytes() == depth1) << threads << " threads";
     }
   }

@@ -232,7 +232,7 @@ std::vector<int> device_owner(SimHarness& h, const std::vector<DeviceTriangle>& 
 
 struct Differences {
   int vertices = 0, coverage = 0, owner = 0, attributes = 0;
-  double worst_z = 0, worst_colour = 0;
+  double worst_z = 0, worst_color = 0;
   std::string first;  // the first difference, readable
   bool none() const { return vertices + coverage + owner + attributes == 0; }
 };
@@ -293,7 +293,7 @@ Differences compare(SimHarness& h, const std::vector<TieVertex>& verts, const st
       double dc = 0;
       for (int k = 0; k < 4; ++k) dc = std::max(dc, std::fabs(got[k] - ref.rgba[k]));
       d.worst_z = std::max(d.worst_z, dz);
-      d.worst_colour = std::max(d.worst_colour, dc);
+      d.worst_color = std::max(d.worst_color, dc);
       if (dz > kHalfLsb || dc > kHalfLsb) {
         ++d.attributes;
         note("pixel (" + std::to_string(x) + ", " + std::to_string(y) + "): Z off by " + std::to_string(dz) +
@@ -307,7 +307,7 @@ std::string describe(const Differences& d) {
   return std::to_string(d.vertices) + " vertices off the rule, " + std::to_string(d.coverage) + " coverage, " +
          std::to_string(d.owner) + " owner and " + std::to_string(d.attributes) +
          " attribute differences (worst Z " + std::to_string(d.worst_z) + " LSB, colour " +
-         std::to_string(d.worst_colour) + " LSB); first: " + d.first;
+         std::to_string(d.worst_color) + " LSB); first: " + d.first;
 }
 
 const char* name(WClass c) { return c == WClass::PowerOfTwo ? "w a power of two" : "w not a power of two"; }

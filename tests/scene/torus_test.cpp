@@ -54,7 +54,7 @@ TEST(TorusCordic, ConvergesToTheFloatingPointVertices) {
   double previous = 1e9;
   for (unsigned n : {4u, 8u, 12u, 16u}) {
     const TorusGeometry geo(n);
-    double worst_pos = 0, worst_colour = 0;
+    double worst_pos = 0, worst_color = 0;
     for (unsigned frame : {0u, 7u, 40u}) {
       TorusGeometry::Frame a, b;
       ref.frame(frame, a);
@@ -65,14 +65,14 @@ TEST(TorusCordic, ConvergesToTheFloatingPointVertices) {
         const auto q = b.model * geometry::Vec4{b.vertices[i].position.x, b.vertices[i].position.y, b.vertices[i].position.z, 1};
         worst_pos = std::max(worst_pos, std::hypot(p.x - q.x, p.y - q.y, p.z - q.z));
         const auto ca = a.vertices[i].color, cb = b.vertices[i].color;
-        worst_colour = std::max({worst_colour, std::abs(ca.x - cb.x), std::abs(ca.y - cb.y), std::abs(ca.z - cb.z)});
+        worst_color = std::max({worst_color, std::abs(ca.x - cb.x), std::abs(ca.y - cb.y), std::abs(ca.z - cb.z)});
       }
     }
     EXPECT_LT(worst_pos, previous) << n << " iterations";
     previous = worst_pos;
     if (n == 16) {
       EXPECT_LT(worst_pos, 1e-4);
-      EXPECT_LT(worst_colour, 1e-3);
+      EXPECT_LT(worst_color, 1e-3);
     }
     if (n == 4) {
       EXPECT_GT(worst_pos, 1e-2) << "4 iterations should visibly move vertices";

@@ -38,7 +38,7 @@ std::vector<std::uint8_t> render(const RandomScene& s, std::uint64_t mode, unsig
   w(*c.dev, Reg::CLEAR_DEPTH, 0xFFFFFF);
   w(*c.dev, Reg::CLEAR_Z, 0);
   s.draw(c, mode);
-  auto bytes = c.colour_bytes();
+  auto bytes = c.color_bytes();
   const auto m = c.dev->memory();
   bytes.insert(bytes.end(), m.begin() + Canvas::kZBase, m.begin() + Canvas::kZBase + w_ * h_ * 4);
   return bytes;
@@ -81,7 +81,7 @@ TEST(SimEquivalence, PipelinedBatchesMatchOneThread) {
             rng() & 0xFFFFFF, rng() & 0xFFFFFF);
     }
     c.dev->drain();
-    auto bytes = c.colour_bytes();
+    auto bytes = c.color_bytes();
     const auto m = c.dev->memory();
     bytes.insert(bytes.end(), m.begin() + Canvas::kZBase, m.begin() + Canvas::kZBase + 160 * 120 * 4);
     for (std::uint64_t r : readback)
@@ -103,7 +103,7 @@ TEST(SimEquivalence, GouraudWithEqualColoursEqualsFlat) {
   w(*b.dev, Reg::TRI_MODE, 0);
   a.tri(3, 7, 600, 40, 100, 620, 0x12345678, 0x12345678, 0x12345678);
   b.tri(3, 7, 600, 40, 100, 620, 0x12345678, 0x9ABCDEF0, 0x0F0F0F0F);
-  EXPECT_EQ(a.colour_bytes(), b.colour_bytes());
+  EXPECT_EQ(a.color_bytes(), b.color_bytes());
   EXPECT_GT(a.count_nonzero(), 100u);
 }
 

@@ -77,7 +77,7 @@ TEST(SimRaster, FanAroundSamplePointCoversEachPixelOnce) {
   Canvas c(32, 32);
   w(*c.dev, Reg::TRI_MODE, 2u << 7);  // ADD
   w(*c.dev, Reg::PRIM, 2);            // FAN
-  w(*c.dev, Reg::COLOR, colour(0x01010101));
+  w(*c.dev, Reg::COLOR, color(0x01010101));
   const int cx = 16 * 16 + 8, cy = 16 * 16 + 8;  // exactly on a pixel centre
   w(*c.dev, Reg::VERTEX, vtx(cx, cy));
   const int n = 37;
@@ -97,7 +97,7 @@ TEST(SimRaster, StripAndFanAssemblyAndFlatColourVertex) {
   const std::uint32_t cols[4] = {0x11111111, 0x22222222, 0x33333333, 0x44444444};
   const int v[4][2] = {{0, 0}, {0, 128}, {128, 0}, {128, 128}};
   for (int i = 0; i < 4; ++i) {
-    w(*c.dev, Reg::COLOR, colour(cols[i]));
+    w(*c.dev, Reg::COLOR, color(cols[i]));
     w(*c.dev, Reg::VERTEX, vtx(v[i][0], v[i][1]));
   }
   EXPECT_EQ(c.rgba(1, 1), 0x11111111u);  // (v0, v1, v2): first vertex v0
@@ -108,7 +108,7 @@ TEST(SimRaster, StripAndFanAssemblyAndFlatColourVertex) {
   w(*f.dev, Reg::PRIM, 2);  // FAN: (v0, v1, v2), (v0, v2, v3)
   const int fv[4][2] = {{0, 0}, {128, 0}, {128, 128}, {0, 128}};
   for (int i = 0; i < 4; ++i) {
-    w(*f.dev, Reg::COLOR, colour(cols[i]));
+    w(*f.dev, Reg::COLOR, color(cols[i]));
     w(*f.dev, Reg::VERTEX, vtx(fv[i][0], fv[i][1]));
   }
   EXPECT_EQ(f.rgba(6, 1), 0x11111111u);
@@ -151,7 +151,7 @@ TEST(SimRaster, SwapComputesFrameCrcOfTheBufferBytes) {
   std::shared_ptr<const backends::ScanoutFrame> got;
   c.dev->set_scanout_callback([&](std::shared_ptr<const backends::ScanoutFrame> f) { got = std::move(f); });
   w(*c.dev, Reg::FB_DISPLAY, 0);
-  const auto bytes = c.colour_bytes();
+  const auto bytes = c.color_bytes();
   const std::uint32_t expect = static_cast<std::uint32_t>(crc32(0, bytes.data(), static_cast<uInt>(bytes.size())));
   EXPECT_EQ(rd(*c.dev, Reg::FRAME_CRC), (1ull << 32) | expect);
   EXPECT_EQ((rd(*c.dev, Reg::STATUS) >> 32) & 0xFFFF, 1u);

@@ -29,7 +29,7 @@ inline std::uint64_t vtx(int x16, int y16, std::uint32_t z = 0) {
   return (std::uint64_t{z & 0xFFFFFF} << 32) | (std::uint64_t{static_cast<std::uint16_t>(y16)} << 16) |
          static_cast<std::uint16_t>(x16);
 }
-inline std::uint64_t colour(std::uint32_t rgba, std::uint32_t q = 0xFFFFFFFFu) {
+inline std::uint64_t color(std::uint32_t rgba, std::uint32_t q = 0xFFFFFFFFu) {
   return (std::uint64_t{q} << 32) | rgba;
 }
 inline std::uint64_t fb_format(unsigned w, unsigned h, unsigned fmt = 0) {
@@ -63,7 +63,7 @@ struct Canvas {
     const auto* p = dev->memory().data() + kZBase + (y * width + x) * 4;
     return ((std::uint32_t{p[0]} << 24) | (std::uint32_t{p[1]} << 16) | (std::uint32_t{p[2]} << 8) | p[3]);
   }
-  std::vector<std::uint8_t> colour_bytes() const {
+  std::vector<std::uint8_t> color_bytes() const {
     auto m = dev->memory();
     return {m.begin(), m.begin() + std::size_t{width} * height * bpp()};
   }
@@ -81,11 +81,11 @@ struct Canvas {
   void tri(int x0, int y0, int x1, int y1, int x2, int y2, std::uint32_t c0 = 0xFFFFFFFF, std::uint32_t c1 = 0xFFFFFFFF,
            std::uint32_t c2 = 0xFFFFFFFF, std::uint32_t z0 = 0, std::uint32_t z1 = 0, std::uint32_t z2 = 0) {
     w(*dev, Reg::PRIM, 0);
-    w(*dev, Reg::COLOR, colour(c0));
+    w(*dev, Reg::COLOR, color(c0));
     w(*dev, Reg::VERTEX, vtx(x0, y0, z0));
-    w(*dev, Reg::COLOR, colour(c1));
+    w(*dev, Reg::COLOR, color(c1));
     w(*dev, Reg::VERTEX, vtx(x1, y1, z1));
-    w(*dev, Reg::COLOR, colour(c2));
+    w(*dev, Reg::COLOR, color(c2));
     w(*dev, Reg::VERTEX, vtx(x2, y2, z2));
   }
 };

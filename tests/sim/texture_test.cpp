@@ -95,7 +95,7 @@ void check_triangle(const TexVertex (&v)[3], unsigned ws, unsigned wt, bool bili
   w(*c.dev, Reg::TRI_MODE, 2u | (modulate ? 0u : 1u << 14));
   const std::uint32_t vc = 0xC08040FF;
   for (const auto& p : v) {
-    w(*c.dev, Reg::COLOR, colour(vc, p.q));
+    w(*c.dev, Reg::COLOR, color(vc, p.q));
     w(*c.dev, Reg::TEXCOORD, (std::uint64_t{static_cast<std::uint32_t>(p.s)} << 32) | static_cast<std::uint32_t>(p.t));
     w(*c.dev, Reg::VERTEX, vtx(p.x, p.y));
   }

@@ -87,7 +87,7 @@ Rendered render(const Case& c, bool vector) {
     w(d, Reg::PRIM, 0);
     for (int k = 0; k < 3; ++k) {
       const std::uint32_t q = affine ? q0 : static_cast<std::uint32_t>(rng()) | 0x100000u;
-      w(d, Reg::COLOR, colour(static_cast<std::uint32_t>(rng()), q));
+      w(d, Reg::COLOR, color(static_cast<std::uint32_t>(rng()), q));
       w(d, Reg::TEXCOORD, (std::uint64_t{static_cast<std::uint32_t>(st(rng))} << 32) | static_cast<std::uint32_t>(st(rng)));
       w(d, Reg::VERTEX, vtx(k == 0 ? x : x + dv(rng), k == 0 ? y : y + dv(rng), rng() & 0xFFFFFF));
     }

@@ -117,16 +117,16 @@ TEST_F(ViewerDaemon, PlayedTraceReachesTheViewerPixelExactly) {
   auto window = load_png(grab);
   ASSERT_TRUE(window.ok());
   ASSERT_EQ(window->width, 640u);
-  std::set<std::uint32_t> colours;
+  std::set<std::uint32_t> colors;
   for (unsigned y = 0; y < 120; ++y) {
     for (unsigned x = 0; x < 160; ++x) {
       const std::uint8_t* want = rendered.pixel(x, y);
       const std::uint8_t* got = window->pixel(4 * x + 2, 4 * y + 1);
       ASSERT_TRUE(want[0] == got[0] && want[1] == got[1] && want[2] == got[2]) << "frame pixel " << x << "," << y;
-      colours.insert((got[0] << 16) | (got[1] << 8) | got[2]);
+      colors.insert((got[0] << 16) | (got[1] << 8) | got[2]);
     }
   }
-  EXPECT_GE(colours.size(), 2u) << "the window shows a flat colour: the triangle is missing";
+  EXPECT_GE(colors.size(), 2u) << "the window shows a flat colour: the triangle is missing";
 }
 
 TEST_F(ViewerDaemon, SurvivesADaemonRestart) {

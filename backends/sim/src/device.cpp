@@ -217,7 +217,7 @@ struct Device::State {
       case Reg::FB_DRAW:
       case Reg::FB_Z:
       case Reg::FB_FORMAT: state.reset(); break;
-      case Reg::CLEAR: clear_colour(); break;
+      case Reg::CLEAR: clear_color(); break;
       case Reg::CLEAR_Z: clear_depth(); break;
       case Reg::FB_DISPLAY: swap(data); break;
       case Reg::MEM_ADDR: load_prefetch(); break;
@@ -286,7 +286,7 @@ struct Device::State {
     }
     if (dropped) errors |= ERR_MEM_RANGE;
   }
-  void clear_colour() {
+  void clear_color() {
     const DrawState& st = draw_state();
     std::uint8_t px[4];
     store_pixel(st.fb_format, px, rgba_from_word(static_cast<std::uint32_t>(regs[index_of(Reg::CLEAR_COLOR)])));

@@ -43,7 +43,7 @@ template <bool kTextured, unsigned kFormat>
     }
   }
   u32x8 covered = {}, passed = {};
-  std::uint8_t* cp = t.colour;
+  std::uint8_t* cp = t.color;
   std::uint8_t* zp = t.depth;
   for (unsigned row = 0; row < t.rows; ++row) {
     const u32x8 cov = in_box & GB_MASK((e[0] | e[1] | e[2]) >= 0);
@@ -77,7 +77,7 @@ template <bool kTextured, unsigned kFormat>
       const u32x8 out = (word & pass) | (cold & ~pass);
       GB_STORE8(cp, out);
     }
-    cp += t.colour_pitch;
+    cp += t.color_pitch;
     covered -= cov;  // mask lanes are all ones (−1)
     passed -= pass;
     for (unsigned i = 0; i < 3; ++i) e[i] += t.ey[i];

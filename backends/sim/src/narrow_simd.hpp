@@ -34,10 +34,10 @@ struct NarrowTriangle {
   unsigned width = 0, rows = 0;  // box width (<= 8) and rows to draw
   std::uint32_t flat = 0;        // colour word (memory order R,G,B,A) when !gouraud
   std::uint32_t zmask = 0xFFFFFF;
-  std::uint8_t* colour = nullptr;  // first pixel of the first row
+  std::uint8_t* color = nullptr;   // first pixel of the first row
   std::uint8_t* depth = nullptr;   // its depth word (when z_test or z_write)
   std::size_t pitch = 0;           // bytes per depth row (4 per pixel)
-  std::size_t colour_pitch = 0;    // bytes per colour row (4, 2 or 1 per pixel)
+  std::size_t color_pitch = 0;     // bytes per colour row (4, 2 or 1 per pixel)
   unsigned format = 0;             // protocol::PixelFormat of the colour buffer
   std::uint32_t keep_packed = 0;   // packed formats: the stored bits the write mask keeps
   std::uint32_t bayer[4][8] = {};  // packed formats with dither: threshold index of row (first + j) % 4, lane k

@@ -3,7 +3,7 @@
 // bytes), shared by both vector routines (span_simd.cpp, narrow_simd.cpp): blend against the
 // stored pixels expanded by bit replication, quantise with the lanes' ordered or temporal dither,
 // keep the bits the write mask protects, store the passing lanes. Byte for byte what pixel.hpp's
-// store_colour() does per pixel (the vector equivalence tests compare them). Internal to those
+// store_color() does per pixel (the vector equivalence tests compare them). Internal to those
 // routines' .cpp files: it is inlined into their target clones.
 #include <cstdint>
 #include <cstring>
@@ -81,7 +81,7 @@ template <unsigned kBits>
 // Ordered dither: t scaled per channel width as (t << (8 - n)) >> 4, saturating add, truncate.
 // Temporal (`temporal`): the scaled quantiser with the centred threshold 16t + 8.
 template <unsigned kFormat>
-[[gnu::always_inline]] inline u32x8 pack_colour(u32x8 word, u32x8 bayer, bool temporal) {
+[[gnu::always_inline]] inline u32x8 pack_color(u32x8 word, u32x8 bayer, bool temporal) {
   if (temporal) {
     const u32x8 t16 = (bayer << 4) + 8u;
     if constexpr (kFormat == 1)
@@ -109,7 +109,7 @@ template <unsigned kFormat>
                                                  bool whole) {
   const u32x8 old = need_old ? load_packed<kFormat>(p, n, whole) : u32x8{};
   if (blend != 0) word = GB_BLEND8(blend, word, expand_packed<kFormat>(old));
-  u32x8 out = pack_colour<kFormat>(word, bayer, temporal);
+  u32x8 out = pack_color<kFormat>(word, bayer, temporal);
   out = (out & ~keep_bits) | (old & keep_bits);
   out = (out & pass) | (old & ~pass);
   store_packed<kFormat>(p, out, n);

@@ -63,7 +63,7 @@ inline unsigned quantise(unsigned v, unsigned n, const DitherMode& d, int x, int
 
 // Quantises (and dithers) c and stores it at p honouring the write mask (keep bit 0 R .. 3 A:
 // 1 = keep the stored channel).
-inline void store_colour(protocol::PixelFormat f, std::uint8_t* p, protocol::Rgba8 c, const DitherMode& dither,
+inline void store_color(protocol::PixelFormat f, std::uint8_t* p, protocol::Rgba8 c, const DitherMode& dither,
                          std::uint8_t keep, int x, int y) {
   using protocol::PixelFormat;
   switch (f) {

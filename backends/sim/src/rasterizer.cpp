@@ -72,7 +72,7 @@ class Kernel {
     zbuf_ = ctx.mem.data() + st.fb_z;
     zmask_ = ctx.z_bits >= 24 ? 0xFFFFFFu : 0xFFFFFFu & ~((1u << (24 - ctx.z_bits)) - 1);
     const std::uint8_t stored = st.fb_format == protocol::PixelFormat::RGB565 ? 0x7 : 0xF;
-    skip_colour_ = (st.keep_mask & stored) == stored;
+    skip_color_ = (st.keep_mask & stored) == stored;
     if (kGouraud) {
       flat_ = {};
     } else if (st.gouraud) {  // Gouraud requested but every vertex has the same colour
@@ -213,7 +213,7 @@ class Kernel {
     return simd_;
   }
   void prepare_simd() {
-    if (!st_.color_in_vram || skip_colour_) return;
+    if (!st_.color_in_vram || skip_color_) return;
     if (kDepth && (!st_.z_in_vram || !st_.buffers_disjoint)) return;
     if (kTextured && (ctx_.fast || !tex_.direct() || !texture_disjoint(st_, kDepth))) return;
     if (t_.den >= (std::int64_t{1} << 30)) return;
@@ -261,8 +261,8 @@ class Kernel {
   // Rows two ahead are fetched while this one is drawn (random triangles miss the caches).
   void prefetch_row(int y, int x, int count) const {
     const std::size_t pix = static_cast<std::size_t>(y) * width_ + static_cast<std::size_t>(x);
-    const std::size_t colour_bytes = static_cast<std::size_t>(count) * st_.bpp, depth_bytes = static_cast<std::size_t>(count) * 4;
-    for (std::size_t b = 0; b < colour_bytes; b += 64) __builtin_prefetch(color_ + pix * st_.bpp + b, 1);
+    const std::size_t color_bytes = static_cast<std::size_t>(count) * st_.bpp, depth_bytes = static_cast<std::size_t>(count) * 4;
+    for (std::size_t b = 0; b < color_bytes; b += 64) __builtin_prefetch(color_ + pix * st_.bpp + b, 1);
     if (kDepth)
       for (std::size_t b = 0; b < depth_bytes; b += 64) __builtin_prefetch(zbuf_ + pix * 4 + b, 1);
   }
@@ -275,7 +275,7 @@ class Kernel {
       sp.r0[p] = used ? static_cast<std::uint32_t>(s.r[kR + p]) : 0;
     }
     const std::size_t pix = static_cast<std::size_t>(y) * width_ + static_cast<std::size_t>(x);
-    sp.colour = color_ + pix * st_.bpp;
+    sp.color = color_ + pix * st_.bpp;
     if (st_.dither.on && st_.fb_format != protocol::PixelFormat::RGBA8888)
       for (unsigned k = 0; k < 8; ++k) sp.bayer[k] = dither_threshold(st_.dither, x + static_cast<int>(k), y);
     sp.depth = kDepth ? zbuf_ + pix * 4 : nullptr;
@@ -305,7 +305,7 @@ class Kernel {
       }
     }
     ++ctx_.counters.passed;
-    if (skip_colour_) return;
+    if (skip_color_) return;
     Rgba8 c = flat_;
     if constexpr (kGouraud) {
       c = {static_cast<std::uint8_t>(s.q[kR]), static_cast<std::uint8_t>(s.q[kG]), static_cast<std::uint8_t>(s.q[kB]),
@@ -345,10 +345,10 @@ class Kernel {
         return;
       }
     }
-    write_colour(pix, x, y, c);
+    write_color(pix, x, y, c);
   }
 
-  void write_colour(std::size_t pix, int x, int y, Rgba8 c) {
+  void write_color(std::size_t pix, int x, int y, Rgba8 c) {
     const unsigned bpp = st_.bpp;
     const std::uint64_t at = std::uint64_t{st_.fb_draw} + pix * bpp;
     std::uint8_t tmp[4] = {0, 0, 0, 0};
@@ -361,7 +361,7 @@ class Kernel {
       ++ctx_.counters.blended;
       c = blend(st_.blend, c, protocol::load_pixel(st_.fb_format, p));
     }
-    store_colour(st_.fb_format, p, c, st_.dither, st_.keep_mask, x, y);
+    store_color(st_.fb_format, p, c, st_.dither, st_.keep_mask, x, y);
     if (!st_.color_in_vram && !ctx_.mem.write(at, tmp, bpp)) ctx_.errors |= protocol::ERR_MEM_RANGE;
   }
 
@@ -374,7 +374,7 @@ class Kernel {
   std::uint8_t* color_ = nullptr;
   std::uint8_t* zbuf_ = nullptr;
   std::uint32_t zmask_ = 0xFFFFFF;
-  bool skip_colour_ = false;
+  bool skip_color_ = false;
   Rgba8 flat_;
   bool q_const_ = false;
   Reciprocal const_rc_;
@@ -410,8 +410,8 @@ bool draw_narrow(const Triangle& t, const DrawState& st, RasterContext& ctx, int
   // Every channel masked (with a Z write, or the draw would have been dropped): the colour stage,
   // texture and blend included, does not run, as in the scalar routine.
   const std::uint8_t stored = st.fb_format == protocol::PixelFormat::RGB565 ? 0x7 : 0xF;  // RGB565 has no alpha
-  const bool colour_stage = (st.keep_mask & stored) != stored;
-  const bool textured = st.textured && colour_stage;
+  const bool color_stage = (st.keep_mask & stored) != stored;
+  const bool textured = st.textured && color_stage;
   std::optional<TextureUnit> unit;  // built only for textured draws (this is the 10-px hot path)
   if (textured) {
     unit.emplace(st.tex, ctx.mem);
@@ -449,10 +449,10 @@ bool draw_narrow(const Triangle& t, const DrawState& st, RasterContext& ctx, int
            (std::uint32_t{t.flat[3]} << 24);
   n.zmask = ctx.z_bits >= 24 ? 0xFFFFFFu : 0xFFFFFFu & ~((1u << (24 - ctx.z_bits)) - 1);
   const std::size_t pix = static_cast<std::size_t>(ya) * st.fb_width + static_cast<std::size_t>(t.x0);
-  n.colour = ctx.mem.data() + st.fb_draw + pix * st.bpp;
+  n.color = ctx.mem.data() + st.fb_draw + pix * st.bpp;
   n.depth = depth ? ctx.mem.data() + st.fb_z + pix * 4 : nullptr;
   n.pitch = std::size_t{st.fb_width} * 4;
-  n.colour_pitch = std::size_t{st.fb_width} * st.bpp;
+  n.color_pitch = std::size_t{st.fb_width} * st.bpp;
   n.format = static_cast<unsigned>(st.fb_format);
   n.keep_packed = keep_packed_bits(st.fb_format, st.keep_mask);
   if (st.dither.on && st.fb_format != protocol::PixelFormat::RGBA8888)
@@ -469,7 +469,7 @@ bool draw_narrow(const Triangle& t, const DrawState& st, RasterContext& ctx, int
   ctx.counters.scanned += static_cast<std::uint64_t>(w) * static_cast<std::uint64_t>(rows);
   ctx.counters.covered += c.covered;
   ctx.counters.passed += c.passed;
-  if (st.blend != protocol::BlendMode::Off && colour_stage) ctx.counters.blended += c.passed;
+  if (st.blend != protocol::BlendMode::Off && color_stage) ctx.counters.blended += c.passed;
   if (textured) {
     ctx.counters.textured += c.passed;
     ctx.counters.texel_bytes += c.passed * (st.tex.bilinear ? 4u : 1u) * protocol::bytes_per_pixel(st.tex.format);
@@ -482,9 +482,9 @@ bool draw_narrow(const Triangle& t, const DrawState& st, RasterContext& ctx, int
 void rasterize_rows(const Triangle& t, const DrawState& st, RasterContext& ctx, int row_begin, int row_end) {
   const int ya = std::max(row_begin, t.y0), yz = std::min(row_end, t.y1);
   if (ya >= yz) return;
-  bool colours_differ = false;
-  for (unsigned ch = 0; ch < 4; ++ch) colours_differ |= !t.plane[kR + ch].constant;
-  const bool gouraud = st.gouraud && colours_differ;  // Gouraud only when colours differ
+  bool colors_differ = false;
+  for (unsigned ch = 0; ch < 4; ++ch) colors_differ |= !t.plane[kR + ch].constant;
+  const bool gouraud = st.gouraud && colors_differ;   // Gouraud only when colours differ
   const bool depth = st.z_test || st.z_write;
   if (ctx.vector && draw_narrow(t, st, ctx, ya, yz, gouraud, depth)) return;
   const unsigned key = (gouraud ? 1u : 0u) | (st.textured ? 2u : 0u) | (depth ? 4u : 0u) | (st.simple_color ? 8u : 0u);

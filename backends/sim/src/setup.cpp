@@ -1,6 +1,6 @@
 #include "setup.hpp"
 
-#include "colour_planes.hpp"
+#include "color_planes.hpp"
 
 #include <algorithm>
 #include <utility>
@@ -91,12 +91,12 @@ bool setup_triangle(const Vertex& va, const Vertex& vb, const Vertex& vc, const 
 
   const Vertex* v = t.v;
   const Divider div(t.den);
-  const bool colour = all_attributes || state.gouraud;
+  const bool color = all_attributes || state.gouraud;
   const bool depth = all_attributes || state.z_test || state.z_write;
   const bool tex = all_attributes || state.textured;
   // Planes not set up read as constant (the kernels never step them).
-  if (colour)
-    setup_colour_planes(&t.plane[kR], v, e20, e01, D);
+  if (color)
+    setup_color_planes(&t.plane[kR], v, e20, e01, D);
   else
     for (unsigned ch = 0; ch < 4; ++ch) t.plane[kR + ch] = Plane{};
   if (depth) setup_plane(t.plane[kZ], v[0].z, v[1].z, v[2].z, e20, e01, D, div);

@@ -21,7 +21,7 @@ struct SimdSpan {
   std::uint32_t den = 1;                   // < 2^30, so r + r8 < 2^31
   std::uint32_t flat = 0;                  // colour word (memory order R,G,B,A) when !gouraud
   std::uint32_t zmask = 0xFFFFFF;
-  std::uint8_t* colour = nullptr;          // first pixel of the span
+  std::uint8_t* color = nullptr;           // first pixel of the span
   std::uint8_t* depth = nullptr;           // first depth word of the span (when z_test or z_write)
   unsigned count = 0;                      // pixels in the span
   unsigned room = 0;                       // pixels from the span's first to the end of its buffer row (>= count)

@@ -132,10 +132,10 @@ class TextureUnit {
 };
 
 // Section 10.5.
-inline protocol::Rgba8 combine(protocol::Rgba8 texel, protocol::Rgba8 colour, bool decal) {
+inline protocol::Rgba8 combine(protocol::Rgba8 texel, protocol::Rgba8 color, bool decal) {
   if (decal) return texel;
-  return {static_cast<std::uint8_t>(div255(texel.r * colour.r)), static_cast<std::uint8_t>(div255(texel.g * colour.g)),
-          static_cast<std::uint8_t>(div255(texel.b * colour.b)), static_cast<std::uint8_t>(div255(texel.a * colour.a))};
+  return {static_cast<std::uint8_t>(div255(texel.r * color.r)), static_cast<std::uint8_t>(div255(texel.g * color.g)),
+          static_cast<std::uint8_t>(div255(texel.b * color.b)), static_cast<std::uint8_t>(div255(texel.a * color.a))};
 }
 
 }  // namespace gpubridge::sim

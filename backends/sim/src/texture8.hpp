@@ -12,7 +12,7 @@ namespace gpubridge::sim {
 // the bilinear filter and the combine with the vertex colour `colour` run in lanes. Returns the
 // combined colour words.
 [[gnu::always_inline]] inline simd::u32x8 texture8(const TextureLanes& s, simd::u32x8 sq, simd::u32x8 tq,
-                                                   simd::u32x8 qq, simd::u32x8 pass, unsigned n, simd::u32x8 colour) {
+                                                   simd::u32x8 qq, simd::u32x8 pass, unsigned n, simd::u32x8 color) {
   using simd::u32x8;
   std::uint32_t sv[8], tv[8], qv[8], pv[8];
   GB_STORE8(sv, sq);
@@ -57,7 +57,7 @@ namespace gpubridge::sim {
   if (s.decal) return texel;
   u32x8 out = {};
   for (unsigned c = 0; c < 32; c += 8) {  // section 10.5 modulate: div255(texel · colour) per channel
-    const u32x8 x = ((texel >> c) & 255u) * ((colour >> c) & 255u);
+    const u32x8 x = ((texel >> c) & 255u) * ((color >> c) & 255u);
     out |= GB_DIV255(x) << c;
   }
   return out;

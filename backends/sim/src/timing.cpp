@@ -7,7 +7,7 @@
 
 namespace gpubridge::sim {
 
-TimingEstimate estimate_timing(const DeviceStats& w, const BoardTiming& b, unsigned colour_bpp, bool depth_buffer) {
+TimingEstimate estimate_timing(const DeviceStats& w, const BoardTiming& b, unsigned color_bpp, bool depth_buffer) {
   TimingEstimate e;
   e.pipeline_cycles = double(w.queued_executed) * b.cycles_per_command +
                       double(w.triangles_rasterised) * b.cycles_per_triangle +
@@ -19,7 +19,7 @@ TimingEstimate estimate_timing(const DeviceStats& w, const BoardTiming& b, unsig
   // Memory: depth read + write (4 + 4) for every covered pixel (an upper bound: not every draw
   // tests or writes Z), colour write, destination read when blending, texels fetched, clears,
   // uploads (8 bytes per MEM_DATA). No depth buffer, no depth traffic.
-  e.memory_bytes = (depth_buffer ? w.pixels_covered * 8 : 0) + w.pixels_depth_passed * colour_bpp + w.pixels_blended * colour_bpp +
+  e.memory_bytes = (depth_buffer ? w.pixels_covered * 8 : 0) + w.pixels_depth_passed * color_bpp + w.pixels_blended * color_bpp +
                    w.texel_bytes + w.clear_bytes + w.mem_data_writes * 8;
   e.memory_cycles = double(e.memory_bytes) / b.memory_bytes_per_cycle;
   e.board_cycles = std::max(e.pipeline_cycles, e.memory_cycles);

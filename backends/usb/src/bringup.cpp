@@ -188,10 +188,10 @@ std::vector<Scene> test_scenes(unsigned w, unsigned h, std::uint32_t fb) {
                                            protocol::write_frame(Reg::CLEAR_COLOR, 0x2060A0FF), protocol::write_frame(Reg::CLEAR, 0),
                                            protocol::write_frame(Reg::FB_DISPLAY, fb)})});
   std::vector<Frame> bars = {protocol::write_frame(Reg::FB_FORMAT, format), protocol::write_frame(Reg::FB_DRAW, fb)};
-  const std::uint32_t colours[] = {0xFFFFFFFF, 0xFFFF00FF, 0x00FFFFFF, 0x00FF00FF, 0xFF00FFFF, 0xFF0000FF, 0x0000FFFF, 0x000000FF};
+  const std::uint32_t colors[] = {0xFFFFFFFF, 0xFFFF00FF, 0x00FFFFFF, 0x00FF00FF, 0xFF00FFFF, 0xFF0000FF, 0x0000FFFF, 0x000000FF};
   for (unsigned i = 0; i < 8; ++i) {
     bars.push_back(protocol::write_frame(Reg::SCISSOR, scissor(w * i / 8, 0, w * (i + 1) / 8, h)));
-    bars.push_back(protocol::write_frame(Reg::CLEAR_COLOR, colours[i]));
+    bars.push_back(protocol::write_frame(Reg::CLEAR_COLOR, colors[i]));
     bars.push_back(protocol::write_frame(Reg::CLEAR, 0));
   }
   bars.push_back(protocol::write_frame(Reg::FB_DISPLAY, fb));

@@ -20,7 +20,7 @@ struct LlvmpipePeer::Gl {
   EGLDisplay display = EGL_NO_DISPLAY;
   EGLContext context = EGL_NO_CONTEXT;
   unsigned width = 0, height = 0;
-  GLuint fbo_rgba8 = 0, fbo_float = 0, colour_rb = 0, float_rb = 0, depth_rb = 0;
+  GLuint fbo_rgba8 = 0, fbo_float = 0, color_rb = 0, float_rb = 0, depth_rb = 0;
   GLuint program = 0, vao = 0, vbo = 0, texture = 0;
   GLint u_scale = -1, u_mode = -1, u_tex_size = -1;
   GLsizei vertex_count = 0;
@@ -35,7 +35,7 @@ struct LlvmpipePeer::Gl {
       glDeleteProgram(program);
       glDeleteFramebuffers(1, &fbo_rgba8);
       glDeleteFramebuffers(1, &fbo_float);
-      GLuint rbs[3] = {colour_rb, float_rb, depth_rb};
+      GLuint rbs[3] = {color_rb, float_rb, depth_rb};
       glDeleteRenderbuffers(3, rbs);
       eglMakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
       eglDestroyContext(display, context);
@@ -48,28 +48,28 @@ namespace {
 
 constexpr const char* kVertexShader = R"(#version 330 core
 layout(location = 0) in vec4 pos;    // x, y in pixels (y down), z in [0, 1], w
-layout(location = 1) in vec4 colour;
+layout(location = 1) in vec4 color;
 layout(location = 2) in vec2 uv;
 uniform vec2 scale;                  // 2 / width, 2 / height
-noperspective out vec4 v_colour;     // the device's Gouraud is linear in screen space
+noperspective out vec4 v_color;      // the device's Gouraud is linear in screen space
 out vec2 v_uv;                       // perspective-correct
 void main() {
   vec2 ndc = pos.xy * scale - 1.0;   // no y flip: FBO row r is window y in [r, r + 1)
   gl_Position = vec4(ndc * pos.w, (2.0 * pos.z - 1.0) * pos.w, pos.w);
-  v_colour = colour;
+  v_color = color;
   v_uv = uv;
 }
 )";
 
 constexpr const char* kFragmentShader = R"(#version 330 core
-noperspective in vec4 v_colour;
+noperspective in vec4 v_color;
 in vec2 v_uv;
 uniform int mode;                    // 0 colour, 1 texture decal, 2 texel coordinates
 uniform sampler2D tex;
 uniform vec2 tex_size;
 out vec4 frag;
 void main() {
-  if (mode == 0) frag = v_colour;
+  if (mode == 0) frag = v_color;
   else if (mode == 1) frag = texture(tex, v_uv);
   else frag = vec4(v_uv * tex_size, 0.0, 1.0);
 }
@@ -150,10 +150,10 @@ Result<std::unique_ptr<LlvmpipePeer>> LlvmpipePeer::create(unsigned width, unsig
     return gl_error(std::string("renderer is \"") + (renderer ? renderer : "?") +
                     "\", not llvmpipe (set GALLIUM_DRIVER=llvmpipe LIBGL_ALWAYS_SOFTWARE=true)");
 
-  gl->colour_rb = make_renderbuffer(GL_RGBA8, width, height);
+  gl->color_rb = make_renderbuffer(GL_RGBA8, width, height);
   gl->float_rb = make_renderbuffer(GL_RGBA32F, width, height);
   gl->depth_rb = make_renderbuffer(GL_DEPTH_COMPONENT24, width, height);
-  for (auto [fbo, rb] : {std::pair{&gl->fbo_rgba8, gl->colour_rb}, std::pair{&gl->fbo_float, gl->float_rb}}) {
+  for (auto [fbo, rb] : {std::pair{&gl->fbo_rgba8, gl->color_rb}, std::pair{&gl->fbo_float, gl->float_rb}}) {
     glGenFramebuffers(1, fbo);
     glBindFramebuffer(GL_FRAMEBUFFER, *fbo);
     glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, rb);
@@ -250,7 +250,7 @@ void LlvmpipePeer::render(const GlDrawState& st) {
   glFinish();
 }
 
-std::vector<std::uint8_t> LlvmpipePeer::read_colour() {
+std::vector<std::uint8_t> LlvmpipePeer::read_color() {
   glBindFramebuffer(GL_FRAMEBUFFER, gl_->fbo_rgba8);
   std::vector<std::uint8_t> out(std::size_t{gl_->width} * gl_->height * 4);
   glPixelStorei(GL_PACK_ALIGNMENT, 1);

@@ -33,10 +33,10 @@ struct AccuracyBenchOptions {
 struct ErrorStats {
   std::uint64_t pixels = 0;              // reference-covered pixels judged
   std::uint64_t coverage_mismatches = 0; // pixels whose hit count or owning triangle differs
-  double colour_max = 0, colour_mean = 0;   // 8-bit LSB (untextured scenes)
+  double color_max = 0, color_mean = 0;     // 8-bit LSB (untextured scenes)
   double z_max = 0;                          // 24-bit LSB
   double texel_max = 0, texel_mean = 0;      // 1/256 texel of the 1024-texel probe (textured scenes)
-  bool has_colour = false, has_texel = false;
+  bool has_color = false, has_texel = false;
 };
 
 struct Row {

@@ -32,7 +32,7 @@ struct CordicRow {
   // |CORDIC - float| where both show the torus.
   std::uint64_t edge_pixels = 0;
   double edge_pct = 0;              // edge pixels, % of the pixels the torus covers in either frame
-  double colour_max = 0, colour_mean = 0;
+  double color_max = 0, color_mean = 0;
   double differing_pct = 0;         // % of the pixels covered in both whose colour differs at all
   double shift_max_px = 0, shift_mean_px = 0;  // screen distance of each vertex from its float position
 };

@@ -38,9 +38,9 @@ struct TimingEstimate {
 };
 
 // Counters of `work` (e.g. the difference of two DeviceStats snapshots) under profile `board`;
-// colour_bpp (bytes per pixel of the colour buffer) sizes the colour traffic; without a depth
+// color_bpp (bytes per pixel of the colour buffer) sizes the colour traffic; without a depth
 // buffer (depth_buffer false: a program drawing in painter's order) covered pixels move no depth bytes.
-TimingEstimate estimate_timing(const DeviceStats& work, const BoardTiming& board, unsigned colour_bpp,
+TimingEstimate estimate_timing(const DeviceStats& work, const BoardTiming& board, unsigned color_bpp,
                                bool depth_buffer = true);
 // a − b, field by field.
 DeviceStats stats_difference(const DeviceStats& a, const DeviceStats& b);

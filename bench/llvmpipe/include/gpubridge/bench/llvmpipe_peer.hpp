@@ -31,7 +31,7 @@ struct GlVertex {
 struct GlDrawState {
   enum class Depth { Off, Less, LessEqual, Always } depth = Depth::Off;  // Always: test on, every fragment writes
   enum class Blend { Off, Alpha, Add } blend = Blend::Off;
-  enum class Output { Colour, TextureDecal, TexelCoordinates } output = Output::Colour;
+  enum class Output { Color, TextureDecal, TexelCoordinates } output = Output::Color;
   bool clear = true;
 };
 
@@ -53,7 +53,7 @@ class LlvmpipePeer {
   void render(const GlDrawState& state);
   // Read-back of the last frame, rows top first: RGBA8 colour, 24-bit depth, texel coordinates
   // (u * W, v * H per pixel, from the float target of Output::TexelCoordinates).
-  std::vector<std::uint8_t> read_colour();
+  std::vector<std::uint8_t> read_color();
   std::vector<std::uint32_t> read_depth24();
   std::vector<float> read_texel_coordinates();
 

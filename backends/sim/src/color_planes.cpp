@@ -1,4 +1,4 @@
-#include "colour_planes.hpp"
+#include "color_planes.hpp"
 
 #include <cmath>
 
@@ -7,7 +7,7 @@ namespace gpubridge::sim {
 // Written as 4-lane loops: the AVX2 clone vectorises them (vroundpd for the floor); the default
 // clone computes the same numbers lane by lane. Every operation but the quotient estimate is exact
 // integer arithmetic in double, so contraction into FMA cannot change a result either.
-__attribute__((target_clones("avx2", "default"))) void setup_colour_planes(Plane* out, const Vertex* v, const Edge& b1,
+__attribute__((target_clones("avx2", "default"))) void setup_color_planes(Plane* out, const Vertex* v, const Edge& b1,
                                                                         const Edge& b2, std::int64_t D) {
   const double den = 2.0 * static_cast<double>(D), inv = 1.0 / den;
   const double dd = static_cast<double>(D);

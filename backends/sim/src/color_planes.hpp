@@ -12,6 +12,6 @@ namespace gpubridge::sim {
 
 // out[0..3] = planes R, G, B, A of vertices v[0..2] with barycentric edges b1 (vertex 1) and b2
 // (vertex 2) and area D > 0.
-void setup_colour_planes(Plane* out, const Vertex* v, const Edge& b1, const Edge& b2, std::int64_t D);
+void setup_color_planes(Plane* out, const Vertex* v, const Edge& b1, const Edge& b2, std::int64_t D);
 
 }  // namespace gpubridge::sim
