@@ -6,10 +6,7 @@
 #include <string>
 
 #include "gpubridge/common/trace_files.hpp"
-#if __has_include("gpubridge/scene/scene.hpp")
 #include "gpubridge/scene/scene.hpp"
-#define GPUBRIDGE_CLI_HAS_SCENES 1
-#endif
 
 namespace gpubridge::cli {
 
@@ -20,17 +17,12 @@ inline Result<protocol::CommandStream> load_commands(const std::string& input, s
   const std::filesystem::path p(input);
   if (!std::filesystem::exists(p)) return make_error(input + ": no such file");
   if (p.extension() == ".json") {
-#ifdef GPUBRIDGE_CLI_HAS_SCENES
     kind = "scene";
     scene::BuildOptions bo;
     bo.vram_bytes = vram_bytes;
     auto built = scene::load_scene(p, bo);
     if (!built) return built.error();
     return std::move(built->stream);
-#else
-    (void)vram_bytes;
-    return make_error(input + ": scene files need the scene library, which this build lacks; use a trace");
-#endif
   }
   kind = "trace";
   return load_trace(p);
