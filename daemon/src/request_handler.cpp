@@ -39,17 +39,6 @@ ErrorCode code_for(const Error& e) {
   }
 }
 
-bool client_may_send(MsgType t) {
-  switch (t) {
-    case MsgType::Hello: case MsgType::Ping: case MsgType::Pong: case MsgType::Bye: case MsgType::WriteFrames:
-    case MsgType::ReadReg: case MsgType::Upload: case MsgType::Readback: case MsgType::Fence: case MsgType::StatusReq:
-    case MsgType::Subscribe: case MsgType::Unsubscribe: case MsgType::LeaseAcquire: case MsgType::LeaseRelease:
-      return true;
-    default:
-      return false;
-  }
-}
-
 std::string hex_index(unsigned index) {
   const char* digits = "0123456789ABCDEF";
   return std::string("0x") + digits[(index >> 4) & 0xF] + digits[index & 0xF];
@@ -82,7 +71,7 @@ void RequestHandler::reply_device_error(std::uint32_t request_id, const Error& e
 
 void RequestHandler::dispatch(Message& m) {
   const MsgType type = protocol::type_of(m.payload);
-  if (!client_may_send(type)) {
+  if (protocol::sender(type) == protocol::Sender::Server) {
     session_.fail(ErrorCode::UnknownType, std::string(protocol::to_string(type)) + " is a server-to-client message",
                   m.request_id);
     return;

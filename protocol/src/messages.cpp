@@ -369,13 +369,15 @@ using Decoder = std::optional<DecodeError> (*)(std::span<const std::uint8_t>, Pa
 struct TypeEntry {
   std::string_view name;
   Decoder decode = nullptr;  // nullptr: not a message type
+  Sender sender = Sender::Server;
 };
 
 // Indexed by the type byte.
 constexpr std::array<TypeEntry, 256> kTypes = []<std::size_t... I>(std::index_sequence<I...>) {
   std::array<TypeEntry, 256> t{};
   ((t[static_cast<std::uint8_t>(std::variant_alternative_t<I, Payload>::kType)] =
-        TypeEntry{std::variant_alternative_t<I, Payload>::kName, &decode_as<std::variant_alternative_t<I, Payload>>}),
+        TypeEntry{std::variant_alternative_t<I, Payload>::kName, &decode_as<std::variant_alternative_t<I, Payload>>,
+                  std::variant_alternative_t<I, Payload>::kSender}),
    ...);
   return t;
 }(std::make_index_sequence<std::variant_size_v<Payload>>{});
@@ -388,6 +390,8 @@ std::string_view to_string(MsgType t) {
 }
 
 bool is_known_type(std::uint8_t t) { return kTypes[t].decode != nullptr; }
+
+Sender sender(MsgType t) { return kTypes[static_cast<std::uint8_t>(t)].sender; }
 
 std::string_view to_string(ErrorCode c) {
   switch (c) {

@@ -1,12 +1,24 @@
-// docs/protocol.md must carry exactly the generated register table between its markers.
+// docs/protocol.md must carry exactly the generated register table between its markers, and its
+// message table (17.3) must name every message type with the sender its struct declares.
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <set>
 #include <sstream>
+#include <string>
+#include <variant>
 
+#include "gpubridge/protocol/messages.hpp"
 #include "gpubridge/protocol/register_doc.hpp"
 
 namespace {
+
+std::string read_doc() {
+  std::ifstream in(GPUBRIDGE_PROTOCOL_DOC);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
 
 TEST(ProtocolDoc, RegisterTableMatchesCode) {
   std::ifstream in(GPUBRIDGE_PROTOCOL_DOC);
@@ -33,6 +45,35 @@ TEST(ProtocolDoc, SocketAndTraceSectionsAreWritten) {
   const std::string doc = ss.str();
   for (const char* needle : {"WRITE_FRAMES", "GBTRACE", ".upload", "BAD_FRAME", "stream offset"})
     EXPECT_NE(doc.find(needle), std::string::npos) << needle;
+}
+
+TEST(ProtocolDoc, MessageTableMatchesTheMessageStructs) {
+  using namespace gpubridge::protocol;
+  const std::string doc = read_doc();
+  const auto section = doc.find("### 17.3 Messages");
+  ASSERT_NE(section, std::string::npos) << "section 17.3 missing";
+  std::istringstream lines(doc.substr(section));
+  std::string line;
+  std::set<unsigned> listed;
+  while (std::getline(lines, line)) {
+    if (line.rfind("| 0x", 0) != 0) {
+      if (!listed.empty() && line.empty()) break;  // the end of the table
+      continue;
+    }
+    // | 0xTT | NAME | Dir | layout |
+    std::istringstream row(line);
+    std::string bar, type, name, dir;
+    row >> bar >> type >> bar >> name >> bar >> dir;
+    SCOPED_TRACE(line);
+    const unsigned t = std::stoul(type, nullptr, 16);
+    ASSERT_TRUE(t < 256 && is_known_type(static_cast<std::uint8_t>(t))) << type << " is not a message type in messages.hpp";
+    EXPECT_TRUE(listed.insert(t).second) << type << " listed twice";
+    EXPECT_EQ(to_string(static_cast<MsgType>(t)), name);
+    const Sender expected = dir == "c→s" ? Sender::Client : dir == "s→c" ? Sender::Server : Sender::Either;
+    EXPECT_TRUE(dir == "c→s" || dir == "s→c" || dir == "both") << "Dir \"" << dir << "\"";
+    EXPECT_EQ(sender(static_cast<MsgType>(t)), expected) << name << ": the Dir column and the struct's kSender disagree";
+  }
+  EXPECT_EQ(listed.size(), std::variant_size_v<Payload>) << "docs/protocol.md 17.3 should list every message type once";
 }
 
 }  // namespace

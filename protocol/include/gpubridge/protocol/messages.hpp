@@ -28,38 +28,42 @@ inline constexpr std::uint32_t kMaxReadbackChunk = 64u << 10;  // READBACK_DATA 
 inline constexpr std::size_t kMaxNameBytes = 64;
 inline constexpr std::size_t kMaxTokenBytes = 128;
 
-// Message types and directions. Each payload's fields are described once, in wire order, by its
-// layout() in messages.cpp (the encoder and the decoder are derived from it); docs/protocol.md
-// "Socket protocol" is the normative description.
+// Message types. Each payload's fields are described once, in wire order, by its layout() in
+// messages.cpp (the encoder and the decoder are derived from it), and who sends it by its struct
+// below; docs/protocol.md "Socket protocol" is the normative description.
 enum class MsgType : std::uint8_t {
-  Hello = 0x01,         // c→s
-  Welcome = 0x02,       // s→c
-  Error = 0x03,         // s→c
-  Ping = 0x04,          // c→s
-  Pong = 0x05,          // s→c
-  Bye = 0x06,           // both: the server answers Bye and closes
-  WriteFrames = 0x10,   // c→s (lease required)
-  ReadReg = 0x11,       // c→s
-  RegValue = 0x12,      // s→c
-  Upload = 0x13,        // c→s (lease required)
-  UploadAck = 0x14,     // s→c
-  Readback = 0x15,      // c→s (lease required)
-  ReadbackData = 0x16,  // s→c
-  Fence = 0x20,         // c→s
-  FenceDone = 0x21,     // s→c: every earlier command of this client has executed
-  StatusReq = 0x22,     // c→s
-  StatusReply = 0x23,   // s→c
-  Subscribe = 0x30,     // c→s
-  Unsubscribe = 0x31,   // c→s
-  FrameMsg = 0x32,      // s→c
-  LeaseAcquire = 0x40,  // c→s
-  LeaseGranted = 0x41,  // s→c
-  LeaseRelease = 0x42,  // c→s
-  LeaseReleased = 0x43, // s→c
-  DeviceEvent = 0x50,   // s→c
+  Hello = 0x01,
+  Welcome = 0x02,
+  Error = 0x03,
+  Ping = 0x04,
+  Pong = 0x05,
+  Bye = 0x06,           // the server answers Bye and closes
+  WriteFrames = 0x10,   // lease required
+  ReadReg = 0x11,
+  RegValue = 0x12,
+  Upload = 0x13,        // lease required
+  UploadAck = 0x14,
+  Readback = 0x15,      // lease required
+  ReadbackData = 0x16,
+  Fence = 0x20,
+  FenceDone = 0x21,     // every earlier command of this client has executed
+  StatusReq = 0x22,
+  StatusReply = 0x23,
+  Subscribe = 0x30,
+  Unsubscribe = 0x31,
+  FrameMsg = 0x32,
+  LeaseAcquire = 0x40,
+  LeaseGranted = 0x41,
+  LeaseRelease = 0x42,
+  LeaseReleased = 0x43,
+  DeviceEvent = 0x50,
 };
+// Who may send a message (the "Dir" column of docs/protocol.md 17.3).
+enum class Sender : std::uint8_t { Client, Server, Either };
 std::string_view to_string(MsgType t);
 bool is_known_type(std::uint8_t t);
+// Who may send messages of type t (Server for an unknown type: no client may send it).
+Sender sender(MsgType t);
 
 // Stable error codes carried by Error messages (never renumbered).
 enum class ErrorCode : std::uint16_t {
@@ -100,50 +104,52 @@ struct Header {
 };
 
 // Typed payloads, one struct per message type: kType is its type byte, kName its name in
-// docs/protocol.md and in error messages. Byte spans point into the parser's buffer and are valid
-// until the next call to MessageParser::next(), feed() or prepare(); copy what you keep.
-#define GPUBRIDGE_MESSAGE(T, NAME)                 \
+// docs/protocol.md and in error messages, kSender who sends it. Byte spans point into the parser's
+// buffer and are valid until the next call to MessageParser::next(), feed() or prepare(); copy
+// what you keep.
+#define GPUBRIDGE_MESSAGE(T, NAME, SENDER)         \
   static constexpr MsgType kType = MsgType::T;     \
-  static constexpr std::string_view kName = NAME
-struct Hello { GPUBRIDGE_MESSAGE(Hello, "HELLO"); std::uint16_t version = kSocketVersion; std::string name; std::string token; };
+  static constexpr std::string_view kName = NAME;  \
+  static constexpr Sender kSender = Sender::SENDER
+struct Hello { GPUBRIDGE_MESSAGE(Hello, "HELLO", Client); std::uint16_t version = kSocketVersion; std::string name; std::string token; };
 struct Welcome {
-  GPUBRIDGE_MESSAGE(Welcome, "WELCOME");
+  GPUBRIDGE_MESSAGE(Welcome, "WELCOME", Server);
   std::uint16_t version = kSocketVersion;
   std::uint32_t max_payload = kMaxPayload;
   std::uint32_t session_id = 0;
   std::string json;  // device description
 };
-struct ErrorMsg { GPUBRIDGE_MESSAGE(Error, "ERROR"); ErrorCode code = ErrorCode::Internal; std::uint32_t ref = 0; std::string text; };
-struct Ping { GPUBRIDGE_MESSAGE(Ping, "PING"); std::vector<std::uint8_t> data; };
-struct Pong { GPUBRIDGE_MESSAGE(Pong, "PONG"); std::vector<std::uint8_t> data; };
-struct Bye { GPUBRIDGE_MESSAGE(Bye, "BYE"); };
-struct WriteFrames { GPUBRIDGE_MESSAGE(WriteFrames, "WRITE_FRAMES"); FrameView frames; };
-struct ReadReg { GPUBRIDGE_MESSAGE(ReadReg, "READ_REG"); std::uint8_t index = 0; };
-struct RegValue { GPUBRIDGE_MESSAGE(RegValue, "REG_VALUE"); std::uint8_t index = 0; std::uint64_t value = 0; };
-struct Upload { GPUBRIDGE_MESSAGE(Upload, "UPLOAD"); std::uint32_t address = 0; std::span<const std::uint8_t> data; };
-struct UploadAck { GPUBRIDGE_MESSAGE(UploadAck, "UPLOAD_ACK"); std::uint32_t address = 0; std::uint32_t length = 0; };
-struct Readback { GPUBRIDGE_MESSAGE(Readback, "READBACK"); std::uint32_t address = 0; std::uint32_t length = 0; };
+struct ErrorMsg { GPUBRIDGE_MESSAGE(Error, "ERROR", Server); ErrorCode code = ErrorCode::Internal; std::uint32_t ref = 0; std::string text; };
+struct Ping { GPUBRIDGE_MESSAGE(Ping, "PING", Either); std::vector<std::uint8_t> data; };
+struct Pong { GPUBRIDGE_MESSAGE(Pong, "PONG", Either); std::vector<std::uint8_t> data; };
+struct Bye { GPUBRIDGE_MESSAGE(Bye, "BYE", Either); };
+struct WriteFrames { GPUBRIDGE_MESSAGE(WriteFrames, "WRITE_FRAMES", Client); FrameView frames; };
+struct ReadReg { GPUBRIDGE_MESSAGE(ReadReg, "READ_REG", Client); std::uint8_t index = 0; };
+struct RegValue { GPUBRIDGE_MESSAGE(RegValue, "REG_VALUE", Server); std::uint8_t index = 0; std::uint64_t value = 0; };
+struct Upload { GPUBRIDGE_MESSAGE(Upload, "UPLOAD", Client); std::uint32_t address = 0; std::span<const std::uint8_t> data; };
+struct UploadAck { GPUBRIDGE_MESSAGE(UploadAck, "UPLOAD_ACK", Server); std::uint32_t address = 0; std::uint32_t length = 0; };
+struct Readback { GPUBRIDGE_MESSAGE(Readback, "READBACK", Client); std::uint32_t address = 0; std::uint32_t length = 0; };
 struct ReadbackData {
-  GPUBRIDGE_MESSAGE(ReadbackData, "READBACK_DATA");
+  GPUBRIDGE_MESSAGE(ReadbackData, "READBACK_DATA", Server);
   std::uint32_t address = 0;
   bool last = false;
   std::span<const std::uint8_t> data;
 };
-struct FenceMsg { GPUBRIDGE_MESSAGE(Fence, "FENCE"); std::uint64_t id = 0; };
-struct FenceDone { GPUBRIDGE_MESSAGE(FenceDone, "FENCE_DONE"); std::uint64_t id = 0; };
-struct StatusReq { GPUBRIDGE_MESSAGE(StatusReq, "STATUS_REQ"); };
-struct StatusReply { GPUBRIDGE_MESSAGE(StatusReply, "STATUS_REPLY"); std::string json; };
+struct FenceMsg { GPUBRIDGE_MESSAGE(Fence, "FENCE", Client); std::uint64_t id = 0; };
+struct FenceDone { GPUBRIDGE_MESSAGE(FenceDone, "FENCE_DONE", Server); std::uint64_t id = 0; };
+struct StatusReq { GPUBRIDGE_MESSAGE(StatusReq, "STATUS_REQ", Client); };
+struct StatusReply { GPUBRIDGE_MESSAGE(StatusReply, "STATUS_REPLY", Server); std::string json; };
 // Without a source, SUBSCRIBE is encoded in the original 3-byte form (board; old daemons accept it).
 // An explicit source is a 4th byte, kept as decoded so that re-encoding gives the same bytes.
 struct Subscribe {
-  GPUBRIDGE_MESSAGE(Subscribe, "SUBSCRIBE");
+  GPUBRIDGE_MESSAGE(Subscribe, "SUBSCRIBE", Client);
   FrameFormat format = FrameFormat::Native;
   std::uint16_t max_fps = 0;  // 0 = every frame
   std::optional<FrameSource> source = std::nullopt;  // absent = FrameSource::Board
 };
-struct Unsubscribe { GPUBRIDGE_MESSAGE(Unsubscribe, "UNSUBSCRIBE"); };
+struct Unsubscribe { GPUBRIDGE_MESSAGE(Unsubscribe, "UNSUBSCRIBE", Client); };
 struct FrameData {
-  GPUBRIDGE_MESSAGE(FrameMsg, "FRAME");
+  GPUBRIDGE_MESSAGE(FrameMsg, "FRAME", Server);
   std::uint32_t number = 0;
   std::uint16_t width = 0, height = 0;
   PixelFormat format = PixelFormat::RGBA8888;
@@ -152,14 +158,15 @@ struct FrameData {
   std::span<const std::uint8_t> pixels;  // width * height * bpp(format)
   FrameSource source = FrameSource::Board;  // payload byte 9 (was reserved 0: board frames are unchanged)
 };
-struct LeaseAcquire { GPUBRIDGE_MESSAGE(LeaseAcquire, "LEASE_ACQUIRE"); LeaseMode mode = LeaseMode::Wait; };
-struct LeaseGranted { GPUBRIDGE_MESSAGE(LeaseGranted, "LEASE_GRANTED"); std::uint32_t session_id = 0; };
-struct LeaseRelease { GPUBRIDGE_MESSAGE(LeaseRelease, "LEASE_RELEASE"); };
-struct LeaseReleased { GPUBRIDGE_MESSAGE(LeaseReleased, "LEASE_RELEASED"); };
-struct DeviceEvent { GPUBRIDGE_MESSAGE(DeviceEvent, "DEVICE_EVENT"); std::string json; };  // {"event": "...", ...}
+struct LeaseAcquire { GPUBRIDGE_MESSAGE(LeaseAcquire, "LEASE_ACQUIRE", Client); LeaseMode mode = LeaseMode::Wait; };
+struct LeaseGranted { GPUBRIDGE_MESSAGE(LeaseGranted, "LEASE_GRANTED", Server); std::uint32_t session_id = 0; };
+struct LeaseRelease { GPUBRIDGE_MESSAGE(LeaseRelease, "LEASE_RELEASE", Client); };
+struct LeaseReleased { GPUBRIDGE_MESSAGE(LeaseReleased, "LEASE_RELEASED", Server); };
+struct DeviceEvent { GPUBRIDGE_MESSAGE(DeviceEvent, "DEVICE_EVENT", Server); std::string json; };  // {"event": "...", ...}
 #undef GPUBRIDGE_MESSAGE
 
-// Every message type: the decoder, to_string(MsgType) and is_known_type() are derived from this list.
+// Every message type: the decoder, to_string(MsgType), is_known_type() and sender() are derived
+// from this list.
 using Payload = std::variant<Hello, Welcome, ErrorMsg, Ping, Pong, Bye, WriteFrames, ReadReg, RegValue, Upload,
                              UploadAck, Readback, ReadbackData, FenceMsg, FenceDone, StatusReq, StatusReply, Subscribe,
                              Unsubscribe, FrameData, LeaseAcquire, LeaseGranted, LeaseRelease, LeaseReleased,
