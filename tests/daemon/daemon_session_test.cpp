@@ -269,6 +269,47 @@ TEST(DaemonSession, MessagesBeforeHelloAreRefused) {
   EXPECT_EQ(std::get<protocol::ErrorMsg>(out[0].payload).ref, 7u);
 }
 
+// Which messages a client may send comes from the message structs (protocol::sender): one of each
+// server-to-client type after a good HELLO is answered with ERROR UNKNOWN_TYPE naming it, and the
+// connection ends; PING, which either side sends, is answered.
+TEST(DaemonSession, ServerToClientMessagesFromAClientAreRefused) {
+  const protocol::Payload server_only[] = {
+      protocol::Welcome{protocol::kSocketVersion, 1u << 20, 1, "{}"},
+      protocol::ErrorMsg{},
+      protocol::RegValue{},
+      protocol::UploadAck{},
+      protocol::FenceDone{},
+      protocol::StatusReply{"{}"},
+      protocol::LeaseGranted{},
+      protocol::LeaseReleased{},
+      protocol::DeviceEvent{R"({"event":"x"})"}};
+  for (const auto& payload : server_only) {
+    const auto type = protocol::type_of(payload);
+    SCOPED_TRACE(std::string(protocol::to_string(type)));
+    ASSERT_EQ(protocol::sender(type), protocol::Sender::Server);
+    std::vector<std::uint8_t> in;
+    protocol::encode(Message{1, protocol::Hello{protocol::kSocketVersion, "s", ""}}, in);
+    protocol::encode(Message{2, payload}, in);
+    protocol::encode(Message{3, protocol::Ping{{1, 2}}}, in);
+    std::vector<std::uint8_t> raw;
+    const auto out = run_session(in, in.size(), raw);
+    ASSERT_EQ(out.size(), 2u);  // WELCOME, ERROR; the PING after it is never read
+    ASSERT_TRUE(std::holds_alternative<protocol::ErrorMsg>(out[1].payload));
+    const auto& e = std::get<protocol::ErrorMsg>(out[1].payload);
+    EXPECT_EQ(e.code, protocol::ErrorCode::UnknownType);
+    EXPECT_EQ(e.ref, 2u);
+    EXPECT_EQ(e.text, std::string(protocol::to_string(type)) + " is a server-to-client message");
+  }
+  std::vector<std::uint8_t> in;
+  protocol::encode(Message{1, protocol::Hello{protocol::kSocketVersion, "s", ""}}, in);
+  protocol::encode(Message{2, protocol::Ping{{1, 2}}}, in);
+  std::vector<std::uint8_t> raw;
+  const auto out = run_session(in, in.size(), raw);
+  ASSERT_EQ(out.size(), 2u);
+  ASSERT_TRUE(std::holds_alternative<protocol::Pong>(out[1].payload));
+  EXPECT_EQ(std::get<protocol::Pong>(out[1].payload).data, (std::vector<std::uint8_t>{1, 2}));
+}
+
 TEST(DaemonSession, ReadFramesInAWriteBatchAreRejected) {
   std::vector<std::uint8_t> in;
   protocol::encode(Message{1, protocol::Hello{protocol::kSocketVersion, "r", ""}}, in);
