@@ -131,15 +131,21 @@ void Session::pause() {
 void Session::resume() {
   paused_ = false;
   probed_ = false;
+  restart_input_clocks();
   if (!closing_ && !terminated_) process();
+}
+
+void Session::restart_input_clocks() {
+  const auto now = Clock::now();
+  last_rx_ = now;
+  window_start_ = now;
+  window_bytes_ = 0;
+  partial_at_window_start_ = false;
 }
 
 void Session::on_lease_granted() {
   if (terminated_) return;
   handler_.on_lease_granted();
-  window_start_ = Clock::now();
-  window_bytes_ = 0;
-  last_rx_ = Clock::now();
   resume();
 }
 
@@ -244,6 +250,7 @@ void Session::on_write(const boost::system::error_code& ec) {
   do_write();
   if (blocked_ && !out_.full()) {
     blocked_ = false;
+    restart_input_clocks();
     process();
   }
 }
@@ -320,12 +327,15 @@ void Session::on_tick() {
     terminate("not reading");
     return;
   }
-  const bool waiting_on_us = paused_;  // device work or lease wait: the client is not at fault
-  if (waiting_on_us) {
+  if (paused_) {  // device work or lease wait: the client is not read, but may have gone
     check_peer(now);
     if (terminated_) return;
   }
-  if (!waiting_on_us && now - window_start_ >= std::chrono::milliseconds(l.trickle_window_ms)) {
+  // The silence and trickle checks measure the client only while it is read: not while a request
+  // is live (paused_) nor while its replies are over queue_bytes (blocked_; one that takes nothing
+  // is closed by the write check above). Both clocks restart when reading resumes.
+  const bool reading = !paused_ && !blocked_;
+  if (reading && now - window_start_ >= std::chrono::milliseconds(l.trickle_window_ms)) {
     const bool partial = parser_.buffered() > 0;
     const auto window_ms = ms(now - window_start_);
     if (partial && partial_at_window_start_ &&
@@ -340,8 +350,7 @@ void Session::on_tick() {
     window_bytes_ = 0;
     partial_at_window_start_ = partial;
   }
-  if (waiting_on_us) last_rx_ = now;
-  if (handshaken_ && l.idle_timeout_ms && !waiting_on_us) {
+  if (handshaken_ && l.idle_timeout_ms && reading) {
     const auto silent = now - last_rx_;
     const auto idle = std::chrono::milliseconds(l.idle_timeout_ms);
     if (silent >= idle) {

@@ -279,5 +279,75 @@ TEST(DaemonSession, PipelinedRepliesStayWithinQueueBytes) {
   EXPECT_LE(raw->written_, 1u << 20);
 }
 
+// A client that reads its replies, but slowly: every write completes after `delay`.
+class SlowReaderStream final : public Stream {
+ public:
+  SlowReaderStream(boost::asio::any_io_executor ex, std::vector<std::uint8_t> input, std::chrono::milliseconds delay)
+      : ex_(ex), timer_(ex), input_(std::move(input)), delay_(delay) {}
+  void async_read_some(boost::asio::mutable_buffer buf, Handler handler) override {
+    const std::size_t n = std::min(buf.size(), input_.size() - pos_);
+    std::memcpy(buf.data(), input_.data() + pos_, n);
+    pos_ += n;
+    if (n) boost::asio::post(ex_, [handler = std::move(handler), n] { handler({}, n); });
+    else pending_read_ = std::move(handler);  // everything sent: the client waits for its replies
+  }
+  void async_write(const std::vector<boost::asio::const_buffer>& bufs, Handler handler) override {
+    std::size_t n = 0;
+    for (const auto& b : bufs) {
+      const auto* p = static_cast<const std::uint8_t*>(b.data());
+      written_.insert(written_.end(), p, p + b.size());
+      n += b.size();
+    }
+    timer_.expires_after(delay_);
+    timer_.async_wait([handler = std::move(handler), n](const boost::system::error_code&) { handler({}, n); });
+  }
+  void close() override { timer_.cancel(); }
+  std::string transport() const override { return "memory"; }
+  std::string peer() const override { return "slow reader"; }
+  std::vector<std::uint8_t> written_;
+
+ private:
+  boost::asio::any_io_executor ex_;
+  boost::asio::steady_timer timer_;
+  std::vector<std::uint8_t> input_;
+  std::size_t pos_ = 0;
+  std::chrono::milliseconds delay_;
+  Handler pending_read_;
+};
+
+// While the replies are over queue_bytes the daemon does not read: the client's silence and the
+// rate of its unread messages then say nothing about it. A client that pipelines more replies than
+// the bound and reads them slowly gets every one, instead of "message arriving too slowly" or "idle"
+// after two trickle windows of the daemon's own not reading.
+TEST(DaemonSession, AClientThrottledByQueueBytesIsNotTakenForATrickleOrIdle) {
+  boost::asio::io_context io;
+  HubOptions opts;
+  opts.limits.queue_bytes = 64u << 10;
+  opts.limits.trickle_window_ms = 50;
+  opts.limits.idle_timeout_ms = 200;
+  Hub hub(io.get_executor(), io.get_executor(), std::make_unique<FakeScanoutBackend>(8, 8, 1u << 20), opts);
+  constexpr std::uint32_t kPings = 4000;  // 300 KB of PONGs: about 60 writes of 5 ms each
+  std::vector<std::uint8_t> in;
+  protocol::encode(Message{1, protocol::Hello{protocol::kSocketVersion, "slow reader", ""}}, in);
+  for (std::uint32_t i = 0; i < kPings; ++i)
+    protocol::encode(Message{2 + i, protocol::Ping{std::vector<std::uint8_t>(64, 0x5A)}}, in);
+  auto stream = std::make_unique<SlowReaderStream>(io.get_executor(), in, 5ms);
+  auto* raw = stream.get();
+  auto session = std::make_shared<Session>(hub, std::move(stream), io.get_executor());  // keeps `raw` alive
+  session->start();
+  io.run_for(3s);
+  protocol::MessageParser p;
+  p.feed(raw->written_);
+  std::vector<Message> out;
+  for (Message m; p.next(m) == protocol::MessageParser::Status::Ok;) out.push_back(std::move(m));
+  ASSERT_GE(out.size(), 1u + kPings);
+  std::uint32_t pongs = 0;
+  for (std::size_t i = 1; i <= kPings; ++i) {
+    if (const auto* e = std::get_if<protocol::ErrorMsg>(&out[i].payload)) FAIL() << "after " << pongs << " PONGs: " << e->text;
+    pongs += std::holds_alternative<protocol::Pong>(out[i].payload);
+  }
+  EXPECT_EQ(pongs, kPings);
+}
+
 }  // namespace
 }  // namespace gpubridge::daemon

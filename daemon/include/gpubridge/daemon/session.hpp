@@ -87,6 +87,7 @@ class Session : public std::enable_shared_from_this<Session> {
   void arm_tick();
   void on_tick();
   void check_peer(Clock::time_point now);  // while a request is live: has the client gone?
+  void restart_input_clocks();             // reading resumes: silence and trickle windows start now
 
   Hub& hub_;
   std::unique_ptr<Stream> stream_;
