@@ -5,6 +5,8 @@
 
 #include <filesystem>
 #include <fstream>
+#include <set>
+#include <utility>
 
 #include <nlohmann/json.hpp>
 
@@ -273,16 +275,31 @@ TEST(DaemonSession, MessagesBeforeHelloAreRefused) {
 // server-to-client type after a good HELLO is answered with ERROR UNKNOWN_TYPE naming it, and the
 // connection ends; PING, which either side sends, is answered.
 TEST(DaemonSession, ServerToClientMessagesFromAClientAreRefused) {
+  static const std::uint8_t pixel[4] = {1, 2, 3, 4};
+  protocol::FrameData frame;
+  frame.width = frame.height = 1;
+  frame.format = protocol::PixelFormat::RGBA8888;
+  frame.pixels = pixel;
   const protocol::Payload server_only[] = {
       protocol::Welcome{protocol::kSocketVersion, 1u << 20, 1, "{}"},
       protocol::ErrorMsg{},
       protocol::RegValue{},
       protocol::UploadAck{},
+      protocol::ReadbackData{0, true, pixel},
       protocol::FenceDone{},
       protocol::StatusReply{"{}"},
+      frame,
       protocol::LeaseGranted{},
       protocol::LeaseReleased{},
       protocol::DeviceEvent{R"({"event":"x"})"}};
+  // Every server-to-client type of the Payload list is above, once: a new one must be added here.
+  constexpr std::size_t server_types = []<std::size_t... I>(std::index_sequence<I...>) {
+    return ((std::variant_alternative_t<I, protocol::Payload>::kSender == protocol::Sender::Server ? 1u : 0u) + ...);
+  }(std::make_index_sequence<std::variant_size_v<protocol::Payload>>{});
+  std::set<protocol::MsgType> listed;
+  for (const auto& payload : server_only) listed.insert(protocol::type_of(payload));
+  EXPECT_EQ(listed.size(), std::size(server_only));
+  EXPECT_EQ(listed.size(), server_types);
   for (const auto& payload : server_only) {
     const auto type = protocol::type_of(payload);
     SCOPED_TRACE(std::string(protocol::to_string(type)));
