@@ -22,7 +22,7 @@ while [[ $# -gt 0 ]]; do
   case "$1" in
     --minutes) minutes=$2; shift 2 ;;
     --trace) trace=$2; shift 2 ;;
-    -h|--help) sed -n '2,7p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,6p' "$0"; exit 0 ;;
     *) echo "soak-daemon.sh: unknown argument $1 (use --minutes N, --trace TRACE)" >&2; exit 2 ;;
   esac
 done
