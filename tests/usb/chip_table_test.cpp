@@ -75,6 +75,8 @@ TEST(ChipTable, CablesMustAgreeWithTheTable) {
       {R"({"name":"x","chip":"mcp2210","vid":"0x04d8","pid":"0x00de","api":"libusb","max_spi_hz":1000000})", "api"},
       {R"({"name":"x","chip":"ch341a","vid":"0x1a86","pid":"0x5512","api":"libusb","max_spi_hz":30000000})", "max_spi_hz"},
       {R"({"name":"x","chip":"ft9999","vid":"0x0403","pid":"0x6014","api":"libusb","max_spi_hz":1000000})", "chip"},
+      {R"({"name":"x","chip":"ft232h","vid":"0x0403","pid":"0x6014","api":"libusb","max_spi_hz":1000000,"interfaces":["A","B"]})",
+       "interfaces"},
   };
   for (const auto& c : cases) {
     std::ofstream(dir / "cables" / "bad.json") << c.json;

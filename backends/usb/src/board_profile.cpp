@@ -155,6 +155,10 @@ Result<CableInfo> parse_cable(std::string_view text, const std::string& file) {
       if (!i.is_string()) return r.fail("interfaces", "expected an array of strings");
       c.interfaces.push_back(i.get<std::string>());
     }
+    if (c.interfaces.size() > chip->channels)
+      return r.fail("interfaces", "the " + std::string(chip->label) + " has " + std::to_string(chip->channels) +
+                                      " SPI-capable interface" + (chip->channels == 1 ? "" : "s") + ", not " +
+                                      std::to_string(c.interfaces.size()));
   }
   if (auto u = r.no_unknown_keys(); !u) return u.error();
   return c;
