@@ -10,7 +10,6 @@ inline CLI::App* bench_group(CLI::App& app) {
   for (CLI::App* sub : app.get_subcommands([](CLI::App* s) { return s->get_name() == "bench"; })) return sub;
   CLI::App* group = app.add_subcommand("bench", "benchmarks: simulator speed and accuracy, daemon, USB links");
   group->require_subcommand(1);
-  group->fallthrough();
   return group;
 }
 

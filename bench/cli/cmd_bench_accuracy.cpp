@@ -167,7 +167,6 @@ GPUBRIDGE_COMMAND("bench", 80, [](CLI::App& app, GlobalOptions& g, auto& runners
                 "floating point); with --out-dir, replaces that section of the existing accuracy-report.md/.json "
                 "and writes cordic-front.svg, leaving the rest of the report as it was");
   sub->add_option("--out-dir", args->out_dir, "directory for accuracy-report.md, accuracy-report.json, accuracy-front.svg");
-  sub->fallthrough();
   runners.emplace_back(sub, [&g, args] { return run_accuracy(g, *args); });
 });
 

@@ -231,7 +231,6 @@ GPUBRIDGE_COMMAND("bench-dmc1", 83, [](CLI::App& app, GlobalOptions& g, auto& ru
   sub->add_option("--min-ms", a->min_ms, "each run renders the stream repeatedly for at least this long")
       ->check(CLI::Range(1.0, 60000.0))
       ->capture_default_str();
-  sub->fallthrough();
   runners.emplace_back(sub, [&g, a] { return run(g, *a); });
 });
 

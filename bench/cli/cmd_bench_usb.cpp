@@ -170,7 +170,6 @@ GPUBRIDGE_COMMAND("bench-usb", 81, [](CLI::App& app, GlobalOptions& g, auto& run
   sub->add_option("--round-trip-us", a->round_trip_us, "assumed cost of one USB round trip in the prediction")->capture_default_str()
       ->check(CLI::Range(0.0, 100000.0));
   sub->add_flag("--hardware", a->hardware, "measure the real board instead of the emulated one");
-  sub->fallthrough();
   runners.emplace_back(sub, [&g, a] { return run_usb_bench(g, *a); });
 });
 

@@ -513,13 +513,11 @@ GPUBRIDGE_COMMAND("client", 40, [](CLI::App& app, GlobalOptions& g, auto& runner
   auto* rd = reg->add_subcommand("read", "read a register: reg read NAME|INDEX");
   rd->add_option("REGISTER", *reg_name, "register name (see `gpubridge regs`) or index")->required();
   add_client_options(rd, g, *copts);
-  rd->fallthrough();  // global --json/--log-level after `reg read ...`
   runners.emplace_back(rd, [&g, copts, reg_name] { return run_reg_read(g, *copts, *reg_name); });
   auto* wr = reg->add_subcommand("write", "write a register: reg write NAME|INDEX VALUE | FIELD=V ...");
   wr->add_option("REGISTER", *reg_name, "register name or index")->required();
   wr->add_option("VALUE", *reg_value, "a number (0x.. hex) or FIELD=VALUE pairs, as in text traces")->required();
   add_client_options(wr, g, *copts);
-  wr->fallthrough();
   runners.emplace_back(wr, [&g, copts, reg_name, reg_value] { return run_reg_write(g, *copts, *reg_name, *reg_value); });
 
   auto addr = std::make_shared<std::string>();

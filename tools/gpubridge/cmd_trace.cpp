@@ -10,6 +10,7 @@
 #include "command_input.hpp"
 #include "gpubridge/protocol/crc32.hpp"
 #include "gpubridge/protocol/text_trace.hpp"
+#include "gpubridge/sim/options.hpp"
 #include "gpubridge/common/json_text.hpp"
 
 namespace gpubridge::cli {
@@ -17,7 +18,7 @@ namespace {
 
 using protocol::CommandStream;
 // Scene files are laid out in the simulator's default video memory (as `gpubridge render` does).
-constexpr std::uint64_t kSceneVramBytes = 8u << 20;
+const std::uint64_t kSceneVramBytes = sim::DeviceOptions{}.vram_bytes;
 
 struct TraceCounts {
   std::size_t batches = 0, frames = 0, uploads = 0, upload_bytes = 0, fences = 0, reads = 0, readbacks = 0;
@@ -195,7 +196,6 @@ GPUBRIDGE_COMMAND("trace", 40, [](CLI::App& app, GlobalOptions& g, auto& runners
   auto* dump = trace->add_subcommand("dump", "list a trace's commands (register writes by name; --json for tools)");
   dump->add_option("IN", *in, "trace file (binary or text), or a scene file (.json)")->required();
   runners.emplace_back(dump, [&g, in] { return run_dump(g, *in); });
-  for (auto* sub : {convert, dump}) sub->fallthrough();
 });
 
 }  // namespace gpubridge::cli
