@@ -69,36 +69,35 @@ template <unsigned kFormat>
   return v >> (8 - n);
 }
 
-// Temporal quantiser of channel c (pixel.hpp's quantise_temporal): `t16` holds each lane's 16t + 8.
-template <unsigned kBits>
-[[gnu::always_inline]] inline u32x8 quantise_temporal8(u32x8 word, unsigned c, u32x8 t16) {
+// Temporal quantiser of channel c to n bits (pixel.hpp's quantise_temporal): `t16` holds each
+// lane's 16t + 8.
+[[gnu::always_inline]] inline u32x8 quantise_temporal8(u32x8 word, unsigned c, unsigned n, u32x8 t16) {
   const u32x8 v = (word >> c) & 255u;
-  const u32x8 a = (v << kBits) - v;
+  const u32x8 a = (v << n) - v;
   return (a + (a >> 8) + t16) >> 8;
 }
 
-// Colour words to packed pixels. `bayer` holds each lane's threshold index t (0 without dither).
-// Ordered dither: t scaled per channel width as (t << (8 - n)) >> 4, saturating add, truncate.
-// Temporal (`temporal`): the scaled quantiser with the centred threshold 16t + 8.
+// Channel c (bit offset in the word) of the lanes to n bits, with the lanes' threshold index t:
+// the ordered dither adds (t << (8 - n)) >> 4 (saturating) and truncates; the temporal one
+// quantises with the centred threshold 16t + 8.
+template <bool kTemporal>
+[[gnu::always_inline]] inline u32x8 quantise_lanes(u32x8 word, unsigned c, unsigned n, u32x8 bayer) {
+  if constexpr (kTemporal) return quantise_temporal8(word, c, n, (bayer << 4) + 8u);
+  else return quantise8(word, c, n, (bayer << (8 - n)) >> 4);
+}
+
+// Colour words to packed pixels. `bayer` holds each lane's threshold index t (0 without dither);
+// `temporal` selects the temporal dither's quantiser.
+template <unsigned kFormat, bool kTemporal>
+[[gnu::always_inline]] inline u32x8 pack_channels(u32x8 word, u32x8 bayer) {
+#define GB_Q(c, n) quantise_lanes<kTemporal>(word, c, n, bayer)
+  if constexpr (kFormat == 1) return (GB_Q(0, 5) << 11) | (GB_Q(8, 6) << 5) | GB_Q(16, 5);
+  else return (GB_Q(0, 2) << 6) | (GB_Q(8, 2) << 4) | (GB_Q(16, 2) << 2) | GB_Q(24, 2);
+#undef GB_Q
+}
 template <unsigned kFormat>
 [[gnu::always_inline]] inline u32x8 pack_color(u32x8 word, u32x8 bayer, bool temporal) {
-  if (temporal) {
-    const u32x8 t16 = (bayer << 4) + 8u;
-    if constexpr (kFormat == 1)
-      return (quantise_temporal8<5>(word, 0, t16) << 11) | (quantise_temporal8<6>(word, 8, t16) << 5) |
-             quantise_temporal8<5>(word, 16, t16);
-    else
-      return (quantise_temporal8<2>(word, 0, t16) << 6) | (quantise_temporal8<2>(word, 8, t16) << 4) |
-             (quantise_temporal8<2>(word, 16, t16) << 2) | quantise_temporal8<2>(word, 24, t16);
-  }
-  if constexpr (kFormat == 1) {
-    const u32x8 add5 = bayer >> 1, add6 = bayer >> 2;
-    return (quantise8(word, 0, 5, add5) << 11) | (quantise8(word, 8, 6, add6) << 5) | quantise8(word, 16, 5, add5);
-  } else {
-    const u32x8 add2 = bayer << 2;
-    return (quantise8(word, 0, 2, add2) << 6) | (quantise8(word, 8, 2, add2) << 4) | (quantise8(word, 16, 2, add2) << 2) |
-           quantise8(word, 24, 2, add2);
-  }
+  return temporal ? pack_channels<kFormat, true>(word, bayer) : pack_channels<kFormat, false>(word, bayer);
 }
 
 // The whole colour write of n pixels at p. `need_old`: the stored pixels matter (blend, write
