@@ -75,9 +75,7 @@ Result<FramePrediction> predict_frame(Example& ex, const DeviceCaps& device, con
   p.estimate = sim::estimate_timing(p.work, timing, bpp, p.fit.context.depth_buffer);
   if (board.readback) {
     // MEM_DATA reads: one 72-bit frame per 8 bytes, in bursts like the writes.
-    const double frames = std::ceil(double(p.fit.context.width) * p.fit.context.height * bpp / 8);
-    p.readback_ms = frames * 72 / (timing.spi_clock_mhz * 1e3) +
-                    std::ceil(frames / std::max(1u, timing.frames_per_burst)) * timing.cs_gap_us / 1e3;
+    p.readback_ms = sim::spi_link_ms(std::ceil(double(p.fit.context.width) * p.fit.context.height * bpp / 8), timing);
   }
   p.fps = p.estimate.fps;
   const double viewed_ms = std::max(p.estimate.board_ms, p.estimate.spi_ms + p.readback_ms);

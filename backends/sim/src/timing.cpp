@@ -24,11 +24,15 @@ TimingEstimate estimate_timing(const DeviceStats& w, const BoardTiming& b, unsig
   e.memory_cycles = double(e.memory_bytes) / b.memory_bytes_per_cycle;
   e.board_cycles = std::max(e.pipeline_cycles, e.memory_cycles);
   e.board_ms = e.board_cycles / (b.clock_mhz * 1e3);
-  const double bursts = std::ceil(double(w.frames_received) / std::max(1u, b.frames_per_burst));
-  e.spi_ms = double(w.frames_received) * 72.0 / (b.spi_clock_mhz * 1e3) + bursts * b.cs_gap_us / 1e3;
+  e.spi_ms = spi_link_ms(double(w.frames_received), b);
   e.frame_ms = std::max(e.board_ms, e.spi_ms);
   e.fps = e.frame_ms > 0 ? 1000.0 / e.frame_ms : 0;
   return e;
+}
+
+double spi_link_ms(double frames, const BoardTiming& b) {
+  const double bursts = std::ceil(frames / std::max(1u, b.frames_per_burst));
+  return frames * 72.0 / (b.spi_clock_mhz * 1e3) + bursts * b.cs_gap_us / 1e3;
 }
 
 DeviceStats stats_difference(const DeviceStats& a, const DeviceStats& b) {

@@ -42,6 +42,9 @@ struct TimingEstimate {
 // buffer (depth_buffer false: a program drawing in painter's order) covered pixels move no depth bytes.
 TimingEstimate estimate_timing(const DeviceStats& work, const BoardTiming& board, unsigned color_bpp,
                                bool depth_buffer = true);
+// Link time (ms) of `frames` 72-bit SPI frames under `board`: the bits at its SPI clock plus the
+// chip-select gap between bursts of frames_per_burst (docs/protocol.md section 19).
+double spi_link_ms(double frames, const BoardTiming& board);
 // a − b, field by field.
 DeviceStats stats_difference(const DeviceStats& a, const DeviceStats& b);
 // "clock_mhz=25 spi_clock_mhz=10 ..." settings applied to a profile (errors name the key).
