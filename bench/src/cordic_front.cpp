@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <memory>
+#include <numeric>
 #include <optional>
 #include <span>
 #include <sstream>
@@ -14,7 +15,7 @@
 #include <fmt/format.h>
 
 #include "gpubridge/bench/accuracy_bench.hpp"
-#include "gpubridge/draw/sim_sink.hpp"
+#include "gpubridge/examples/golden.hpp"
 #include "gpubridge/examples/torus.hpp"
 
 namespace gpubridge::bench {
@@ -94,20 +95,16 @@ Result<void> time_configurations(std::vector<Timed>& all, unsigned frames, unsig
 Result<std::vector<std::vector<std::uint8_t>>> render_rgba(unsigned iterations, unsigned frames, unsigned& width,
                                                            unsigned& height) {
   auto ex = examples::make_torus({.cordic_iterations = iterations, .rgba8888 = true});
-  auto sink = draw::SimulatorSink::create();
-  if (!sink) return sink.error();
-  auto ctx = draw::Context::create(**sink, ex->options());
-  if (!ctx) return ctx.error();
+  std::vector<unsigned> numbers(frames);
+  std::iota(numbers.begin(), numbers.end(), 0u);
+  auto rendered = examples::render_frames(*ex, numbers);
+  if (!rendered) return rendered.error();
   std::vector<std::vector<std::uint8_t>> out;
-  auto r = examples::run_frames(*ex, *ctx, 0, frames, [&](unsigned) -> Result<void> {
-    const auto f = (*sink)->latest_frame();
-    if (!f) return make_error("torus: a swap scanned out no frame");
-    width = f->width;
-    height = f->height;
-    out.push_back(f->pixels);
-    return {};
-  });
-  if (!r) return r.error();
+  for (auto& f : *rendered) {
+    width = f.image.width;
+    height = f.image.height;
+    out.push_back(std::move(f.image.rgba));
+  }
   return out;
 }
 

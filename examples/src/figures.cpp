@@ -2,11 +2,12 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <numeric>
 
 #include <fmt/format.h>
 
 #include "gpubridge/common/image.hpp"
-#include "gpubridge/draw/sim_sink.hpp"
+#include "gpubridge/examples/golden.hpp"
 #include "gpubridge/examples/torus.hpp"
 
 namespace gpubridge::examples {
@@ -15,18 +16,12 @@ namespace {
 // Frames 0..count-1 of the torus held at kFigurePose (the temporal phase still follows the frame).
 Result<std::vector<Image>> render(const TorusOptions& options, unsigned count) {
   auto ex = make_torus(options);
-  auto sink = draw::SimulatorSink::create();
-  if (!sink) return sink.error();
-  auto ctx = draw::Context::create(**sink, ex->options());
-  if (!ctx) return ctx.error();
+  std::vector<unsigned> numbers(count);
+  std::iota(numbers.begin(), numbers.end(), 0u);
+  auto frames = render_frames(*ex, numbers);
+  if (!frames) return frames.error();
   std::vector<Image> out;
-  auto r = run_frames(*ex, *ctx, 0, count, [&](unsigned) -> Result<void> {
-    const auto f = (*sink)->latest_frame();
-    if (!f) return make_error("torus: a swap scanned out no frame");
-    out.push_back(image_from_device(f->format, f->width, f->height, f->pixels));
-    return {};
-  });
-  if (!r) return r.error();
+  for (auto& f : *frames) out.push_back(std::move(f.image));
   return out;
 }
 

@@ -9,9 +9,9 @@
 
 namespace gpubridge::examples {
 
-Result<std::vector<GoldenFrame>> render_golden_frames(Example& ex, const sim::DeviceOptions& device) {
-  const auto wanted = ex.golden_frames();
-  if (wanted.empty()) return make_error(ex.info().name + ": no golden frames");
+Result<std::vector<GoldenFrame>> render_frames(Example& ex, const std::vector<unsigned>& wanted,
+                                               const sim::DeviceOptions& device) {
+  if (wanted.empty()) return make_error(ex.info().name + ": no frames to render");
   auto sink = draw::SimulatorSink::create(device);
   if (!sink) return sink.error();
   auto ctx = draw::Context::create(**sink, ex.options());
@@ -63,7 +63,7 @@ Result<std::vector<GoldenFrame>> render_golden_frames(Example& ex, const GoldenC
   if (auto f = configure(ex, cls.device); !f) return f.error();
   auto options = cls.device.simulator_options();
   options.threads = threads;
-  return render_golden_frames(ex, options);
+  return render_frames(ex, ex.golden_frames(), options);
 }
 
 Result<Image> render_golden_frame(Example& ex, const GoldenClass& cls, unsigned threads) {

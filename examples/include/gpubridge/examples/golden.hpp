@@ -11,13 +11,15 @@
 
 namespace gpubridge::examples {
 
-// Renders frames 0..last of ex.golden_frames() of the example as configured, on a fresh simulator,
-// and returns those frames, in that order; any device error flag is an error.
+// Renders frames 0..frames.back() of the example as configured, on a fresh simulator, and
+// returns the scanned-out images of `frames` (ascending), in that order; any device error flag is
+// an error.
 struct GoldenFrame {
   unsigned frame = 0;
   Image image;
 };
-Result<std::vector<GoldenFrame>> render_golden_frames(Example& ex, const sim::DeviceOptions& device = {});
+Result<std::vector<GoldenFrame>> render_frames(Example& ex, const std::vector<unsigned>& frames,
+                                               const sim::DeviceOptions& device = {});
 // DIR/NAME.png for kGoldenFrame, DIR/NAME-fN.png for a later golden frame N.
 std::filesystem::path golden_path(const std::filesystem::path& dir, const std::string& name, unsigned frame = kGoldenFrame);
 
