@@ -188,7 +188,7 @@ class Torus final : public Example {
     // The temporal dither where the device has it (CAPS bit 6), else the ordered dither.
     const bool temporal = opt_.temporal && config().dither && config().has(kTemporalDither);
     ctx.state().temporal = temporal;
-    ctx.state().dither_phase = temporal ? n : 0;  // DITHER_PHASE = frame number mod 16
+    ctx.state().dither_phase = n;  // DITHER_PHASE = frame number mod 16 (sent only with TEMPORAL)
     ctx.set_cull(geometry::CullMode::Back);
     // Lighting per vertex on the host (the ASIC shades each sample).
     geometry_->frame(opt_.pose.value_or(n), frame_);

@@ -78,6 +78,16 @@ TEST(Encode, TriModeFields) {
   EXPECT_EQ(field(Reg::TRI_MODE, "DITHER_PHASE", w), 5);
 }
 
+TEST(Encode, DitherPhaseIsSentOnlyWithTheTemporalDither) {
+  // A device without CAPS bit 6 flags a non-zero phase; a draw without TEMPORAL must not send one.
+  RenderState s;
+  s.dither = true;
+  s.dither_phase = 7;
+  EXPECT_EQ(field(Reg::TRI_MODE, "DITHER_PHASE", tri_mode_word(s)), 0);
+  s.temporal = true;
+  EXPECT_EQ(field(Reg::TRI_MODE, "DITHER_PHASE", tri_mode_word(s)), 7);
+}
+
 TEST(Encode, TexFmtValidatesSizes) {
   TextureFormat t{256, 8, protocol::PixelFormat::RGB565, protocol::Wrap::Mirror, protocol::Wrap::Clamp, true};
   const auto w = tex_fmt_word(t);

@@ -39,7 +39,9 @@ std::uint64_t tri_mode_word(const RenderState& s) {
   w = put(Reg::TRI_MODE, "MASK_A", w, s.mask_a);
   w = put(Reg::TRI_MODE, "TEX_DECAL", w, s.tex_decal);
   w = put(Reg::TRI_MODE, "TEMPORAL", w, s.temporal);
-  w = put(Reg::TRI_MODE, "DITHER_PHASE", w, s.dither_phase & 15);
+  // The phase means something only to the temporal dither; sent without it, a device lacking
+  // CAPS bit 6 would flag ERR_BAD_VALUE for a draw that asked for no temporal dither.
+  w = put(Reg::TRI_MODE, "DITHER_PHASE", w, s.temporal ? s.dither_phase & 15 : 0);
   return w;
 }
 

@@ -26,7 +26,7 @@ struct RenderState {
   protocol::BlendMode blend = protocol::BlendMode::Off;
   bool dither = false;
   bool temporal = false;        // with dither: temporal dither (CAPS.FEATURES bit 6, protocol 1.1)
-  unsigned dither_phase = 0;    // temporal dither phase: pass the frame number (its low four bits are sent)
+  unsigned dither_phase = 0;    // temporal dither phase: pass the frame number (its low four bits are sent with temporal only)
   bool mask_r = false, mask_g = false, mask_b = false, mask_a = false;
   bool tex_decal = false;
   friend bool operator==(const RenderState&, const RenderState&) = default;
