@@ -14,6 +14,24 @@ namespace {
 // The default socket under the private XDG_RUNTIME_DIR, as the programs print it.
 const std::string kDefaultSocket = R"(unix:[^ ]*/run/gpubridge/gpubridge\.sock)";
 
+// The DMC-1 lines README.md and docs/dmc1.md's quick start both carry.
+Step render_mixed_dmc1() {
+  return run("build/tools/gpubridge render --device dmc1 tests/dmc1/data/streams/mixed.dmc1 --textures "
+             "tests/dmc1/data/textures.bin.gz     --palette tests/dmc1/data/palette.bin --out mixed.png --raw mixed.rgb565 "
+             "--timing")
+      .prints(R"(rendered .*mixed\.dmc1 \(DMC-1, dmc1 format\): \d+ commands, 1 frame)")
+      .prints(R"(wrote mixed\.rgb565: 153600 bytes of RGB565)")
+      .prints(R"(timing frame 0: \d+ GPU cycles)")
+      .leaves("mixed.png")
+      .leaves("mixed.rgb565");
+}
+Step write_level_dmc1() {
+  return run("build/examples/dmc1/gpubridge-dmc1-demo write --frames 64 --out level.dmc1")
+      .prints(R"(wrote level\.dmc1: 64 frame\(s\))")
+      .leaves("level.dmc1");
+}
+Step list_dmc1_fields() { return run("build/tools/gpubridge regs --device dmc1").prints(R"(wall +texture +bits +0\.\.9)"); }
+
 std::vector<Example> make() {
   std::vector<Example> all;
 
@@ -88,18 +106,9 @@ std::vector<Example> make() {
           .prints(R"(frame #\d+ \(160x120, sim\) written to sim\.png)")
           .leaves("sim.png"),
 
-      run("build/tools/gpubridge render --device dmc1 tests/dmc1/data/streams/mixed.dmc1 --textures "
-          "tests/dmc1/data/textures.bin.gz     --palette tests/dmc1/data/palette.bin --out mixed.png --raw mixed.rgb565 "
-          "--timing")
-          .prints(R"(rendered .*mixed\.dmc1 \(DMC-1, dmc1 format\): \d+ commands, 1 frame)")
-          .prints(R"(wrote mixed\.rgb565: 153600 bytes of RGB565)")
-          .prints(R"(timing frame 0: \d+ GPU cycles)")
-          .leaves("mixed.png")
-          .leaves("mixed.rgb565"),
-      run("build/examples/dmc1/gpubridge-dmc1-demo write --frames 64 --out level.dmc1")
-          .prints(R"(wrote level\.dmc1: 64 frame\(s\))")
-          .leaves("level.dmc1"),
-      run("build/tools/gpubridge regs --device dmc1").prints(R"(wall +texture +bits +0\.\.9)"),
+      render_mixed_dmc1(),
+      write_level_dmc1(),
+      list_dmc1_fields(),
 
       skip("build/tools/gpubridge bench accuracy --out-dir docs",
            "rewrites docs/accuracy-report.* and runs for minutes; CTest bench_accuracy_quick_smoke runs it with --quick"),
@@ -135,18 +144,9 @@ std::vector<Example> make() {
   }});
 
   all.push_back({"docs/dmc1.md", "Quick start", 0, "docs_dmc1_QuickStart", {
-      run("build/tools/gpubridge render --device dmc1 tests/dmc1/data/streams/mixed.dmc1 --textures "
-          "tests/dmc1/data/textures.bin.gz     --palette tests/dmc1/data/palette.bin --out mixed.png --raw mixed.rgb565 "
-          "--timing")
-          .prints(R"(rendered .*mixed\.dmc1 \(DMC-1, dmc1 format\): \d+ commands, 1 frame)")
-          .prints(R"(wrote mixed\.rgb565: 153600 bytes of RGB565)")
-          .prints(R"(timing frame 0: \d+ GPU cycles)")
-          .leaves("mixed.png")
-          .leaves("mixed.rgb565"),
+      render_mixed_dmc1(),
       run("cmp mixed.rgb565 tests/dmc1/data/golden/mixed.rgb565"),
-      run("build/examples/dmc1/gpubridge-dmc1-demo write --frames 64 --out level.dmc1")
-          .prints(R"(wrote level\.dmc1: 64 frame\(s\))")
-          .leaves("level.dmc1"),
+      write_level_dmc1(),
       run("build/tools/gpubridge render --device dmc1 level.dmc1 --textures tests/dmc1/data/textures.bin.gz     "
           "--palette tests/dmc1/data/palette.bin --frames-dir level-frames")
           .prints(R"(64 frame\(s\))")
@@ -154,7 +154,7 @@ std::vector<Example> make() {
           .within(120),
       skip("build/tools/gpubridge bench dmc1",
            "measures for seconds per stream; CTest dmc1_bench_smoke runs it with one short round"),
-      run("build/tools/gpubridge regs --device dmc1").prints(R"(wall +texture +bits +0\.\.9)"),
+      list_dmc1_fields(),
   }});
 
   all.push_back({"docs/daemon.md", "Running", 0, "docs_daemon_Running", {
