@@ -25,22 +25,39 @@ int fail(const std::string& msg, int code = 1) {
   return code;
 }
 
-// Appends little-endian RGB565 words (the golden format).
-void append_raw(std::vector<std::uint8_t>& out, std::span<const std::uint16_t> words) {
-  for (const std::uint16_t w : words) {
-    out.push_back(static_cast<std::uint8_t>(w));
-    out.push_back(static_cast<std::uint8_t>(w >> 8));
+// --raw: every frame appended to the file as it completes, as little-endian RGB565 words (the golden
+// format). Written frame by frame: a long stream's frames never accumulate in memory.
+class RawWriter {
+ public:
+  Result<void> open(const std::string& path) {
+    path_ = path;
+    file_.open(path, std::ios::binary | std::ios::trunc);
+    if (!file_) return make_error(path + ": cannot create the file (check the directory exists and is writable)");
+    return {};
   }
-}
+  bool is_open() const { return file_.is_open(); }
+  void append(std::span<const std::uint16_t> words) {
+    bytes_.resize(words.size() * 2);
+    for (std::size_t i = 0; i < words.size(); ++i) {
+      bytes_[2 * i] = static_cast<char>(words[i] & 0xFF);
+      bytes_[2 * i + 1] = static_cast<char>(words[i] >> 8);
+    }
+    file_.write(bytes_.data(), static_cast<std::streamsize>(bytes_.size()));
+    written_ += bytes_.size();
+  }
+  Result<void> close() {
+    file_.close();
+    if (!file_) return make_error(path_ + ": write failed (disk full?)");
+    return {};
+  }
+  std::uint64_t written() const { return written_; }
 
-Result<void> write_file(const std::string& path, const std::vector<std::uint8_t>& bytes) {
-  std::ofstream f(path, std::ios::binary | std::ios::trunc);
-  if (!f) return make_error(path + ": cannot create the file (check the directory exists and is writable)");
-  f.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
-  f.close();
-  if (!f) return make_error(path + ": write failed (disk full?)");
-  return {};
-}
+ private:
+  std::string path_;
+  std::ofstream file_;
+  std::vector<char> bytes_;  // one frame, reused
+  std::uint64_t written_ = 0;
+};
 
 }  // namespace
 
@@ -69,12 +86,14 @@ int render_dmc1(const GlobalOptions& g, const Dmc1RenderArgs& a) {
     fs::create_directories(a.frames_dir, ec);
     if (ec) return fail("--frames-dir " + a.frames_dir + ": " + ec.message());
   }
-  std::vector<std::uint8_t> raw;
+  RawWriter raw;
+  if (!a.raw.empty())
+    if (auto r = raw.open(a.raw); !r) return fail(r.error().message);
   std::vector<std::uint16_t> last;
   std::vector<std::uint64_t> cycles;
   std::string frame_error;
   d.set_frame_callback([&](const dmc1::Frame& f) {
-    if (!a.raw.empty()) append_raw(raw, f.rgb565);
+    if (raw.is_open()) raw.append(f.rgb565);
     last.assign(f.rgb565.begin(), f.rgb565.end());
     cycles.push_back(f.gpu_cycles);
     if (!a.frames_dir.empty() && frame_error.empty()) {
@@ -94,7 +113,7 @@ int render_dmc1(const GlobalOptions& g, const Dmc1RenderArgs& a) {
   const unsigned columns = d.column();
   if (partial) {
     last.assign(d.screen().begin(), d.screen().end());
-    if (!a.raw.empty()) append_raw(raw, last);
+    if (raw.is_open()) raw.append(last);
     std::fprintf(stderr,
                  "gpubridge render: warning: %s ended after %u of 320 columns without completing a frame; the image shows "
                  "the panel (unsent columns black)\n",
@@ -105,8 +124,8 @@ int render_dmc1(const GlobalOptions& g, const Dmc1RenderArgs& a) {
   }
   if (!a.out.empty())
     if (auto r = save_png(a.out, dmc1::frame_image(last)); !r) return fail(r.error().message);
-  if (!a.raw.empty())
-    if (auto r = write_file(a.raw, raw); !r) return fail(r.error().message);
+  if (raw.is_open())
+    if (auto r = raw.close(); !r) return fail(r.error().message);
 
   const auto& tp = opt.timing;
   const dmc1::DeviceStats& st = d.stats();
@@ -149,7 +168,7 @@ int render_dmc1(const GlobalOptions& g, const Dmc1RenderArgs& a) {
   std::printf("rendered %s (DMC-1, %s format): %zu commands, %zu frame(s) in %.2f ms\n", a.input.c_str(),
               std::string(dmc1::to_string(stream->format)).c_str(), stream->words.size(), cycles.size(), elapsed_ms);
   if (!a.out.empty()) std::printf("wrote %s: 320x240, %s\n", a.out.c_str(), partial ? "the panel (no complete frame)" : "the last frame");
-  if (!a.raw.empty()) std::printf("wrote %s: %zu bytes of RGB565\n", a.raw.c_str(), raw.size());
+  if (!a.raw.empty()) std::printf("wrote %s: %llu bytes of RGB565\n", a.raw.c_str(), static_cast<unsigned long long>(raw.written()));
   if (a.timing) {
     for (const auto& t : timing)
       std::printf("timing frame %s: %s GPU cycles = %.3f ms at %.1f MHz (%.1f fps)\n", json_text(t["frame"]).c_str(),
