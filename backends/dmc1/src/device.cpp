@@ -1,11 +1,11 @@
 #include "gpubridge/dmc1/device.hpp"
 
-
 #include "column_buffers.hpp"
 #include "column_renderer.hpp"
 #include "command_fifo.hpp"
 #include "dispatcher.hpp"
 #include "gpubridge/dmc1/scanout.hpp"
+#include "gpubridge/protocol/pixel.hpp"
 
 namespace gpubridge::dmc1 {
 
@@ -90,11 +90,10 @@ Image frame_image(std::span<const std::uint16_t> rgb565) {
   img.rgba.assign(kFramePixels * 4, 0);
   for (std::size_t i = 0; i < kFramePixels; ++i) {
     const std::uint16_t w = i < rgb565.size() ? rgb565[i] : 0;  // a short buffer leaves the rest black
-    const unsigned r5 = w >> 11, g6 = (w >> 5) & 63, b5 = w & 31;
     std::uint8_t* px = img.pixel(static_cast<unsigned>(i / kRows), kRows - 1 - static_cast<unsigned>(i % kRows));
-    px[0] = static_cast<std::uint8_t>(r5 << 3 | r5 >> 2);
-    px[1] = static_cast<std::uint8_t>(g6 << 2 | g6 >> 4);
-    px[2] = static_cast<std::uint8_t>(b5 << 3 | b5 >> 2);
+    px[0] = protocol::expand5(w >> 11);
+    px[1] = protocol::expand6((w >> 5) & 63);
+    px[2] = protocol::expand5(w & 31);
     px[3] = 255;
   }
   return img;
