@@ -79,7 +79,6 @@ std::span<const std::uint16_t> Device::screen() const { return impl_->screen; }
 unsigned Device::column() const { return impl_->dispatcher.column(); }
 const DeviceStats& Device::stats() const { return impl_->stats; }
 const TimingModel& Device::timing() const { return impl_->timing; }
-void Device::timing_model_idle_until(std::uint64_t cycle) { impl_->timing.idle_until(cycle); }
 std::uint8_t Device::picked_height() const { return impl_->dispatcher.registers().picked_height; }
 unsigned Device::threads() const { return impl_->renderer.threads(); }
 

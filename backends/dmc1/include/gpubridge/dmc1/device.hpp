@@ -73,8 +73,6 @@ class Device {
   unsigned column() const;
   const DeviceStats& stats() const;
   const TimingModel& timing() const;
-  // The next command arrives at `cycle` (a link slower than the GPU; see link.hpp).
-  void timing_model_idle_until(std::uint64_t cycle);
   // Height sample latched by the last terrain span with the pick bit (the SOC's user_data 23:16).
   std::uint8_t picked_height() const;
   unsigned threads() const;
