@@ -46,7 +46,8 @@ std::vector<std::uint64_t> random_stream(std::uint32_t seed, unsigned columns) {
   return s;
 }
 
-std::vector<std::uint16_t> device_output(const std::vector<std::uint64_t>& words, unsigned threads, std::size_t chunk) {
+std::vector<std::uint16_t> device_output(const std::vector<std::uint64_t>& words, unsigned threads, std::size_t chunk,
+                                         std::uint8_t* picked_height = nullptr) {
   DeviceOptions opt;
   opt.threads = threads;
   auto dev = Device::create(opt, golden_textures(), golden_palette());
@@ -60,6 +61,7 @@ std::vector<std::uint16_t> device_output(const std::vector<std::uint64_t>& words
   const unsigned partial = (*dev)->column();
   const auto screen = (*dev)->screen();
   out.insert(out.end(), screen.begin(), screen.begin() + std::size_t{partial} * kRows);
+  if (picked_height) *picked_height = (*dev)->picked_height();
   return out;
 }
 
@@ -70,7 +72,10 @@ TEST(Equivalence, RandomStreamsMatchTheEventLevelModel) {
     ref.run(words);
     const std::size_t chunk = seed % 2 ? words.size() : 1 + seed * 37;
     for (unsigned threads : {1u, 2u, 5u}) {
-      const auto got = device_output(words, threads, chunk);
+      std::uint8_t picked = 0;
+      const auto got = device_output(words, threads, chunk, &picked);
+      // The height the last picking terrain span latched (the SOC's user_data 23:16).
+      EXPECT_EQ(picked, ref.picked_height()) << "seed " << seed << ", " << threads << " thread(s)";
       ASSERT_EQ(got.size(), ref.output().size()) << "seed " << seed;
       std::size_t bad = 0, first = 0;
       for (std::size_t i = 0; i < got.size(); ++i)
