@@ -31,7 +31,7 @@ struct TimingParameters {
 
   std::uint32_t column_send() const { return column_words * screen_cycles_per_word + sender_pipeline; }
 };
-// "KEY=VALUE" for one field above (`gpubridge render --timing-param`).
+// "KEY=VALUE" for one field above (`gpubridge render --device dmc1 --board-timing`).
 Result<void> apply_timing_setting(TimingParameters& p, const std::string& setting);
 
 class TimingModel {
