@@ -1,4 +1,6 @@
-// Fuzzes board profiles: parse_board_profile on the input as the text of a profile file.
+// Fuzzes board profiles: parse_board_profile and parse_uart_board_profile on the input as the text
+// of a profile file. A UART board (a DMC-1 on a USB-UART) has a device kind other than spigpu, a
+// baud rate in range and an interface A..D; no text is accepted by both parsers.
 // Properties: a refusal is an error naming the file, with the BackendError code for a bad request;
 // an accepted profile holds only what its chip can do (clock within the chip's maximum, a chip
 // select the chip has, channel B only on dual-channel FTDI parts, device sizes in range).
@@ -14,7 +16,18 @@ using usb::BridgeChip;
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string_view text(reinterpret_cast<const char*>(data), size);
+  auto u = usb::parse_uart_board_profile(text, "fuzz.json");
+  if (!u) {
+    FUZZ_CHECK(u.error().message.rfind("fuzz.json: ", 0) == 0);
+    FUZZ_CHECK(u.error().code == backends::kBadRequest);
+  } else {
+    FUZZ_CHECK(u->device_kind != protocol::DeviceKind::Spigpu);
+    FUZZ_CHECK(u->baud >= 300 && u->baud <= 4'000'000);
+    FUZZ_CHECK(u->interface >= 0 && u->interface <= 3);
+    FUZZ_CHECK(!u->name.empty());
+  }
   auto p = usb::parse_board_profile(text, "fuzz.json");
+  FUZZ_CHECK(!(p && u));
   if (!p) {
     FUZZ_CHECK(p.error().message.rfind("fuzz.json: ", 0) == 0);
     FUZZ_CHECK(p.error().code == backends::kBadRequest);

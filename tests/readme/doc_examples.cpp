@@ -30,6 +30,12 @@ Step write_level_dmc1() {
       .prints(R"(wrote level\.dmc1: 64 frame\(s\))")
       .leaves("level.dmc1");
 }
+Step stream_to_dmc1_board() {
+  return skip("build/tools/gpubridge render --device dmc1 level.dmc1 --textures tests/dmc1/data/textures.bin.gz     "
+              "--palette tests/dmc1/data/palette.bin --board icebreaker-dmc1",
+              "needs an iCEBreaker on USB; SerialLink.RenderStreamsToTheBoardThroughItsPort runs it with --tty on a "
+              "pseudo-terminal whose other end is the SOC's receiver model");
+}
 Step list_dmc1_fields() { return run("build/tools/gpubridge regs --device dmc1").prints(R"(wall +texture +bits +0\.\.9)"); }
 
 std::vector<Example> make() {
@@ -82,7 +88,7 @@ std::vector<Example> make() {
       run("build/tools/gpubridge --connect unix:$XDG_RUNTIME_DIR/gpubridge/gpubridge.sock status")
           .prints("daemon: +gpubridged .* at " + kDefaultSocket),
 
-      run("build/tools/gpubridge boards").prints(R"(icebreaker +ft2232h +0403:6010)"),
+      run("build/tools/gpubridge boards").prints(R"(icebreaker +spigpu +ft2232h +0403:6010)"),
       // No bridge on a test machine; one that has some lists them.
       run("build/tools/gpubridge probe").prints(R"(No USB-SPI bridges found|0403:|1a86:|04d8:|10c4:)"),
       run("build/tools/gpubridge bringup --board icebreaker")
@@ -109,6 +115,7 @@ std::vector<Example> make() {
       render_mixed_dmc1(),
       write_level_dmc1(),
       list_dmc1_fields(),
+      stream_to_dmc1_board(),
 
       skip("build/tools/gpubridge bench accuracy --out-dir docs",
            "rewrites docs/accuracy-report.* and runs for minutes; CTest bench_accuracy_quick_smoke runs it with --quick"),
@@ -155,6 +162,16 @@ std::vector<Example> make() {
       skip("build/tools/gpubridge bench dmc1",
            "measures for seconds per stream; CTest dmc1_bench_smoke runs it with one short round"),
       list_dmc1_fields(),
+  }});
+
+  all.push_back({"docs/dmc1.md", "Board path", 0, "docs_dmc1_BoardPath", {
+      run("build/tools/gpubridge boards").prints(R"(icebreaker-dmc1 +dmc1 +uart +0403:6010)"),
+      skip("build/tools/gpubridge probe --board icebreaker-dmc1",
+           "needs the board; without one it exits 1 naming the USB ids it looked for (CTest dmc1_cli_probe_uart_board)"),
+      skip("build/tools/gpubridge render --device dmc1 level.dmc1 --textures tests/dmc1/data/textures.bin.gz     "
+           "--palette tests/dmc1/data/palette.bin --out level.png --board icebreaker-dmc1",
+           "needs an iCEBreaker on USB; SerialLink.RenderStreamsToTheBoardThroughItsPort runs it with --tty on a "
+           "pseudo-terminal whose other end is the SOC's receiver model"),
   }});
 
   all.push_back({"docs/daemon.md", "Running", 0, "docs_daemon_Running", {

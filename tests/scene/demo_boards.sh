@@ -1,6 +1,6 @@
 #!/bin/sh
 # The README's main job on every board profile (issue 22): scripts/demo-run.sh with
-# DEMO_BACKEND=emulated:NAME for each configs/boards/NAME.json, headless. Every scene fits itself to
+# DEMO_BACKEND=emulated:NAME for each spigpu board profile in configs/boards, headless. Every scene fits itself to
 # the board's device (it says so), the daemon mirrors the board on the simulator, and not one frame
 # of any scene differs; boards that read pixels back leave one decodable PNG per swap.
 # Usage: demo_boards.sh SOURCE_DIR BUILD_DIR WORK_DIR
@@ -12,8 +12,11 @@ scenes=$("$build/examples/gpubridge-demo" list | grep -c .)
 expected=$((frames * scenes))
 rm -rf "$work" && mkdir -p "$work"
 boards=0
-for profile in "$src"/configs/boards/*.json; do
-  board=$(basename "$profile" .json)
+# The spigpu boards, as `gpubridge boards` lists them (UART boards such as icebreaker-dmc1 run
+# other devices and have no emulated SPI bridge).
+spigpu_boards=$("$build/tools/gpubridge" boards | awk 'NR > 1 && $2 == "spigpu" { print $1 }')
+for board in $spigpu_boards; do
+  profile="$src/configs/boards/$board.json"
   log="$work/$board.log" out="$work/$board"
   env -u DISPLAY -u WAYLAND_DISPLAY DEMO_BACKEND="emulated:$board" DEMO_OUT="$out" DEMO_FRAMES=$frames \
     "$src/scripts/demo-run.sh" "$build" > "$log" 2>&1 || { cat "$log"; echo "$board: demo-run.sh failed"; exit 1; }

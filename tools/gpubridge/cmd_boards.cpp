@@ -18,15 +18,22 @@ std::string hex4(std::uint16_t v) {
 }
 
 int run_boards(const GlobalOptions& g, const std::string& dir) {
-  auto boards = usb::load_board_profiles(dir.empty() ? usb::default_config_dir() : std::filesystem::path(dir));
+  const auto config = dir.empty() ? usb::default_config_dir() : std::filesystem::path(dir);
+  auto boards = usb::load_board_profiles(config);
   if (!boards) {
     std::fprintf(stderr, "gpubridge boards: %s\n", boards.error().message.c_str());
+    return 1;
+  }
+  auto uart_boards = usb::load_uart_board_profiles(config);
+  if (!uart_boards) {
+    std::fprintf(stderr, "gpubridge boards: %s\n", uart_boards.error().message.c_str());
     return 1;
   }
   if (g.json) {
     nlohmann::json out = nlohmann::json::array();
     for (const auto& p : *boards)
       out.push_back({{"name", p.name},
+                     {"device_kind", "spigpu"},
                      {"description", p.description},
                      {"fpga", p.fpga},
                      {"file", p.file.string()},
@@ -42,13 +49,30 @@ int run_boards(const GlobalOptions& g, const std::string& dir) {
                       {{"vram_kib", p.vram_kib}, {"max_width", p.max_width}, {"max_height", p.max_height}, {"fifo_depth", p.fifo_depth},
                        {"clock_mhz", p.clock_mhz}}},
                      {"strict_link", p.strict_link}});
+    for (const auto& p : *uart_boards)
+      out.push_back({{"name", p.name},
+                     {"device_kind", protocol::device_kind_info(p.device_kind).name},
+                     {"description", p.description},
+                     {"fpga", p.fpga},
+                     {"file", p.file.string()},
+                     {"uart",
+                      {{"vid", hex4(p.vid)},
+                       {"pid", hex4(p.pid)},
+                       {"interface", std::string(1, static_cast<char>('A' + p.interface))},
+                       {"baud", p.baud},
+                       {"tty", p.tty}}}});
     std::puts(json_text(out, 2).c_str());
     return 0;
   }
-  std::printf("%-16s %-8s %-10s %8s %9s %9s  %s\n", "BOARD", "BRIDGE", "VID:PID", "SPI MHz", "VRAM KiB", "MAX", "FPGA");
+  std::printf("%-16s %-7s %-8s %-10s %8s %9s %9s  %s\n", "BOARD", "DEVICE", "BRIDGE", "VID:PID", "SPI MHz", "VRAM KiB", "MAX", "FPGA");
   for (const auto& p : *boards)
-    std::printf("%-16s %-8s %s:%s %8.3g %9u %4ux%-4u  %s\n", p.name.c_str(), std::string(usb::to_string(p.chip)).c_str(),
+    std::printf("%-16s %-7s %-8s %s:%s %8.3g %9u %4ux%-4u  %s\n", p.name.c_str(), "spigpu", std::string(usb::to_string(p.chip)).c_str(),
                 hex4(p.vid).c_str(), hex4(p.pid).c_str(), p.spi_clock_hz / 1e6, p.vram_kib, p.max_width, p.max_height, p.fpga.c_str());
+  for (const auto& p : *uart_boards)
+    std::printf("%-16s %-7s %-8s %s:%s %8s %9s %9s  %s (UART channel %c at %u baud; render --device %s --board %s)\n",
+                p.name.c_str(), std::string(protocol::device_kind_info(p.device_kind).name).c_str(), "uart", hex4(p.vid).c_str(),
+                hex4(p.pid).c_str(), "-", "-", "-", p.fpga.c_str(), static_cast<char>('A' + p.interface), p.baud,
+                std::string(protocol::device_kind_info(p.device_kind).name).c_str(), p.name.c_str());
   return 0;
 }
 
@@ -77,7 +101,7 @@ int run_cables(const GlobalOptions& g, const std::string& dir) {
 
 GPUBRIDGE_COMMAND("boards", 70, [](CLI::App& app, GlobalOptions& g, auto& runners) {
   auto dir = std::make_shared<std::string>();
-  auto* boards = app.add_subcommand("boards", "list the board profiles (configs/boards/*.json): bridge chip, wiring, SPI clock, video memory");
+  auto* boards = app.add_subcommand("boards", "list the board profiles (configs/boards/*.json): device kind, bridge chip or UART, wiring, SPI clock, video memory");
   boards->add_option("--config-dir", *dir, "directory holding boards/ and cables/ (default: $GPUBRIDGE_CONFIG_DIR or the source tree's configs/)");
   runners.emplace_back(boards, [&g, dir] { return run_boards(g, *dir); });
   auto* cables = app.add_subcommand("cables", "list the USB-SPI bridge chips gpubridge can drive (configs/cables/*.json)");

@@ -11,6 +11,7 @@
 #include "gpubridge/usb/bringup.hpp"
 #include "gpubridge/usb/hidapi_transport.hpp"
 #include "gpubridge/usb/libusb_transport.hpp"
+#include "gpubridge/usb/usb_tty.hpp"
 #include "gpubridge/common/json_text.hpp"
 
 namespace gpubridge::cli {
@@ -29,7 +30,28 @@ std::string hex4(std::uint16_t v) {
 
 std::filesystem::path config_dir(const std::string& d) { return d.empty() ? usb::default_config_dir() : std::filesystem::path(d); }
 
+// A board on a USB-UART (a DMC-1's standalone SOC): there is no ID to read, as the SOC sends
+// nothing back, so probing finds its port from the profile's USB ids.
+int probe_uart_board(const GlobalOptions& g, const usb::UartBoardProfile& p) {
+  const auto& kind = protocol::device_kind_info(p.device_kind);
+  auto port = p.tty.empty() ? usb::find_usb_tty(p.vid, p.pid, p.interface, p.serial) : Result<std::string>(p.tty);
+  if (g.json) {
+    std::puts(json_text(nlohmann::json{{"board", p.name}, {"device_kind", kind.name}, {"baud", p.baud},
+                                       {"tty", port ? *port : ""}, {"problem", port ? "" : port.error().message}},
+                        2).c_str());
+  } else if (port) {
+    std::printf("board %s (%s over a USB-UART at %u baud): port %s; the SOC sends nothing back, so there is no ID to read. "
+                "Stream to it: gpubridge render --device %s STREAM --board %s ...\n",
+                p.name.c_str(), std::string(kind.label).c_str(), p.baud, port->c_str(), std::string(kind.name).c_str(), p.name.c_str());
+  } else {
+    std::fprintf(stderr, "gpubridge probe: board %s: %s\n", p.name.c_str(), port.error().message.c_str());
+  }
+  return port ? 0 : 1;
+}
+
 int probe_board(const GlobalOptions& g, const ProbeArgs& a) {
+  if (!a.emulate)
+    if (auto uart = usb::find_uart_board_profile(config_dir(a.config_dir), a.board)) return probe_uart_board(g, *uart);
   auto profile = usb::find_board_profile(config_dir(a.config_dir), a.board);
   if (!profile) {
     std::fprintf(stderr, "gpubridge probe: %s\n", profile.error().message.c_str());
@@ -101,9 +123,31 @@ int probe_bus(const GlobalOptions& g, const ProbeArgs& a) {
                              {"accessible", true}, {"problem", ""}});
     }
   }
+  // USB serial ports, with the UART boards (configs/boards, "uart") whose adapter each one is.
+  auto uart_boards = usb::load_uart_board_profiles(config_dir(a.config_dir));
+  nlohmann::json serial = nlohmann::json::array();
+  for (const auto& t : usb::list_usb_ttys()) {
+    nlohmann::json boards = nlohmann::json::array();
+    if (uart_boards)
+      for (const auto& b : *uart_boards)
+        if (b.vid == t.vid && b.pid == t.pid && b.interface == t.interface) boards.push_back(b.name);
+    serial.push_back({{"tty", t.path}, {"vid", hex4(t.vid)}, {"pid", hex4(t.pid)}, {"interface", t.interface}, {"serial", t.serial},
+                      {"driver", t.driver}, {"boards", boards}});
+  }
   if (g.json) {
-    std::puts(json_text(nlohmann::json{{"bridges", found}, {"usb_error", usb_problem}, {"looked_for", looked_for}}, 2).c_str());
+    std::puts(json_text(nlohmann::json{{"bridges", found}, {"serial_ports", serial}, {"usb_error", usb_problem}, {"looked_for", looked_for}},
+                        2).c_str());
     return usb_problem.empty() ? 0 : 1;
+  }
+  if (!serial.empty()) {
+    std::printf("%-14s %-10s %-5s %-10s %-16s %s\n", "SERIAL PORT", "VID:PID", "IFACE", "DRIVER", "SERIAL", "BOARDS");
+    for (const auto& t : serial) {
+      std::string boards;
+      for (const auto& b : t["boards"]) boards += (boards.empty() ? "" : ", ") + b.get<std::string>();
+      std::printf("%-14s %s:%s %-5d %-10s %-16s %s\n", t["tty"].get<std::string>().c_str(), t["vid"].get<std::string>().c_str(),
+                  t["pid"].get<std::string>().c_str(), t["interface"].get<int>(), t["driver"].get<std::string>().c_str(),
+                  t["serial"].get<std::string>().c_str(), boards.c_str());
+    }
   }
   if (!usb_problem.empty()) std::fprintf(stderr, "gpubridge probe: cannot scan USB: %s\n", usb_problem.c_str());
   if (found.empty()) {
@@ -167,7 +211,7 @@ int run_bringup(const GlobalOptions& g, const BringupArgs& a) {
 
 GPUBRIDGE_COMMAND("probe", 71, [](CLI::App& app, GlobalOptions& g, auto& runners) {
   auto a = std::make_shared<ProbeArgs>();
-  auto* probe = app.add_subcommand("probe", "list attached USB-SPI bridges (chip, VID:PID, serial, port, access); with --board read the ID register");
+  auto* probe = app.add_subcommand("probe", "list attached USB-SPI bridges (chip, VID:PID, serial, port, access) and USB serial ports (UART boards such as icebreaker-dmc1); with --board read the ID register (a UART board: find its port)");
   probe->add_option("--board", a->board, "board profile name (configs/boards) or a .json file: open it and read ID/CAPS");
   probe->add_flag("--emulate", a->emulate, "use the emulated bridge chip and simulator instead of USB hardware");
   probe->add_option("--config-dir", a->config_dir, "directory holding boards/ and cables/");

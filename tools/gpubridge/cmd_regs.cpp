@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
+#include "device_option.hpp"
 #include "gpubridge/dmc1/command.hpp"
 #include "gpubridge/protocol/register_doc.hpp"
 #include "gpubridge/protocol/registers.hpp"
@@ -32,8 +33,8 @@ int run_dmc1_fields(const GlobalOptions& g, bool markdown) {
   return 0;
 }
 
-int run_regs(const GlobalOptions& g, bool markdown, const std::string& device) {
-  if (device == "dmc1") return run_dmc1_fields(g, markdown);
+int run_regs(const GlobalOptions& g, bool markdown, protocol::DeviceKind device) {
+  if (device == protocol::DeviceKind::Dmc1) return run_dmc1_fields(g, markdown);
   using namespace protocol;
   if (markdown) {
     std::fputs(register_table_markdown().c_str(), stdout);
@@ -68,9 +69,9 @@ GPUBRIDGE_COMMAND("regs", 90, [](CLI::App& app, GlobalOptions& g, auto& runners)
                                  "list the spigpu v1 registers (the table docs/protocol.md is generated from), or with "
                                  "--device dmc1 the DMC-1's command fields (docs/dmc1.md)");
   auto markdown = std::make_shared<bool>(false);
-  auto device = std::make_shared<std::string>("spigpu");
+  auto device = std::make_shared<protocol::DeviceKind>(protocol::DeviceKind::Spigpu);
   sub->add_flag("--markdown", *markdown, "print the Markdown tables used in docs/protocol.md (docs/dmc1.md for dmc1)");
-  sub->add_option("--device", *device, "device kind: spigpu or dmc1")->check(CLI::IsMember({"spigpu", "dmc1"}))->capture_default_str();
+  add_device_option(sub, *device);
   runners.emplace_back(sub, [&g, markdown, device] { return run_regs(g, *markdown, *device); });
 });
 

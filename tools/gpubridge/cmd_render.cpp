@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -13,6 +14,7 @@
 
 #include "command.hpp"
 #include "command_input.hpp"
+#include "device_option.hpp"
 #include "render_dmc1.hpp"
 #include "gpubridge/common/image.hpp"
 #include "gpubridge/common/json_text.hpp"
@@ -31,9 +33,9 @@ struct RenderArgs {
   std::vector<std::string> accuracy, timing_params;
   unsigned threads = 1;
   bool timing = false;
-  std::uint64_t vram_mib = 8;
-  std::string device = "spigpu";
-  std::string textures, palette, raw;  // DMC-1 only
+  std::optional<std::uint64_t> vram_mib;  // spigpu only (default 8)
+  protocol::DeviceKind device = protocol::DeviceKind::Spigpu;
+  std::string textures, palette, raw, board, tty;  // DMC-1 only
 };
 
 struct FrameRecord {
@@ -53,14 +55,14 @@ nlohmann::json timing_json(const sim::TimingEstimate& e) {
 }
 
 int run_render(const GlobalOptions& g, const RenderArgs& a) {
-  if (a.device == "dmc1") {
-    if (!a.accuracy.empty() || !a.dump_attributes.empty() || a.vram_mib != 8)
+  if (a.device == protocol::DeviceKind::Dmc1) {
+    if (!a.accuracy.empty() || !a.dump_attributes.empty() || a.vram_mib)
       return fail("--accuracy, --dump-attributes and --vram-mib are spigpu options; the DMC-1 is always bit-exact", 2);
-    return render_dmc1(g, Dmc1RenderArgs{a.input, a.out, a.raw, a.frames_dir, a.textures, a.palette, a.timing_params,
-                                         a.threads, a.timing});
+    return render_dmc1(g, Dmc1RenderArgs{a.input, a.out, a.raw, a.frames_dir, a.textures, a.palette, a.board, a.tty,
+                                         a.timing_params, a.threads, a.timing});
   }
-  if (!a.textures.empty() || !a.palette.empty() || !a.raw.empty())
-    return fail("--textures, --palette and --raw are DMC-1 options; add --device dmc1", 2);
+  if (!a.textures.empty() || !a.palette.empty() || !a.raw.empty() || !a.board.empty() || !a.tty.empty())
+    return fail("--textures, --palette, --raw, --board and --tty are DMC-1 options; add --device dmc1", 2);
   if (a.out.empty() && a.frames_dir.empty() && !a.timing && a.dump_attributes.empty())
     return fail("nothing to produce; pass --out FILE.png (or --frames-dir, --timing, --dump-attributes)", 2);
   sim::DeviceOptions opt;
@@ -68,8 +70,9 @@ int run_render(const GlobalOptions& g, const RenderArgs& a) {
   if (!knobs) return fail(knobs.error().message, 2);
   opt.accuracy = *knobs;
   opt.threads = a.threads;
-  if (a.vram_mib < 1 || a.vram_mib > 4096) return fail("--vram-mib " + std::to_string(a.vram_mib) + ": expected 1..4096", 2);
-  opt.vram_bytes = a.vram_mib << 20;
+  const std::uint64_t vram_mib = a.vram_mib.value_or(8);
+  if (vram_mib < 1 || vram_mib > 4096) return fail("--vram-mib " + std::to_string(vram_mib) + ": expected 1..4096", 2);
+  opt.vram_bytes = vram_mib << 20;
   sim::BoardTiming board;
   for (const auto& s : a.timing_params)
     if (auto r = sim::apply_timing_setting(board, s); !r) return fail(r.error().message, 2);
@@ -220,9 +223,7 @@ GPUBRIDGE_COMMAND("render", 10, [](CLI::App& app, GlobalOptions& g, auto& runner
   auto a = std::make_shared<RenderArgs>();
   sub->add_option("INPUT", a->input, "trace (.trace/.txt text, .gbt binary) or scene (.json); DMC-1: stream (.dmc1, .nfo)")
       ->required();
-  sub->add_option("--device", a->device, "device kind: spigpu (the gpubridge GPU) or dmc1 (sylefeb's DMC-1)")
-      ->check(CLI::IsMember({"spigpu", "dmc1"}))
-      ->capture_default_str();
+  add_device_option(sub, a->device);
   sub->add_option("--textures", a->textures, "DMC-1: texture memory image (raw or .gz), mapped at 0x200000");
   sub->add_option("--palette", a->palette, "DMC-1: palette, 768 bytes of R6, G6, B6");
   sub->add_option("--raw", a->raw, "DMC-1: every frame as little-endian RGB565 words in the GPU's output order");
@@ -242,7 +243,11 @@ GPUBRIDGE_COMMAND("render", 10, [](CLI::App& app, GlobalOptions& g, auto& runner
   sub->add_option("--dump-attributes", a->dump_attributes,
                   "CSV of every covered pixel: x,y,triangle,z,r,g,b,a,u,v (exact values, docs/simulator.md)");
   sub->add_option("--frames-dir", a->frames_dir, "write every scanned-out frame as DIR/frame-NNNNN.png");
-  sub->add_option("--vram-mib", a->vram_mib, "simulated video memory in MiB")->capture_default_str();
+  sub->add_option("--vram-mib", a->vram_mib, "simulated video memory in MiB (default 8)");
+  sub->add_option("--board", a->board,
+                  "DMC-1: also stream the commands to this board's SOC over its USB-UART (a DMC-1 board profile, e.g. "
+                  "icebreaker-dmc1; `gpubridge boards`). The images written are the simulator's: the board sends none back");
+  sub->add_option("--tty", a->tty, "DMC-1 with --board: the serial port (default: found from the profile's USB ids)");
   runners.emplace_back(sub, [&g, a] { return run_render(g, *a); });
 });
 

@@ -1,18 +1,26 @@
 // `gpubridge render --device dmc1 STREAM --textures FILE --palette FILE --out frame.png [--raw out.rgb565]
-// [--frames-dir DIR] [--timing] [--json]`: runs a DMC-1 stream on the in-process DMC-1 and writes its
-// frames. The output is the RTL's, bit for bit (docs/dmc1.md).
+// [--frames-dir DIR] [--timing] [--board NAME [--tty PATH]] [--json]`: runs a DMC-1 stream on the
+// in-process DMC-1 and writes its frames (the RTL's, bit for bit; docs/dmc1.md); with --board it also
+// streams the commands to that board's standalone SOC over its USB-UART.
+#include <atomic>
 #include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 
 #include <nlohmann/json.hpp>
 
 #include "gpubridge/common/image.hpp"
 #include "gpubridge/common/json_text.hpp"
 #include "gpubridge/dmc1/device.hpp"
+#include "gpubridge/dmc1/link.hpp"
+#include "gpubridge/dmc1/serial_link.hpp"
 #include "gpubridge/dmc1/stream.hpp"
 #include "gpubridge/dmc1/uart.hpp"
+#include "gpubridge/usb/board_profile.hpp"
+#include "gpubridge/usb/usb_tty.hpp"
 #include "render_dmc1.hpp"
 
 namespace gpubridge::cli {
@@ -59,11 +67,66 @@ class RawWriter {
   std::uint64_t written_ = 0;
 };
 
+std::atomic<bool> g_send_interrupted{false};  // executable-level: SIGINT while streaming to a board
+
+// --board: the stream to the board's SOC over its USB-UART, after checking that the SOC's command
+// FIFO keeps up at the profile's rate (nothing flow-controls it; overflowing commands are lost).
+struct BoardSend {
+  std::string board, tty;
+  unsigned baud = 0;
+  dmc1::SerialStats sent;
+  double seconds = 0;
+  unsigned max_fifo = 0;
+};
+
+Result<BoardSend> send_to_board(const Dmc1RenderArgs& a, std::span<const std::uint64_t> words,
+                                std::shared_ptr<const dmc1::TextureMemory> textures, const dmc1::TimingParameters& timing) {
+  auto profile = usb::find_uart_board_profile(usb::default_config_dir(), a.board);
+  if (!profile) return profile.error();
+  if (profile->device_kind != protocol::DeviceKind::Dmc1)
+    return make_error("--board " + a.board + ": a " + std::string(protocol::device_kind_info(profile->device_kind).label) +
+                      " board, not a DMC-1");
+  BoardSend out;
+  out.board = profile->name;
+  out.baud = profile->baud;
+  auto link = dmc1::estimate_link(words, profile->baud, textures, timing);
+  if (!link) return link.error();
+  out.max_fifo = link->max_fifo;
+  if (link->overflow) {
+    auto lossless = dmc1::fastest_lossless_baud(words, textures, timing);
+    return make_error("at " + std::to_string(profile->baud) + " baud this stream would queue " + std::to_string(link->max_fifo) +
+                      " commands in the SOC's " + std::to_string(dmc1::kStandaloneFifoDepth) +
+                      "-entry FIFO, which nothing flow-controls: the board would lose commands. Use a rate up to " +
+                      (lossless ? std::to_string(static_cast<unsigned>(*lossless)) : std::string("?")) + " baud (uart.baud in " +
+                      profile->file.string() + ", and the SOC built for it)");
+  }
+  out.tty = !a.tty.empty() ? a.tty : profile->tty;
+  if (out.tty.empty()) {
+    auto found = usb::find_usb_tty(profile->vid, profile->pid, profile->interface, profile->serial);
+    if (!found) return make_error("--board " + profile->name + ": " + found.error().message);
+    out.tty = *found;
+  }
+  auto serial = dmc1::SerialLink::open(out.tty, profile->baud);
+  if (!serial) return serial.error();
+  g_send_interrupted = false;
+  (*serial)->set_cancel_flag(&g_send_interrupted);
+  auto previous = std::signal(SIGINT, [](int) { g_send_interrupted = true; });
+  const auto t0 = std::chrono::steady_clock::now();
+  auto sent = (*serial)->send(words);
+  if (sent) sent = (*serial)->drain();
+  std::signal(SIGINT, previous);
+  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  out.sent = (*serial)->stats();
+  if (!sent) return sent.error();
+  return out;
+}
+
 }  // namespace
 
 int render_dmc1(const GlobalOptions& g, const Dmc1RenderArgs& a) {
-  if (a.out.empty() && a.raw.empty() && a.frames_dir.empty() && !a.timing)
-    return fail("nothing to produce; pass --out FILE.png (or --raw, --frames-dir, --timing)", 2);
+  if (a.out.empty() && a.raw.empty() && a.frames_dir.empty() && !a.timing && a.board.empty())
+    return fail("nothing to produce; pass --out FILE.png (or --raw, --frames-dir, --timing, --board)", 2);
+  if (!a.tty.empty() && a.board.empty()) return fail("--tty names the port of a --board; add --board NAME", 2);
   if (a.textures.empty() || a.palette.empty())
     return fail("the DMC-1 needs its texture memory and palette: pass --textures FILE and --palette FILE "
                 "(tests/dmc1/data has textures.bin.gz and palette.bin)", 2);
@@ -107,6 +170,15 @@ int render_dmc1(const GlobalOptions& g, const Dmc1RenderArgs& a) {
   d.flush();
   const double elapsed_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   if (!frame_error.empty()) return fail(frame_error);
+  std::optional<BoardSend> board;
+  if (!a.board.empty()) {
+    if (!g.json)
+      std::printf("streaming %zu commands to %s (the frames written are the simulator's: the board sends none back)\n",
+                  stream->words.size(), a.board.c_str());
+    auto sent = send_to_board(a, stream->words, *textures, opt.timing);
+    if (!sent) return fail(sent.error().message, sent.error().code == dmc1::kSerialCancelled ? 130 : 1);
+    board = std::move(*sent);
+  }
 
   // Without a complete frame, show what the panel holds: the columns sent so far.
   const bool partial = cycles.empty();
@@ -156,6 +228,9 @@ int render_dmc1(const GlobalOptions& g, const Dmc1RenderArgs& a) {
                      {"texture_binds", st.texture_binds},
                      {"threads", d.threads()},
                      {"elapsed_ms", elapsed_ms}};
+    if (board)
+      j["board"] = {{"name", board->board}, {"tty", board->tty}, {"baud", board->baud}, {"bytes", board->sent.bytes},
+                    {"words", board->sent.words}, {"seconds", board->seconds}, {"max_fifo", board->max_fifo}};
     if (a.timing) {
       j["timing"] = timing;
       j["clock_mhz"] = tp.clock_mhz;
@@ -169,6 +244,10 @@ int render_dmc1(const GlobalOptions& g, const Dmc1RenderArgs& a) {
               std::string(dmc1::to_string(stream->format)).c_str(), stream->words.size(), cycles.size(), elapsed_ms);
   if (!a.out.empty()) std::printf("wrote %s: 320x240, %s\n", a.out.c_str(), partial ? "the panel (no complete frame)" : "the last frame");
   if (!a.raw.empty()) std::printf("wrote %s: %llu bytes of RGB565\n", a.raw.c_str(), static_cast<unsigned long long>(raw.written()));
+  if (board)
+    std::printf("sent %llu bytes (%llu words) to %s on %s at %u baud in %.2f s; the SOC's FIFO peaks at %u of %u commands\n",
+                static_cast<unsigned long long>(board->sent.bytes), static_cast<unsigned long long>(board->sent.words),
+                board->board.c_str(), board->tty.c_str(), board->baud, board->seconds, board->max_fifo, dmc1::kStandaloneFifoDepth);
   if (a.timing) {
     for (const auto& t : timing)
       std::printf("timing frame %s: %s GPU cycles = %.3f ms at %.1f MHz (%.1f fps)\n", json_text(t["frame"]).c_str(),

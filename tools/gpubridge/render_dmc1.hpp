@@ -9,6 +9,7 @@ namespace gpubridge::cli {
 
 struct Dmc1RenderArgs {
   std::string input, out, raw, frames_dir, textures, palette;
+  std::string board, tty;  // --board: also stream to that board over its UART; --tty overrides the port
   std::vector<std::string> timing_params;
   unsigned threads = 1;
   bool timing = false;

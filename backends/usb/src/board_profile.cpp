@@ -108,10 +108,34 @@ Result<json> parse_json_object(std::string_view text, const std::string& file) {
   return root;
 }
 
-// Every *.json file of `dir`, in name order, through `parse`; the first bad file is the error.
+// A board file's "device_kind" (default spigpu), which says whether the SPI or the UART board loader reads it.
+Result<protocol::DeviceKind> device_kind_of(const json& root, const std::string& file) {
+  const auto it = root.find("device_kind");
+  if (it == root.end()) return protocol::DeviceKind::Spigpu;
+  if (!it->is_string()) return make_error(file + ": device_kind: expected a string (" + protocol::device_kind_names() + ")", backends::kBadRequest);
+  const auto name = it->get<std::string>();
+  if (auto k = protocol::parse_device_kind(name)) return *k;
+  return make_error(file + ": device_kind: unknown \"" + name + "\" (" + protocol::device_kind_names() + ")", backends::kBadRequest);
+}
+
+// Whether a board file is read by the SPI-board loader (spigpu) or the UART-board loader (the rest).
+enum class BoardFamily { Spi, Uart };
+Result<bool> board_file_is(BoardFamily family, std::string_view text, const std::string& file) {
+  auto root = parse_json_object(text, file);
+  if (!root) return root.error();
+  auto kind = device_kind_of(*root, file);
+  if (!kind) return kind.error();
+  return (*kind == protocol::DeviceKind::Spigpu) == (family == BoardFamily::Spi);
+}
+Result<bool> spi_board_file(std::string_view text, const std::string& file) { return board_file_is(BoardFamily::Spi, text, file); }
+Result<bool> uart_board_file(std::string_view text, const std::string& file) { return board_file_is(BoardFamily::Uart, text, file); }
+
+// Every *.json file of `dir`, in name order, through `parse` (those `wanted` accepts, when given);
+// the first bad file is the error.
 template <class T>
 Result<std::vector<T>> load_dir(const std::filesystem::path& dir, const std::string& what_is_missing,
-                                Result<T> (*parse)(std::string_view text, const std::string& file)) {
+                                Result<T> (*parse)(std::string_view text, const std::string& file),
+                                Result<bool> (*wanted)(std::string_view text, const std::string& file) = nullptr) {
   std::error_code ec;
   if (!std::filesystem::is_directory(dir, ec)) return make_error(dir.string() + ": " + what_is_missing, backends::kBadRequest);
   std::vector<std::filesystem::path> files;
@@ -122,6 +146,11 @@ Result<std::vector<T>> load_dir(const std::filesystem::path& dir, const std::str
   for (const auto& f : files) {
     auto text = read_config_file(f);
     if (!text) return text.error();
+    if (wanted) {
+      auto w = wanted(*text, f.string());
+      if (!w) return w.error();
+      if (!*w) continue;
+    }
     auto item = parse(*text, f.string());
     if (!item) return item.error();
     out.push_back(std::move(*item));
@@ -164,6 +193,29 @@ Result<CableInfo> parse_cable(std::string_view text, const std::string& file) {
   return c;
 }
 
+// What every board file starts with, whatever its kind: device_kind (read by the caller), name,
+// description, fpga.
+template <class Profile>
+Result<void> read_identity(Reader& top, Profile& p) {
+  top.get("device_kind");
+  GPUBRIDGE_TRY_SET(p.name, top.str("name"));
+  if (p.name.empty() || p.name.find_first_not_of("abcdefghijklmnopqrstuvwxyz0123456789-_") != std::string::npos)
+    return top.fail("name", "use lower-case letters, digits, '-' and '_' only");
+  GPUBRIDGE_TRY_SET(p.description, top.str("description", ""));
+  GPUBRIDGE_TRY_SET(p.fpga, top.str("fpga", ""));
+  return {};
+}
+
+// The profile called `name`, else nullptr with every name listed in `names`.
+template <class Profile>
+Profile* find_named(std::vector<Profile>& all, const std::string& name, std::string& names) {
+  for (auto& p : all) {
+    if (p.name == name) return &p;
+    names += (names.empty() ? "" : ", ") + p.name;
+  }
+  return nullptr;
+}
+
 }  // namespace
 
 std::filesystem::path default_config_dir() {
@@ -177,11 +229,14 @@ Result<BoardProfile> parse_board_profile(std::string_view text, const std::strin
   BoardProfile p;
   p.file = file;
   Reader top(*root, file, "");
-  GPUBRIDGE_TRY_SET(p.name, top.str("name"));
-  if (p.name.empty() || p.name.find_first_not_of("abcdefghijklmnopqrstuvwxyz0123456789-_") != std::string::npos)
-    return top.fail("name", "use lower-case letters, digits, '-' and '_' only");
-  GPUBRIDGE_TRY_SET(p.description, top.str("description", ""));
-  GPUBRIDGE_TRY_SET(p.fpga, top.str("fpga", ""));
+  if (auto kind = device_kind_of(*root, file); !kind) {
+    return kind.error();
+  } else if (*kind != protocol::DeviceKind::Spigpu) {
+    return top.fail("device_kind", "this is a " + std::string(protocol::device_kind_info(*kind).label) +
+                                       " board, reached over its UART, not an SPI bridge: use it with `gpubridge render "
+                                       "--device " + std::string(protocol::device_kind_info(*kind).name) + " --board NAME` (docs/dmc1.md)");
+  }
+  if (auto r = read_identity(top, p); !r) return r.error();
   std::string scanout;
   GPUBRIDGE_TRY_SET(scanout, top.str("scanout", "readback"));
   if (scanout == "readback") p.scanout = ScanoutMode::Readback;
@@ -257,7 +312,7 @@ Result<BoardProfile> load_board_profile(const std::filesystem::path& file) {
 
 Result<std::vector<BoardProfile>> load_board_profiles(const std::filesystem::path& config_dir) {
   return load_dir<BoardProfile>(config_dir / "boards", "no board profile directory (set GPUBRIDGE_CONFIG_DIR or --config-dir)",
-                                &parse_board_profile);
+                                &parse_board_profile, &spi_board_file);
 }
 
 Result<BoardProfile> find_board_profile(const std::filesystem::path& config_dir, const std::string& name) {
@@ -265,11 +320,65 @@ Result<BoardProfile> find_board_profile(const std::filesystem::path& config_dir,
   auto all = load_board_profiles(config_dir);
   if (!all) return all.error();
   std::string names;
-  for (auto& p : *all) {
-    if (p.name == name) return std::move(p);
-    names += (names.empty() ? "" : ", ") + p.name;
-  }
+  if (auto* p = find_named(*all, name, names)) return std::move(*p);
+  std::string uart_names;
+  if (auto uart = load_uart_board_profiles(config_dir))
+    if (const auto* u = find_named(*uart, name, uart_names))
+      return make_error("board \"" + name + "\" (" + u->file.string() + ") is a " +
+                            std::string(protocol::device_kind_info(u->device_kind).label) +
+                            " board on a USB-UART, not an spigpu board on an SPI bridge: stream to it with `gpubridge render --device " +
+                            std::string(protocol::device_kind_info(u->device_kind).name) + " STREAM --board " + name + " ...` (docs/dmc1.md)",
+                        backends::kBadRequest);
   return make_error("no board profile named \"" + name + "\" in " + (config_dir / "boards").string() + " (known: " + names + ")",
+                    backends::kBadRequest);
+}
+
+Result<UartBoardProfile> parse_uart_board_profile(std::string_view text, const std::string& file) {
+  auto root = parse_json_object(text, file);
+  if (!root) return root.error();
+  UartBoardProfile p;
+  p.file = file;
+  Reader top(*root, file, "");
+  auto kind = device_kind_of(*root, file);
+  if (!kind) return kind.error();
+  if (*kind == protocol::DeviceKind::Spigpu)
+    return top.fail("device_kind", "missing or \"spigpu\": an spigpu board has a \"bridge\" (SPI), not a \"uart\"");
+  p.device_kind = *kind;
+  if (auto r = read_identity(top, p); !r) return r.error();
+  const json* uart = top.get("uart");
+  if (!uart || !uart->is_object()) return top.fail("uart", "missing (required object: vid, pid, interface, baud)");
+  Reader u(*uart, file, "uart.");
+  GPUBRIDGE_TRY_SET(p.vid, u.hex16("vid"));
+  GPUBRIDGE_TRY_SET(p.pid, u.hex16("pid"));
+  std::string iface;
+  GPUBRIDGE_TRY_SET(iface, u.str("interface", "A"));
+  if (iface.size() != 1 || iface[0] < 'A' || iface[0] > 'D') return u.fail("interface", "expected \"A\" to \"D\" (the USB interface)");
+  p.interface = iface[0] - 'A';
+  GPUBRIDGE_TRY_SET(p.serial, u.str("serial", ""));
+  GPUBRIDGE_TRY_SET(p.tty, u.str("tty", ""));
+  GPUBRIDGE_TRY_SET(p.baud, u.uint("baud", 300, 4000000, 115200));
+  if (auto r = u.no_unknown_keys(); !r) return r.error();
+  if (auto r = top.no_unknown_keys(); !r) return r.error();
+  return p;
+}
+
+Result<std::vector<UartBoardProfile>> load_uart_board_profiles(const std::filesystem::path& config_dir) {
+  return load_dir<UartBoardProfile>(config_dir / "boards", "no board profile directory (set GPUBRIDGE_CONFIG_DIR or --config-dir)",
+                                    &parse_uart_board_profile, &uart_board_file);
+}
+
+Result<UartBoardProfile> find_uart_board_profile(const std::filesystem::path& config_dir, const std::string& name) {
+  if (name.size() > 5 && name.ends_with(".json")) {
+    auto text = read_config_file(name);
+    if (!text) return text.error();
+    return parse_uart_board_profile(*text, name);
+  }
+  auto all = load_uart_board_profiles(config_dir);
+  if (!all) return all.error();
+  std::string names;
+  if (auto* p = find_named(*all, name, names)) return std::move(*p);
+  return make_error("no UART board profile named \"" + name + "\" in " + (config_dir / "boards").string() + " (known: " +
+                        (names.empty() ? "none" : names) + "; `gpubridge boards` lists every board)",
                     backends::kBadRequest);
 }
 

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "gpubridge/common/result.hpp"
+#include "gpubridge/protocol/device_kind.hpp"
 #include "gpubridge/usb/bridge_chips.hpp"
 #include "gpubridge/usb/ftdi_mpsse.hpp"
 
@@ -48,6 +49,20 @@ struct CableInfo {
   std::filesystem::path file;
 };
 
+// A board whose device is not spigpu and that is reached over a USB-UART rather than an SPI bridge:
+// the iCEBreaker running tinygpus' standalone DMC-1 SOC (docs/dmc1.md, "Board path"). Same
+// directory as the SPI boards; the file's "device_kind" says which loader reads it.
+struct UartBoardProfile {
+  std::string name, description, fpga;
+  std::filesystem::path file;
+  protocol::DeviceKind device_kind = protocol::DeviceKind::Dmc1;
+  std::uint16_t vid = 0, pid = 0;  // the USB-UART
+  int interface = 0;               // its USB interface (the iCEBreaker's FT2232H: channel B = 1)
+  std::string serial;              // optional: select this adapter when several are attached
+  std::string tty;                 // optional: a fixed port instead of finding it from the USB ids
+  unsigned baud = 115200;
+};
+
 // GPUBRIDGE_CONFIG_DIR from the environment, else the source tree's configs/ (compile time).
 std::filesystem::path default_config_dir();
 
@@ -57,6 +72,11 @@ Result<BoardProfile> parse_board_profile(std::string_view json_text, const std::
 Result<std::vector<BoardProfile>> load_board_profiles(const std::filesystem::path& config_dir);
 // Finds a profile by name in config_dir/boards, or loads `name_or_path` if it is a .json file.
 Result<BoardProfile> find_board_profile(const std::filesystem::path& config_dir, const std::string& name_or_path);
+// UART boards (files with a "device_kind" other than "spigpu"); the SPI loaders above skip them,
+// and find_board_profile names the right command when asked for one.
+Result<UartBoardProfile> parse_uart_board_profile(std::string_view json_text, const std::string& file_for_errors);
+Result<std::vector<UartBoardProfile>> load_uart_board_profiles(const std::filesystem::path& config_dir);
+Result<UartBoardProfile> find_uart_board_profile(const std::filesystem::path& config_dir, const std::string& name_or_path);
 Result<std::vector<CableInfo>> load_cables(const std::filesystem::path& config_dir);
 
 }  // namespace gpubridge::usb
