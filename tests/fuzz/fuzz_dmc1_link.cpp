@@ -2,6 +2,7 @@
 // DMC-1, and the same bytes over the wire model at a baud rate picked by the first byte. Properties:
 // no crash/UB; the receiver hands over one word per 8 bytes after the sync byte; the framer's
 // output is read back as the commands it was given.
+#include <cmath>
 #include <memory>
 
 #include "fuzz_check.hpp"
@@ -28,11 +29,25 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   FUZZ_CHECK(words == synced_bytes / 8);
   FUZZ_CHECK(rx.partial_bytes() == synced_bytes % 8);
 
-  // The wire at a mismatched rate never delivers more bytes than bit times allow.
+  // The wire at a mismatched rate never delivers more bytes than bit times allow: every byte the
+  // receiver delivers starts at its own falling edge of the line, and the next one is looked for
+  // only after its stop-bit sample, 9.5 receiver bit periods later.
   const double tx_baud = 1200.0 + 4800.0 * data[0];
   LineStats st;
   const auto wire = uart_transfer(bytes, tx_baud, kStandaloneBaud, &st);
   FUZZ_CHECK(st.bytes_received == wire.size());
+  std::size_t falls = 0;
+  bool high = true;  // idle line
+  for (const std::uint8_t b : bytes)
+    for (unsigned bit = 0; bit < kUartBitsPerByte; ++bit) {  // start, 8 data bits LSB first, stop
+      const bool level = bit == 0 ? false : bit == 9 ? true : ((b >> (bit - 1)) & 1) != 0;
+      falls += high && !level;
+      high = level;
+    }
+  FUZZ_CHECK(wire.size() <= falls);
+  const double line_ticks = static_cast<double>(bytes.size()) * kUartBitsPerByte * kSocUartClockHz / tx_baud;
+  const double byte_ticks = 9.5 * std::round(kSocUartClockHz / kStandaloneBaud);
+  FUZZ_CHECK(static_cast<double>(wire.size()) <= (line_ticks + 1) / byte_ticks + 1);
 
   // The bytes as commands: framed, they come back as the same words (zero words as stand-ins).
   std::vector<std::uint64_t> cmds;
