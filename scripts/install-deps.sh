@@ -15,6 +15,7 @@ packages=(
   nlohmann-json3-dev libspdlog-dev libfmt-dev libcli11-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libpng-dev zlib1g-dev
+  libzstd-dev libssl-dev                      
   libsystemd-dev                              
   umockdev libumockdev-dev                    
   xvfb xauth x11-utils                        

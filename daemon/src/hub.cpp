@@ -113,14 +113,28 @@ void Hub::enable_hotplug(BackendFactory reattach, std::chrono::milliseconds inte
   hotplug_.enable(std::move(reattach), interval, info_.backend == "board");
 }
 
-std::string Hub::device_json() const {
+std::string Hub::device_json(const std::string& compression, const std::string& transport) const {
   nlohmann::json j{{"backend", info_.backend},     {"board", info_.board},
                    {"bridge", info_.bridge},       {"max_width", info_.max_width},
                    {"max_height", info_.max_height}, {"vram_bytes", info_.vram_bytes},
                    {"id", info_.id},               {"caps", info_.caps},
-                   {"mirror", options_.mirror},    {"daemon_version", kVersion}};
+                   {"mirror", options_.mirror},    {"daemon_version", kVersion},
+                   {"compression", compression},   {"transport", transport}};
   return json_text(j);
 }
+
+namespace {
+// STATUS says how each client's bytes travel: "tls", "none (unix socket)", "none (plain TCP)".
+std::string encryption_of(const Session& s) {
+  switch (s.security()) {
+    case Stream::Security::Tls: return "tls";
+    case Stream::Security::Plain: return "none (plain TCP)";
+    case Stream::Security::Undecided: return "undecided (nothing received yet)";
+    case Stream::Security::Local: break;
+  }
+  return "none (" + s.transport() + " socket)";
+}
+}  // namespace
 
 nlohmann::json Hub::status_json() const {
   nlohmann::json clients = nlohmann::json::array();
@@ -132,6 +146,7 @@ nlohmann::json Hub::status_json() const {
     clients.push_back({{"session", id},
                        {"name", s->name()},
                        {"transport", s->transport()},
+                       {"encryption", encryption_of(*s)},
                        {"handshaken", s->handshaken()},
                        {"subscribed", s->subscribed()},
                        {"source", std::string(protocol::to_string(s->frame_source()))},
@@ -165,6 +180,8 @@ nlohmann::json Hub::status_json() const {
           {"frames", {{"count", feed_.count()}, {"last_number", feed_.last_number()}, {"pngs_written", feed_.pngs_written()}}},
           {"mirror", mirror},
           {"hotplug", hotplug_.status_json()},
+          {"tls", options_.tls_fingerprint.empty() ? nlohmann::json(nullptr)
+                                                   : nlohmann::json{{"fingerprint", options_.tls_fingerprint}}},
           {"uptime_s", uptime}};
 }
 

@@ -3,6 +3,7 @@
 // "ready" on stdout once it accepts connections.
 #include <cstdio>
 #include <functional>
+#include <optional>
 #include <thread>
 
 #include <CLI/CLI.hpp>
@@ -21,6 +22,7 @@
 #include "gpubridge/daemon/hub.hpp"
 #include "gpubridge/daemon/mirror_backend.hpp"
 #include "gpubridge/daemon/server.hpp"
+#include "gpubridge/daemon/tls_identity.hpp"
 #include "gpubridge/version.hpp"
 
 namespace {
@@ -60,8 +62,35 @@ int run(daemon::DaemonConfig cfg) {
     if (device_thread.joinable()) device_thread.join();
   };
 
-  daemon::HubOptions opts{cfg.limits, cfg.token, cfg.frames_dir, cfg.record_dir};
+  daemon::HubOptions opts;
+  opts.limits = cfg.limits;
+  opts.token = cfg.token;
+  opts.frames_dir = cfg.frames_dir;
+  opts.record_dir = cfg.record_dir;
   opts.mirror = cfg.mirror;
+  // TCP listeners speak TLS with the daemon's own key, created on first start (tls_identity.hpp).
+  // A listener other machines can reach (or one given as tls:) needs it: without a key the daemon
+  // does not start. Loopback-only TCP serves plain clients (and SSH tunnels) without one.
+  std::optional<daemon::TlsIdentity> tls;
+  bool tcp = false, tls_needed = false;
+  for (const auto& text : cfg.listen) {
+    const auto a = client::parse_address(text);
+    tcp = tcp || a->kind == client::Address::Kind::Tcp;
+    tls_needed = tls_needed || (a->kind == client::Address::Kind::Tcp && (a->tls || !client::is_loopback_host(a->host)));
+  }
+  if (tcp) {
+    auto id = daemon::load_or_create_tls_identity(cfg.tls_dir.empty() ? daemon::default_tls_dir() : cfg.tls_dir);
+    if (id) {
+      tls = std::move(*id);
+      opts.tls_fingerprint = tls->fingerprint;
+    } else if (tls_needed) {
+      std::fprintf(stderr, "gpubridged: %s (set tls_dir / --tls-dir to a directory of your own)\n", id.error().message.c_str());
+      join_device();
+      return 1;
+    } else {
+      log->warn("no TLS on the loopback TCP listeners: {}", id.error().message);
+    }
+  }
   const daemon::Hub::BackendFactory fallback = daemon::fallback_factory(cfg);
   int exit_code = 0;
   {
@@ -85,6 +114,16 @@ int run(daemon::DaemonConfig cfg) {
                 cfg.reattach_interval_ms);
     hub.set_hotplug_notifications(usb_watch && *usb_watch);
     daemon::Server server(net, hub);
+    if (tls) {
+      if (auto r = server.enable_tls(tls->key_path, tls->cert_path); !r) {
+        std::fprintf(stderr, "gpubridged: %s\n", r.error().message.c_str());
+        join_device();
+        return 1;
+      }
+      // Clients pin this (tls: addresses); print it where the operator sees it.
+      std::printf("tls fingerprint %s%s\n", tls->fingerprint.c_str(), tls->created ? " (new key)" : "");
+      log->info("TLS certificate {} ({}){}", tls->cert_path, tls->fingerprint, tls->created ? ", generated now" : "");
+    }
     for (const auto& text : cfg.listen) {
       auto addr = client::parse_address(text);
       auto bound = addr ? server.listen(*addr) : Result<client::Address>(addr.error());
@@ -159,6 +198,7 @@ int print_checked_config(const daemon::DaemonConfig& cfg, const std::string& con
   std::printf("  backend: %s\n", backend.c_str());
   for (const auto& l : listen) std::printf("  listen:  %s\n", l.c_str());
   std::printf("  token:   %s\n", token.c_str());
+  std::printf("  tls_dir: %s\n", (cfg.tls_dir.empty() ? daemon::default_tls_dir() : cfg.tls_dir).c_str());
   std::printf("effective configuration (loadable with --config):\n%s\n", json_text(effective, 2).c_str());
   return 0;
 }
@@ -183,6 +223,12 @@ int main(int argc, char** argv) {
   app.add_option("-l,--listen", listen, "unix:PATH or tcp:HOST:PORT (repeatable; replaces the config's list)");
   app.add_option("--token", token, "token TCP clients must present (required for non-loopback TCP)");
   app.add_option("--token-file", token_file, "read the token from the first line of this file");
+  std::string tls_dir;
+  bool print_fingerprint = false;
+  app.add_option("--tls-dir", tls_dir, "directory of the TLS key and self-signed certificate (created on first start)");
+  app.add_flag("--tls-fingerprint", print_fingerprint,
+               "print the TLS certificate's fingerprint (creating the key if there is none) and exit; give it to "
+               "clients as GPUBRIDGE_TLS_FINGERPRINT");
   app.add_option("-b,--backend", backend,
                  gpubridge::daemon::backend_syntax() +
                      " (BOARD: a board profile name or .json file; presence: the emulated adapter is plugged in "
@@ -246,6 +292,7 @@ int main(int argc, char** argv) {
   if (!frames_dir.empty()) cfg.frames_dir = frames_dir;
   if (!record_dir.empty()) cfg.record_dir = record_dir;
   if (!log_level.empty()) cfg.log_level = log_level;
+  if (!tls_dir.empty()) cfg.tls_dir = tls_dir;
   if (max_clients) cfg.limits.max_clients = *max_clients;
   if (max_pending) cfg.limits.max_pending_handshakes = *max_pending;
   if (max_message) cfg.limits.max_message_bytes = *max_message;
@@ -256,6 +303,16 @@ int main(int argc, char** argv) {
   if (queue_bytes) cfg.limits.queue_bytes = *queue_bytes;
   if (auto r = gpubridge::daemon::finalize_config(cfg); !r) return config_error(r.error().message);
   if (auto r = gpubridge::daemon::check_output_dirs(cfg); !r) return config_error(r.error().message);
+  if (print_fingerprint) {
+    auto id = gpubridge::daemon::load_or_create_tls_identity(cfg.tls_dir.empty() ? gpubridge::daemon::default_tls_dir()
+                                                                                 : cfg.tls_dir);
+    if (!id) {
+      std::fprintf(stderr, "gpubridged: %s\n", id.error().message.c_str());
+      return 1;
+    }
+    std::printf("%s\n", id->fingerprint.c_str());
+    return 0;
+  }
   if (check_config) {
     auto backend_text = gpubridge::daemon::check_backend(cfg);
     if (!backend_text) return config_error(backend_text.error().message);

@@ -85,8 +85,9 @@ void RequestHandler::dispatch(Message& m) {
     handle_hello(m);
     return;
   }
-  if (recorder_) recorder_->record(m);
-  switch (type) {
+  if (type == MsgType::WriteFramesZ && !inflate(m)) return;
+  if (recorder_) recorder_->record(m);  // a compressed batch is recorded as the WRITE_FRAMES it stands for
+  switch (protocol::type_of(m.payload)) {
     case MsgType::Hello: session_.fail(ErrorCode::Malformed, "HELLO sent twice", m.request_id); return;
     case MsgType::Ping: session_.reply(m.request_id, protocol::Pong{std::get<protocol::Ping>(m.payload).data}); return;
     case MsgType::Pong: return;  // the answer to a keepalive; receiving it is all that counts
@@ -116,6 +117,14 @@ void RequestHandler::handle_hello(const Message& m) {
                   "protocol version " + std::to_string(h.version) + " is not supported (this daemon speaks 1)", m.request_id);
     return;
   }
+  if (session_.tls_required() && session_.security() != Stream::Security::Tls) {
+    hub_.log_refusal("refused a plain TCP client from " + session_.peer() + " on a TLS-only listener");
+    session_.fail(ErrorCode::AuthFailed,
+                  "this listener takes TLS only (it is reachable from other machines): connect with tls:HOST:PORT "
+                  "instead of tcp:HOST:PORT (docs/daemon.md \"Remote use\")",
+                  m.request_id, /*quiet=*/true);
+    return;
+  }
   const auto& token = hub_.options().token;
   if (!token.empty() && session_.transport() == "tcp" && !tokens_equal(h.token, token)) {
     hub_.log_refusal("bad token from " + session_.peer());
@@ -130,14 +139,40 @@ void RequestHandler::handle_hello(const Message& m) {
     return;
   }
   session_.handshake_done(h.name);
+  const bool zstd = h.codecs && (*h.codecs & protocol::codec_bit(protocol::Codec::Zstd));
+  if (zstd) inflater_ = std::make_unique<protocol::FrameInflater>();
   if (!hub_.options().record_dir.empty()) {
     auto r = TraceRecorder::open(hub_.options().record_dir, session_.id(), h.name);
     if (r) recorder_ = std::move(*r);
     else logger("daemon")->error("session {}: {}", session_.id(), r.error().message);
   }
-  logger("daemon")->info("session {}: \"{}\" connected over {}", session_.id(), h.name, session_.transport());
+  logger("daemon")->info("session {}: \"{}\" connected over {}{}", session_.id(), h.name, session_.transport(),
+                         zstd ? " (zstd)" : "");
   session_.reply(m.request_id, protocol::Welcome{protocol::kSocketVersion, hub_.options().limits.max_message_bytes,
-                                                 session_.id(), hub_.device_json()});
+                                                 session_.id(), hub_.device_json(zstd ? "zstd" : "none", session_.transport())});
+}
+
+bool RequestHandler::inflate(Message& m) {
+  const auto z = std::get<protocol::WriteFramesZ>(m.payload);
+  if (!inflater_) {
+    session_.fail(ErrorCode::Malformed, "WRITE_FRAMES_Z without compression: HELLO offered no codec", m.request_id);
+    return false;
+  }
+  if (!require_lease(m)) return false;  // no work spent inflating for a client that may not draw
+  // The bound holds before a byte is inflated: frames_bytes is what the daemon will allocate.
+  const auto limit = hub_.options().limits.max_message_bytes;
+  if (z.frames_bytes > limit) {
+    session_.fail(ErrorCode::TooLarge, "WRITE_FRAMES_Z frames_bytes " + std::to_string(z.frames_bytes) +
+                                           " exceeds the maximum payload of " + std::to_string(limit) + " bytes",
+                  m.request_id);
+    return false;
+  }
+  if (auto e = inflater_->inflate(z, inflated_)) {
+    session_.fail(e->code, e->message + " (request " + std::to_string(m.request_id) + ")", m.request_id);
+    return false;
+  }
+  m.payload = protocol::WriteFrames{protocol::FrameView{inflated_}};
+  return true;
 }
 
 bool RequestHandler::require_lease(const Message& m) {

@@ -13,6 +13,9 @@
 #include "gpubridge/common/log.hpp"
 #include "gpubridge/daemon/session.hpp"
 #include "gpubridge/daemon/socket_dir.hpp"
+#include "gpubridge/daemon/tcp_stream.hpp"
+
+#include <openssl/ssl.h>
 
 namespace gpubridge::daemon {
 
@@ -30,10 +33,22 @@ struct Server::UnixListener {
 struct Server::TcpListener {
   explicit TcpListener(asio::io_context& io) : acceptor(io) {}
   tcp::acceptor acceptor;
+  bool tls_required = false;
 };
 
 Server::Server(asio::io_context& io, Hub& hub) : io_(io), hub_(hub) {}
 Server::~Server() { stop(); }
+
+Result<void> Server::enable_tls(const std::string& key_path, const std::string& cert_path) {
+  auto ctx = std::make_shared<asio::ssl::context>(asio::ssl::context::tls_server);
+  boost::system::error_code ec;
+  ctx->use_private_key_file(key_path, asio::ssl::context::pem, ec);
+  if (!ec) ctx->use_certificate_file(cert_path, asio::ssl::context::pem, ec);
+  if (ec) return make_error("TLS: cannot load " + key_path + " / " + cert_path + ": " + ec.message());
+  SSL_CTX_set_min_proto_version(ctx->native_handle(), TLS1_3_VERSION);
+  tls_ = std::move(ctx);
+  return {};
+}
 
 Result<client::Address> Server::listen(const client::Address& address) {
   if (address.kind == client::Address::Kind::Unix) {
@@ -109,6 +124,8 @@ Result<client::Address> Server::listen(const client::Address& address) {
   if (ec) return make_error("cannot listen on " + address.to_string() + ": " + ec.message());
   client::Address bound = address;
   bound.port = l->acceptor.local_endpoint().port();
+  if (address.tls && !tls_) return make_error("cannot listen on " + address.to_string() + ": TLS is not set up");
+  l->tls_required = tls_ && (address.tls || !client::is_loopback_host(address.host));
   accept_tcp(*l);
   tcp_.push_back(std::move(l));
   return bound;
@@ -139,7 +156,7 @@ void Server::accept_tcp(TcpListener& l) {
       ::setsockopt(fd, IPPROTO_TCP, TCP_KEEPCNT, &count, sizeof count);
       if (const unsigned ms = hub_.options().limits.idle_timeout_ms; ms > 0) ::setsockopt(fd, IPPROTO_TCP, TCP_USER_TIMEOUT, &ms, sizeof ms);
       auto remote = socket.remote_endpoint(ignored);
-      admit(std::move(socket), "tcp", remote.address().to_string() + ":" + std::to_string(remote.port()));
+      admit(std::move(socket), "tcp", remote.address().to_string() + ":" + std::to_string(remote.port()), &l);
     } else {
       hub_.log_refusal("accept on tcp: " + ec.message());
     }
@@ -148,7 +165,7 @@ void Server::accept_tcp(TcpListener& l) {
 }
 
 template <class Socket>
-void Server::admit(Socket socket, std::string transport, std::string peer) {
+void Server::admit(Socket socket, std::string transport, std::string peer, const TcpListener* tcp_listener) {
   const auto& l = hub_.options().limits;
   // Connections waiting for HELLO have their own budget (the oldest gives way); handshaken ones
   // are capped at HELLO. This hard ceiling only bounds descriptors if sessions linger in closing.
@@ -170,7 +187,11 @@ void Server::admit(Socket socket, std::string transport, std::string peer) {
   }
   hub_.make_room_for_handshake(transport);
   auto executor = socket.get_executor();
-  auto stream = std::make_unique<AsioStream<Socket>>(std::move(socket), std::move(transport), std::move(peer));
+  std::unique_ptr<Stream> stream;
+  if constexpr (std::is_same_v<Socket, tcp::socket>)
+    stream = std::make_unique<TcpStream>(std::move(socket), tls_, tcp_listener && tcp_listener->tls_required, std::move(peer));
+  else
+    stream = std::make_unique<AsioStream<Socket>>(std::move(socket), std::move(transport), std::move(peer));
   std::make_shared<Session>(hub_, std::move(stream), executor)->start();
 }
 

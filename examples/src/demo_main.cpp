@@ -79,14 +79,22 @@ int run_render(const std::vector<std::string>& names, const examples::ExamplePar
   return 0;
 }
 
+struct StreamOptions {
+  std::string address, token;
+  unsigned frames = 120;
+  double fps = 30;
+  unsigned window = 4;  // frames in flight (ContextOptions::frames_in_flight)
+  bool sync = false;    // wait for every frame to execute (a round trip each)
+};
+
 int run_stream(const std::vector<std::string>& names, const examples::ExampleParams& params, const FitOptions& fit_options,
-               const std::string& address,
-               unsigned frames, double fps, bool json) {
+               const StreamOptions& o, bool json) {
   auto list = select(names, params);
   if (!list) return fail(list.error().message);
   auto request = fit_options.request();
   if (!request) return fail(request.error().message, 2);
-  auto sink = draw::ClientSink::connect(address, "gpubridge-demo");
+  // An empty address or token: $GPUBRIDGE_ADDRESS / $GPUBRIDGE_TOKEN (client library).
+  auto sink = draw::ClientSink::connect(o.address, "gpubridge-demo", o.token);
   if (!sink) return fail("cannot stream to the daemon: " + sink.error().message);
   const auto device = examples::DeviceCaps::from((*sink)->device());
   nlohmann::json summary = nlohmann::json::array();
@@ -95,18 +103,26 @@ int run_stream(const std::vector<std::string>& names, const examples::ExamplePar
     auto fitted = examples::configure(*ex, device, *request);
     if (!fitted) return fail(fitted.error().message);
     if (!json) print_fit(name, *fitted);
-    auto ctx = draw::Context::create(**sink, ex->options());
+    auto options = ex->options();
+    options.frames_in_flight = o.sync ? 0 : o.window;
+    auto ctx = draw::Context::create(**sink, options);
     if (!ctx) return fail(name + ": " + ctx.error().message);
+    const unsigned frames = o.frames;
     const auto start = std::chrono::steady_clock::now();
+    const std::uint64_t wire_before = (*sink)->client().wire_stats().bytes_sent;
     auto r = examples::run_frames(*ex, *ctx, 0, frames, [&](unsigned n) -> Result<void> {
-      if (fps > 0) std::this_thread::sleep_until(start + std::chrono::duration<double>((n + 1) / fps));
+      if (o.sync)
+        if (auto f = ctx->flush(); !f) return f;
+      if (o.fps > 0) std::this_thread::sleep_until(start + std::chrono::duration<double>((n + 1) / o.fps));
       return {};
     });
     if (!r) return fail(r.error().message);
     if (auto f = ctx->flush(); !f) return fail(name + ": " + f.error().message);
     const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const std::uint64_t wire = (*sink)->client().wire_stats().bytes_sent - wire_before;
     summary.push_back({{"example", name}, {"frames", frames}, {"seconds", secs}, {"triangles", ctx->stats().emitted},
-                       {"config", fit_json(*fitted)}});
+                       {"config", fit_json(*fitted)}, {"bytes_sent", wire},
+                       {"compressed", (*sink)->client().session().compressed}});
     if (!json) std::printf("%-12s %u frames in %.2f s (%zu triangles sent)\n", name.c_str(), frames, secs, ctx->stats().emitted);
   }
   if (json) std::puts(json_text(summary, 2).c_str());
@@ -220,14 +236,19 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(examples::cordic::kMinIterations, examples::cordic::kMaxIterations))
       ->capture_default_str();
 
-  std::string address;
-  unsigned stream_frames = 120;
-  double fps = 30;
+  StreamOptions so;
   auto* stream = app.add_subcommand("stream", "stream examples to a running gpubridged (the viewer shows them)");
   stream->add_option("EXAMPLES", names, "example names, or all (default)");
-  stream->add_option("--connect", address, "daemon address: unix:PATH or tcp:HOST:PORT (default: the default socket)");
-  stream->add_option("--frames", stream_frames, "frames per example")->check(CLI::Range(1u, 1000000u))->capture_default_str();
-  stream->add_option("--fps", fps, "frames per second (0 = as fast as possible)")->check(CLI::Range(0.0, 1000.0))->capture_default_str();
+  stream->add_option("--connect", so.address,
+                     "daemon address: unix:PATH, tcp:HOST:PORT or tls:HOST:PORT (default: $GPUBRIDGE_ADDRESS, else "
+                     "the default socket)");
+  stream->add_option("--token", so.token, "access token for a daemon that requires one (default: $GPUBRIDGE_TOKEN)");
+  stream->add_option("--frames", so.frames, "frames per example")->check(CLI::Range(1u, 1000000u))->capture_default_str();
+  stream->add_option("--fps", so.fps, "frames per second (0 = as fast as possible)")->check(CLI::Range(0.0, 1000.0))->capture_default_str();
+  stream->add_option("--window", so.window, "frames in flight before a swap waits for the daemon (pipelined fences)")
+      ->check(CLI::Range(1u, 1024u))
+      ->capture_default_str();
+  stream->add_flag("--sync", so.sync, "wait for every frame to execute before the next (a round trip each)");
   add_fit_options(stream, fit_options);
   stream->add_option("--cordic-iterations", params.cordic_iterations, iterations_help)
       ->check(CLI::Range(examples::cordic::kMinIterations, examples::cordic::kMaxIterations))
@@ -261,7 +282,7 @@ int main(int argc, char** argv) {
   gpubridge::init_logging("warn");
   if (*list) return run_list(json);
   if (*render) return run_render(names, params, fit_options, board, out_dir, first, frames, json);
-  if (*stream) return run_stream(names, params, fit_options, address, stream_frames, fps, json);
+  if (*stream) return run_stream(names, params, fit_options, so, json);
   if (*figures) return run_figures(figures_dir, json);
   if (*fit) return run_fit(names, boards, fit_options, timing, markdown, json);
   return run_goldens(golden_dir, classes, write, json);

@@ -107,6 +107,14 @@ class FieldReader {
     code<Wire>(field, e, r);
     v = e;
   }
+  // A number that may end the payload (absent in a message's original, shorter form).
+  template <std::unsigned_integral T>
+  void optional_num(const char* field, std::optional<T>& v) {
+    if (failed() || remaining() == 0) return;
+    T n = 0;
+    num(field, n);
+    v = n;
+  }
   void flag(const char* field, bool& v) {
     std::uint8_t w = 0;
     num(field, w, Range{0, 1, "is not 0 or 1"});
@@ -244,6 +252,10 @@ class FieldWriter {
   void optional_code(const char*, const std::optional<E>& v, Range) {
     if (v) put_le(o_, static_cast<Wire>(*v));
   }
+  template <std::unsigned_integral T>
+  void optional_num(const char*, const std::optional<T>& v) {
+    if (v) put_le(o_, *v);
+  }
   void flag(const char*, bool v) { put_le(o_, static_cast<std::uint8_t>(v ? 1 : 0)); }
   void counted(const char*, const char*, std::string_view s, std::size_t max, Text) {
     s = s.substr(0, max);
@@ -282,6 +294,7 @@ void layout(auto& io, OneOf<Hello> auto& m) {
   io.num("version", m.version);
   io.counted("name_len", "name", m.name, kMaxNameBytes, Text::Utf8);
   io.counted("token_len", "token", m.token, kMaxTokenBytes, Text::Bytes);
+  io.optional_num("codecs", m.codecs);  // absent in the original form (no compression offered)
 }
 void layout(auto& io, OneOf<Welcome> auto& m) {
   io.num("version", m.version);
@@ -323,6 +336,18 @@ void layout(auto& io, OneOf<ReadbackData> auto& m) {
   io.num("address", m.address);
   io.flag("last", m.last);
   io.rest("data", m.data, MaxBytes{kMaxReadbackChunk, "exceeds the 65536-byte chunk limit"});
+}
+// The bounds of the inflated size hold before anything is inflated: frames_bytes is a WRITE_FRAMES
+// payload size here, and the receiver checks it against its own max_payload (compression.hpp).
+void layout(auto& io, OneOf<WriteFramesZ> auto& m) {
+  io.template code<std::uint8_t>("codec", m.codec, Range{1, 1, "is not a known codec (1 = zstd)"});
+  io.num("frames_bytes", m.frames_bytes);
+  io.check([&] {
+    if (m.frames_bytes != 0 && m.frames_bytes <= kMaxPayload && m.frames_bytes % kFrameBytes == 0) return std::string();
+    return std::to_string(m.frames_bytes) + " is not a WRITE_FRAMES payload size (a multiple of 9, 9..16777216)";
+  });
+  io.rest("data", m.data);
+  io.check([&] { return m.data.empty() ? std::string("is empty") : std::string(); });
 }
 void layout(auto& io, OneOf<FenceMsg, FenceDone> auto& m) { io.num("id", m.id); }
 void layout(auto& io, OneOf<StatusReply> auto& m) { io.rest_json("status", m.json); }
@@ -416,6 +441,8 @@ std::string_view to_string(ErrorCode c) {
   }
   return "UNKNOWN_ERROR";
 }
+
+std::string_view to_string(Codec c) { return c == Codec::Zstd ? "zstd" : "?"; }
 
 std::string_view to_string(FrameSource s) {
   switch (s) {

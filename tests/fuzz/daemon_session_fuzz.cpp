@@ -1,6 +1,7 @@
 // libFuzzer target: the real Session dispatch (handshake, lease, device calls, replies) over an
 // in-memory stream. The first bytes choose the read split points, the rest is the client's byte
-// stream (a HELLO is prepended half the time so the fuzzer reaches post-handshake paths).
+// stream (a HELLO is prepended half the time so the fuzzer reaches post-handshake paths; that HELLO
+// offers zstd when bit 1 of the first byte is set, so WRITE_FRAMES_Z is inflated and checked).
 // Built with -DGPUBRIDGE_FUZZ=ON (clang): target daemon_session_fuzz.
 #include <cstddef>
 #include <cstdint>
@@ -24,12 +25,16 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (size < 2) return 0;
   const bool prepend_hello = data[0] & 1;
   std::vector<std::size_t> chunks;
-  const std::size_t n_chunks = 1 + (data[0] >> 1) % 8;
+  const bool offer_zstd = data[0] & 2;
+  const std::size_t n_chunks = 1 + (data[0] >> 2) % 8;
   for (std::size_t i = 0; i < n_chunks && 1 + i < size; ++i) chunks.push_back(1 + data[1 + i] % 97);
   const std::size_t skip = std::min(size, 1 + n_chunks);
   std::vector<std::uint8_t> input;
-  if (prepend_hello)
-    protocol::encode(protocol::Message{1, protocol::Hello{protocol::kSocketVersion, "fuzz", ""}}, input);
+  if (prepend_hello) {
+    protocol::Hello hello{protocol::kSocketVersion, "fuzz", ""};
+    if (offer_zstd) hello.codecs = protocol::codec_bit(protocol::Codec::Zstd);
+    protocol::encode(protocol::Message{1, hello}, input);
+  }
   input.insert(input.end(), data + skip, data + size);
 
   boost::asio::io_context io;

@@ -45,6 +45,8 @@ inline Samples make_samples() {
   m.push_back({23, LeaseRelease{}});
   m.push_back({24, LeaseReleased{}});
   m.push_back({0xFFFFFFFFu, DeviceEvent{R"({"event":"unplugged"})"}});
+  m.push_back({25, WriteFramesZ{Codec::Zstd, 18, s.upload}});  // decoding does not inflate
+  m.push_back({26, Hello{1, "z", "", codec_bit(Codec::Zstd)}});
   return s;
 }
 

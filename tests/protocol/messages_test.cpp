@@ -67,6 +67,17 @@ TEST(Messages, HelloLayout) {
   EXPECT_EQ(payload, (std::vector<std::uint8_t>{0x02, 0x01, 2, 'a', 'b', 3, 'x', 'y', 'z'}));
 }
 
+// The optional codecs byte (docs/protocol.md 17.6) and WRITE_FRAMES_Z, byte by byte.
+TEST(Messages, HelloCodecsAndCompressedWriteLayout) {
+  const auto h = encode(Message{1, Hello{1, "a", "", codec_bit(Codec::Zstd)}});
+  EXPECT_EQ(std::vector<std::uint8_t>(h.begin() + kHeaderBytes, h.end()), (std::vector<std::uint8_t>{1, 0, 1, 'a', 0, 1}));
+  const std::vector<std::uint8_t> data{0xAA, 0xBB};
+  const auto z = encode(Message{2, WriteFramesZ{Codec::Zstd, 0x0102'0309, data}});
+  EXPECT_EQ(z[3], 0x17);
+  EXPECT_EQ(std::vector<std::uint8_t>(z.begin() + kHeaderBytes, z.end()),
+            (std::vector<std::uint8_t>{1, 0x09, 0x03, 0x02, 0x01, 0xAA, 0xBB}));
+}
+
 TEST(Messages, WriteFramesCarriesFramesUnchangedAndWithoutCopy) {
   std::vector<std::uint8_t> frames;
   append(frames, write_frame(Reg::CLEAR, 0));

@@ -43,6 +43,22 @@ std::vector<std::uint8_t> le32(std::uint32_t v) {
 
 // Found by the binary-trace fuzzer: the socket/binary path accepted an UPLOAD wrapping past 4 GiB
 // that the text trace refuses. Address ranges are checked where the message is decoded.
+TEST(ParserMalformed, CompressedWritesNameTheirBadField) {
+  const auto z = [](std::uint8_t codec, std::uint32_t frames_bytes, std::vector<std::uint8_t> data) {
+    std::vector<std::uint8_t> p{codec};
+    for (int i = 0; i < 4; ++i) p.push_back(static_cast<std::uint8_t>(frames_bytes >> (8 * i)));
+    p.insert(p.end(), data.begin(), data.end());
+    return raw(static_cast<std::uint8_t>(MsgType::WriteFramesZ), p);
+  };
+  expect_error(z(2, 9, {1}), ErrorCode::Malformed, "codec 2 is not a known codec");
+  expect_error(z(1, 10, {1}), ErrorCode::Malformed, "frames_bytes 10 is not a WRITE_FRAMES payload size");
+  expect_error(z(1, 0, {1}), ErrorCode::Malformed, "frames_bytes 0");
+  expect_error(z(1, 9, {}), ErrorCode::Malformed, "data (payload byte 5) is empty");
+  // HELLO: one optional codecs byte, no more.
+  std::vector<std::uint8_t> hello{1, 0, 1, 'a', 0, 1, 0};
+  expect_error(raw(static_cast<std::uint8_t>(MsgType::Hello), hello), ErrorCode::Malformed, "1 unexpected trailing bytes");
+}
+
 TEST(ParserMalformed, UploadAndReadbackMayNotWrapPast4GiB) {
   auto upload = encode(Message{7, Upload{0xFFFFFFFFu, std::span<const std::uint8_t>(le32(0x1234).data(), 2)}});
   expect_error(upload, ErrorCode::Malformed, "run past the 4 GiB address space");

@@ -34,10 +34,8 @@ Result<client::Client> open_client(const GlobalOptions& g, const ClientOptions& 
   const client::Timeout timeout{o.timeout_ms};
   auto c = client::Client::connect(g.connect, timeout);
   if (!c) return c.error();
-  std::string token = g.token;
-  if (token.empty())
-    if (const char* env = std::getenv("GPUBRIDGE_TOKEN")) token = env;
-  if (auto r = c->handshake(name, token, timeout); !r) return r.error();
+  // No --token: the library takes $GPUBRIDGE_TOKEN or $GPUBRIDGE_TOKEN_FILE.
+  if (auto r = c->handshake(name, g.token, timeout); !r) return r.error();
   return std::move(*c);
 }
 
@@ -111,10 +109,15 @@ int run_status(const GlobalOptions& g, const ClientOptions& o) {
   else
     std::printf("lease:     free\n");
   std::printf("clients:   %zu\n", j.value("client_count", std::size_t{0}));
-  for (const auto& cl : j["clients"])
-    std::printf("  #%-4u %-24s %-5s%s%s\n", cl.value("session", 0u), cl.value("name", "").c_str(),
-                cl.value("transport", "").c_str(), cl.value("lease", false) ? " lease" : "",
-                cl.value("subscribed", false) ? " subscribed" : "");
+  for (const auto& cl : j["clients"]) {
+    // TCP clients: "tcp (tls)" or "tcp (plain)"; Unix socket clients: "unix".
+    std::string via = cl.value("transport", "");
+    if (via == "tcp") via += cl.value("encryption", "") == "tls" ? " (tls)" : " (plain)";
+    std::printf("  #%-4u %-24s %-11s%s%s\n", cl.value("session", 0u), cl.value("name", "").c_str(), via.c_str(),
+                cl.value("lease", false) ? " lease" : "", cl.value("subscribed", false) ? " subscribed" : "");
+  }
+  if (j.contains("tls") && j["tls"].is_object())
+    std::printf("tls:       TCP listeners present certificate %s\n", j["tls"].value("fingerprint", "").c_str());
   std::printf("frames:    %llu scanned out, last #%u\n",
               static_cast<unsigned long long>(j["frames"].value("count", std::uint64_t{0})),
               j["frames"].value("last_number", 0u));
@@ -171,6 +174,8 @@ struct PlayOptions {
   unsigned repeat = 1;
   double fps = 0;
   bool fail_if_busy = false;
+  unsigned window = 8;  // swaps/fences in flight (pipelined completion); --sync: a round trip each
+  bool sync = false;
 };
 
 std::size_t count_swaps(protocol::FrameView v) {
@@ -196,6 +201,12 @@ int run_play(const GlobalOptions& g, const ClientOptions& o, const PlayOptions& 
   c->set_interrupt_flag(&g_interrupted);
   auto stopped = [](const Result<void>& r) { return !r && r.error().code == client::kInterrupted; };
 
+  const unsigned window = p.sync ? 0 : p.window;
+  auto pace = [&](client::Client& cl) -> Result<void> {
+    if (p.sync) return cl.fence(timeout);
+    if (auto h = cl.fence_async(timeout); !h) return h.error();
+    return cl.wait_fences(window, timeout);
+  };
   const auto start = Clock::now();
   std::uint64_t frames = 0, swaps = 0, commands = 0, passes = 0;
   nlohmann::json reads = nlohmann::json::array();
@@ -211,7 +222,9 @@ int run_play(const GlobalOptions& g, const ClientOptions& o, const PlayOptions& 
         swaps += n;
         if (r && n && p.fps > 0) {
           // Pace on swaps: the next swap may not happen before swaps/fps seconds after the start.
-          r = c->fence(timeout);
+          // Pipelined: a fence marks the swap and at most `window` swaps are in flight, so a link
+          // with latency costs no round trip per frame; --sync waits for each swap to execute.
+          r = pace(*c);
           const auto due = start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(swaps / p.fps));
           while (r && !g_interrupted && Clock::now() < due)
             std::this_thread::sleep_for(std::min<Clock::duration>(due - Clock::now(), std::chrono::milliseconds(50)));
@@ -220,7 +233,7 @@ int run_play(const GlobalOptions& g, const ClientOptions& o, const PlayOptions& 
         r = c->upload(u->address, u->data, {}, timeout);
       } else if (auto* fe = std::get_if<protocol::FenceCmd>(&tc.command)) {
         (void)fe;
-        r = c->fence(timeout);
+        r = pace(*c);
       } else if (auto* rr = std::get_if<protocol::ReadRegCmd>(&tc.command)) {
         auto v = c->read_register(rr->index, timeout);
         if (v) {
@@ -246,8 +259,11 @@ int run_play(const GlobalOptions& g, const ClientOptions& o, const PlayOptions& 
   const bool interrupted = g_interrupted.load();
   if (!interrupted) c->close();
   if (g.json) {
+    const auto& w = c->wire_stats();
     print_json({{"trace", p.trace}, {"passes", passes}, {"commands", commands}, {"register_writes", frames},
-                {"swaps", swaps}, {"seconds", seconds}, {"reads", reads}, {"interrupted", interrupted}});
+                {"swaps", swaps}, {"seconds", seconds}, {"reads", reads}, {"interrupted", interrupted},
+                {"window", window}, {"compressed", c->session().compressed}, {"bytes_sent", w.bytes_sent},
+                {"frame_bytes", w.frame_bytes}, {"frame_wire_bytes", w.frame_wire_bytes}});
   } else {
     for (const auto& rd : reads)
       std::printf("%s = 0x%016llx\n", rd["register"].get<std::string>().c_str(),
@@ -487,6 +503,12 @@ GPUBRIDGE_COMMAND("client", 40, [](CLI::App& app, GlobalOptions& g, auto& runner
   play->add_option("--repeat", popts->repeat, "play the trace N times")->check(CLI::Range(1u, 1000000u));
   play->add_option("--fps", popts->fps, "at most N swaps (FB_DISPLAY writes) per second; 0 = as fast as possible");
   play->add_flag("--no-wait", popts->fail_if_busy, "fail with BUSY instead of waiting when another client draws");
+  play->add_option("--window", popts->window,
+                   "trace fences and --fps swaps kept in flight: the next waits only when N are unfinished, so a "
+                   "remote daemon costs no round trip per frame")
+      ->check(CLI::Range(1u, 1024u))
+      ->capture_default_str();
+  play->add_flag("--sync", popts->sync, "wait for every trace fence and paced swap to execute (one round trip each)");
   add_client_options(play, g, *copts);
   runners.emplace_back(play, [&g, copts, popts] { return run_play(g, *copts, *popts); });
 

@@ -258,7 +258,9 @@ Result<void> Context::swap() {
     back_ = 1 - back_;
     write(Reg::FB_DRAW, back_buffer());
   }
-  return send_pending();
+  if (auto r = send_pending(); !r) return r;
+  if (options_.frames_in_flight == 0) return {};
+  return sink_->end_frame(options_.frames_in_flight);
 }
 
 Result<void> Context::flush() {

@@ -10,8 +10,9 @@ namespace gpubridge::client {
 
 std::string Address::to_string() const {
   if (kind == Kind::Unix) return "unix:" + path;
-  if (host.find(':') != std::string::npos) return "tcp:[" + host + "]:" + std::to_string(port);
-  return "tcp:" + host + ":" + std::to_string(port);
+  const char* scheme = tls ? "tls:" : "tcp:";
+  if (host.find(':') != std::string::npos) return scheme + ("[" + host + "]:") + std::to_string(port);
+  return scheme + host + ":" + std::to_string(port);
 }
 
 std::string default_socket_path() {
@@ -23,7 +24,7 @@ std::string default_socket_path() {
 Result<Address> parse_address(std::string_view text) {
   auto bad = [&](std::string_view why) {
     return make_error("bad address \"" + std::string(text) + "\": " + std::string(why) +
-                      " (expected unix:PATH or tcp:HOST:PORT)");
+                      " (expected unix:PATH, tcp:HOST:PORT or tls:HOST:PORT)");
   };
   Address a;
   if (text.starts_with("/")) {
@@ -36,8 +37,9 @@ Result<Address> parse_address(std::string_view text) {
     if (a.path.size() >= 108) return bad("Unix socket paths are limited to 107 bytes");
     return a;
   }
-  if (!text.starts_with("tcp:")) return bad("unknown scheme");
+  if (!text.starts_with("tcp:") && !text.starts_with("tls:")) return bad("unknown scheme");
   a.kind = Address::Kind::Tcp;
+  a.tls = text.starts_with("tls:");
   std::string_view rest = text.substr(4);
   std::string_view port_text;
   if (rest.starts_with("[")) {
@@ -62,6 +64,12 @@ Result<Address> parse_address(std::string_view text) {
 }
 
 Result<Address> parse_connect_address(std::string_view text) {
+  if (text.empty())
+    if (const char* env = std::getenv(kAddressEnv); env && *env) {
+      auto a = parse_address(env);
+      if (!a) return make_error(std::string(kAddressEnv) + ": " + a.error().message);
+      return a;
+    }
   return parse_address(text.empty() ? std::string_view("unix:") : text);
 }
 

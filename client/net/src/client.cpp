@@ -15,6 +15,10 @@
 #include <cstring>
 
 #include "gpubridge/client/daemon_owner.hpp"
+#include "gpubridge/client/tls.hpp"
+
+#include <fstream>
+#include <sys/stat.h>
 
 namespace gpubridge::client {
 namespace {
@@ -139,11 +143,36 @@ Client& Client::operator=(Client&& o) noexcept {
     async_error_ = std::move(o.async_error_);
     pongs_ = std::move(o.pongs_);
     interrupt_ = o.interrupt_;
+    tls_ = std::move(o.tls_);
+    fences_ = std::move(o.fences_);
+    fences_done_ = o.fences_done_;
+    fence_callback_ = std::move(o.fence_callback_);
+    deflater_ = std::move(o.deflater_);
+    deflated_ = std::move(o.deflated_);
+    wire_ = o.wire_;
   }
   return *this;
 }
 Client::~Client() {
+  tls_.reset();  // before the socket it uses
   if (fd_ >= 0) ::close(fd_);
+}
+
+Result<std::string> token_from_environment() {
+  if (const char* env = std::getenv(kTokenEnv); env && *env) return std::string(env);
+  const char* file = std::getenv(kTokenFileEnv);
+  if (!file || !*file) return std::string();
+  const std::string where = std::string(kTokenFileEnv) + "=" + file;
+  struct stat st{};
+  if (::stat(file, &st) != 0) return make_error(where + ": " + errno_text(errno));
+  if (!S_ISREG(st.st_mode)) return make_error(where + ": not a regular file");
+  if (st.st_size > 4096) return make_error(where + ": larger than 4 KiB; the token goes on the first line");
+  std::ifstream in(file);
+  std::string line;
+  if (!in || !std::getline(in, line)) return make_error(where + ": cannot read it (or it is empty)");
+  while (!line.empty() && (line.back() == '\r' || line.back() == ' ' || line.back() == '\t')) line.pop_back();
+  if (line.empty()) return make_error(where + ": the first line is empty; put the token there");
+  return line;
 }
 
 Result<Client> Client::connect(std::string_view address, Timeout timeout) {
@@ -161,6 +190,11 @@ Result<Client> Client::connect(std::string_view address, Timeout timeout) {
   Client c;
   c.fd_ = *fd;
   c.address_ = *addr;
+  if (addr->tls) {
+    auto t = TlsConnection::establish(*fd, *addr, deadline);
+    if (!t) return t.error();  // c closes the socket
+    c.tls_ = std::move(*t);
+  }
   c.parser_ = std::make_unique<protocol::MessageParser>(protocol::kMaxPayload);
   return c;
 }
@@ -168,9 +202,42 @@ Result<Client> Client::connect(std::string_view address, Timeout timeout) {
 void Client::close() {
   if (fd_ < 0) return;
   (void)send_message(Message{next_request_id(), protocol::Bye{}}, Timeout{200});
+  tls_.reset();
   ::close(fd_);
   fd_ = -1;
 }
+
+long Client::read_some(std::span<std::uint8_t> room) {
+  if (tls_) return tls_->read(room);
+  const ssize_t n = ::recv(fd_, room.data(), room.size(), 0);
+  return n < 0 ? -errno : n;
+}
+
+long Client::write_some(std::span<const std::uint8_t> a, std::span<const std::uint8_t> b) {
+  if (tls_) {
+    // One TLS record per call; a small header goes together with what follows it.
+    if (!a.empty() && a.size() < 64 && !b.empty()) {
+      std::uint8_t joined[64 + 16384];
+      const std::size_t nb = std::min(b.size(), sizeof joined - a.size());
+      std::memcpy(joined, a.data(), a.size());
+      std::memcpy(joined + a.size(), b.data(), nb);
+      return tls_->write({joined, a.size() + nb});
+    }
+    return tls_->write(!a.empty() ? a : b);
+  }
+  iovec iov[2];
+  int n_iov = 0;
+  if (!a.empty()) iov[n_iov++] = {const_cast<std::uint8_t*>(a.data()), a.size()};
+  if (!b.empty()) iov[n_iov++] = {const_cast<std::uint8_t*>(b.data()), b.size()};
+  msghdr msg{};
+  msg.msg_iov = iov;
+  msg.msg_iovlen = static_cast<std::size_t>(n_iov);
+  // MSG_NOSIGNAL: a daemon that went away is an error to return, not a SIGPIPE to die of.
+  const ssize_t n = ::sendmsg(fd_, &msg, MSG_NOSIGNAL);
+  return n < 0 ? -errno : n;
+}
+
+bool Client::read_buffered() const { return tls_ && tls_->pending(); }
 
 Result<void> Client::send_message(const Message& m, Timeout timeout) {
   const auto bytes = protocol::encode(m);
@@ -197,24 +264,17 @@ Result<void> Client::write_all(std::span<const std::uint8_t> a, std::span<const 
   const auto deadline = Clock::now() + timeout;
   while (!a.empty() || !b.empty()) {
     if (interrupted()) return interrupted_error();
-    iovec iov[2];
-    int n_iov = 0;
-    if (!a.empty()) iov[n_iov++] = {const_cast<std::uint8_t*>(a.data()), a.size()};
-    if (!b.empty()) iov[n_iov++] = {const_cast<std::uint8_t*>(b.data()), b.size()};
-    msghdr msg{};
-    msg.msg_iov = iov;
-    msg.msg_iovlen = static_cast<std::size_t>(n_iov);
-    // MSG_NOSIGNAL: a daemon that went away is an error to return, not a SIGPIPE to die of.
-    const ssize_t n = ::sendmsg(fd_, &msg, MSG_NOSIGNAL);
+    const long n = write_some(a, b);
     if (n > 0) {
       std::size_t done = static_cast<std::size_t>(n);
+      wire_.bytes_sent += done;
       const std::size_t from_a = std::min(done, a.size());
       a = a.subspan(from_a);
       b = b.subspan(done - from_a);
       continue;
     }
-    if (n < 0 && errno != EAGAIN && errno != EINTR) {
-      const std::string why = errno_text(errno);
+    if (n < 0 && -n != EAGAIN && -n != EINTR) {
+      const std::string why = errno_text(static_cast<int>(-n));
       if (auto words = daemon_last_words()) return *words;
       return io_error("lost connection to " + address_.to_string() + ": " + why);
     }
@@ -222,7 +282,7 @@ Result<void> Client::write_all(std::span<const std::uint8_t> a, std::span<const 
     pollfd p{fd_, POLLOUT | POLLIN, 0};
     const int rc = ::poll(&p, 1, remaining_ms(deadline));
     if (rc == 0) return make_error("timed out sending to " + address_.to_string(), kTimeoutError);
-    if (rc > 0 && (p.revents & POLLIN)) {
+    if ((rc > 0 && (p.revents & POLLIN)) || read_buffered()) {
       if (auto r = pump(deadline, false); !r) return r;
     }
   }
@@ -248,15 +308,17 @@ std::optional<Error> Client::daemon_last_words() {
 
 Result<void> Client::pump(Clock::time_point deadline, bool block) {
   if (fd_ < 0) return io_error("not connected");
-  pollfd p{fd_, POLLIN, 0};
-  const int rc = ::poll(&p, 1, block ? remaining_ms(deadline) : 0);
-  if (rc < 0 && errno != EINTR) return io_error("poll: " + errno_text(errno));
-  if (rc <= 0) return {};
+  if (!read_buffered()) {  // decrypted bytes TLS already holds are not visible to poll
+    pollfd p{fd_, POLLIN, 0};
+    const int rc = ::poll(&p, 1, block ? remaining_ms(deadline) : 0);
+    if (rc < 0 && errno != EINTR) return io_error("poll: " + errno_text(errno));
+    if (rc <= 0) return {};
+  }
   // Read straight into the parser's buffer (no copy per read; frames can be 4 MiB). The span is
   // empty only once the stream has failed to parse, which was already reported.
   const auto room = parser_->prepare(256 * 1024);
   if (room.empty()) return io_error("bad data from daemon: " + parser_->error().message);
-  const ssize_t n = ::recv(fd_, room.data(), room.size(), 0);
+  const long n = read_some(room);
   if (n == 0) {
     // Report the daemon's last words (e.g. SERVER_FULL, SHUTTING_DOWN) if it sent any.
     for (auto& m : inbox_)
@@ -264,8 +326,9 @@ Result<void> Client::pump(Clock::time_point deadline, bool block) {
     return io_error("daemon at " + address_.to_string() + " closed the connection");
   }
   if (n < 0) {
-    if (errno == EAGAIN || errno == EINTR) return {};
-    return io_error("lost connection to " + address_.to_string() + ": " + errno_text(errno));
+    if (-n == EAGAIN || -n == EINTR) return {};
+    if (tls_ && -n == EPROTO) return make_error("TLS error from " + address_.to_string() + ": " + tls_->last_error(), kSecurityError);
+    return io_error("lost connection to " + address_.to_string() + ": " + errno_text(static_cast<int>(-n)));
   }
   parser_->commit(static_cast<std::size_t>(n));
   for (;;) {
@@ -290,6 +353,14 @@ Result<void> Client::pump(Clock::time_point deadline, bool block) {
     } else if (auto* ping = std::get_if<protocol::Ping>(&m.payload)) {
       // The daemon's keepalive: answered by the next send_pongs() (never from inside a message).
       if (pongs_.size() < 16) pongs_.push_back(ping->data);
+    } else if (auto* fd = std::get_if<protocol::FenceDone>(&m.payload)) {
+      // Fences complete in order: this one and every earlier one are done.
+      fences_done_ = std::max(fences_done_, fd->id);
+      while (!fences_.empty() && fences_.front() <= fences_done_) {
+        const auto h = fences_.front();
+        fences_.pop_front();
+        if (fence_callback_) fence_callback_(h);
+      }
     } else if (auto* rd = std::get_if<protocol::ReadbackData>(&m.payload)) {
       // The span points into the parser buffer: keep an owning copy.
       readback_chunks_.push_back(ReadbackChunk{m.request_id, rd->last, {rd->data.begin(), rd->data.end()}});
@@ -341,10 +412,32 @@ Result<Message> Client::wait_for(std::uint32_t request_id, MsgType type, Timeout
   }
 }
 
-Result<SessionInfo> Client::handshake(std::string_view name, std::string_view token, Timeout timeout) {
+Result<SessionInfo> Client::handshake(std::string_view name, std::string_view token, Timeout timeout,
+                                      Compression compression) {
   protocol::Hello h;
   h.name = std::string(name.substr(0, protocol::kMaxNameBytes));
   h.token = std::string(token);
+  if (h.token.empty()) {
+    auto env = token_from_environment();
+    if (!env) return env.error();
+    // The daemon asks only TCP clients for a token; a Unix socket client keeps it to itself.
+    if (address_.kind == Address::Kind::Tcp) h.token = *env;
+  }
+  const bool remote = address_.kind == Address::Kind::Tcp && !is_loopback_host(address_.host);
+  if (!h.token.empty() && remote && !tls_)
+    return make_error("refusing to send the token in clear to " + address_.to_string() + ": connect with tls:" +
+                          address_.to_string().substr(4) + " (the daemon's TCP listeners speak TLS) or through an "
+                          "SSH tunnel to a loopback address (docs/daemon.md \"Remote use\")",
+                      kSecurityError);
+  if (compression == Compression::Auto)
+    if (const char* env = std::getenv(kCompressEnv); env && *env) {
+      const std::string v = env;
+      if (v == "zstd") compression = Compression::Zstd;
+      else if (v == "none") compression = Compression::None;
+      else if (v != "auto") return make_error(std::string(kCompressEnv) + "=" + v + ": expected zstd, none or auto");
+    }
+  if (compression == Compression::Zstd || (compression == Compression::Auto && remote))
+    h.codecs = protocol::codec_bit(protocol::Codec::Zstd);
   const auto id = next_request_id();
   if (auto r = send_message(Message{id, h}, timeout); !r) return r.error();
   auto reply = wait_for(id, MsgType::Welcome, timeout);
@@ -354,7 +447,13 @@ Result<SessionInfo> Client::handshake(std::string_view name, std::string_view to
     return io_error("the daemon at " + address_.to_string() + " announced max_payload " + std::to_string(w.max_payload) +
                     ", outside the protocol's " + std::to_string(protocol::kMinMaxPayload) + ".." +
                     std::to_string(protocol::kMaxPayload) + " bytes (docs/protocol.md 17.1); is it a gpubridged?");
-  session_ = SessionInfo{w.session_id, w.max_payload, w.json};
+  session_ = SessionInfo{w.session_id, w.max_payload, w.json, false};
+  // The daemon's choice is in the device description; a daemon that predates compression says
+  // nothing, and gets plain WRITE_FRAMES.
+  if (h.codecs && w.json.find("\"compression\":\"zstd\"") != std::string::npos) {
+    session_.compressed = true;
+    deflater_ = std::make_unique<protocol::FrameDeflater>();
+  }
   return session_;
 }
 
@@ -380,9 +479,23 @@ Result<void> Client::write_frames(protocol::FrameView frames, Timeout timeout) {
   auto bytes = frames.bytes;
   while (!bytes.empty()) {
     const auto chunk = bytes.first(std::min(per_message, bytes.size()));
-    std::uint8_t header[protocol::kHeaderBytes];
-    protocol::encode_header(MsgType::WriteFrames, static_cast<std::uint32_t>(chunk.size()), next_request_id(), header);
-    if (auto r = send_raw(header, chunk, timeout); !r) return r;
+    const auto before = wire_.bytes_sent;
+    if (deflater_ && deflater_->deflate(protocol::FrameView{chunk}, deflated_)) {
+      // WRITE_FRAMES_Z: header, codec, frames_bytes, then the compressed bytes.
+      std::uint8_t head[protocol::kHeaderBytes + 5];
+      protocol::encode_header(MsgType::WriteFramesZ, static_cast<std::uint32_t>(deflated_.size() + 5), next_request_id(),
+                              head);
+      head[protocol::kHeaderBytes] = static_cast<std::uint8_t>(protocol::Codec::Zstd);
+      for (int i = 0; i < 4; ++i)
+        head[protocol::kHeaderBytes + 1 + i] = static_cast<std::uint8_t>(chunk.size() >> (8 * i));
+      if (auto r = send_raw(head, deflated_, timeout); !r) return r;
+    } else {
+      std::uint8_t header[protocol::kHeaderBytes];
+      protocol::encode_header(MsgType::WriteFrames, static_cast<std::uint32_t>(chunk.size()), next_request_id(), header);
+      if (auto r = send_raw(header, chunk, timeout); !r) return r;
+    }
+    wire_.frame_bytes += chunk.size();
+    wire_.frame_wire_bytes += wire_.bytes_sent - before;  // includes any PONG sent first (a few bytes, rarely)
     bytes = bytes.subspan(chunk.size());
   }
   return take_async_error();
@@ -464,11 +577,50 @@ Result<std::vector<std::uint8_t>> Client::readback(std::uint32_t address, std::u
 }
 
 Result<void> Client::fence(Timeout timeout) {
+  auto h = fence_async(timeout);
+  if (!h) return h.error();
+  return wait_fence(*h, timeout);
+}
+
+Result<Client::FenceHandle> Client::fence_async(Timeout timeout) {
   const auto id = next_request_id();
-  if (auto r = send_message(Message{id, protocol::FenceMsg{id}}, timeout); !r) return r;
-  auto reply = wait_for(id, MsgType::FenceDone, timeout);
-  if (!reply) return reply.error();
+  if (auto r = send_message(Message{id, protocol::FenceMsg{id}}, timeout); !r) return r.error();
+  fences_.push_back(id);
+  return FenceHandle{id};
+}
+
+Result<void> Client::wait_fence(FenceHandle handle, Timeout timeout) {
+  if (auto r = wait_until([&] { return fence_done(handle); }, "FENCE_DONE", timeout); !r) return r;
   return take_async_error();
+}
+
+Result<void> Client::wait_fences(std::size_t max_in_flight, Timeout timeout) {
+  if (auto r = wait_until([&] { return fences_.size() <= max_in_flight; }, "FENCE_DONE", timeout); !r) return r;
+  return take_async_error();
+}
+
+Result<void> Client::wait_until(const std::function<bool()>& done, const char* what, Timeout timeout) {
+  const auto deadline = Clock::now() + timeout;
+  for (;;) {
+    for (auto it = inbox_.begin(); it != inbox_.end();) {
+      auto* e = std::get_if<protocol::ErrorMsg>(&it->payload);
+      if (!e) {
+        ++it;
+        continue;
+      }
+      Error err = from_error_msg(*e);
+      const bool fatal = e->ref == 0 || std::find(fences_.begin(), fences_.end(), FenceHandle{e->ref}) != fences_.end();
+      it = inbox_.erase(it);
+      if (fatal) return err;
+      if (!async_error_) async_error_ = std::move(err);  // for an earlier fire-and-forget write
+    }
+    if (done()) return {};
+    if (interrupted()) return interrupted_error();
+    if (Clock::now() >= deadline)
+      return make_error("timed out waiting for " + std::string(what) + " from " + address_.to_string(), kTimeoutError);
+    if (auto r = pump(deadline, true); !r) return r.error();
+    if (auto r = send_pongs(timeout); !r) return r.error();
+  }
 }
 
 Result<std::string> Client::status(Timeout timeout) {

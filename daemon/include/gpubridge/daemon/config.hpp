@@ -28,7 +28,7 @@ inline constexpr std::uint64_t kMaxConfigFileBytes = 1u << 20;
 inline constexpr std::uint64_t kMaxTokenFileBytes = 4096;
 
 struct DaemonConfig {
-  std::vector<std::string> listen;  // "unix:PATH" | "tcp:HOST:PORT"; empty = the default Unix socket
+  std::vector<std::string> listen;  // "unix:PATH" | "tcp:HOST:PORT" | "tls:HOST:PORT"; empty = the default Unix socket
   std::string token;                // required from TCP clients when set
   std::string token_file;           // alternative to token (first line, trimmed)
   std::string backend = "sim";      // "sim" | "discard" | "fake" | board name | "auto"
@@ -40,6 +40,7 @@ struct DaemonConfig {
   std::string frames_dir;           // write every scanned-out frame as PNG here
   std::string record_dir;           // write each session's stream as a binary trace here
   std::string log_level = "info";
+  std::string tls_dir;              // TLS key + self-signed certificate (created on first start); empty = default_tls_dir()
   Limits limits;
 };
 

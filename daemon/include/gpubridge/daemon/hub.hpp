@@ -32,6 +32,7 @@ struct HubOptions {
   std::string frames_dir;  // PNG per scanned-out frame when non-empty
   std::string record_dir;  // binary trace per session when non-empty
   bool mirror = false;     // the backend is a MirrorBackend: frames carry the simulator's reference
+  std::string tls_fingerprint;  // the certificate clients pin, when TCP listeners speak TLS
 };
 
 class Hub {
@@ -82,7 +83,8 @@ class Hub {
   void hotplug_event() { hotplug_.event(); }
   void set_hotplug_notifications(bool on) { hotplug_.set_notifications(on); }
 
-  std::string device_json() const;     // WELCOME's device description
+  // WELCOME's device description, with the session's compression ("zstd" | "none") and transport.
+  std::string device_json(const std::string& compression = "none", const std::string& transport = "unix") const;
   nlohmann::json status_json() const;  // STATUS_REPLY
   std::uint64_t frames_seen() const { return feed_.count(); }
   MirrorStats mirror_stats() const { return feed_.mirror_stats(); }

@@ -11,6 +11,7 @@
 
 #include "gpubridge/common/result.hpp"
 #include "gpubridge/daemon/trace_recorder.hpp"
+#include "gpubridge/protocol/compression.hpp"
 #include "gpubridge/protocol/messages.hpp"
 
 namespace gpubridge::daemon {
@@ -29,6 +30,9 @@ class RequestHandler {
  private:
   void handle_hello(const protocol::Message& m);
   void handle_write_frames(const protocol::Message& m);
+  // WRITE_FRAMES_Z: inflates into inflated_ (bounded by max_message_bytes before it starts) and
+  // turns m into the WRITE_FRAMES it stands for. False when the session was failed or answered.
+  bool inflate(protocol::Message& m);
   void handle_read_reg(const protocol::Message& m);
   void handle_upload(const protocol::Message& m);
   void handle_readback(const protocol::Message& m);
@@ -51,6 +55,10 @@ class RequestHandler {
   std::unique_ptr<TraceRecorder> recorder_;
   std::uint32_t lease_request_id_ = 0;
   bool continues_ = false;  // set by a device_request step that started the next step of its message
+  // WRITE_FRAMES compression, when HELLO offered it (docs/protocol.md 17.6). inflated_ holds one
+  // message's frames while its device work runs (the session reads nothing meanwhile).
+  std::unique_ptr<protocol::FrameInflater> inflater_;
+  std::vector<std::uint8_t> inflated_;
 };
 
 }  // namespace gpubridge::daemon

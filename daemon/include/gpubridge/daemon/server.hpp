@@ -12,6 +12,7 @@
 
 #include <utility>  // before Asio: Boost 1.74's awaitable.hpp uses std::exchange without it
 #include <boost/asio.hpp>
+#include <boost/asio/ssl/context.hpp>
 
 #include "gpubridge/client/address.hpp"
 #include "gpubridge/daemon/hub.hpp"
@@ -25,7 +26,10 @@ class Server {
   Server(const Server&) = delete;
   Server& operator=(const Server&) = delete;
 
-  // Binds and starts accepting. Returns the bound address (TCP port 0 is resolved).
+  // TLS for TCP listeners: the key and certificate (tls_identity.hpp). Without it TCP is plain.
+  Result<void> enable_tls(const std::string& key_path, const std::string& cert_path);
+  // Binds and starts accepting. Returns the bound address (TCP port 0 is resolved). A TCP listener
+  // with TLS enabled takes TLS and plain clients; only TLS ones when it is `tls:` or not loopback.
   Result<client::Address> listen(const client::Address& address);
   // Stops accepting; the socket and lock files stay until stop() (shutdown: nothing can connect,
   // and no second daemon can start on the path while this one still runs). Idempotent.
@@ -40,12 +44,13 @@ class Server {
   void accept_unix(UnixListener& l);
   void accept_tcp(TcpListener& l);
   template <class Socket>
-  void admit(Socket socket, std::string transport, std::string peer);
+  void admit(Socket socket, std::string transport, std::string peer, const TcpListener* tcp_listener = nullptr);
 
   boost::asio::io_context& io_;
   Hub& hub_;
   std::vector<std::unique_ptr<UnixListener>> unix_;
   std::vector<std::unique_ptr<TcpListener>> tcp_;
+  std::shared_ptr<boost::asio::ssl::context> tls_;
   std::size_t refused_ = 0;
   bool accepting_ = true;
   bool stopped_ = false;

@@ -68,6 +68,8 @@ class Session : public std::enable_shared_from_this<Session> {
   const std::string& name() const { return name_; }
   std::string transport() const { return stream_->transport(); }
   std::string peer() const { return stream_->peer(); }
+  Stream::Security security() const { return stream_->security(); }
+  bool tls_required() const { return stream_->tls_required(); }
   bool handshaken() const { return handshaken_; }
   bool closed() const { return closing_ || terminated_; }
   bool subscribed() const { return subscription_.active(); }

@@ -27,6 +27,11 @@ class Stream {
   enum class PeerState { Open, HalfClosed, Gone };
   virtual PeerState peer_state() const { return PeerState::Open; }
   virtual std::string transport() const = 0;  // "unix" | "tcp" | "memory"
+  // TCP only: whether this connection is encrypted (decided by its first byte, tcp_stream.hpp).
+  enum class Security { Local, Undecided, Plain, Tls };
+  virtual Security security() const { return Security::Local; }
+  // The listener accepts only TLS (it is reachable from other machines, or was given as tls:).
+  virtual bool tls_required() const { return false; }
   virtual std::string peer() const = 0;       // for logs and status
 };
 

@@ -45,6 +45,7 @@ enum class MsgType : std::uint8_t {
   UploadAck = 0x14,
   Readback = 0x15,      // lease required
   ReadbackData = 0x16,
+  WriteFramesZ = 0x17,  // lease required; only after WELCOME named a codec (docs/protocol.md 17.6)
   Fence = 0x20,
   FenceDone = 0x21,     // every earlier command of this client has executed
   StatusReq = 0x22,
@@ -111,7 +112,20 @@ struct Header {
   static constexpr MsgType kType = MsgType::T;     \
   static constexpr std::string_view kName = NAME;  \
   static constexpr Sender kSender = Sender::SENDER
-struct Hello { GPUBRIDGE_MESSAGE(Hello, "HELLO", Client); std::uint16_t version = kSocketVersion; std::string name; std::string token; };
+// Compression of WRITE_FRAMES (docs/protocol.md 17.6). HELLO may end with a byte of codec bits the
+// client accepts; the server names its choice in WELCOME's JSON ("compression") and from then on
+// the client may send WRITE_FRAMES_Z in that codec. Bits the server does not know are ignored.
+enum class Codec : std::uint8_t { Zstd = 1 };
+inline constexpr std::uint8_t codec_bit(Codec c) { return static_cast<std::uint8_t>(1u << (static_cast<unsigned>(c) - 1)); }
+std::string_view to_string(Codec c);  // "zstd"
+
+struct Hello {
+  GPUBRIDGE_MESSAGE(Hello, "HELLO", Client);
+  std::uint16_t version = kSocketVersion;
+  std::string name;
+  std::string token;
+  std::optional<std::uint8_t> codecs = std::nullopt;  // codec_bit()s offered; absent = the original form (no compression)
+};
 struct Welcome {
   GPUBRIDGE_MESSAGE(Welcome, "WELCOME", Server);
   std::uint16_t version = kSocketVersion;
@@ -133,6 +147,13 @@ struct ReadbackData {
   GPUBRIDGE_MESSAGE(ReadbackData, "READBACK_DATA", Server);
   std::uint32_t address = 0;
   bool last = false;
+  std::span<const std::uint8_t> data;
+};
+// A WRITE_FRAMES payload of frames_bytes bytes, compressed with codec (only after WELCOME chose it).
+struct WriteFramesZ {
+  GPUBRIDGE_MESSAGE(WriteFramesZ, "WRITE_FRAMES_Z", Client);
+  Codec codec = Codec::Zstd;
+  std::uint32_t frames_bytes = 0;
   std::span<const std::uint8_t> data;
 };
 struct FenceMsg { GPUBRIDGE_MESSAGE(Fence, "FENCE", Client); std::uint64_t id = 0; };
@@ -168,9 +189,9 @@ struct DeviceEvent { GPUBRIDGE_MESSAGE(DeviceEvent, "DEVICE_EVENT", Server); std
 // Every message type: the decoder, to_string(MsgType), is_known_type() and sender() are derived
 // from this list.
 using Payload = std::variant<Hello, Welcome, ErrorMsg, Ping, Pong, Bye, WriteFrames, ReadReg, RegValue, Upload,
-                             UploadAck, Readback, ReadbackData, FenceMsg, FenceDone, StatusReq, StatusReply, Subscribe,
-                             Unsubscribe, FrameData, LeaseAcquire, LeaseGranted, LeaseRelease, LeaseReleased,
-                             DeviceEvent>;
+                             UploadAck, Readback, ReadbackData, WriteFramesZ, FenceMsg, FenceDone, StatusReq, StatusReply,
+                             Subscribe, Unsubscribe, FrameData, LeaseAcquire, LeaseGranted, LeaseRelease,
+                             LeaseReleased, DeviceEvent>;
 
 struct Message {
   std::uint32_t request_id = 0;

@@ -13,8 +13,9 @@ class ClientSink final : public CommandSink {
  public:
   // Uses a connected, handshaken client that holds the device lease.
   explicit ClientSink(client::Client& client);
-  // Connects to `address` ("" = the default socket), says hello as `name` and acquires the lease
-  // (waiting for it up to `timeout`).
+  // Connects to `address` ("" = $GPUBRIDGE_ADDRESS, else the default socket), says hello as `name`
+  // (token "" = $GPUBRIDGE_TOKEN / $GPUBRIDGE_TOKEN_FILE) and acquires the lease (waiting for it up
+  // to `timeout`).
   static Result<std::unique_ptr<ClientSink>> connect(std::string_view address, std::string_view name,
                                                      std::string_view token = {},
                                                      client::Timeout timeout = client::kDefaultTimeout);
@@ -30,6 +31,10 @@ class ClientSink final : public CommandSink {
   // From the daemon's WELCOME device description (backend, board, limits, "vram_bytes", "caps",
   // "id"); what it does not say keeps DeviceInfo's defaults, and 8 MiB of video memory.
   backends::DeviceInfo device() const override { return device_; }
+  Result<void> end_frame(unsigned max_in_flight) override {
+    if (auto h = client_->fence_async(); !h) return h.error();
+    return client_->wait_fences(max_in_flight);
+  }
 
   client::Client& client() { return *client_; }
 

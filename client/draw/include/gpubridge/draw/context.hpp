@@ -52,6 +52,11 @@ struct ContextOptions {
   bool depth_buffer = true;
   bool double_buffer = true;
   std::size_t batch_frames = 8192;  // pending register writes sent to the sink in one go
+  // swap() returns once at most this many swapped frames are still unexecuted (a remote daemon:
+  // pipelined fences, no round trip per frame; 0 = no pacing: only the socket buffers bound how far
+  // the program runs ahead of the device). Costs no memory in the program: the frames in flight
+  // are in the socket buffers.
+  unsigned frames_in_flight = 4;
 };
 
 // A vertex of an indexed mesh, in model space.
@@ -119,6 +124,7 @@ class Context {
   // is snapped from the x, y given, whatever its w (docs/protocol.md 16.2).
   Result<void> draw_screen(std::span<const geometry::ScreenVertex> vertices);
   // Shows the back buffer (FB_DISPLAY) and, double-buffered, starts drawing into the other one.
+  // Paced by ContextOptions::frames_in_flight.
   Result<void> swap();
   // Sends pending commands and waits until the device has executed them.
   Result<void> flush();

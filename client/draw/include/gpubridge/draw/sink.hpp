@@ -25,6 +25,13 @@ class CommandSink {
   // The device behind the sink: video memory, largest framebuffer and the CAPS register (a
   // program can fit itself to it, as the examples do).
   virtual backends::DeviceInfo device() const = 0;
+  // Frame pacing (Context::swap): marks the end of a frame and returns once at most
+  // `max_in_flight` marked frames have not executed yet. Sinks that execute in the caller's
+  // thread have nothing in flight; a remote daemon's (ClientSink) uses pipelined fences.
+  virtual Result<void> end_frame(unsigned max_in_flight) {
+    (void)max_in_flight;
+    return {};
+  }
   // Size of the device's video memory (bytes), used to place buffers and textures.
   std::uint64_t vram_bytes() const { return device().vram_bytes; }
 };
