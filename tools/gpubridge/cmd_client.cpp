@@ -230,7 +230,8 @@ int run_play(const GlobalOptions& g, const ClientOptions& o, const PlayOptions& 
             std::this_thread::sleep_for(std::min<Clock::duration>(due - Clock::now(), std::chrono::milliseconds(50)));
         }
       } else if (auto* u = std::get_if<protocol::UploadCmd>(&tc.command)) {
-        r = c->upload(u->address, u->data, {}, timeout);
+        // Pipelined, an upload is not a round trip either (its ACK is taken when it arrives).
+        r = p.sync ? c->upload(u->address, u->data, {}, timeout) : c->upload_async(u->address, u->data, timeout);
       } else if (auto* fe = std::get_if<protocol::FenceCmd>(&tc.command)) {
         (void)fe;
         r = pace(*c);

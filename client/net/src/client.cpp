@@ -145,6 +145,7 @@ Client& Client::operator=(Client&& o) noexcept {
     interrupt_ = o.interrupt_;
     tls_ = std::move(o.tls_);
     fences_ = std::move(o.fences_);
+    async_uploads_ = std::move(o.async_uploads_);
     fences_done_ = o.fences_done_;
     fence_callback_ = std::move(o.fence_callback_);
     deflater_ = std::move(o.deflater_);
@@ -361,6 +362,13 @@ Result<void> Client::pump(Clock::time_point deadline, bool block) {
         fences_.pop_front();
         if (fence_callback_) fence_callback_(h);
       }
+    } else if (std::holds_alternative<protocol::UploadAck>(m.payload) && !async_uploads_.empty() &&
+               async_uploads_.front() <= m.request_id) {
+      // An upload_async() chunk executed; nobody waits for its ACK. Ids before it were answered
+      // with an ERROR instead (kept as the async error).
+      while (!async_uploads_.empty() && async_uploads_.front() < m.request_id) async_uploads_.pop_front();
+      if (!async_uploads_.empty() && async_uploads_.front() == m.request_id) async_uploads_.pop_front();
+      else inbox_.push_back(std::move(m));
     } else if (auto* rd = std::get_if<protocol::ReadbackData>(&m.payload)) {
       // The span points into the parser buffer: keep an owning copy.
       readback_chunks_.push_back(ReadbackChunk{m.request_id, rd->last, {rd->data.begin(), rd->data.end()}});
@@ -528,6 +536,24 @@ Result<void> Client::upload(std::uint32_t address, std::span<const std::uint8_t>
     if (!reply) return reply.error();
     done += n;
     if (progress) progress(done, total);
+  }
+  return take_async_error();
+}
+
+Result<void> Client::upload_async(std::uint32_t address, std::span<const std::uint8_t> bytes, Timeout timeout) {
+  const std::size_t max_payload = session_.max_payload ? session_.max_payload : protocol::kMaxPayload;
+  const std::size_t chunk_max = std::min<std::size_t>(1u << 20, max_payload - 4);
+  for (std::size_t done = 0; done < bytes.size();) {
+    const std::size_t n = std::min(chunk_max, bytes.size() - done);
+    const std::uint64_t at = std::uint64_t{address} + done;
+    if (at > 0xFFFFFFFFull) return make_error("upload runs past the 32-bit address space", 1);
+    std::uint8_t head[protocol::kHeaderBytes + 4];
+    const auto id = next_request_id();
+    protocol::encode_header(MsgType::Upload, static_cast<std::uint32_t>(n + 4), id, head);
+    for (int i = 0; i < 4; ++i) head[protocol::kHeaderBytes + i] = static_cast<std::uint8_t>(at >> (8 * i));
+    async_uploads_.push_back(id);  // before sending: the ACK may be read while the send waits
+    if (auto r = send_raw(head, bytes.subspan(done, n), timeout); !r) return r;
+    done += n;
   }
   return take_async_error();
 }

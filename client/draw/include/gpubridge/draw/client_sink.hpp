@@ -21,8 +21,10 @@ class ClientSink final : public CommandSink {
                                                      client::Timeout timeout = client::kDefaultTimeout);
 
   Result<void> write_frames(protocol::FrameView frames) override { return client_->write_frames(frames); }
+  // Not waiting for UPLOAD_ACK: a texture streamed every frame costs no round trip (the daemon
+  // executes it in order; an error comes back with a later call).
   Result<void> upload(std::uint32_t address, std::span<const std::uint8_t> bytes) override {
-    return client_->upload(address, bytes);
+    return client_->upload_async(address, bytes);
   }
   Result<std::vector<std::uint8_t>> readback(std::uint32_t address, std::uint32_t length) override {
     return client_->readback(address, length);

@@ -108,6 +108,10 @@ class Client {
   Result<std::uint64_t> read_register(std::uint8_t index, Timeout timeout = kDefaultTimeout);
   Result<void> upload(std::uint32_t address, std::span<const std::uint8_t> bytes, const Progress& progress = {},
                       Timeout timeout = kDefaultTimeout);
+  // Like upload(), but returns once the bytes are handed to the kernel: the UPLOAD_ACKs are taken
+  // as they arrive and an error is returned by a later wait (like write_frames). For streaming
+  // textures over a link with latency (the drawing API's uploads use it).
+  Result<void> upload_async(std::uint32_t address, std::span<const std::uint8_t> bytes, Timeout timeout = kDefaultTimeout);
   Result<std::vector<std::uint8_t>> readback(std::uint32_t address, std::uint32_t length, const Progress& progress = {},
                                              Timeout timeout = kDefaultTimeout);
   // Blocks until the daemon has executed every earlier command of this client (one round trip).
@@ -197,6 +201,7 @@ class Client {
   std::vector<std::vector<std::uint8_t>> pongs_;  // owed for the daemon's PINGs, sent between messages
   const std::atomic<bool>* interrupt_ = nullptr;
   std::deque<FenceHandle> fences_;  // outstanding, in the order sent
+  std::deque<std::uint32_t> async_uploads_;  // UPLOAD request ids whose ACK nobody waits for
   FenceHandle fences_done_ = 0;     // the newest completed handle (they complete in order)
   std::function<void(FenceHandle)> fence_callback_;
   std::unique_ptr<protocol::FrameDeflater> deflater_;  // when WELCOME agreed to compression
