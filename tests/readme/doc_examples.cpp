@@ -128,10 +128,36 @@ std::vector<Example> make() {
       skip("build/tools/gpubridge bench daemon",
            "a 20-second measurement on a machine shared with the rest of the suite; CTest bench_daemon_smoke runs "
            "it with fewer rounds"),
+      skip("build/tools/gpubridge bench remote",
+           "minutes of paced frame streams on a machine shared with the rest of the suite; CTest bench_remote_smoke "
+           "runs it on one example with few frames"),
       run("build/tools/gpubridge bench usb")
           .prints(R"(write-heavy frame: 30000 register writes, payload/SPI clock bits = [\d.]+%)"),
       skip("build/bench/protocol/protocol_parser_bench",
            "Google Benchmark runs for minutes (and is built only with libbenchmark)"),
+  }});
+
+  // Issue 21: TLS with a pinned fingerprint, the token from the environment, the viewer and the
+  // demo pointed at the daemon over tls: (each line in its own shell, so the variables are inline).
+  all.push_back({"README.md", "Remote use", 0, "README_RemoteUse", {
+      run("echo \"a-long-random-secret\" > token && chmod 600 token").leaves("token"),
+      daemon("build/daemon/gpubridged --listen tcp:0.0.0.0:7420 --listen unix: --token-file token &")
+          .prints(R"(tls fingerprint SHA256:[0-9a-f]{64})")
+          .prints("listening on tcp:0.0.0.0:7420"),
+      run("build/daemon/gpubridged --tls-fingerprint").prints(R"(^SHA256:[0-9a-f]{64}\n$)"),
+      run("GPUBRIDGE_ADDRESS=tls:127.0.0.1:7420 GPUBRIDGE_TOKEN_FILE=token build/tools/gpubridge status")
+          .prints("daemon: +gpubridged .* at tls:127.0.0.1:7420")
+          .warns(R"(trusting the daemon at tls:127\.0\.0\.1:7420 on first use: certificate SHA256:[0-9a-f]{64})"),
+      viewer("build/viewer/gpubridge-view --connect tls:127.0.0.1:7420 --token \"$(cat token)\" &",
+             {R"(gpubridge-view - tls:127\.0\.0\.1:7420)"}),
+      run("GPUBRIDGE_ADDRESS=tls:127.0.0.1:7420 GPUBRIDGE_TOKEN_FILE=token build/examples/gpubridge-demo stream "
+          "terrain --frames 90")
+          .prints(R"(terrain +90 frames in [\d.]+ s)")
+          .within(120),
+      run("GPUBRIDGE_ADDRESS=tls:127.0.0.1:7420 GPUBRIDGE_TOKEN_FILE=token build/tools/gpubridge play "
+          "tests/daemon/data/triangle.trace --fps 30 --repeat 60")
+          .prints(R"(played tests/daemon/data/triangle\.trace: \d+ register writes, 60 swaps)")
+          .within(120),
   }});
 
   all.push_back({"README.md", "Testing", 0, "README_Testing", {
