@@ -248,24 +248,36 @@ TEST_F(DaemonE2E, NonLoopbackTcpNeedsAToken) {
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("token"), std::string::npos) << r.err;
 
-  start({"--listen", "tcp:0.0.0.0:0", "--token", "s3cret"});
+  start({"--listen", "tcp:0.0.0.0:0", "--token", "s3cret", "--tls-dir", (dir_ / "tls").string()});
   ASSERT_EQ(daemon_.endpoints().size(), 2u);
   const auto port = daemon_.endpoints()[1].substr(daemon_.endpoints()[1].rfind(':') + 1);
-  const std::string addr = "tcp:127.0.0.1:" + port;
+  // A listener other machines can reach takes TLS only (issue 21): the token never crosses in clear.
+  ::setenv("GPUBRIDGE_KNOWN_HOSTS", (dir_ / "known_hosts").c_str(), 1);
+  {
+    auto c = client::Client::connect("tcp:127.0.0.1:" + port, 1000ms);
+    ASSERT_TRUE(c) << c.error().message;
+    auto h = c->handshake("plain", "s3cret", 2000ms);
+    ASSERT_FALSE(h);
+    EXPECT_TRUE(client::is_protocol_error(h.error(), protocol::ErrorCode::AuthFailed)) << h.error().message;
+    EXPECT_NE(h.error().message.find("takes TLS only"), std::string::npos) << h.error().message;
+  }
+  const std::string addr = "tls:127.0.0.1:" + port;
   {
     auto c = client::Client::connect(addr, 1000ms);
     ASSERT_TRUE(c) << c.error().message;
     auto h = c->handshake("intruder", "wrong", 2000ms);
     ASSERT_FALSE(h);
     EXPECT_TRUE(client::is_protocol_error(h.error(), protocol::ErrorCode::AuthFailed)) << h.error().message;
+    EXPECT_NE(h.error().message.find("token rejected"), std::string::npos) << h.error().message;
   }
   {
     auto c = client::Client::connect(addr, 1000ms);
-    ASSERT_TRUE(c);
+    ASSERT_TRUE(c) << c.error().message;
     auto h = c->handshake("friend", "s3cret", 2000ms);
     ASSERT_TRUE(h) << h.error().message;
     EXPECT_TRUE(c->ping(1000ms));
   }
+  ::unsetenv("GPUBRIDGE_KNOWN_HOSTS");
   // The Unix socket needs no token: file permissions guard it.
   auto u = connect("local");
   EXPECT_TRUE(u.ping(1000ms));

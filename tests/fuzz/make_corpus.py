@@ -30,8 +30,18 @@ def frame(index, data, read=False):
     return bytes([(0x80 if read else 0) | index]) + struct.pack(">Q", data)
 
 
-def hello(name=b"fuzz", token=b""):
-    return msg(0x01, struct.pack("<HB", 1, len(name)) + name + bytes([len(token)]) + token)
+def hello(name=b"fuzz", token=b"", codecs=None):
+    extra = b"" if codecs is None else bytes([codecs])
+    return msg(0x01, struct.pack("<HB", 1, len(name)) + name + bytes([len(token)]) + token + extra)
+
+
+def zstd(data):
+    return subprocess.run(["zstd", "-q", "-1", "-c"], input=data, capture_output=True, check=True).stdout
+
+
+def write_frames_z(frames, rid):
+    """WRITE_FRAMES_Z (docs/protocol.md 17.6): codec 1 (zstd), frames_bytes, compressed frames."""
+    return msg(0x17, struct.pack("<BI", 1, len(frames)) + zstd(frames), rid)
 
 
 FRAMES = frame(0x0F, (480 << 16) | 640) + frame(0x0B, 0) + frame(0x02, 0x00FFFFFF00100020) + frame(0x04, 0x0D)
@@ -53,6 +63,13 @@ MESSAGES = {
     "event": msg(0x50, b'{"event":"unplugged"}'),
     "bad_read_bit": msg(0x10, frame(0x10, 0, read=True)),
     "huge_length": b"GB\x01\x13" + struct.pack("<II", 0xFFFFFFFF, 1),
+    # HELLO offering zstd, then a compressed batch, a zip bomb (1 MiB declared as 9 bytes) and a
+    # compressed read frame.
+    "zstd_session": hello(codecs=1) + msg(0x40, b"\x00") + write_frames_z(FRAMES * 8, 2)
+    + msg(0x20, struct.pack("<Q", 7), 3),
+    "zstd_bomb": hello(codecs=1) + msg(0x40, b"\x00")
+    + msg(0x17, struct.pack("<BI", 1, 9) + zstd(bytes(1 << 20)), 2),
+    "zstd_read_frame": hello(codecs=1) + msg(0x40, b"\x00") + write_frames_z(frame(0x10, 0, read=True), 2),
 }
 
 
