@@ -72,6 +72,14 @@ MESSAGES = {
     "zstd_read_frame": hello(codecs=1) + msg(0x40, b"\x00") + write_frames_z(frame(0x10, 0, read=True), 2),
 }
 
+# After daemon_session_fuzz's own HELLO (offering zstd): a lease, then a compressed batch and a
+# fence, a zip bomb, or a compressed read frame.
+SESSION_ZSTD = {
+    "session_zstd_batch": msg(0x40, b"\x00") + write_frames_z(FRAMES * 8, 2) + msg(0x20, struct.pack("<Q", 7), 3),
+    "session_zstd_bomb": msg(0x40, b"\x00") + msg(0x17, struct.pack("<BI", 1, 9) + zstd(bytes(1 << 20)), 2),
+    "session_zstd_read_frame": msg(0x40, b"\x00") + write_frames_z(frame(0x10, 0, read=True), 2),
+}
+
 
 def trace(records, meta=b'{"created_by":"make_corpus.py"}'):
     out = b"GBTRACE\x00" + struct.pack("<HHI", 1, 0, len(meta)) + meta
@@ -314,6 +322,11 @@ def main():
         # The fuzz target's first byte chooses the receive limit (odd: small limit); keep it even here
         # so the seeds parse with the full limit.
         write("message_parser", name, b"\x00" + data)
+    # daemon_session_fuzz shares this corpus but reads byte 0 as flags (bit 0: prepend a HELLO, bit 1:
+    # that HELLO offers zstd, bits 2-4: read split count - 1) and the next bytes as split sizes:
+    # 0x03 + one split byte reaches WRITE_FRAMES_Z inflation after a HELLO offering zstd.
+    for name, data in SESSION_ZSTD.items():
+        write("message_parser", name, b"\x03\x60" + data)
     for name, data in TRACES.items():
         write("binary_trace", name + ".gbt", data)
     for name, data in TEXTS.items():
