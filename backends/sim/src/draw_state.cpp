@@ -6,6 +6,28 @@ namespace gpubridge::sim {
 
 using namespace protocol;
 
+namespace {
+
+// The stored bits of a pixel of format f that TRI_MODE's write mask keeps (RGBA8888: the bytes of
+// the colour word, byte c = channel c).
+std::uint32_t keep_bits_of(PixelFormat f, std::uint8_t keep_mask) {
+  std::uint32_t bits = 0;
+  if (f == PixelFormat::RGB565) {
+    if (keep_mask & 1) bits |= 0xF800;
+    if (keep_mask & 2) bits |= 0x07E0;
+    if (keep_mask & 4) bits |= 0x001F;
+  } else if (f == PixelFormat::RGBA2222) {
+    for (unsigned c = 0; c < 4; ++c)
+      if (keep_mask & (1u << c)) bits |= 3u << (6 - 2 * c);
+  } else {
+    for (unsigned c = 0; c < 4; ++c)
+      if (keep_mask & (1u << c)) bits |= 0xFFu << (8 * c);
+  }
+  return bits;
+}
+
+}  // namespace
+
 DrawState decode_draw_state(const RegisterValues& r, std::uint64_t vram_bytes) {
   DrawState s;
   const std::uint64_t m = r.tri_mode;
@@ -56,6 +78,7 @@ DrawState decode_draw_state(const RegisterValues& r, std::uint64_t vram_bytes) {
   const std::uint64_t clen = pixels * s.bpp, zlen = pixels * 4;
   s.buffers_disjoint = s.fb_draw + clen <= s.fb_z || s.fb_z + zlen <= s.fb_draw;
   s.simple_color = s.fb_format == PixelFormat::RGBA8888 && s.blend == BlendMode::Off && !some_masked;
+  s.keep_bits = keep_bits_of(s.fb_format, s.keep_mask);
   return s;
 }
 

@@ -4,8 +4,8 @@
 // stored bits) with optional texture (as the span routine: texels fetched lane by lane, filter and
 // combine in lanes), blend and write mask, optional depth test/write. One row of the box is one
 // 8-lane step: the three edge functions, the coverage mask, every attribute plane and the depth
-// compare are lane vectors, the colour and depth rows are read
-// and written whole and merged under the mask. There is no branch per pixel or per row (a small
+// compare are lane vectors, the colour and depth rows are read and written whole and merged under
+// the mask (pixel8.hpp, the pixel stage it shares with the span routine). There is no branch per pixel or per row (a small
 // triangle's rows are too short for per-pixel branches to predict), and the arithmetic is the
 // exact (q, r) stepping of the scalar routine with 32-bit lanes, so the output is the same byte
 // for byte.
@@ -18,7 +18,7 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "texture_lanes.hpp"
+#include "pixel_lanes.hpp"
 
 namespace gpubridge::sim {
 
@@ -31,22 +31,13 @@ struct NarrowTriangle {
   std::uint32_t q[kPlanes], r[kPlanes];
   std::uint32_t qx[kPlanes], rx[kPlanes], qy[kPlanes], ry[kPlanes];
   std::uint32_t den = 1;
-  unsigned width = 0, rows = 0;  // box width (<= 8) and rows to draw
-  std::uint32_t flat = 0;        // colour word (memory order R,G,B,A) when !gouraud
-  std::uint32_t zmask = 0xFFFFFF;
+  unsigned width = 0, rows = 0;    // box width (<= 8) and rows to draw
   std::uint8_t* color = nullptr;   // first pixel of the first row
   std::uint8_t* depth = nullptr;   // its depth word (when z_test or z_write)
   std::size_t pitch = 0;           // bytes per depth row (4 per pixel)
   std::size_t color_pitch = 0;     // bytes per colour row (4, 2 or 1 per pixel)
-  unsigned format = 0;             // protocol::PixelFormat of the colour buffer
-  std::uint32_t keep_packed = 0;   // packed formats: the stored bits the write mask keeps
   std::uint32_t bayer[4][8] = {};  // packed formats with dither: threshold index of row (first + j) % 4, lane k
-  bool temporal = false;           // packed formats: the temporal quantiser (section 11) on `bayer`
-  unsigned z_func = 0;             // protocol::DepthFunc
-  unsigned blend = 0;              // protocol::BlendMode (0 = off)
-  std::uint32_t keep = 0;          // bytes of the colour word the write mask keeps
-  bool gouraud = false, z_test = false, z_write = false;
-  TextureLanes texture;  // texture.tex == nullptr: untextured
+  PixelLanes pixel;                // the draw's depth, texture and colour stages
 };
 
 struct NarrowCounts {

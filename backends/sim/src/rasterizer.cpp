@@ -29,26 +29,27 @@ bool texture_disjoint(const DrawState& st, bool depth) {
   return apart(st.fb_draw, pixels * st.bpp) && (!depth || apart(st.fb_z, pixels * 4));
 }
 
-// The bytes of a colour word (byte c = channel c) that TRI_MODE's write mask keeps.
-std::uint32_t keep_bytes(std::uint8_t keep_mask) {
-  std::uint32_t bytes = 0;
-  for (unsigned c = 0; c < 4; ++c)
-    if (keep_mask & (1u << c)) bytes |= 0xFFu << (8 * c);
-  return bytes;
+// The Z bits a depth buffer of ctx.z_bits precision compares and stores.
+std::uint32_t z_mask(const RasterContext& ctx) {
+  return ctx.z_bits >= 24 ? 0xFFFFFFu : 0xFFFFFFu & ~((1u << (24 - ctx.z_bits)) - 1);
 }
 
-// The bits of a packed pixel (RGB565, RGBA2222) that TRI_MODE's write mask keeps; 0 for RGBA8888.
-std::uint32_t keep_packed_bits(protocol::PixelFormat f, std::uint8_t keep_mask) {
-  std::uint32_t bits = 0;
-  if (f == protocol::PixelFormat::RGB565) {
-    if (keep_mask & 1) bits |= 0xF800;
-    if (keep_mask & 2) bits |= 0x07E0;
-    if (keep_mask & 4) bits |= 0x001F;
-  } else if (f == protocol::PixelFormat::RGBA2222) {
-    for (unsigned c = 0; c < 4; ++c)
-      if (keep_mask & (1u << c)) bits |= 3u << (6 - 2 * c);
-  }
-  return bits;
+// The vector routines' pixel stage for a draw (pixel_lanes.hpp): colour `flat` when !gouraud,
+// the depth test and write only when `depth` (the routine has a depth buffer). The texture stage
+// is the caller's.
+inline void set_pixel_lanes(PixelLanes& px, const DrawState& st, const RasterContext& ctx, Rgba8 flat, bool gouraud,
+                     bool depth) {
+  px.flat = std::uint32_t{flat.r} | (std::uint32_t{flat.g} << 8) | (std::uint32_t{flat.b} << 16) |
+            (std::uint32_t{flat.a} << 24);
+  px.zmask = z_mask(ctx);
+  px.format = st.fb_format;
+  px.z_func = st.z_func;
+  px.blend = st.blend;
+  px.keep = st.keep_bits;
+  px.temporal = st.dither.temporal && st.fb_format != protocol::PixelFormat::RGBA8888;
+  px.gouraud = gouraud;
+  px.z_test = depth && st.z_test;
+  px.z_write = depth && st.z_write;
 }
 
 // Rows this long or longer find their covered span by division instead of testing every pixel.
@@ -70,7 +71,7 @@ class Kernel {
     width_ = st.fb_width;
     color_ = ctx.mem.data() + st.fb_draw;
     zbuf_ = ctx.mem.data() + st.fb_z;
-    zmask_ = ctx.z_bits >= 24 ? 0xFFFFFFu : 0xFFFFFFu & ~((1u << (24 - ctx.z_bits)) - 1);
+    zmask_ = z_mask(ctx);
     const std::uint8_t stored = st.fb_format == protocol::PixelFormat::RGB565 ? 0x7 : 0xF;
     skip_color_ = (st.keep_mask & stored) == stored;
     if (kGouraud) {
@@ -241,19 +242,8 @@ class Kernel {
         }
       }
     }
-    simd_tpl_.flat = std::uint32_t{flat_.r} | (std::uint32_t{flat_.g} << 8) | (std::uint32_t{flat_.b} << 16) |
-                     (std::uint32_t{flat_.a} << 24);
-    simd_tpl_.zmask = zmask_;
-    simd_tpl_.gouraud = kGouraud;
-    simd_tpl_.z_test = kDepth && st_.z_test;
-    simd_tpl_.z_write = kDepth && st_.z_write;
-    simd_tpl_.z_func = static_cast<unsigned>(st_.z_func);
-    simd_tpl_.blend = static_cast<unsigned>(st_.blend);
-    simd_tpl_.keep = keep_bytes(st_.keep_mask);
-    simd_tpl_.format = static_cast<unsigned>(st_.fb_format);
-    simd_tpl_.keep_packed = keep_packed_bits(st_.fb_format, st_.keep_mask);
-    simd_tpl_.temporal = st_.dither.temporal && st_.fb_format != protocol::PixelFormat::RGBA8888;
-    if (kTextured) simd_tpl_.texture = {&tex_, &ctx_.recip, q_const_, const_rc_, st_.tex.wl, st_.tex.hl, st_.decal};
+    set_pixel_lanes(simd_tpl_.pixel, st_, ctx_, flat_, kGouraud, kDepth);
+    if (kTextured) simd_tpl_.pixel.texture = {&tex_, &ctx_.recip, q_const_, const_rc_, st_.tex.wl, st_.tex.hl, st_.decal};
     simd_ = true;
   }
   static constexpr bool simd_plane_used(unsigned p) { return p < 4 ? kGouraud : p == 4 ? kDepth : kTextured; }
@@ -407,6 +397,7 @@ bool draw_narrow(const Triangle& t, const DrawState& st, RasterContext& ctx, int
   if (st.textured && (ctx.fast || !st.tex.in_vram || !texture_disjoint(st, depth))) return false;
   if (t.den >= (std::int64_t{1} << 28)) return false;
   NarrowTriangle n;
+  set_pixel_lanes(n.pixel, st, ctx, Rgba8{t.flat[0], t.flat[1], t.flat[2], t.flat[3]}, gouraud, depth);
   // Every channel masked (with a Z write, or the draw would have been dropped): the colour stage,
   // texture and blend included, does not run, as in the scalar routine.
   const std::uint8_t stored = st.fb_format == protocol::PixelFormat::RGB565 ? 0x7 : 0xF;  // RGB565 has no alpha
@@ -416,8 +407,9 @@ bool draw_narrow(const Triangle& t, const DrawState& st, RasterContext& ctx, int
   if (textured) {
     unit.emplace(st.tex, ctx.mem);
     const bool q_const = t.plane[kQ].constant && t.plane[kQ].q != 0;  // affine: one reciprocal
-    n.texture = {&*unit, &ctx.recip, q_const, q_const ? ctx.recip(static_cast<std::uint32_t>(t.plane[kQ].q)) : Reciprocal{},
-                 st.tex.wl, st.tex.hl, st.decal};
+    n.pixel.texture = {&*unit, &ctx.recip, q_const,
+                       q_const ? ctx.recip(static_cast<std::uint32_t>(t.plane[kQ].q)) : Reciprocal{},
+                       st.tex.wl, st.tex.hl, st.decal};
   }
   const std::int64_t k = ya - t.y0, rows = yz - ya;
   for (int i = 0; i < 3; ++i) {
@@ -445,26 +437,14 @@ bool draw_narrow(const Triangle& t, const DrawState& st, RasterContext& ctx, int
   n.den = static_cast<std::uint32_t>(t.den);
   n.width = static_cast<unsigned>(w);
   n.rows = static_cast<unsigned>(rows);
-  n.flat = std::uint32_t{t.flat[0]} | (std::uint32_t{t.flat[1]} << 8) | (std::uint32_t{t.flat[2]} << 16) |
-           (std::uint32_t{t.flat[3]} << 24);
-  n.zmask = ctx.z_bits >= 24 ? 0xFFFFFFu : 0xFFFFFFu & ~((1u << (24 - ctx.z_bits)) - 1);
   const std::size_t pix = static_cast<std::size_t>(ya) * st.fb_width + static_cast<std::size_t>(t.x0);
   n.color = ctx.mem.data() + st.fb_draw + pix * st.bpp;
   n.depth = depth ? ctx.mem.data() + st.fb_z + pix * 4 : nullptr;
   n.pitch = std::size_t{st.fb_width} * 4;
   n.color_pitch = std::size_t{st.fb_width} * st.bpp;
-  n.format = static_cast<unsigned>(st.fb_format);
-  n.keep_packed = keep_packed_bits(st.fb_format, st.keep_mask);
   if (st.dither.on && st.fb_format != protocol::PixelFormat::RGBA8888)
     for (int j = 0; j < 4; ++j)
       for (int lane = 0; lane < 8; ++lane) n.bayer[j][lane] = dither_threshold(st.dither, t.x0 + lane, ya + j);
-  n.temporal = st.dither.temporal && st.fb_format != protocol::PixelFormat::RGBA8888;
-  n.z_func = static_cast<unsigned>(st.z_func);
-  n.gouraud = gouraud;
-  n.z_test = st.z_test;
-  n.z_write = st.z_write;
-  n.blend = static_cast<unsigned>(st.blend);
-  n.keep = keep_bytes(st.keep_mask);
   const NarrowCounts c = shade_narrow_simd(n);
   ctx.counters.scanned += static_cast<std::uint64_t>(w) * static_cast<std::uint64_t>(rows);
   ctx.counters.covered += c.covered;

@@ -1,6 +1,6 @@
 #pragma once
-// The texture stage of the vector routines (span_simd.cpp, narrow_simd.cpp), for eight lanes.
-// Internal to those routines' .cpp files: it is inlined into their target clones.
+// The texture stage of the vector routines for eight lanes (called by pixel8.hpp). Internal to
+// those routines' .cpp files: it is inlined into their target clones.
 #include "simd_lanes.hpp"
 #include "texture.hpp"
 #include "texture_lanes.hpp"
@@ -9,16 +9,16 @@ namespace gpubridge::sim {
 
 // The texture stage for eight pixels (section 10): lanes that passed the depth test get their
 // texel coordinates and addressed neighbours one by one (64-bit products, a table lookup), then
-// the bilinear filter and the combine with the vertex colour `colour` run in lanes. Returns the
+// the bilinear filter and the combine with the vertex colour `color` run in lanes. Returns the
 // combined colour words.
 [[gnu::always_inline]] inline simd::u32x8 texture8(const TextureLanes& s, simd::u32x8 sq, simd::u32x8 tq,
                                                    simd::u32x8 qq, simd::u32x8 pass, unsigned n, simd::u32x8 color) {
   using simd::u32x8;
   std::uint32_t sv[8], tv[8], qv[8], pv[8];
-  GB_STORE8(sv, sq);
-  GB_STORE8(tv, tq);
-  GB_STORE8(qv, qq);
-  GB_STORE8(pv, pass);
+  simd::store8(sv, sq);
+  simd::store8(tv, tq);
+  simd::store8(qv, qq);
+  simd::store8(pv, pass);
   alignas(32) std::uint32_t c00[8] = {}, c10[8] = {}, c01[8] = {}, c11[8] = {}, fu[8] = {}, fv[8] = {};
   // Texel coordinates of every lane first, in a branch-free loop of independent chains (the
   // reciprocal's multiplies overlap across lanes); q = 0 gives (0, 0) as in the scalar routine.
@@ -36,15 +36,10 @@ namespace gpubridge::sim {
   }
   for (unsigned k = 0; k < n; ++k)
     if (pv[k]) s.tex->quad(tc[k], c00[k], c10[k], c01[k], c11[k], fu[k], fv[k]);  // rejected lanes: never sampled
-  u32x8 texel;
-  GB_LOAD8(texel, c00);
+  u32x8 texel = simd::load8(c00);
   if (s.tex->bilinear()) {
-    u32x8 t10, t01, t11, u, v;
-    GB_LOAD8(t10, c10);
-    GB_LOAD8(t01, c01);
-    GB_LOAD8(t11, c11);
-    GB_LOAD8(u, fu);
-    GB_LOAD8(v, fv);
+    const u32x8 t10 = simd::load8(c10), t01 = simd::load8(c01), t11 = simd::load8(c11);
+    const u32x8 u = simd::load8(fu), v = simd::load8(fv);
     const u32x8 w00 = (256u - u) * (256u - v), w10 = u * (256u - v), w01 = (256u - u) * v, w11 = u * v;
     const u32x8 t00 = texel;
     texel = u32x8{};
@@ -58,7 +53,7 @@ namespace gpubridge::sim {
   u32x8 out = {};
   for (unsigned c = 0; c < 32; c += 8) {  // section 10.5 modulate: div255(texel · colour) per channel
     const u32x8 x = ((texel >> c) & 255u) * ((color >> c) & 255u);
-    out |= GB_DIV255(x) << c;
+    out |= simd::div255(x) << c;
   }
   return out;
 }

@@ -1,0 +1,70 @@
+#pragma once
+// The pixel stage of both vector routines (span_simd.cpp, narrow_simd.cpp) for eight lanes, in
+// section 11's order: depth test and Z write, the colour (flat, Gouraud or textured), blend, write
+// mask and store in the buffer's format. Internal to those routines' .cpp files: it is inlined into
+// their target clones.
+#include <cstdint>
+
+#include "color_lanes.hpp"
+#include "pixel_lanes.hpp"
+#include "simd_lanes.hpp"
+#include "texture8.hpp"
+
+namespace gpubridge::sim::simd {
+
+// How the caller's chunks fall. A span's chunks of eight mostly pass or fail whole (long rows,
+// coherent depth), so `Chunk::Span` checks: a chunk that fails whole touches nothing after the
+// depth read, and one that passes whole stores its colour without reading it. A small triangle's
+// box rows rarely do, and a branch on it would mispredict: `Chunk::Row` merges every row.
+enum class Chunk { Span, Row };
+
+// Eight pixels: colour at cp, depth at zp (when the draw tests or writes depth); lanes 0..n-1
+// are pixels and `pass` holds the covered ones among them; `whole` as for load_words; q the
+// lanes' planes (R, G, B, A when gouraud, Z when depth, S, T, Q when textured); `bayer` the lanes'
+// dither threshold indices (packed formats). Returns the lanes that passed the depth test.
+template <bool kTextured, PixelFormat kFormat, Chunk kChunk>
+[[gnu::always_inline]] inline u32x8 pixel8(const PixelLanes& px, const u32x8* q, u32x8 pass, std::uint8_t* cp,
+                                           std::uint8_t* zp, unsigned n, bool whole, u32x8 bayer) {
+  bool none = false, all = n == 8;
+  if (px.z_test || px.z_write) {
+    const u32x8 z = q[4] & px.zmask;
+    const u32x8 old = load_words(zp, n, whole);  // lanes beyond n are masked off
+    if (px.z_test) pass = depth_test(px.z_func, pass, (i32x8)z, (i32x8)(bswap(old) & 0xFFFFFFu));  // both < 2^24
+    if constexpr (kChunk == Chunk::Span) {
+      std::uint64_t m[4];
+      std::memcpy(m, &pass, sizeof m);
+      none = (m[0] | m[1] | m[2] | m[3]) == 0;
+      all = all && (m[0] & m[1] & m[2] & m[3]) == ~std::uint64_t{0};
+    }
+    if (px.z_write && !none) store_words(zp, (bswap(z) & pass) | (old & ~pass), n);
+  }
+  if (none) return pass;  // rejected chunks touch no colour
+  u32x8 word = u32x8{} + px.flat;
+  if (px.gouraud) word = (q[0] & 255u) | ((q[1] & 255u) << 8) | ((q[2] & 255u) << 16) | (q[3] << 24);
+  if constexpr (kTextured) word = texture8(px.texture, q[5], q[6], q[7], pass, n, word);
+  const bool need_old = kChunk == Chunk::Row || px.blend != protocol::BlendMode::Off || px.keep != 0 || !all;
+  write_color8<kFormat>(cp, n, word, pass, need_old, px.blend, bayer, px.temporal, px.keep, whole);
+  return pass;
+}
+
+// The routine instance for the draw's colour buffer format and texture: `routine` is a lambda
+// template <bool kTextured, PixelFormat kFormat>, marked always_inline like every helper here, so
+// that each instance inlines into the caller's target clone. The one place where a draw's modes
+// become template parameters.
+template <class Routine>
+[[gnu::always_inline]] inline auto dispatch(const PixelLanes& px, const Routine& routine) {
+  const bool textured = px.texture.tex != nullptr;
+  switch (px.format) {
+    case PixelFormat::RGB565:
+      return textured ? routine.template operator()<true, PixelFormat::RGB565>()
+                      : routine.template operator()<false, PixelFormat::RGB565>();
+    case PixelFormat::RGBA2222:
+      return textured ? routine.template operator()<true, PixelFormat::RGBA2222>()
+                      : routine.template operator()<false, PixelFormat::RGBA2222>();
+    case PixelFormat::RGBA8888: break;
+  }
+  return textured ? routine.template operator()<true, PixelFormat::RGBA8888>()
+                  : routine.template operator()<false, PixelFormat::RGBA8888>();
+}
+
+}  // namespace gpubridge::sim::simd
