@@ -111,17 +111,13 @@ template <PixelFormat kFormat>
   else return temporal ? pack_channels<kFormat, true>(word, bayer) : pack_channels<kFormat, false>(word, bayer);
 }
 
-// The whole colour write of n pixels at p. `need_old`: the stored pixels matter (blend, write mask,
-// or lanes that do not pass); without it nothing is read and every lane is stored. `keep_bits`:
-// the stored bits the write mask keeps. `whole`: as for load_color.
+// The colour write of n pixels at p merged with the stored ones: blend (`mode`), the bits the
+// write mask keeps (`keep_bits`) and the lanes that do not pass keep what is stored. `whole`: as
+// for load_color.
 template <PixelFormat kFormat>
-[[gnu::always_inline]] inline void write_color8(std::uint8_t* p, unsigned n, u32x8 word, u32x8 pass, bool need_old,
+[[gnu::always_inline]] inline void write_color8(std::uint8_t* p, unsigned n, u32x8 word, u32x8 pass,
                                                 protocol::BlendMode mode, u32x8 bayer, bool temporal,
                                                 std::uint32_t keep_bits, bool whole) {
-  if (!need_old) {  // a fully passing chunk of a plain store: no read
-    store_color<kFormat>(p, pack_color<kFormat>(word, bayer, temporal), n);
-    return;
-  }
   const u32x8 old = load_color<kFormat>(p, n, whole);
   if (mode != protocol::BlendMode::Off) word = blend(mode, word, expand_color<kFormat>(old));
   u32x8 out = pack_color<kFormat>(word, bayer, temporal);

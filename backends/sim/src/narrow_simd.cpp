@@ -11,9 +11,7 @@ using simd::u32x8;
 // One instance per plane count (constant loop bounds keep the lanes in registers).
 template <bool kTextured, PixelFormat kFormat>
 [[gnu::always_inline]] inline NarrowCounts shade_narrow(const NarrowTriangle& t) {
-  // A local copy: the stage's modes stay in registers (the colour stores, through byte pointers,
-  // could alias t.pixel, so its fields would be reloaded every row).
-  const PixelLanes px = t.pixel;
+  const PixelLanes& px = t.pixel;
   const i32x8 lane = {0, 1, 2, 3, 4, 5, 6, 7};
   const u32x8 in_box = simd::mask(lane < static_cast<std::int32_t>(t.width));
   i32x8 e[3];
@@ -22,8 +20,8 @@ template <bool kTextured, PixelFormat kFormat>
   // and 1 den where it fits (exact floor-divmod). q wraps modulo 2^32; covered lanes hold
   // attribute values, which are far below 2^32, so they are exact.
   const unsigned first = px.gouraud ? 0 : 4;
-  const bool depth = px.z_test || px.z_write;
-  const unsigned last = kTextured ? 8 : depth ? 5 : 4;
+  const simd::StageFlags flags = simd::stage_flags(px);
+  const unsigned last = kTextured ? 8 : flags.depth ? 5 : 4;
   const u32x8 den = u32x8{} + t.den;
   // Only planes first..last-1 are read; no zero fill (a `rep stos` here cost more than a row).
   u32x8 q[NarrowTriangle::kPlanes], r[NarrowTriangle::kPlanes];
@@ -44,10 +42,10 @@ template <bool kTextured, PixelFormat kFormat>
     u32x8 bayer = {};
     if constexpr (kFormat != PixelFormat::RGBA8888) bayer = simd::load8(t.bayer[row & 3]);
     // The box's eight lanes lie inside the framebuffer row (the caller checks): whole rows.
-    passed -= simd::pixel8<kTextured, kFormat, simd::Chunk::Row>(px, q, cov, cp, zp, 8, true, bayer);
+    passed -= simd::pixel8<kTextured, kFormat, simd::Chunk::Row>(px, flags, q, cov, cp, zp, 8, true, bayer);
     covered -= cov;  // mask lanes are all ones (−1)
     cp += t.color_pitch;
-    if (depth) zp += t.pitch;
+    if (flags.depth) zp += t.pitch;
     for (unsigned i = 0; i < 3; ++i) e[i] += t.ey[i];
     for (unsigned p = first; p < last; ++p) {
       q[p] += t.qy[p];

@@ -15,9 +15,7 @@ template <bool kTextured, PixelFormat kFormat>
   constexpr std::size_t kBpp = protocol::bytes_per_pixel(kFormat);
   constexpr unsigned kUsed = kTextured ? 8 : 5;
   u32x8 q[kUsed], r[kUsed];
-  // A local copy: the stage's modes stay in registers (the colour stores, through byte pointers,
-  // could alias s.pixel, so its fields would be reloaded every chunk).
-  const PixelLanes px = s.pixel;
+  const PixelLanes& px = s.pixel;
   const unsigned first = px.gouraud ? 0 : 4;
   const u32x8 den = u32x8{} + s.den;
   for (unsigned p = first; p < kUsed; ++p) {
@@ -26,10 +24,12 @@ template <bool kTextured, PixelFormat kFormat>
     simd::carry(q[p], r[p], den);
   }
   const i32x8 lane = {0, 1, 2, 3, 4, 5, 6, 7};
-  const bool depth = px.z_test || px.z_write;  // s.depth is null otherwise
+  const simd::StageFlags flags = simd::stage_flags(px);
   u32x8 bayer = {};
   if constexpr (kFormat != PixelFormat::RGBA8888) bayer = simd::load8(s.bayer);
   u32x8 passed = {};
+  std::uint8_t* cp = s.color;
+  std::uint8_t* zp = s.depth;
   for (unsigned i = 0; i < s.count; i += 8) {
     const unsigned n = s.count - i < 8 ? s.count - i : 8;
     // A tail chunk loads a full vector when the row has room. Not for textured spans: their short
@@ -37,9 +37,9 @@ template <bool kTextured, PixelFormat kFormat>
     // lost 7% (cubes unchanged), while untextured 1,000-px spans gained 10%.
     const bool whole = !kTextured && i + 8 <= s.room;
     const u32x8 in_span = simd::mask(lane < static_cast<std::int32_t>(n));
-    std::uint8_t* cp = s.color + std::size_t{i} * kBpp;
-    std::uint8_t* zp = depth ? s.depth + std::size_t{i} * 4 : nullptr;
-    passed -= simd::pixel8<kTextured, kFormat, simd::Chunk::Span>(px, q, in_span, cp, zp, n, whole, bayer);
+    passed -= simd::pixel8<kTextured, kFormat, simd::Chunk::Span>(px, flags, q, in_span, cp, zp, n, whole, bayer);
+    cp += 8 * kBpp;
+    if (flags.depth) zp += 8 * 4;  // s.depth is null without depth
     for (unsigned p = first; p < kUsed; ++p) {
       q[p] += s.q8[p];
       r[p] += s.r8[p];
