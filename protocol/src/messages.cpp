@@ -349,6 +349,15 @@ void layout(auto& io, OneOf<WriteFramesZ> auto& m) {
   io.rest("data", m.data);
   io.check([&] { return m.data.empty() ? std::string("is empty") : std::string(); });
 }
+void layout(auto& io, OneOf<Dmc1Words> auto& m) {
+  io.rest("words", m.bytes);
+  io.check([&] {
+    if (m.bytes.empty()) return std::string("are empty; send at least one 8-byte command word");
+    if (m.bytes.size() % kDmc1WordBytes != 0)
+      return "of " + std::to_string(m.bytes.size()) + " bytes are not whole 8-byte command words";
+    return std::string();
+  });
+}
 void layout(auto& io, OneOf<FenceMsg, FenceDone> auto& m) { io.num("id", m.id); }
 void layout(auto& io, OneOf<StatusReply> auto& m) { io.rest_json("status", m.json); }
 void layout(auto& io, OneOf<Subscribe> auto& m) {
@@ -438,8 +447,22 @@ std::string_view to_string(ErrorCode c) {
     case ErrorCode::Internal: return "INTERNAL";
     case ErrorCode::BadFrame: return "BAD_FRAME";
     case ErrorCode::Unavailable: return "UNAVAILABLE";
+    case ErrorCode::WrongDevice: return "WRONG_DEVICE";
   }
   return "UNKNOWN_ERROR";
+}
+
+std::uint64_t Dmc1Words::word(std::size_t i) const { return get_le<std::uint64_t>(bytes.data() + i * kDmc1WordBytes); }
+
+void append_dmc1_words(std::span<const std::uint64_t> words, std::vector<std::uint8_t>& out) {
+  out.reserve(out.size() + words.size() * kDmc1WordBytes);
+  for (const auto w : words) put_le(out, w);
+}
+
+std::vector<std::uint64_t> dmc1_words_of(std::span<const std::uint8_t> bytes) {
+  std::vector<std::uint64_t> out(bytes.size() / kDmc1WordBytes);
+  for (std::size_t i = 0; i < out.size(); ++i) out[i] = get_le<std::uint64_t>(bytes.data() + i * kDmc1WordBytes);
+  return out;
 }
 
 std::string_view to_string(Codec c) { return c == Codec::Zstd ? "zstd" : "?"; }

@@ -14,6 +14,7 @@ bool is_trace_record_type(MsgType t) {
   return t == MsgType::WriteFrames || t == MsgType::Upload || t == MsgType::Fence || t == MsgType::ReadReg ||
          t == MsgType::Readback;
 }
+bool is_dmc1_record_type(MsgType t) { return t == MsgType::Dmc1Words || t == MsgType::Fence; }
 
 template <class T>
 T get_le(const std::uint8_t* p) {
@@ -80,12 +81,49 @@ Result<void> BinaryTraceReader::open() {
   if (auto r = read_exact(std::span(reinterpret_cast<std::uint8_t*>(json.data()), json.size()), false); !r)
     return r.error();
   if (auto problem = json_object_problem(json); !problem.empty()) return fail(16, "metadata " + problem);
+  const auto meta = nlohmann::json::parse(json, nullptr, false);
+  if (meta.contains("device_kind")) {
+    const auto& k = meta["device_kind"];
+    const auto kind = k.is_string() ? parse_device_kind(k.get<std::string>()) : std::nullopt;
+    if (!kind) return fail(16, "metadata device_kind " + k.dump() + " is not a device kind (" + device_kind_names() + ")");
+    kind_ = *kind;
+  }
   metadata_ = std::move(json);
   opened_ = true;
   return {};
 }
 
 Result<bool> BinaryTraceReader::next(TimedCommand& out) {
+  if (opened_ && kind_ != DeviceKind::Spigpu)
+    return make_error(name_ + ": a " + std::string(device_kind_info(kind_).label) + " trace (metadata \"device_kind\": \"" +
+                      std::string(device_kind_info(kind_).name) + "\"), not a spigpu one: play it to a daemon serving a " +
+                      std::string(device_kind_info(kind_).label) + " (gpubridge play) or render it with gpubridge render --device " +
+                      std::string(device_kind_info(kind_).name));
+  Message m;
+  std::uint64_t timestamp = 0;
+  const std::uint64_t record_start = offset_;
+  auto more = next_message(m, timestamp, &is_trace_record_type, "only WRITE_FRAMES, UPLOAD, FENCE, READ_REG, READBACK");
+  if (!more || !*more) return more;
+  auto cmd = command_from_message(m);
+  if (!cmd) return fail(record_start, "internal: record type has no command");  // excluded by next_message
+  out.timestamp_ns = timestamp;
+  out.command = std::move(*cmd);
+  return true;
+}
+
+Result<bool> BinaryTraceReader::next_dmc1(std::uint64_t& timestamp_ns, std::vector<std::uint64_t>& words) {
+  if (opened_ && kind_ != DeviceKind::Dmc1)
+    return make_error(name_ + ": a " + std::string(device_kind_info(kind_).label) + " trace, not a DMC-1 one");
+  Message m;
+  auto more = next_message(m, timestamp_ns, &is_dmc1_record_type, "a DMC-1 trace holds only DMC1_WORDS and FENCE");
+  if (!more || !*more) return more;
+  if (const auto* w = std::get_if<Dmc1Words>(&m.payload)) words = dmc1_words_of(w->bytes);
+  else words.clear();
+  return true;
+}
+
+Result<bool> BinaryTraceReader::next_message(Message& m, std::uint64_t& out_timestamp, bool (*allowed)(MsgType),
+                                             const char* allowed_text) {
   if (!opened_) return make_error(name_ + ": next() before open()");
   const std::uint64_t record_start = offset_;
   std::uint8_t head[kTraceTimestampBytes + kHeaderBytes];
@@ -102,10 +140,9 @@ Result<bool> BinaryTraceReader::next(TimedCommand& out) {
   if (auto e = decode_header(std::span<const std::uint8_t, kHeaderBytes>(head + kTraceTimestampBytes, kHeaderBytes),
                              kMaxPayload, h))
     return fail(record_start + kTraceTimestampBytes, e->message);
-  if (!is_trace_record_type(h.type))
+  if (!allowed(h.type))
     return fail(record_start + kTraceTimestampBytes,
-                std::string(to_string(h.type)) +
-                    " cannot appear in a trace (only WRITE_FRAMES, UPLOAD, FENCE, READ_REG, READBACK)");
+                std::string(to_string(h.type)) + " cannot appear in a trace (" + allowed_text + ")");
 
   record_.clear();
   while (record_.size() < h.length) {
@@ -113,12 +150,8 @@ Result<bool> BinaryTraceReader::next(TimedCommand& out) {
     record_.resize(old + std::min<std::size_t>(kReadSlice, h.length - old));
     if (auto r = read_exact(std::span(record_).subspan(old), false); !r) return r.error();
   }
-  Message m;
   if (auto e = decode_payload(h, record_, m)) return fail(record_start + kTraceTimestampBytes + kHeaderBytes, e->message);
-  auto cmd = command_from_message(m);
-  if (!cmd) return fail(record_start, "internal: record type has no command");  // excluded above
-  out.timestamp_ns = timestamp;
-  out.command = std::move(*cmd);
+  out_timestamp = timestamp;
   last_timestamp_ = timestamp;
   ++records_;
   return true;
@@ -138,6 +171,32 @@ Result<CommandStream> read_binary_trace(std::span<const std::uint8_t> bytes, con
     s.commands.push_back(std::move(c));
   }
   return s;
+}
+
+Result<DeviceKind> binary_trace_device_kind(std::span<const std::uint8_t> bytes, const std::string& name_for_errors) {
+  MemorySource src(bytes);
+  BinaryTraceReader reader(src, name_for_errors);
+  if (auto r = reader.open(); !r) return r.error();
+  return reader.device_kind();
+}
+
+Result<std::vector<std::uint64_t>> read_dmc1_trace(std::span<const std::uint8_t> bytes, const std::string& name_for_errors) {
+  MemorySource src(bytes);
+  BinaryTraceReader reader(src, name_for_errors);
+  if (auto r = reader.open(); !r) return r.error();
+  std::vector<std::uint64_t> all, words;
+  std::uint64_t timestamp = 0;
+  for (;;) {
+    auto more = reader.next_dmc1(timestamp, words);
+    if (!more) return more.error();
+    if (!*more) return all;
+    all.insert(all.end(), words.begin(), words.end());
+  }
+}
+
+void append_trace_message(std::uint64_t timestamp_ns, const Message& m, std::vector<std::uint8_t>& out) {
+  put_le(out, timestamp_ns);
+  encode(m, out);
 }
 
 Result<void> append_trace_header(std::string_view metadata_json, std::vector<std::uint8_t>& out) {

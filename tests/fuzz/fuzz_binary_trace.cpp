@@ -1,5 +1,7 @@
 // Fuzzes the streaming binary trace reader. Properties: no crash/UB; whatever it accepts writes
-// back as a trace that reads to the same commands, and survives the text form unchanged.
+// back as a trace that reads to the same commands, and survives the text form unchanged; a DMC-1
+// trace (metadata "device_kind": "dmc1") reads to words that write back to the same words, and
+// the spigpu reader refuses it.
 #include <cstring>
 
 #include "fuzz_check.hpp"
@@ -9,6 +11,23 @@
 using namespace gpubridge::protocol;
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  if (auto words = read_dmc1_trace(std::span(data, size), "fuzz.gbt"); words.ok()) {
+    FUZZ_CHECK(!read_binary_trace(std::span(data, size), "fuzz.gbt").ok());
+    std::vector<std::uint8_t> out;
+    FUZZ_CHECK(append_trace_header("{\"device_kind\":\"dmc1\"}", out).ok());
+    if (!words->empty()) {
+      Dmc1Words m;
+      std::vector<std::uint8_t> payload;
+      append_dmc1_words(*words, payload);
+      m.bytes = payload;
+      append_trace_message(0, Message{1, m}, out);
+    }
+    auto again = read_dmc1_trace(out, "again");
+    FUZZ_CHECK(again.ok() && *again == *words);
+    return 0;
+  } else {
+    FUZZ_CHECK(words.error().message.rfind("fuzz.gbt: ", 0) == 0);
+  }
   auto s = read_binary_trace(std::span(data, size), "fuzz.gbt");
   if (!s.ok()) {
     FUZZ_CHECK(s.error().message.rfind("fuzz.gbt: ", 0) == 0);

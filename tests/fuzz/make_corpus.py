@@ -72,6 +72,18 @@ MESSAGES = {
     "zstd_read_frame": hello(codecs=1) + msg(0x40, b"\x00") + write_frames_z(frame(0x10, 0, read=True), 2),
 }
 
+# DMC1_WORDS (docs/protocol.md 17.7): two command words (a wall span and an end of column), and two
+# malformed ones (empty, not whole words).
+DMC1_WORDS = struct.pack("<QQ", 0x0000FFFF3FBC0000, 0xC0000001)
+MESSAGES["dmc1_words"] = msg(0x18, DMC1_WORDS)
+MESSAGES["dmc1_words_empty"] = msg(0x18, b"")
+MESSAGES["dmc1_words_partial"] = msg(0x18, DMC1_WORDS[:12])
+# After daemon_session_fuzz's own HELLO: a lease, DMC-1 words (the fuzzer's spigpu backend answers
+# WRONG_DEVICE), then a fence.
+SESSION_DMC1 = {
+    "session_dmc1_words": msg(0x40, b"\x00") + msg(0x18, DMC1_WORDS * 4, 2) + msg(0x20, struct.pack("<Q", 7), 3),
+}
+
 # After daemon_session_fuzz's own HELLO (offering zstd): a lease, then a compressed batch and a
 # fence, a zip bomb, or a compressed read frame.
 SESSION_ZSTD = {
@@ -95,6 +107,10 @@ TRACES = {
                       (40, msg(0x15, struct.pack("<II", 0, 16), 5))]),
     "two_batches": trace([(0, msg(0x10, frame(0x0B, 0))), (0, msg(0x10, frame(0x42, 0x1234)))]),
     "nested_meta": trace([], json.dumps({"device": {"backend": "sim", "size": [640, 480]}}).encode()),
+    # A recorded DMC-1 session (gpubridged --record on --backend dmc1), and a device kind nobody knows.
+    "dmc1_session": trace([(0, msg(0x18, DMC1_WORDS, 1)), (5, msg(0x20, struct.pack("<Q", 1), 2)),
+                           (9, msg(0x18, DMC1_WORDS * 3, 3))], b'{"source":"gpubridged","device_kind":"dmc1"}'),
+    "unknown_kind": trace([], b'{"device_kind":"vga"}'),
 }
 
 TEXTS = {
@@ -327,6 +343,8 @@ def main():
     # 0x03 + one split byte reaches WRITE_FRAMES_Z inflation after a HELLO offering zstd.
     for name, data in SESSION_ZSTD.items():
         write("message_parser", name, b"\x03\x60" + data)
+    for name, data in SESSION_DMC1.items():
+        write("message_parser", name, b"\x01\x60" + data)
     for name, data in TRACES.items():
         write("binary_trace", name + ".gbt", data)
     for name, data in TEXTS.items():

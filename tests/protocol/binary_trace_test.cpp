@@ -230,5 +230,51 @@ TEST(BinaryTrace, BinaryTextBinaryIsByteIdentical) {
   EXPECT_EQ(write_text_trace(*again), text);
 }
 
+// A DMC-1 session's trace (docs/protocol.md 18.1): metadata "device_kind": "dmc1", records
+// DMC1_WORDS and FENCE. The DMC-1 reader returns its words in order; the spigpu reader refuses it by
+// kind, and an unknown kind is refused at the metadata.
+TEST(BinaryTrace, Dmc1TracesNameTheirKind) {
+  std::vector<std::uint8_t> out;
+  ASSERT_TRUE(append_trace_header(R"({"source":"test","device_kind":"dmc1"})", out));
+  const std::vector<std::uint64_t> a{0x0000FFFF3FBC0000ull, 0xC0000001ull}, b{0x1234'5678'9ABC'DEF0ull};
+  std::vector<std::uint8_t> pa, pb;
+  append_dmc1_words(a, pa);
+  append_dmc1_words(b, pb);
+  append_trace_message(10, Message{1, Dmc1Words{pa}}, out);
+  append_trace_message(20, Message{2, FenceMsg{7}}, out);
+  append_trace_message(30, Message{3, Dmc1Words{pb}}, out);
+  auto kind = binary_trace_device_kind(out, "d.gbtrace");
+  ASSERT_TRUE(kind) << kind.error().message;
+  EXPECT_EQ(*kind, DeviceKind::Dmc1);
+  auto words = read_dmc1_trace(out, "d.gbtrace");
+  ASSERT_TRUE(words) << words.error().message;
+  EXPECT_EQ(*words, (std::vector<std::uint64_t>{a[0], a[1], b[0]}));
+  auto spigpu = read_binary_trace(out, "d.gbtrace");
+  ASSERT_FALSE(spigpu);
+  EXPECT_NE(spigpu.error().message.find("d.gbtrace: a DMC-1 trace (metadata \"device_kind\": \"dmc1\"), not a spigpu one"),
+            std::string::npos)
+      << spigpu.error().message;
+  // A spigpu message in a DMC-1 trace, and a spigpu trace read as a DMC-1 one.
+  auto bad = out;
+  std::vector<std::uint8_t> frames;
+  append(frames, write_frame(Reg::FB_DISPLAY, 0));
+  append_trace_message(40, Message{4, WriteFrames{FrameView{frames}}}, bad);
+  auto mixed = read_dmc1_trace(bad, "m.gbtrace");
+  ASSERT_FALSE(mixed);
+  EXPECT_NE(mixed.error().message.find("WRITE_FRAMES cannot appear in a trace (a DMC-1 trace holds only DMC1_WORDS and FENCE)"),
+            std::string::npos)
+      << mixed.error().message;
+  std::vector<std::uint8_t> plain;
+  ASSERT_TRUE(append_trace_header("{}", plain));
+  EXPECT_EQ(*binary_trace_device_kind(plain, "p.gbt"), DeviceKind::Spigpu);
+  EXPECT_FALSE(read_dmc1_trace(plain, "p.gbt"));
+  std::vector<std::uint8_t> vga;
+  ASSERT_TRUE(append_trace_header(R"({"device_kind":"vga"})", vga));
+  auto unknown = binary_trace_device_kind(vga, "v.gbt");
+  ASSERT_FALSE(unknown);
+  EXPECT_NE(unknown.error().message.find("metadata device_kind \"vga\" is not a device kind (spigpu, dmc1)"), std::string::npos)
+      << unknown.error().message;
+}
+
 }  // namespace
 }  // namespace gpubridge::protocol

@@ -8,7 +8,7 @@ namespace gpubridge::protocol::testing {
 
 // Byte storage for the spans inside the sample payloads; lives as long as the samples.
 struct Samples {
-  std::vector<std::uint8_t> frames, upload, readback, pixels;
+  std::vector<std::uint8_t> frames, upload, readback, pixels, dmc1;
   std::vector<Message> messages;
 };
 
@@ -47,6 +47,8 @@ inline Samples make_samples() {
   m.push_back({0xFFFFFFFFu, DeviceEvent{R"({"event":"unplugged"})"}});
   m.push_back({25, WriteFramesZ{Codec::Zstd, 18, s.upload}});  // decoding does not inflate
   m.push_back({26, Hello{1, "z", "", codec_bit(Codec::Zstd)}});
+  append_dmc1_words(std::vector<std::uint64_t>{0x0000'FFFF'3FBC'0000ull, 0x8000'0000'0000'0000ull}, s.dmc1);
+  m.push_back({27, Dmc1Words{s.dmc1}});
   return s;
 }
 

@@ -59,6 +59,29 @@ TEST(ParserMalformed, CompressedWritesNameTheirBadField) {
   expect_error(raw(static_cast<std::uint8_t>(MsgType::Hello), hello), ErrorCode::Malformed, "1 unexpected trailing bytes");
 }
 
+TEST(ParserMalformed, Dmc1WordsAreWholeWords) {
+  const auto words = [](std::size_t n) { return raw(static_cast<std::uint8_t>(MsgType::Dmc1Words), std::vector<std::uint8_t>(n, 0x5A)); };
+  expect_error(words(0), ErrorCode::Malformed, "DMC1_WORDS words are empty; send at least one 8-byte command word");
+  expect_error(words(12), ErrorCode::Malformed, "DMC1_WORDS words of 12 bytes are not whole 8-byte command words");
+  const auto ok = parse_one(words(16));
+  ASSERT_EQ(ok.status, MessageParser::Status::Ok) << ok.error.message;
+}
+
+TEST(ParserMalformed, Dmc1WordsAreLittleEndian) {
+  const std::vector<std::uint64_t> w{0x0102'0304'0506'0708ull, 0xFFEE'DDCC'BBAA'9988ull};
+  std::vector<std::uint8_t> bytes;
+  append_dmc1_words(w, bytes);
+  ASSERT_EQ(bytes.size(), 16u);
+  EXPECT_EQ(bytes[0], 0x08);
+  EXPECT_EQ(bytes[7], 0x01);
+  EXPECT_EQ(dmc1_words_of(bytes), w);
+  const Dmc1Words m{bytes};
+  EXPECT_EQ(m.size(), 2u);
+  EXPECT_EQ(m.word(1), w[1]);
+  EXPECT_EQ(to_string(ErrorCode::WrongDevice), "WRONG_DEVICE");
+  EXPECT_EQ(static_cast<int>(ErrorCode::WrongDevice), 19);
+}
+
 TEST(ParserMalformed, UploadAndReadbackMayNotWrapPast4GiB) {
   auto upload = encode(Message{7, Upload{0xFFFFFFFFu, std::span<const std::uint8_t>(le32(0x1234).data(), 2)}});
   expect_error(upload, ErrorCode::Malformed, "run past the 4 GiB address space");

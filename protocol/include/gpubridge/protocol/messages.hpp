@@ -46,6 +46,7 @@ enum class MsgType : std::uint8_t {
   Readback = 0x15,      // lease required
   ReadbackData = 0x16,
   WriteFramesZ = 0x17,  // lease required; only after WELCOME named a codec (docs/protocol.md 17.6)
+  Dmc1Words = 0x18,     // lease required; only to a daemon serving a DMC-1 (docs/protocol.md 17.7)
   Fence = 0x20,
   FenceDone = 0x21,     // every earlier command of this client has executed
   StatusReq = 0x22,
@@ -86,6 +87,7 @@ enum class ErrorCode : std::uint16_t {
   Internal = 16,
   BadFrame = 17,
   Unavailable = 18,  // the request needs a daemon feature that is off (SUBSCRIBE source sim/diff without --mirror)
+  WrongDevice = 19,  // the message is another device kind's (WRITE_FRAMES to a DMC-1, DMC1_WORDS to a spigpu)
 };
 std::string_view to_string(ErrorCode c);
 
@@ -156,6 +158,19 @@ struct WriteFramesZ {
   std::uint32_t frames_bytes = 0;
   std::span<const std::uint8_t> data;
 };
+// DMC-1 command words (docs/protocol.md 17.7, docs/dmc1.md): 8 bytes each, little-endian, at least
+// one; the whole payload is words, so the bound per message is max_payload / 8 words.
+inline constexpr std::size_t kDmc1WordBytes = 8;
+struct Dmc1Words {
+  GPUBRIDGE_MESSAGE(Dmc1Words, "DMC1_WORDS", Client);
+  std::span<const std::uint8_t> bytes;  // a non-zero multiple of kDmc1WordBytes
+  std::size_t size() const { return bytes.size() / kDmc1WordBytes; }
+  std::uint64_t word(std::size_t i) const;
+};
+// Little-endian bytes of command words (a DMC1_WORDS payload), appended to out.
+void append_dmc1_words(std::span<const std::uint64_t> words, std::vector<std::uint8_t>& out);
+// The words of a DMC1_WORDS payload (whole words; a trailing partial word is ignored).
+std::vector<std::uint64_t> dmc1_words_of(std::span<const std::uint8_t> bytes);
 struct FenceMsg { GPUBRIDGE_MESSAGE(Fence, "FENCE", Client); std::uint64_t id = 0; };
 struct FenceDone { GPUBRIDGE_MESSAGE(FenceDone, "FENCE_DONE", Server); std::uint64_t id = 0; };
 struct StatusReq { GPUBRIDGE_MESSAGE(StatusReq, "STATUS_REQ", Client); };
@@ -189,7 +204,7 @@ struct DeviceEvent { GPUBRIDGE_MESSAGE(DeviceEvent, "DEVICE_EVENT", Server); std
 // Every message type: the decoder, to_string(MsgType), is_known_type() and sender() are derived
 // from this list.
 using Payload = std::variant<Hello, Welcome, ErrorMsg, Ping, Pong, Bye, WriteFrames, ReadReg, RegValue, Upload,
-                             UploadAck, Readback, ReadbackData, WriteFramesZ, FenceMsg, FenceDone, StatusReq, StatusReply,
+                             UploadAck, Readback, ReadbackData, WriteFramesZ, Dmc1Words, FenceMsg, FenceDone, StatusReq, StatusReply,
                              Subscribe, Unsubscribe, FrameData, LeaseAcquire, LeaseGranted, LeaseRelease,
                              LeaseReleased, DeviceEvent>;
 

@@ -14,6 +14,7 @@
 
 #include "gpubridge/common/result.hpp"
 #include "gpubridge/protocol/command_stream.hpp"
+#include "gpubridge/protocol/device_kind.hpp"
 
 namespace gpubridge::protocol {
 
@@ -49,12 +50,20 @@ class BinaryTraceReader {
   // Reads and validates the file header; call once before next().
   Result<void> open();
   const std::string& metadata_json() const { return metadata_; }
-  // true: `out` holds the next record; false: clean end of the trace.
+  // The metadata's "device_kind" (docs/protocol.md 18.1); spigpu when it has none.
+  DeviceKind device_kind() const { return kind_; }
+  // spigpu traces: true: `out` holds the next record; false: clean end of the trace. A trace of
+  // another device kind is an error saying what reads it.
   Result<bool> next(TimedCommand& out);
+  // DMC-1 traces (records DMC1_WORDS or FENCE): true: `words` holds the next record's command words
+  // (empty for a FENCE) and `timestamp_ns` its time; false: clean end of the trace.
+  Result<bool> next_dmc1(std::uint64_t& timestamp_ns, std::vector<std::uint64_t>& words);
   std::uint64_t records_read() const { return records_; }
 
  private:
   Result<bool> read_exact(std::span<std::uint8_t> out, bool eof_ok);
+  // The next record's message, of a type `allowed` accepts (`allowed_text` lists them for errors).
+  Result<bool> next_message(Message& m, std::uint64_t& timestamp, bool (*allowed)(MsgType), const char* allowed_text);
   Error fail(std::uint64_t at, const std::string& what) const;
 
   ByteSource& source_;
@@ -65,7 +74,16 @@ class BinaryTraceReader {
   std::uint64_t records_ = 0;
   std::uint64_t last_timestamp_ = 0;
   bool opened_ = false;
+  DeviceKind kind_ = DeviceKind::Spigpu;
 };
+
+// The device kind a binary trace held in memory records (its header and metadata only).
+Result<DeviceKind> binary_trace_device_kind(std::span<const std::uint8_t> bytes, const std::string& name_for_errors);
+// Reads a whole DMC-1 binary trace held in memory: every command word, in order.
+Result<std::vector<std::uint64_t>> read_dmc1_trace(std::span<const std::uint8_t> bytes, const std::string& name_for_errors);
+// Appends one record holding message m (a DMC-1 trace's DMC1_WORDS or FENCE; spigpu traces use
+// append_trace_record).
+void append_trace_message(std::uint64_t timestamp_ns, const Message& m, std::vector<std::uint8_t>& out);
 
 // Reads a whole binary trace held in memory.
 Result<CommandStream> read_binary_trace(std::span<const std::uint8_t> bytes, const std::string& name_for_errors);
