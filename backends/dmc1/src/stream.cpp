@@ -5,6 +5,7 @@
 #include <fstream>
 
 #include "gpubridge/common/regular_file.hpp"
+#include "gpubridge/protocol/trace.hpp"
 
 namespace gpubridge::dmc1 {
 namespace {
@@ -197,9 +198,22 @@ std::string format_line_stream(std::span<const std::uint64_t> words) {
 Result<LoadedStream> load_stream(const std::filesystem::path& path) {
   auto data = read_regular_file(path, kMaxStreamFileBytes, "DMC-1 stream");
   if (!data) return data.error();
-  if (data->starts_with(std::string_view("GBTRACE\0", 8)))
-    return make_error(path.string() + ": is a gpubridge binary trace; DMC-1 streams are .dmc1 text or tinygpus .nfo lines");
   LoadedStream s;
+  const std::span<const std::uint8_t> bytes(reinterpret_cast<const std::uint8_t*>(data->data()), data->size());
+  if (protocol::looks_like_binary_trace(bytes)) {
+    // A recording of a DMC-1 session (gpubridged --record); a spigpu trace is refused by its kind.
+    auto kind = protocol::binary_trace_device_kind(bytes, path.string());
+    if (!kind) return kind.error();
+    if (*kind != protocol::DeviceKind::Dmc1)
+      return make_error(path.string() + ": is a gpubridge binary trace of a " +
+                        std::string(protocol::device_kind_info(*kind).label) +
+                        " (metadata \"device_kind\"), not of a DMC-1; play it to a daemon serving one, or render it without --device dmc1");
+    auto words = protocol::read_dmc1_trace(bytes, path.string());
+    if (!words) return words.error();
+    s.words = std::move(words).value();
+    s.binary_trace = true;
+    return s;
+  }
   s.format = stream_format_for_path(path).value_or(sniff_stream_format(*data));
   auto words = parse_stream(*data, s.format, path.string());
   if (!words) return words.error();

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "gpubridge/common/result.hpp"
+#include "gpubridge/protocol/device_kind.hpp"
 #include "gpubridge/protocol/frame.hpp"
 #include "gpubridge/protocol/registers.hpp"
 
@@ -33,6 +34,9 @@ struct ScanoutFrame {
 using ScanoutCallback = std::function<void(std::shared_ptr<const ScanoutFrame>)>;
 
 struct DeviceInfo {
+  // The device kind the backend serves (docs/protocol.md 17.7): which command messages it takes
+  // (spigpu: WRITE_FRAMES, READ_REG, UPLOAD, READBACK; dmc1: DMC1_WORDS).
+  protocol::DeviceKind kind = protocol::DeviceKind::Spigpu;
   std::string backend;  // "sim" or "board"
   std::string board;    // profile name ("" for the plain simulator)
   std::string bridge;   // bridge chip ("" for the simulator)
@@ -41,6 +45,9 @@ struct DeviceInfo {
   std::uint64_t vram_bytes = 0;
   std::uint64_t id = 0;    // ID register
   std::uint64_t caps = 0;  // CAPS register
+  // Where the scanned-out frames come from when not from the device itself ("" = the device's own):
+  // a board that sends no frames back shows the simulator's, and says so here.
+  std::string frames_note;
 };
 
 // Error codes of backend results (Error::code).
@@ -59,7 +66,14 @@ class Backend {
   virtual DeviceInfo info() const = 0;
 
   // Register writes exactly as 9-byte wire frames (read bit must be 0). Executed in order.
+  // spigpu backends only; the daemon sends a DMC-1 backend none (it answers WRONG_DEVICE).
   virtual Result<void> write_frames(protocol::FrameView frames) = 0;
+  // DMC-1 command words (docs/dmc1.md), executed in order. DMC-1 backends only: the default refuses.
+  virtual Result<void> write_dmc1_words(std::span<const std::uint64_t> words) {
+    (void)words;
+    return make_error(std::string(protocol::device_kind_info(info().kind).label) + " backend takes no DMC-1 command words",
+                      kBadRequest);
+  }
   // Reads a register over the device's read path (immediate; see docs/protocol.md).
   virtual Result<std::uint64_t> read_register(std::uint8_t index) = 0;
   // Bulk memory access through MEM_ADDR/MEM_DATA (or an equivalent fast path with the same effect).

@@ -37,10 +37,12 @@ std::string format_line_stream(std::span<const std::uint64_t> words);
 
 struct LoadedStream {
   StreamFormat format = StreamFormat::Text;
+  bool binary_trace = false;  // read from a gpubridge binary trace of a DMC-1 session (format unused)
   std::vector<std::uint64_t> words;
 };
-// Reads a stream file (format by extension, else sniffed). Project binary traces (GBTRACE) are
-// refused with a message: DMC-1 streams travel in the text formats.
+// Reads a stream file (format by extension, else sniffed), or a gpubridge binary trace whose metadata
+// says "device_kind": "dmc1" (a recorded DMC-1 session, docs/protocol.md 18.1); a binary trace of
+// another device kind is refused with a message.
 Result<LoadedStream> load_stream(const std::filesystem::path& path);
 Result<void> save_stream(const std::filesystem::path& path, std::span<const std::uint64_t> words,
                          std::optional<StreamFormat> format = std::nullopt);
