@@ -6,11 +6,14 @@
 #include <cstdio>
 
 #include "gpubridge/common/log.hpp"
+#include "gpubridge/dmc1/dmc1_backend.hpp"
+#include "gpubridge/dmc1/serial_link.hpp"
 #include "gpubridge/daemon/test_backends.hpp"
 #include "gpubridge/sim/sim_backend.hpp"
 #include "gpubridge/usb/board_factory.hpp"
 #include "gpubridge/usb/board_profile.hpp"
 #include "gpubridge/usb/hotplug_monitor.hpp"
+#include "gpubridge/usb/usb_tty.hpp"
 
 namespace gpubridge::daemon {
 
@@ -191,18 +194,89 @@ Result<std::string> describe_emulated(std::string_view spec, const DaemonConfig&
   return describe_board(profiles->front(), true, cfg);
 }
 
+// dmc1: the DMC-1 simulator. Its texture image and palette come from the configuration, else from
+// the data the repository's DMC-1 streams were made with (GPUBRIDGE_DMC1_DATA_DIR overrides where
+// that is).
+std::filesystem::path dmc1_data_dir() {
+  if (const char* env = std::getenv("GPUBRIDGE_DMC1_DATA_DIR"); env && *env) return env;
+  return GPUBRIDGE_DMC1_DEFAULT_DATA_DIR;
+}
+std::filesystem::path dmc1_textures_of(const DaemonConfig& cfg) {
+  return cfg.dmc1_textures.empty() ? dmc1_data_dir() / "textures.bin.gz" : std::filesystem::path(cfg.dmc1_textures);
+}
+std::filesystem::path dmc1_palette_of(const DaemonConfig& cfg) {
+  return cfg.dmc1_palette.empty() ? dmc1_data_dir() / "palette.bin" : std::filesystem::path(cfg.dmc1_palette);
+}
+std::string dmc1_data_text(const DaemonConfig& cfg) {
+  return "textures " + dmc1_textures_of(cfg).string() + ", palette " + dmc1_palette_of(cfg).string();
+}
+
+Result<BackendPtr> open_dmc1_device(const DaemonConfig& cfg, std::unique_ptr<dmc1::SerialLink> link, const std::string& board) {
+  const std::string hint = " (set --dmc1-textures FILE --dmc1-palette FILE, or dmc1_textures / dmc1_palette in the configuration)";
+  auto textures = dmc1::load_texture_memory(dmc1_textures_of(cfg));
+  if (!textures) return make_error("backend dmc1: " + textures.error().message + hint);
+  auto palette = dmc1::load_palette(dmc1_palette_of(cfg));
+  if (!palette) return make_error("backend dmc1: " + palette.error().message + hint);
+  dmc1::Dmc1BackendOptions opts;
+  opts.board = board;
+  opts.textures_label = dmc1_data_text(cfg);
+  auto b = dmc1::Dmc1Backend::create(std::move(*textures), *palette, opts, std::move(link));
+  if (!b) return make_error("backend dmc1: " + b.error().message);
+  logger("daemon")->info("backend: DMC-1 {}{} ({})", board.empty() ? "simulator" : "board " + board,
+                         board.empty() ? "" : ", showing the simulator's frames", dmc1_data_text(cfg));
+  return BackendPtr(std::move(*b));
+}
+Result<BackendPtr> open_dmc1(std::string_view, const DaemonConfig& cfg) { return open_dmc1_device(cfg, nullptr, {}); }
+Result<std::string> describe_dmc1(std::string_view, const DaemonConfig& cfg) {
+  for (const auto& f : {dmc1_textures_of(cfg), dmc1_palette_of(cfg)}) {
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(f, ec))
+      return make_error("backend dmc1: " + f.string() + " is not a file (set --dmc1-textures / --dmc1-palette)");
+  }
+  return "the DMC-1 simulator (" + dmc1_data_text(cfg) + ")";
+}
+
+// A UART board profile (device_kind dmc1, e.g. icebreaker-dmc1): the board over its USB-UART, with
+// the DMC-1 simulator computing the frames it cannot send back. nullopt: `name` is no UART board.
+std::optional<usb::UartBoardProfile> uart_board(std::string_view name, const DaemonConfig& cfg) {
+  auto p = usb::find_uart_board_profile(config_dir_of(cfg), std::string(name));
+  if (!p) return std::nullopt;
+  return std::move(*p);
+}
+Result<BackendPtr> open_uart_board(const usb::UartBoardProfile& profile, const DaemonConfig& cfg) {
+  std::string tty = profile.tty;
+  if (tty.empty()) {
+    auto found = usb::find_usb_tty(profile.vid, profile.pid, profile.interface, profile.serial);
+    if (!found) return make_error("board "" + profile.name + "": " + found.error().message + "; or run without it: --backend dmc1 (the DMC-1 simulator)",
+                                  backends::kDeviceGone);
+    tty = *found;
+  }
+  auto link = dmc1::SerialLink::open(tty, profile.baud);
+  if (!link) return make_error("board "" + profile.name + "": " + link.error().message, backends::kDeviceGone);
+  return open_dmc1_device(cfg, std::move(*link), profile.name);
+}
+std::string describe_uart_board(const usb::UartBoardProfile& profile, const DaemonConfig& cfg) {
+  return "board " + profile.name + " (" + std::string(protocol::device_kind_info(profile.device_kind).label) +
+         " over a USB-UART at " + std::to_string(profile.baud) + " baud" +
+         (profile.tty.empty() ? "" : ", " + profile.tty) + ") from " + profile.file.string() +
+         ", showing the DMC-1 simulator's frames (" + dmc1_data_text(cfg) + ")";
+}
+
 // BOARD: a board profile name or .json file, the real board
 Result<std::vector<usb::BoardProfile>> profiles_board(std::string_view name, const DaemonConfig& cfg) {
+  if (uart_board(name, cfg)) return std::vector<usb::BoardProfile>{};  // a tty: no libusb notifications to watch
   auto profile = named_profile(std::string(name), std::string(name), cfg);
   if (!profile) return profile.error();
   return std::vector<usb::BoardProfile>{std::move(*profile)};
 }
 Result<BackendPtr> open_real_board(std::string_view name, const DaemonConfig& cfg) {
+  if (auto uart = uart_board(name, cfg)) return open_uart_board(*uart, cfg);
   auto profile = named_profile(std::string(name), std::string(name), cfg);
   if (!profile) return profile.error();
   return open_board(*profile, false);
 }
 Result<std::string> describe_real_board(std::string_view name, const DaemonConfig& cfg) {
+  if (auto uart = uart_board(name, cfg)) return describe_uart_board(*uart, cfg);
   auto profiles = profiles_board(name, cfg);
   if (!profiles) return profiles.error();
   return describe_board(profiles->front(), false, cfg);
@@ -238,6 +312,7 @@ constexpr BackendKind kKinds[] = {
   {"emulated", Arg::Required,  "emulated:BOARD[?presence=PATH]", true,  false, &open_emulated,   &describe_emulated},
   {"fake",     Arg::Optional,  "fake[:WIDTHxHEIGHT]",            false, false, &open_fake,       &describe_fake},
   {"discard",  Arg::None,      "discard",                        false, false, &open_discard,    &describe_discard},
+  {"dmc1",     Arg::None,      "dmc1",                           false, false, &open_dmc1,       &describe_dmc1},
   {"",         Arg::WholeName, "BOARD",                          true,  true,  &open_real_board, &describe_real_board, &profiles_board},
 };
 // clang-format on
@@ -281,6 +356,9 @@ Result<BackendPtr> make_backend(const std::string& name, const DaemonConfig& cfg
 
 Result<std::string> check_backend(const DaemonConfig& cfg) {
   const auto r = resolve(cfg.backend);
+  if (cfg.mirror && uart_board(cfg.backend, cfg))
+    return make_error("--mirror needs an spigpu board; \"" + cfg.backend +
+                      "\" is a DMC-1 board, whose frames are already the simulator's (it sends none back)");
   if (cfg.mirror && !r.kind.board)
     return make_error("--mirror needs a board backend (a board profile name, emulated:BOARD or auto), not \"" + cfg.backend +
                       "\": mirror mode compares a board with the simulator");
@@ -291,6 +369,9 @@ bool is_board_backend(const std::string& name) { return resolve(name).kind.board
 
 std::function<Result<BackendPtr>()> fallback_factory(const DaemonConfig& cfg) {
   if (!cfg.fallback_to_sim || !resolve(cfg.backend).kind.board) return {};  // only boards disappear
+  // A DMC-1 board falls back to nothing: the spigpu simulator would change the device kind under
+  // its clients (DEVICE_GONE, then the board again when its port comes back).
+  if (uart_board(cfg.backend, cfg)) return {};
   return make_simulator;
 }
 

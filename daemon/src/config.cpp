@@ -102,7 +102,8 @@ Result<DaemonConfig> parse_config(const json& doc, const std::string& source) {
   Reader rd(source);
   if (!doc.is_object()) return rd.fail("(top level)", "expected a JSON object");
   GPUBRIDGE_TRY(rd.known_keys(doc, "", {"listen", "token", "token_file", "backend", "fallback_to_sim", "reattach_interval_ms", "boards_dir",
-                                        "frames_dir", "record_dir", "log_level", "limits", "mirror", "tls_dir", "comment"}));
+                                        "frames_dir", "record_dir", "log_level", "limits", "mirror", "tls_dir", "dmc1_textures",
+                                        "dmc1_palette", "comment"}));
   DaemonConfig cfg;
   if (doc.contains("listen")) {
     const auto& l = doc.at("listen");
@@ -127,6 +128,8 @@ Result<DaemonConfig> parse_config(const json& doc, const std::string& source) {
   GPUBRIDGE_TRY(rd.read_string(doc, "", "record_dir", cfg.record_dir));
   GPUBRIDGE_TRY(rd.read_string(doc, "", "log_level", cfg.log_level));
   GPUBRIDGE_TRY(rd.read_string(doc, "", "tls_dir", cfg.tls_dir));
+  GPUBRIDGE_TRY(rd.read_string(doc, "", "dmc1_textures", cfg.dmc1_textures));
+  GPUBRIDGE_TRY(rd.read_string(doc, "", "dmc1_palette", cfg.dmc1_palette));
   if (!is_log_level(cfg.log_level)) return rd.fail("log_level", log_level_problem(cfg.log_level));
   if (doc.contains("limits")) {
     const auto& l = doc.at("limits");
@@ -155,6 +158,8 @@ nlohmann::json config_to_json(const DaemonConfig& cfg) {
            {"log_level", cfg.log_level}};
   if (!cfg.token_file.empty()) doc["token_file"] = cfg.token_file;
   if (!cfg.tls_dir.empty()) doc["tls_dir"] = cfg.tls_dir;
+  if (!cfg.dmc1_textures.empty()) doc["dmc1_textures"] = cfg.dmc1_textures;
+  if (!cfg.dmc1_palette.empty()) doc["dmc1_palette"] = cfg.dmc1_palette;
   json limits = json::object();
   for_each_limit(cfg.limits, [&](const char* key, const char*, std::uint64_t, std::uint64_t, auto value) { limits[key] = value; });
   doc["limits"] = limits;

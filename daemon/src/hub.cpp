@@ -114,12 +114,14 @@ void Hub::enable_hotplug(BackendFactory reattach, std::chrono::milliseconds inte
 }
 
 std::string Hub::device_json(const std::string& compression, const std::string& transport) const {
-  nlohmann::json j{{"backend", info_.backend},     {"board", info_.board},
+  nlohmann::json j{{"device_kind", protocol::device_kind_info(info_.kind).name},
+                   {"backend", info_.backend},     {"board", info_.board},
                    {"bridge", info_.bridge},       {"max_width", info_.max_width},
                    {"max_height", info_.max_height}, {"vram_bytes", info_.vram_bytes},
                    {"id", info_.id},               {"caps", info_.caps},
                    {"mirror", options_.mirror},    {"daemon_version", kVersion},
                    {"compression", compression},   {"transport", transport}};
+  if (!info_.frames_note.empty()) j["frames_note"] = info_.frames_note;
   return json_text(j);
 }
 
@@ -169,7 +171,8 @@ nlohmann::json Hub::status_json() const {
                               {"model_errors", decorator.model_errors},
                               {"unpaired_frames", decorator.unpaired_frames},
                               {"coalesced_swaps", decorator.coalesced_swaps}};
-  return {{"daemon_version", kVersion},
+  nlohmann::json status{{"daemon_version", kVersion},
+          {"device_kind", protocol::device_kind_info(info_.kind).name},
           {"backend", info_.backend},
           {"board", info_.board},
           {"bridge", info_.bridge},
@@ -183,6 +186,8 @@ nlohmann::json Hub::status_json() const {
           {"tls", options_.tls_fingerprint.empty() ? nlohmann::json(nullptr)
                                                    : nlohmann::json{{"fingerprint", options_.tls_fingerprint}}},
           {"uptime_s", uptime}};
+  if (!info_.frames_note.empty()) status["frames_note"] = info_.frames_note;
+  return status;
 }
 
 void Hub::fan_out(std::shared_ptr<const backends::ScanoutFrame> frame) {

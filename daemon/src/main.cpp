@@ -206,7 +206,7 @@ int print_checked_config(const daemon::DaemonConfig& cfg, const std::string& con
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"gpubridged: serves spigpu devices (simulator or boards) to gpubridge clients over Unix/TCP sockets"};
+  CLI::App app{"gpubridged: serves spigpu and DMC-1 devices (simulators or boards) to gpubridge clients over Unix/TCP sockets"};
   app.set_version_flag("--version", std::string("gpubridged ") + gpubridge::kVersion);
   std::string config_path;
   std::vector<std::string> listen;
@@ -223,7 +223,7 @@ int main(int argc, char** argv) {
   app.add_option("-l,--listen", listen, "unix:PATH or tcp:HOST:PORT (repeatable; replaces the config's list)");
   app.add_option("--token", token, "token TCP clients must present (required for non-loopback TCP)");
   app.add_option("--token-file", token_file, "read the token from the first line of this file");
-  std::string tls_dir;
+  std::string tls_dir, dmc1_textures, dmc1_palette;
   bool print_fingerprint = false;
   app.add_option("--tls-dir", tls_dir, "directory of the TLS key and self-signed certificate (created on first start)");
   app.add_flag("--tls-fingerprint", print_fingerprint,
@@ -231,8 +231,13 @@ int main(int argc, char** argv) {
                "clients as GPUBRIDGE_TLS_FINGERPRINT");
   app.add_option("-b,--backend", backend,
                  gpubridge::daemon::backend_syntax() +
-                     " (BOARD: a board profile name or .json file; presence: the emulated adapter is plugged in "
-                     "while PATH exists)");
+                     " (BOARD: a board profile name or .json file, a spigpu board or a DMC-1 UART board such as "
+                     "icebreaker-dmc1; dmc1: the DMC-1 simulator; presence: the emulated adapter is plugged in while "
+                     "PATH exists)");
+  app.add_option("--dmc1-textures", dmc1_textures,
+                 "DMC-1 backends: the texture memory image (raw or .gz; default: the repository's tests/dmc1/data, "
+                 "which its DMC-1 streams and goldens use)");
+  app.add_option("--dmc1-palette", dmc1_palette, "DMC-1 backends: the palette (768 bytes; default: tests/dmc1/data's)");
   app.add_flag("--no-fallback", no_fallback, "do not switch to the simulator when a board disappears");
   app.add_flag("--mirror", mirror,
                "board backends: also run the simulator on the same commands and compare every frame "
@@ -293,6 +298,8 @@ int main(int argc, char** argv) {
   if (!record_dir.empty()) cfg.record_dir = record_dir;
   if (!log_level.empty()) cfg.log_level = log_level;
   if (!tls_dir.empty()) cfg.tls_dir = tls_dir;
+  if (!dmc1_textures.empty()) cfg.dmc1_textures = dmc1_textures;
+  if (!dmc1_palette.empty()) cfg.dmc1_palette = dmc1_palette;
   if (max_clients) cfg.limits.max_clients = *max_clients;
   if (max_pending) cfg.limits.max_pending_handshakes = *max_pending;
   if (max_message) cfg.limits.max_message_bytes = *max_message;

@@ -1,6 +1,7 @@
 #include "gpubridge/daemon/request_handler.hpp"
 
 #include <algorithm>
+#include <optional>
 
 #include "gpubridge/common/json_text.hpp"
 #include "gpubridge/common/log.hpp"
@@ -85,6 +86,7 @@ void RequestHandler::dispatch(Message& m) {
     handle_hello(m);
     return;
   }
+  if (!device_kind_fits(m)) return;
   if (type == MsgType::WriteFramesZ && !inflate(m)) return;
   if (recorder_) recorder_->record(m);  // a compressed batch is recorded as the WRITE_FRAMES it stands for
   switch (protocol::type_of(m.payload)) {
@@ -96,6 +98,7 @@ void RequestHandler::dispatch(Message& m) {
       session_.close_after_flush();
       return;
     case MsgType::WriteFrames: handle_write_frames(m); return;
+    case MsgType::Dmc1Words: handle_dmc1_words(m); return;
     case MsgType::ReadReg: handle_read_reg(m); return;
     case MsgType::Upload: handle_upload(m); return;
     case MsgType::Readback: handle_readback(m); return;
@@ -142,7 +145,7 @@ void RequestHandler::handle_hello(const Message& m) {
   const bool zstd = h.codecs && (*h.codecs & protocol::codec_bit(protocol::Codec::Zstd));
   if (zstd) inflater_ = std::make_unique<protocol::FrameInflater>();
   if (!hub_.options().record_dir.empty()) {
-    auto r = TraceRecorder::open(hub_.options().record_dir, session_.id(), h.name);
+    auto r = TraceRecorder::open(hub_.options().record_dir, session_.id(), h.name, hub_.device_info().kind);
     if (r) recorder_ = std::move(*r);
     else logger("daemon")->error("session {}: {}", session_.id(), r.error().message);
   }
@@ -175,6 +178,37 @@ bool RequestHandler::inflate(Message& m) {
   return true;
 }
 
+// Which device kind a command message is for; nullopt for messages every kind takes (FENCE, STATUS,
+// SUBSCRIBE, the lease, ...).
+static std::optional<protocol::DeviceKind> kind_of_command(MsgType t) {
+  switch (t) {
+    case MsgType::WriteFrames:
+    case MsgType::WriteFramesZ:
+    case MsgType::ReadReg:
+    case MsgType::Upload:
+    case MsgType::Readback: return protocol::DeviceKind::Spigpu;
+    case MsgType::Dmc1Words: return protocol::DeviceKind::Dmc1;
+    default: return std::nullopt;
+  }
+}
+
+bool RequestHandler::device_kind_fits(const Message& m) {
+  const MsgType type = protocol::type_of(m.payload);
+  const auto wanted = kind_of_command(type);
+  const auto served = hub_.device_info().kind;
+  if (!wanted || *wanted == served) return true;
+  // Not fatal: the client learns what this daemon serves and may go on (STATUS, SUBSCRIBE, ...).
+  const auto& have = protocol::device_kind_info(served);
+  const auto& want = protocol::device_kind_info(*wanted);
+  std::string what = std::string(protocol::to_string(type)) + " is a " + std::string(want.label) + " command, but this gpubridged serves a " +
+                     std::string(have.label) + " (WELCOME's \"device_kind\": \"" + std::string(have.name) + "\"); ";
+  what += served == protocol::DeviceKind::Dmc1
+              ? "send DMC-1 command words (DMC1_WORDS; `gpubridge play STREAM.dmc1`), or start gpubridged with a spigpu backend"
+              : "send spigpu register writes (WRITE_FRAMES), or start gpubridged with --backend dmc1";
+  session_.reply_error(m.request_id, ErrorCode::WrongDevice, what);
+  return false;
+}
+
 bool RequestHandler::require_lease(const Message& m) {
   if (hub_.lease().held_by(session_.id())) return true;
   session_.reply_error(m.request_id, ErrorCode::NoLease,
@@ -189,6 +223,16 @@ void RequestHandler::handle_write_frames(const Message& m) {
   // `frames` points into the parser buffer; the session reads nothing until the work is done.
   const auto frames = std::get<protocol::WriteFrames>(m.payload).frames;
   device_request<void>(m.request_id, [frames](backends::Backend& b) { return b.write_frames(frames); },
+                       [](RequestHandler&) {});
+}
+
+void RequestHandler::handle_dmc1_words(const Message& m) {
+  if (!require_lease(m)) return;
+  // Copied out of the parser buffer as whole 64-bit words (the payload's alignment is arbitrary);
+  // bounded by max_payload like every message.
+  dmc1_words_ = protocol::dmc1_words_of(std::get<protocol::Dmc1Words>(m.payload).bytes);
+  const std::span<const std::uint64_t> words = dmc1_words_;
+  device_request<void>(m.request_id, [words](backends::Backend& b) { return b.write_dmc1_words(words); },
                        [](RequestHandler&) {});
 }
 

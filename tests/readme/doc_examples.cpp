@@ -36,6 +36,20 @@ Step stream_to_dmc1_board() {
               "needs an iCEBreaker on USB; SerialLink.RenderStreamsToTheBoardThroughItsPort runs it with --tty on a "
               "pseudo-terminal whose other end is the SOC's receiver model");
 }
+// gpubridged serving the DMC-1 simulator, a golden stream played to it, its next frame taken back.
+Step serve_dmc1() {
+  return daemon("build/daemon/gpubridged --backend dmc1 &").prints("listening on " + kDefaultSocket).prints("ready");
+}
+Step play_mixed_dmc1() {
+  return alongside("build/tools/gpubridge play tests/dmc1/data/streams/mixed.dmc1 --fps 10 --repeat 30 &")
+      .prints(R"(played tests/dmc1/data/streams/mixed\.dmc1: \d+ DMC-1 command words, 30 frames)")
+      .within(120);
+}
+Step screenshot_dmc1() {
+  return run("build/tools/gpubridge screenshot --out dmc1-frame.png")
+      .prints(R"(frame #\d+ \(320x240, board\) written to dmc1-frame\.png)")
+      .leaves("dmc1-frame.png");
+}
 Step list_dmc1_fields() { return run("build/tools/gpubridge regs --device dmc1").prints(R"(wall +texture +bits +0\.\.9)"); }
 
 std::vector<Example> make() {
@@ -116,6 +130,9 @@ std::vector<Example> make() {
       write_level_dmc1(),
       list_dmc1_fields(),
       stream_to_dmc1_board(),
+      serve_dmc1(),
+      play_mixed_dmc1(),
+      screenshot_dmc1(),
 
       skip("build/tools/gpubridge bench accuracy --out-dir docs",
            "rewrites docs/accuracy-report.* and runs for minutes; CTest bench_accuracy_quick_smoke runs it with --quick"),
@@ -188,6 +205,16 @@ std::vector<Example> make() {
       skip("build/tools/gpubridge bench dmc1",
            "measures for seconds per stream; CTest dmc1_bench_smoke runs it with one short round"),
       list_dmc1_fields(),
+  }});
+
+  all.push_back({"docs/dmc1.md", "Behind the daemon", 0, "docs_dmc1_BehindTheDaemon", {
+      serve_dmc1(),
+      play_mixed_dmc1(),
+      screenshot_dmc1(),
+      run("build/tools/gpubridge status").prints("device: +DMC-1").prints("backend: +sim"),
+      skip("build/daemon/gpubridged --backend icebreaker-dmc1 &",
+           "needs an iCEBreaker on USB; DaemonDmc1.BoardBackendStreamsToItsPortAndShowsTheSimulatorsFrames serves a "
+           "board profile whose port is a pseudo-terminal, the SOC's receiver model on its other end"),
   }});
 
   all.push_back({"docs/dmc1.md", "Board path", 0, "docs_dmc1_BoardPath", {

@@ -18,7 +18,10 @@
 #include "client_common.hpp"
 #include "gpubridge/common/image.hpp"
 #include "gpubridge/common/trace_files.hpp"
+#include "gpubridge/dmc1/command.hpp"
+#include "gpubridge/dmc1/stream.hpp"
 #include "gpubridge/protocol/text_trace.hpp"
+#include "gpubridge/protocol/trace.hpp"
 #include "gpubridge/common/json_text.hpp"
 
 namespace gpubridge::cli {
@@ -100,9 +103,13 @@ int run_status(const GlobalOptions& g, const ClientOptions& o) {
   }
   std::printf("daemon:    gpubridged %s at %s, up %.0f s\n", j.value("daemon_version", "?").c_str(),
               c->address().to_string().c_str(), j.value("uptime_s", 0.0));
+  // A daemon that predates device kinds serves spigpu (docs/protocol.md 17.7).
+  const auto kind = protocol::parse_device_kind(j.value("device_kind", "spigpu"));
+  std::printf("device:    %s\n", kind ? std::string(protocol::device_kind_info(*kind).label).c_str() : j.value("device_kind", "?").c_str());
   std::printf("backend:   %s%s%s\n", j.value("backend", "?").c_str(),
               j.value("board", "").empty() ? "" : (" board " + j.value("board", "")).c_str(),
               j.value("bridge", "").empty() ? "" : (" via " + j.value("bridge", "")).c_str());
+  if (j.contains("frames_note")) std::printf("frames:    %s\n", j.value("frames_note", "").c_str());
   if (j["lease"].is_object())
     std::printf("lease:     session %u (%s), %zu waiting\n", j["lease"].value("session", 0u),
                 j["lease"].value("name", "").c_str(), j.value("lease_waiters", std::size_t{0}));
@@ -185,28 +192,127 @@ std::size_t count_swaps(protocol::FrameView v) {
   return n;
 }
 
+// The stream's device kind must be the daemon's (WELCOME "device_kind", docs/protocol.md 17.7): said
+// here, before the lease, rather than by an ERROR WRONG_DEVICE per message.
+Result<void> check_device_kind(const client::Client& c, const std::string& file, protocol::DeviceKind stream_kind) {
+  const auto served = c.session().device_kind;
+  if (served == stream_kind) return {};
+  const auto& have = protocol::device_kind_info(served);
+  const auto& want = protocol::device_kind_info(stream_kind);
+  return make_error(file + " is a " + std::string(want.label) + " stream, but the daemon at " + c.address().to_string() +
+                    " serves a " + std::string(have.label) + " (`gpubridge status` shows its device kind); start gpubridged " +
+                    (stream_kind == protocol::DeviceKind::Dmc1 ? "--backend dmc1 (or a DMC-1 board: --backend icebreaker-dmc1)"
+                                                               : "with a spigpu backend (--backend sim, a board)") +
+                    " for it");
+}
+
+// Takes the lease and arms Ctrl-C for a play.
+Result<void> start_play(client::Client& c, const PlayOptions& p, client::Timeout timeout) {
+  if (auto r = c.acquire_lease(p.fail_if_busy ? protocol::LeaseMode::FailIfBusy : protocol::LeaseMode::Wait,
+                               p.fail_if_busy ? timeout : client::Timeout{24 * 3600 * 1000});
+      !r)
+    return r;
+  std::signal(SIGINT, [](int) { g_interrupted = true; });
+  // Ctrl-C stops at once, even inside a call waiting for the daemon (a full socket, a fence).
+  c.set_interrupt_flag(&g_interrupted);
+  return {};
+}
+
+bool stopped_by_ctrl_c(const Result<void>& r) { return !r && r.error().code == client::kInterrupted; }
+
+// Pipelined pacing: a fence marks a swap and at most `window` are in flight; --sync waits for each.
+Result<void> pace_swap(client::Client& c, const PlayOptions& p, client::Timeout timeout) {
+  if (p.sync) return c.fence(timeout);
+  if (auto h = c.fence_async(timeout); !h) return h.error();
+  return c.wait_fences(p.window, timeout);
+}
+
+// Sleeps until `swaps` swaps at `fps` are due since `start` (or Ctrl-C).
+void wait_until_due(Clock::time_point start, std::uint64_t swaps, double fps) {
+  const auto due = start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(static_cast<double>(swaps) / fps));
+  while (!g_interrupted && Clock::now() < due)
+    std::this_thread::sleep_for(std::min<Clock::duration>(due - Clock::now(), std::chrono::milliseconds(50)));
+}
+
+// A DMC-1 stream (.dmc1, .nfo: docs/dmc1.md "Stream files") to a daemon serving a DMC-1: its command
+// words in DMC1_WORDS messages, one frame (320 end-of-column commands) per message, so --fps paces
+// frames as it paces spigpu swaps.
+int run_play_dmc1(const GlobalOptions& g, const ClientOptions& o, const PlayOptions& p) {
+  auto stream = dmc1::load_stream(p.trace);
+  if (!stream) return fail("play", stream.error().message);
+  auto c = open_client(g, o, "gpubridge play");
+  if (!c) return fail("play", c.error().message);
+  if (auto r = check_device_kind(*c, p.trace, protocol::DeviceKind::Dmc1); !r) return fail("play", r.error().message);
+  const client::Timeout timeout{o.timeout_ms};
+  if (auto r = start_play(*c, p, timeout); !r) return fail("play", r.error().message);
+  // Frame boundaries: after every 320th end-of-column command; the rest is one last piece.
+  std::vector<std::size_t> ends;
+  unsigned columns = 0;
+  for (std::size_t i = 0; i < stream->words.size(); ++i)
+    if (dmc1::kind_of(stream->words[i]) == dmc1::CommandKind::EndOfColumn && ++columns % dmc1::kColumns == 0) ends.push_back(i + 1);
+  const std::size_t complete_frames = ends.size();
+  if (ends.empty() || ends.back() != stream->words.size()) ends.push_back(stream->words.size());
+  const auto start = Clock::now();
+  std::uint64_t words = 0, frames = 0, passes = 0;
+  for (unsigned pass = 0; (p.loop || pass < p.repeat) && !g_interrupted; ++pass, ++passes) {
+    std::size_t from = 0;
+    for (std::size_t k = 0; k < ends.size() && !g_interrupted; ++k) {
+      const std::span<const std::uint64_t> piece(stream->words.data() + from, ends[k] - from);
+      from = ends[k];
+      if (piece.empty()) continue;
+      auto r = c->write_dmc1_words(piece, timeout);
+      words += piece.size();
+      const bool frame = k < complete_frames;  // else the tail after the last complete frame
+      frames += frame;
+      if (r && frame && p.fps > 0) {
+        r = pace_swap(*c, p, timeout);
+        if (r) wait_until_due(start, frames, p.fps);
+      }
+      if (stopped_by_ctrl_c(r)) break;
+      if (!r) return fail("play", r.error().message);
+    }
+  }
+  if (!g_interrupted)
+    if (auto r = c->fence(timeout); !r && !stopped_by_ctrl_c(r)) return fail("play", r.error().message);
+  const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  const bool interrupted = g_interrupted.load();
+  if (!interrupted) c->close();
+  if (g.json) {
+    print_json({{"trace", p.trace}, {"device_kind", "dmc1"}, {"passes", passes}, {"command_words", words},
+                {"frames", frames}, {"seconds", seconds}, {"interrupted", interrupted}});
+  } else {
+    std::printf("%s %s: %llu DMC-1 command words, %llu frames in %.3f s\n",
+                interrupted ? "stopped (Ctrl-C) after playing" : "played", p.trace.c_str(),
+                static_cast<unsigned long long>(words), static_cast<unsigned long long>(frames), seconds);
+  }
+  return 0;
+}
+
+// True for a binary trace whose metadata says "device_kind": "dmc1" (a recorded DMC-1 session);
+// only its header and metadata are read.
+bool is_dmc1_binary_trace(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::vector<std::uint8_t> head(protocol::kTraceHeaderBytes + protocol::kMaxTraceJson);
+  in.read(reinterpret_cast<char*>(head.data()), static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<std::size_t>(in.gcount()));
+  if (!protocol::looks_like_binary_trace(head)) return false;
+  const auto kind = protocol::binary_trace_device_kind(head, path);
+  return kind && *kind == protocol::DeviceKind::Dmc1;
+}
+
 int run_play(const GlobalOptions& g, const ClientOptions& o, const PlayOptions& p) {
   if (p.fps < 0 || p.fps > 100000 || p.fps != p.fps) return fail("play", "--fps must be 0 (unpaced) .. 100000");
+  if (dmc1::stream_format_for_path(p.trace) || is_dmc1_binary_trace(p.trace)) return run_play_dmc1(g, o, p);
   auto stream = load_trace(p.trace);
   if (!stream) return fail("play", stream.error().message);
   auto c = open_client(g, o, "gpubridge play");
   if (!c) return fail("play", c.error().message);
+  if (auto r = check_device_kind(*c, p.trace, protocol::DeviceKind::Spigpu); !r) return fail("play", r.error().message);
   const client::Timeout timeout{o.timeout_ms};
-  if (auto r = c->acquire_lease(p.fail_if_busy ? protocol::LeaseMode::FailIfBusy : protocol::LeaseMode::Wait,
-                                p.fail_if_busy ? timeout : client::Timeout{24 * 3600 * 1000});
-      !r)
-    return fail("play", r.error().message);
-  std::signal(SIGINT, [](int) { g_interrupted = true; });
-  // Ctrl-C stops at once, even inside a call waiting for the daemon (a full socket, a fence).
-  c->set_interrupt_flag(&g_interrupted);
-  auto stopped = [](const Result<void>& r) { return !r && r.error().code == client::kInterrupted; };
-
+  if (auto r = start_play(*c, p, timeout); !r) return fail("play", r.error().message);
+  auto stopped = stopped_by_ctrl_c;
   const unsigned window = p.sync ? 0 : p.window;
-  auto pace = [&](client::Client& cl) -> Result<void> {
-    if (p.sync) return cl.fence(timeout);
-    if (auto h = cl.fence_async(timeout); !h) return h.error();
-    return cl.wait_fences(window, timeout);
-  };
+  auto pace = [&](client::Client& cl) { return pace_swap(cl, p, timeout); };
   const auto start = Clock::now();
   std::uint64_t frames = 0, swaps = 0, commands = 0, passes = 0;
   nlohmann::json reads = nlohmann::json::array();
@@ -225,9 +331,7 @@ int run_play(const GlobalOptions& g, const ClientOptions& o, const PlayOptions& 
           // Pipelined: a fence marks the swap and at most `window` swaps are in flight, so a link
           // with latency costs no round trip per frame; --sync waits for each swap to execute.
           r = pace(*c);
-          const auto due = start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(swaps / p.fps));
-          while (r && !g_interrupted && Clock::now() < due)
-            std::this_thread::sleep_for(std::min<Clock::duration>(due - Clock::now(), std::chrono::milliseconds(50)));
+          if (r) wait_until_due(start, swaps, p.fps);
         }
       } else if (auto* u = std::get_if<protocol::UploadCmd>(&tc.command)) {
         // Pipelined, an upload is not a round trip either (its ACK is taken when it arrives).
@@ -498,11 +602,14 @@ GPUBRIDGE_COMMAND("client", 40, [](CLI::App& app, GlobalOptions& g, auto& runner
   runners.emplace_back(status, [&g, copts] { return run_status(g, *copts); });
 
   auto popts = std::make_shared<PlayOptions>();
-  auto* play = app.add_subcommand("play", "stream a text or binary trace to the daemon (holding the device lease)");
-  play->add_option("TRACE", popts->trace, "trace file (.trace/.txt text or .gbt binary)")->required()->check(CLI::ExistingFile);
+  auto* play = app.add_subcommand("play", "stream a text or binary trace, or a DMC-1 stream, to the daemon (holding the device lease)");
+  play->add_option("TRACE", popts->trace,
+                   "trace file (.trace/.txt text or .gbt binary) for a spigpu daemon, or a DMC-1 stream (.dmc1, .nfo) "
+                   "for a daemon serving a DMC-1")->required()->check(CLI::ExistingFile);
   play->add_flag("--loop", popts->loop, "repeat until interrupted (Ctrl-C)");
   play->add_option("--repeat", popts->repeat, "play the trace N times")->check(CLI::Range(1u, 1000000u));
-  play->add_option("--fps", popts->fps, "at most N swaps (FB_DISPLAY writes) per second; 0 = as fast as possible");
+  play->add_option("--fps", popts->fps,
+                   "at most N swaps (FB_DISPLAY writes; DMC-1: frames of 320 columns) per second; 0 = as fast as possible");
   play->add_flag("--no-wait", popts->fail_if_busy, "fail with BUSY instead of waiting when another client draws");
   play->add_option("--window", popts->window,
                    "trace fences and --fps swaps kept in flight: the next waits only when N are unfinished, so a "

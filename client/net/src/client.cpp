@@ -456,6 +456,8 @@ Result<SessionInfo> Client::handshake(std::string_view name, std::string_view to
                     ", outside the protocol's " + std::to_string(protocol::kMinMaxPayload) + ".." +
                     std::to_string(protocol::kMaxPayload) + " bytes (docs/protocol.md 17.1); is it a gpubridged?");
   session_ = SessionInfo{w.session_id, w.max_payload, w.json, false};
+  for (const auto& k : protocol::device_kinds())
+    if (w.json.find("\"device_kind\":\"" + std::string(k.name) + "\"") != std::string::npos) session_.device_kind = k.kind;
   // The daemon's choice is in the device description; a daemon that predates compression says
   // nothing, and gets plain WRITE_FRAMES.
   if (h.codecs && w.json.find("\"compression\":\"zstd\"") != std::string::npos) {
@@ -505,6 +507,22 @@ Result<void> Client::write_frames(protocol::FrameView frames, Timeout timeout) {
     wire_.frame_bytes += chunk.size();
     wire_.frame_wire_bytes += wire_.bytes_sent - before;  // includes any PONG sent first (a few bytes, rarely)
     bytes = bytes.subspan(chunk.size());
+  }
+  return take_async_error();
+}
+
+Result<void> Client::write_dmc1_words(std::span<const std::uint64_t> words, Timeout timeout) {
+  const std::size_t max_payload = session_.max_payload ? session_.max_payload : protocol::kMaxPayload;
+  const std::size_t per_message = std::max<std::size_t>(1, max_payload / protocol::kDmc1WordBytes);
+  std::vector<std::uint8_t> bytes;
+  while (!words.empty()) {
+    const auto chunk = words.first(std::min(per_message, words.size()));
+    bytes.clear();
+    protocol::append_dmc1_words(chunk, bytes);
+    std::uint8_t header[protocol::kHeaderBytes];
+    protocol::encode_header(MsgType::Dmc1Words, static_cast<std::uint32_t>(bytes.size()), next_request_id(), header);
+    if (auto r = send_raw(header, bytes, timeout); !r) return r;
+    words = words.subspan(chunk.size());
   }
   return take_async_error();
 }

@@ -40,6 +40,10 @@ struct DaemonConfig {
   std::string frames_dir;           // write every scanned-out frame as PNG here
   std::string record_dir;           // write each session's stream as a binary trace here
   std::string log_level = "info";
+  // DMC-1 backends (docs/dmc1.md "Behind the daemon"): the texture memory image and the palette;
+  // empty = the data the repository's DMC-1 streams and goldens were made with (tests/dmc1/data).
+  std::string dmc1_textures;
+  std::string dmc1_palette;
   std::string tls_dir;              // TLS key + self-signed certificate (created on first start); empty = default_tls_dir()
   Limits limits;
 };

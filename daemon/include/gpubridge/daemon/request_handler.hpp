@@ -30,6 +30,10 @@ class RequestHandler {
  private:
   void handle_hello(const protocol::Message& m);
   void handle_write_frames(const protocol::Message& m);
+  void handle_dmc1_words(const protocol::Message& m);
+  // False (and an ERROR WRONG_DEVICE reply) when m is a command for another device kind than the
+  // one this daemon serves (docs/protocol.md 17.7).
+  bool device_kind_fits(const protocol::Message& m);
   // WRITE_FRAMES_Z: inflates into inflated_ (bounded by max_message_bytes before it starts) and
   // turns m into the WRITE_FRAMES it stands for. False when the session was failed or answered.
   bool inflate(protocol::Message& m);
@@ -59,6 +63,7 @@ class RequestHandler {
   // message's frames while its device work runs (the session reads nothing meanwhile).
   std::unique_ptr<protocol::FrameInflater> inflater_;
   std::vector<std::uint8_t> inflated_;
+  std::vector<std::uint64_t> dmc1_words_;  // one DMC1_WORDS message's words while its device work runs
 };
 
 }  // namespace gpubridge::daemon

@@ -9,15 +9,19 @@
 #include <string>
 
 #include "gpubridge/common/result.hpp"
+#include "gpubridge/protocol/device_kind.hpp"
 #include "gpubridge/protocol/messages.hpp"
 
 namespace gpubridge::daemon {
 
 class TraceRecorder {
  public:
-  // Creates DIR/session-ID[-NAME].gbtrace (NAME reduced to [A-Za-z0-9_-]) and writes its header.
+  // Creates DIR/session-ID[-NAME].gbtrace (NAME reduced to [A-Za-z0-9_-]) and writes its header,
+  // whose metadata names the device kind (docs/protocol.md 18.1): a DMC-1 session's trace holds its
+  // DMC1_WORDS and FENCE messages.
   static Result<std::unique_ptr<TraceRecorder>> open(const std::filesystem::path& dir, std::uint32_t session,
-                                                     const std::string& client_name);
+                                                     const std::string& client_name,
+                                                     protocol::DeviceKind kind = protocol::DeviceKind::Spigpu);
   void record(const protocol::Message& m);  // ignores messages that do not affect the device
   void flush() { out_.flush(); }
 
@@ -26,6 +30,7 @@ class TraceRecorder {
   TraceRecorder() = default;
   std::ofstream out_;
   std::uint64_t records_ = 0;
+  protocol::DeviceKind kind_ = protocol::DeviceKind::Spigpu;
   Clock::time_point start_ = Clock::now();
 };
 

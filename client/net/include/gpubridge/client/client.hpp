@@ -27,6 +27,7 @@
 #include "gpubridge/client/address.hpp"
 #include "gpubridge/common/result.hpp"
 #include "gpubridge/protocol/compression.hpp"
+#include "gpubridge/protocol/device_kind.hpp"
 #include "gpubridge/protocol/frame.hpp"
 #include "gpubridge/protocol/messages.hpp"
 
@@ -65,6 +66,8 @@ struct SessionInfo {
   std::uint32_t max_payload = 0;
   std::string device_json;  // WELCOME's device description
   bool compressed = false;  // WRITE_FRAMES go out as WRITE_FRAMES_Z (zstd)
+  // WELCOME's "device_kind" (docs/protocol.md 17.7); a daemon that predates device kinds serves spigpu.
+  protocol::DeviceKind device_kind = protocol::DeviceKind::Spigpu;
 };
 
 struct ReceivedFrame {
@@ -105,6 +108,9 @@ class Client {
   // Sends register writes (9-byte wire frames, write bit clear), split into WRITE_FRAMES
   // messages of at most the negotiated payload. Returns once the bytes are handed to the kernel.
   Result<void> write_frames(protocol::FrameView frames, Timeout timeout = kDefaultTimeout);
+  // DMC-1 command words (a daemon serving a DMC-1), split into DMC1_WORDS messages of at most
+  // max_payload bytes; like write_frames, errors come back with a later wait.
+  Result<void> write_dmc1_words(std::span<const std::uint64_t> words, Timeout timeout = kDefaultTimeout);
   Result<std::uint64_t> read_register(std::uint8_t index, Timeout timeout = kDefaultTimeout);
   Result<void> upload(std::uint32_t address, std::span<const std::uint8_t> bytes, const Progress& progress = {},
                       Timeout timeout = kDefaultTimeout);
