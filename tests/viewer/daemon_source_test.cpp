@@ -4,6 +4,7 @@
 #include <cstdlib>
 
 #include "gpubridge/viewer/daemon_frame_source.hpp"
+#include "gpubridge/viewer/overlay.hpp"
 
 namespace gpubridge::viewer {
 namespace {
@@ -17,6 +18,23 @@ TEST(DaemonSource, ReadsBackendAndBoardFromTheWelcome) {
   EXPECT_EQ(backend_and_board(R"({"backend":5})"), (std::pair<std::string, std::string>{"", ""}));
   EXPECT_EQ(backend_and_board("not json"), (std::pair<std::string, std::string>{"?", ""}));
   EXPECT_EQ(backend_and_board("[1,2]"), (std::pair<std::string, std::string>{"?", ""}));
+}
+
+// A DMC-1 board's WELCOME says whose frames it shows (docs/protocol.md 17.7); the overlay prints it
+// under the device line.
+TEST(DaemonSource, TheOverlaySaysWhoseFramesTheyAre) {
+  EXPECT_EQ(frames_note(R"({"backend":"board","frames_note":"the simulator's frames"})"), "the simulator's frames");
+  EXPECT_EQ(frames_note(R"({"backend":"sim"})"), "");
+  EXPECT_EQ(frames_note(R"({"frames_note":3})"), "");
+  ViewState v;
+  v.status.backend = "board";
+  v.status.board = "icebreaker-dmc1";
+  v.status.frames_note = "the simulator's frames";
+  const auto lines = overlay_lines(v);
+  ASSERT_GE(lines.size(), 2u);
+  EXPECT_EQ(lines[1], "frames: the simulator's frames");
+  v.status.frames_note.clear();
+  EXPECT_NE(overlay_lines(v)[1].rfind("frames:", 0), 0u) << "no note line for a device's own frames";
 }
 
 SourceStatus wait_for_end(FrameSource& s) {

@@ -50,6 +50,13 @@ bool mirror_enabled(const std::string& device_json) {
   return it != j.end() && it->is_boolean() && it->get<bool>();
 }
 
+std::string frames_note(const std::string& device_json) {
+  const auto j = nlohmann::json::parse(device_json, nullptr, false);
+  if (j.is_discarded() || !j.is_object()) return {};
+  const auto it = j.find("frames_note");
+  return it != j.end() && it->is_string() ? it->get<std::string>() : std::string();
+}
+
 std::optional<std::pair<std::uint64_t, std::uint64_t>> mirror_counts(const std::string& status_json) {
   const auto j = nlohmann::json::parse(status_json, nullptr, false);
   if (j.is_discarded() || !j.is_object()) return std::nullopt;
@@ -116,6 +123,7 @@ void DaemonFrameSource::run(std::stop_token stop) {
     }
     std::tie(status.backend, status.board) = backend_and_board(session->device_json);
     status.mirror = mirror_enabled(session->device_json);
+    status.frames_note = frames_note(session->device_json);
     const auto max_fps = static_cast<std::uint16_t>(std::min(config_.max_fps, 65535u));
     const auto subscribe = [&](protocol::FrameSource p) {
       // The board in the original 3-byte form, which daemons without mirror mode understand too.

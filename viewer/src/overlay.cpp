@@ -40,6 +40,7 @@ std::string status_line(const SourceStatus& s) {
 std::vector<std::string> overlay_lines(const ViewState& v) {
   std::vector<std::string> lines;
   lines.push_back(fmt::format("{}  {}", v.status.address, device_name(v.status)));
+  if (!v.status.frames_note.empty()) lines.push_back("frames: " + v.status.frames_note);
   if (auto s = status_line(v.status); !s.empty()) lines.push_back(std::move(s));
   if (auto p = picture_line(v); !p.empty()) lines.push_back(std::move(p));
   if (!v.status.picture_problem.empty()) lines.push_back(v.status.picture_problem);
