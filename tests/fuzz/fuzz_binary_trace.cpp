@@ -2,6 +2,7 @@
 // back as a trace that reads to the same commands, and survives the text form unchanged; a DMC-1
 // trace (metadata "device_kind": "dmc1") reads to words that write back to the same words, and
 // the spigpu reader refuses it.
+#include <algorithm>
 #include <cstring>
 
 #include "fuzz_check.hpp"
@@ -15,12 +16,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     FUZZ_CHECK(!read_binary_trace(std::span(data, size), "fuzz.gbt").ok());
     std::vector<std::uint8_t> out;
     FUZZ_CHECK(append_trace_header("{\"device_kind\":\"dmc1\"}", out).ok());
-    if (!words->empty()) {
-      Dmc1Words m;
+    // In messages of at most kMaxPayload bytes, as the daemon's recorder receives them.
+    constexpr std::size_t kPerMessage = kMaxPayload / kDmc1WordBytes;
+    for (std::size_t at = 0; at < words->size(); at += kPerMessage) {
       std::vector<std::uint8_t> payload;
-      append_dmc1_words(*words, payload);
-      m.bytes = payload;
-      append_trace_message(0, Message{1, m}, out);
+      append_dmc1_words(std::span(*words).subspan(at, std::min(kPerMessage, words->size() - at)), payload);
+      append_trace_message(0, Message{1, Dmc1Words{payload}}, out);
     }
     auto again = read_dmc1_trace(out, "again");
     FUZZ_CHECK(again.ok() && *again == *words);
