@@ -219,7 +219,6 @@ Result<BackendPtr> open_dmc1_device(const DaemonConfig& cfg, std::unique_ptr<dmc
   if (!palette) return make_error("backend dmc1: " + palette.error().message + hint);
   dmc1::Dmc1BackendOptions opts;
   opts.board = board;
-  opts.textures_label = dmc1_data_text(cfg);
   auto b = dmc1::Dmc1Backend::create(std::move(*textures), *palette, opts, std::move(link));
   if (!b) return make_error("backend dmc1: " + b.error().message);
   logger("daemon")->info("backend: DMC-1 {}{} ({})", board.empty() ? "simulator" : "board " + board,
@@ -247,12 +246,12 @@ Result<BackendPtr> open_uart_board(const usb::UartBoardProfile& profile, const D
   std::string tty = profile.tty;
   if (tty.empty()) {
     auto found = usb::find_usb_tty(profile.vid, profile.pid, profile.interface, profile.serial);
-    if (!found) return make_error("board "" + profile.name + "": " + found.error().message + "; or run without it: --backend dmc1 (the DMC-1 simulator)",
+    if (!found) return make_error("board \"" + profile.name + "\": " + found.error().message + "; or run without it: --backend dmc1 (the DMC-1 simulator)",
                                   backends::kDeviceGone);
     tty = *found;
   }
   auto link = dmc1::SerialLink::open(tty, profile.baud);
-  if (!link) return make_error("board "" + profile.name + "": " + link.error().message, backends::kDeviceGone);
+  if (!link) return make_error("board \"" + profile.name + "\": " + link.error().message, backends::kDeviceGone);
   return open_dmc1_device(cfg, std::move(*link), profile.name);
 }
 std::string describe_uart_board(const usb::UartBoardProfile& profile, const DaemonConfig& cfg) {

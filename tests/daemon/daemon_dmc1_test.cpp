@@ -231,6 +231,30 @@ TEST_F(DaemonDmc1, MissingTexturesSayWhatToSet) {
   EXPECT_NE(ok.out.find("the DMC-1 simulator (textures "), std::string::npos) << ok.out;
 }
 
+// A DMC-1 board whose port is not there: gpubridged does not start, and says which board, which
+// port and what to do; --check-config describes the board without opening it; --mirror is refused.
+TEST_F(DaemonDmc1, ABoardWithoutItsPortSaysWhatToDo) {
+  fs::create_directories(dir_ / "boards");
+  const auto tty = (dir_ / "ttyNONE").string();
+  std::ofstream(dir_ / "boards" / "gone-dmc1.json")
+      << R"({"name": "gone-dmc1", "description": "test: a DMC-1 SOC behind a port that is not there", "fpga": "iCE40 UP5K",
+             "device_kind": "dmc1", "uart": {"vid": "0x0403", "pid": "0x6010", "interface": "B", "baud": 115200,
+             "tty": ")" << tty << R"("}})";
+  const auto r = run_process({GPUBRIDGED_PATH, "--listen", "unix:" + socket_, "--backend", "gone-dmc1", "--boards-dir",
+                              dir_.string()}, 10s);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("gpubridged: board \"gone-dmc1\": " + tty + ": no such serial port; is the USB-UART plugged in?"),
+            std::string::npos)
+      << r.err;
+  const auto check = run_process({GPUBRIDGED_PATH, "--check-config", "--backend", "gone-dmc1", "--boards-dir", dir_.string()}, 10s);
+  EXPECT_EQ(check.exit_code, 0) << check.err;
+  EXPECT_NE(check.out.find("board gone-dmc1 (DMC-1 over a USB-UART at 115200 baud, " + tty + ")"), std::string::npos) << check.out;
+  const auto mirror = run_process(
+      {GPUBRIDGED_PATH, "--check-config", "--backend", "gone-dmc1", "--boards-dir", dir_.string(), "--mirror"}, 10s);
+  EXPECT_EQ(mirror.exit_code, 2);
+  EXPECT_NE(mirror.err.find("\"gone-dmc1\" is a DMC-1 board"), std::string::npos) << mirror.err;
+}
+
 // `gpubridged --backend BOARD` for a DMC-1 UART board: the words reach the SOC's receiver through
 // the port (the frame it draws is the golden one), the subscribers get the simulator's frame of
 // the same words (also the golden one), and STATUS says whose frames they are.

@@ -19,7 +19,6 @@ namespace gpubridge::dmc1 {
 
 struct Dmc1BackendOptions {
   unsigned threads = 1;
-  std::string textures_label;  // where the texture image and the palette came from (STATUS)
   std::string board;           // board profile name, with a link
 };
 
