@@ -12,6 +12,7 @@
 
 #include "../dmc1/golden_data.hpp"
 #include "../dmc1/pty.hpp"
+#include "daemon_fixture.hpp"
 #include "daemon_process.hpp"
 #include "gpubridge/client/client.hpp"
 #include "gpubridge/common/image.hpp"
@@ -55,21 +56,7 @@ client::Client connect_to(const std::string& socket, const std::string& name) {
   return ::testing::AssertionFailure() << "not " << n << " subscribers after 10 s";
 }
 
-class DaemonDmc1 : public ::testing::Test {
- protected:
-  void SetUp() override {
-    dir_ = make_temp_dir("dmc1-daemon");
-    socket_ = (dir_ / "d.sock").string();
-  }
-  void TearDown() override {
-    daemon_.stop();
-    std::error_code ec;
-    fs::remove_all(dir_, ec);
-  }
-  fs::path dir_;
-  std::string socket_;
-  Daemon daemon_;
-};
+class DaemonDmc1 : public DaemonDirTest {};
 
 // Every golden, as the README says: `gpubridged --backend dmc1` (no texture or palette options: the
 // repository's DMC-1 data is the default), `gpubridge play STREAM`, `gpubridge screenshot`.

@@ -6,6 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "daemon_fixture.hpp"
 #include "daemon_process.hpp"
 #include "gpubridge/client/client.hpp"
 #include "gpubridge/protocol/messages.hpp"
@@ -65,21 +66,7 @@ int last_error_code(const std::vector<std::uint8_t>& bytes) {
   return code;
 }
 
-class DaemonHostile : public ::testing::Test {
- protected:
-  void SetUp() override {
-    dir_ = make_temp_dir(::testing::UnitTest::GetInstance()->current_test_info()->name());
-    socket_ = (dir_ / "d.sock").string();
-  }
-  void TearDown() override {
-    daemon_.stop();
-    std::error_code ec;
-    fs::remove_all(dir_, ec);
-  }
-  fs::path dir_;
-  std::string socket_;
-  Daemon daemon_;
-};
+class DaemonHostile : public DaemonDirTest {};
 
 TEST_F(DaemonHostile, BadClientsAreClosedAndTheGoodOneIsUnaffected) {
   ASSERT_TRUE(daemon_.start({"--listen", "unix:" + socket_, "--backend", "fake", "--log-level", "error",

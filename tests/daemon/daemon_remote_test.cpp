@@ -7,6 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "daemon_fixture.hpp"
 #include "daemon_process.hpp"
 #include "gpubridge/bench/delay_proxy.hpp"
 #include "gpubridge/client/client.hpp"
@@ -19,16 +20,11 @@ namespace {
 using namespace std::chrono_literals;
 using Clock = std::chrono::steady_clock;
 
-class DaemonRemote : public ::testing::Test {
+class DaemonRemote : public DaemonDirTest {
  protected:
   void SetUp() override {
-    dir_ = make_temp_dir(::testing::UnitTest::GetInstance()->current_test_info()->name());
+    DaemonDirTest::SetUp();
     known_hosts_ = (dir_ / "known_hosts").string();
-  }
-  void TearDown() override {
-    daemon_.stop();
-    std::error_code ec;
-    fs::remove_all(dir_, ec);
   }
   // A daemon on loopback TCP (port chosen by the kernel) with its TLS key in the test directory.
   void start(std::vector<std::string> extra = {}, const std::string& listen = "tcp:127.0.0.1:0") {
@@ -66,10 +62,8 @@ class DaemonRemote : public ::testing::Test {
     return path.string();
   }
 
-  fs::path dir_;
   std::string known_hosts_;
   std::uint16_t port_ = 0;
-  Daemon daemon_;
 };
 
 double play_seconds(const ProcessResult& r) {

@@ -220,6 +220,20 @@ Result<void> start_play(client::Client& c, const PlayOptions& p, client::Timeout
 
 bool stopped_by_ctrl_c(const Result<void>& r) { return !r && r.error().code == client::kInterrupted; }
 
+// How a play ended: the final fence (unless Ctrl-C: closing without one makes the daemon drop the
+// client's queued work and free the lease), the elapsed time, and a clean close when not interrupted.
+struct PlayEnd {
+  double seconds = 0;
+  bool interrupted = false;
+};
+Result<PlayEnd> end_play(client::Client& c, Clock::time_point start, client::Timeout timeout) {
+  if (!g_interrupted)
+    if (auto r = c.fence(timeout); !r && !stopped_by_ctrl_c(r)) return r.error();
+  PlayEnd end{std::chrono::duration<double>(Clock::now() - start).count(), g_interrupted.load()};
+  if (!end.interrupted) c.close();
+  return end;
+}
+
 // Pipelined pacing: a fence marks a swap and at most `window` are in flight; --sync waits for each.
 Result<void> pace_swap(client::Client& c, const PlayOptions& p, client::Timeout timeout) {
   if (p.sync) return c.fence(timeout);
@@ -272,11 +286,9 @@ int run_play_dmc1(const GlobalOptions& g, const ClientOptions& o, const PlayOpti
       if (!r) return fail("play", r.error().message);
     }
   }
-  if (!g_interrupted)
-    if (auto r = c->fence(timeout); !r && !stopped_by_ctrl_c(r)) return fail("play", r.error().message);
-  const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
-  const bool interrupted = g_interrupted.load();
-  if (!interrupted) c->close();
+  auto end = end_play(*c, start, timeout);
+  if (!end) return fail("play", end.error().message);
+  const auto [seconds, interrupted] = *end;
   if (g.json) {
     print_json({{"trace", p.trace}, {"device_kind", "dmc1"}, {"passes", passes}, {"command_words", words},
                 {"frames", frames}, {"seconds", seconds}, {"interrupted", interrupted}});
@@ -356,13 +368,9 @@ int run_play(const GlobalOptions& g, const ClientOptions& o, const PlayOptions& 
       if (!r) return fail("play", r.error().message);
     }
   }
-  // Interrupted: what was sent but not executed yet is dropped (closing the connection without a
-  // fence makes the daemon drop the client's queued work and free the lease).
-  if (!g_interrupted)
-    if (auto r = c->fence(timeout); !r && !stopped(r)) return fail("play", r.error().message);
-  const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
-  const bool interrupted = g_interrupted.load();
-  if (!interrupted) c->close();
+  auto end = end_play(*c, start, timeout);
+  if (!end) return fail("play", end.error().message);
+  const auto [seconds, interrupted] = *end;
   if (g.json) {
     const auto& w = c->wire_stats();
     print_json({{"trace", p.trace}, {"passes", passes}, {"commands", commands}, {"register_writes", frames},
