@@ -82,20 +82,23 @@ const TimingModel& Device::timing() const { return impl_->timing; }
 std::uint8_t Device::picked_height() const { return impl_->dispatcher.registers().picked_height; }
 unsigned Device::threads() const { return impl_->renderer.threads(); }
 
-Image frame_image(std::span<const std::uint16_t> rgb565) {
-  Image img;
-  img.width = kColumns;
-  img.height = kRows;
-  img.rgba.assign(kFramePixels * 4, 0);
-  for (std::size_t i = 0; i < kFramePixels; ++i) {
-    const std::uint16_t w = i < rgb565.size() ? rgb565[i] : 0;  // a short buffer leaves the rest black
-    std::uint8_t* px = img.pixel(static_cast<unsigned>(i / kRows), kRows - 1 - static_cast<unsigned>(i % kRows));
-    px[0] = protocol::expand5(w >> 11);
-    px[1] = protocol::expand6((w >> 5) & 63);
-    px[2] = protocol::expand5(w & 31);
-    px[3] = 255;
+std::vector<std::uint8_t> frame_rows_rgb565(std::span<const std::uint16_t> column_major) {
+  std::vector<std::uint8_t> out(kFramePixels * 2, 0);
+  for (unsigned y = 0; y < kRows; ++y) {
+    const unsigned row = kRows - 1 - y;
+    std::uint8_t* line = out.data() + std::size_t{y} * kColumns * 2;
+    for (unsigned x = 0; x < kColumns; ++x) {
+      const std::size_t i = std::size_t{x} * kRows + row;
+      const std::uint16_t v = i < column_major.size() ? column_major[i] : 0;
+      line[2 * x] = static_cast<std::uint8_t>(v >> 8);
+      line[2 * x + 1] = static_cast<std::uint8_t>(v);
+    }
   }
-  return img;
+  return out;
+}
+
+Image frame_image(std::span<const std::uint16_t> rgb565) {
+  return image_from_device(protocol::PixelFormat::RGB565, kColumns, kRows, frame_rows_rgb565(rgb565));
 }
 
 }  // namespace gpubridge::dmc1

@@ -12,20 +12,6 @@ constexpr std::size_t kSubmitSlice = 4096;
 
 }  // namespace
 
-std::vector<std::uint8_t> frame_rows_rgb565(std::span<const std::uint16_t> column_major) {
-  std::vector<std::uint8_t> out(kFramePixels * 2);
-  for (unsigned y = 0; y < kRows; ++y) {
-    const unsigned row = kRows - 1 - y;
-    std::uint8_t* line = out.data() + std::size_t{y} * kColumns * 2;
-    for (unsigned x = 0; x < kColumns; ++x) {
-      const std::uint16_t v = column_major[std::size_t{x} * kRows + row];
-      line[2 * x] = static_cast<std::uint8_t>(v >> 8);
-      line[2 * x + 1] = static_cast<std::uint8_t>(v);
-    }
-  }
-  return out;
-}
-
 Result<std::unique_ptr<Dmc1Backend>> Dmc1Backend::create(std::shared_ptr<const TextureMemory> textures,
                                                          const Palette& palette, const Dmc1BackendOptions& options,
                                                          std::unique_ptr<SerialLink> link) {

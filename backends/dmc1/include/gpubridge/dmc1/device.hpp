@@ -83,8 +83,12 @@ class Device {
   std::unique_ptr<Impl> impl_;
 };
 
-// The picture of a frame (docs/dmc1.md, "Images"): x = column, y = 239 - row (row 0 at the bottom),
-// 8-bit channels by bit replication, opaque.
+// A frame in screen order, as a FRAME message carries it (docs/protocol.md 17.3): rows top to bottom
+// (x = column, y = 239 - row: the DMC-1's row 0 is the bottom), each pixel big-endian RGB565. Words
+// a short buffer lacks are black.
+std::vector<std::uint8_t> frame_rows_rgb565(std::span<const std::uint16_t> column_major);
+// The picture of a frame (docs/dmc1.md, "Images"): those rows with 8-bit channels by bit
+// replication (image_from_device), opaque.
 Image frame_image(std::span<const std::uint16_t> rgb565);
 
 }  // namespace gpubridge::dmc1

@@ -53,8 +53,4 @@ class Dmc1Backend final : public backends::Backend {
   const std::atomic<bool>* cancel_ = nullptr;
 };
 
-// A DMC-1 frame in the order a FRAME message carries it (docs/protocol.md 17.3): rows top to bottom
-// (row 239 of the DMC-1 first: its row 0 is the bottom), each pixel big-endian RGB565.
-std::vector<std::uint8_t> frame_rows_rgb565(std::span<const std::uint16_t> column_major);
-
 }  // namespace gpubridge::dmc1
