@@ -37,6 +37,21 @@ TEST(DaemonSource, TheOverlaySaysWhoseFramesTheyAre) {
   EXPECT_NE(overlay_lines(v)[1].rfind("frames:", 0), 0u) << "no note line for a device's own frames";
 }
 
+// A daemon serving a DMC-1 says so on the device line and in the title; spigpu, the protocol's own
+// device, keeps the plain backend name.
+TEST(DaemonSource, TheOverlayNamesADeviceKindOtherThanSpigpu) {
+  ViewState v;
+  v.status.address = "unix:/tmp/g.sock";
+  v.status.backend = "sim";
+  EXPECT_EQ(overlay_lines(v)[0], "unix:/tmp/g.sock  sim");
+  v.status.device = "DMC-1";
+  EXPECT_EQ(overlay_lines(v)[0], "unix:/tmp/g.sock  DMC-1 sim");
+  EXPECT_EQ(window_title(v), "gpubridge-view - unix:/tmp/g.sock - DMC-1 sim");
+  v.status.backend = "board";
+  v.status.board = "icebreaker-dmc1";
+  EXPECT_EQ(overlay_lines(v)[0], "unix:/tmp/g.sock  DMC-1 board/icebreaker-dmc1");
+}
+
 SourceStatus wait_for_end(FrameSource& s) {
   for (int i = 0; i < 100; ++i) {
     const auto v = s.status_version();

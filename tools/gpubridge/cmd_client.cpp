@@ -10,12 +10,12 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
-#include <thread>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "client_common.hpp"
+#include "gpubridge/client/pacing.hpp"
 #include "gpubridge/common/image.hpp"
 #include "gpubridge/common/trace_files.hpp"
 #include "gpubridge/dmc1/command.hpp"
@@ -192,20 +192,6 @@ std::size_t count_swaps(protocol::FrameView v) {
   return n;
 }
 
-// The stream's device kind must be the daemon's (WELCOME "device_kind", docs/protocol.md 17.7): said
-// here, before the lease, rather than by an ERROR WRONG_DEVICE per message.
-Result<void> check_device_kind(const client::Client& c, const std::string& file, protocol::DeviceKind stream_kind) {
-  const auto served = c.session().device_kind;
-  if (served == stream_kind) return {};
-  const auto& have = protocol::device_kind_info(served);
-  const auto& want = protocol::device_kind_info(stream_kind);
-  return make_error(file + " is a " + std::string(want.label) + " stream, but the daemon at " + c.address().to_string() +
-                    " serves a " + std::string(have.label) + " (`gpubridge status` shows its device kind); start gpubridged " +
-                    (stream_kind == protocol::DeviceKind::Dmc1 ? "--backend dmc1 (or a DMC-1 board: --backend icebreaker-dmc1)"
-                                                               : "with a spigpu backend (--backend sim, a board)") +
-                    " for it");
-}
-
 // Takes the lease and arms Ctrl-C for a play.
 Result<void> start_play(client::Client& c, const PlayOptions& p, client::Timeout timeout) {
   if (auto r = c.acquire_lease(p.fail_if_busy ? protocol::LeaseMode::FailIfBusy : protocol::LeaseMode::Wait,
@@ -226,27 +212,15 @@ struct PlayEnd {
   double seconds = 0;
   bool interrupted = false;
 };
-Result<PlayEnd> end_play(client::Client& c, Clock::time_point start, client::Timeout timeout) {
+Result<PlayEnd> end_play(client::Client& c, const client::FramePacer& pacer, client::Timeout timeout) {
   if (!g_interrupted)
     if (auto r = c.fence(timeout); !r && !stopped_by_ctrl_c(r)) return r.error();
-  PlayEnd end{std::chrono::duration<double>(Clock::now() - start).count(), g_interrupted.load()};
+  PlayEnd end{pacer.elapsed_seconds(), g_interrupted.load()};
   if (!end.interrupted) c.close();
   return end;
 }
 
-// Pipelined pacing: a fence marks a swap and at most `window` are in flight; --sync waits for each.
-Result<void> pace_swap(client::Client& c, const PlayOptions& p, client::Timeout timeout) {
-  if (p.sync) return c.fence(timeout);
-  if (auto h = c.fence_async(timeout); !h) return h.error();
-  return c.wait_fences(p.window, timeout);
-}
-
-// Sleeps until `swaps` swaps at `fps` are due since `start` (or Ctrl-C).
-void wait_until_due(Clock::time_point start, std::uint64_t swaps, double fps) {
-  const auto due = start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(static_cast<double>(swaps) / fps));
-  while (!g_interrupted && Clock::now() < due)
-    std::this_thread::sleep_for(std::min<Clock::duration>(due - Clock::now(), std::chrono::milliseconds(50)));
-}
+client::PaceOptions pace_options(const PlayOptions& p) { return {p.fps, p.window, p.sync}; }
 
 // A DMC-1 stream (.dmc1, .nfo: docs/dmc1.md "Stream files") to a daemon serving a DMC-1: its command
 // words in DMC1_WORDS messages, one frame (320 end-of-column commands) per message, so --fps paces
@@ -256,7 +230,7 @@ int run_play_dmc1(const GlobalOptions& g, const ClientOptions& o, const PlayOpti
   if (!stream) return fail("play", stream.error().message);
   auto c = open_client(g, o, "gpubridge play");
   if (!c) return fail("play", c.error().message);
-  if (auto r = check_device_kind(*c, p.trace, protocol::DeviceKind::Dmc1); !r) return fail("play", r.error().message);
+  if (auto r = client::require_device_kind(*c, p.trace, protocol::DeviceKind::Dmc1); !r) return fail("play", r.error().message);
   const client::Timeout timeout{o.timeout_ms};
   if (auto r = start_play(*c, p, timeout); !r) return fail("play", r.error().message);
   // Frame boundaries: after every 320th end-of-column command; the rest is one last piece.
@@ -266,7 +240,7 @@ int run_play_dmc1(const GlobalOptions& g, const ClientOptions& o, const PlayOpti
     if (dmc1::kind_of(stream->words[i]) == dmc1::CommandKind::EndOfColumn && ++columns % dmc1::kColumns == 0) ends.push_back(i + 1);
   const std::size_t complete_frames = ends.size();
   if (ends.empty() || ends.back() != stream->words.size()) ends.push_back(stream->words.size());
-  const auto start = Clock::now();
+  client::FramePacer pacer(*c, pace_options(p), &g_interrupted);
   std::uint64_t words = 0, frames = 0, passes = 0;
   for (unsigned pass = 0; (p.loop || pass < p.repeat) && !g_interrupted; ++pass, ++passes) {
     std::size_t from = 0;
@@ -278,15 +252,12 @@ int run_play_dmc1(const GlobalOptions& g, const ClientOptions& o, const PlayOpti
       words += piece.size();
       const bool frame = k < complete_frames;  // else the tail after the last complete frame
       frames += frame;
-      if (r && frame && p.fps > 0) {
-        r = pace_swap(*c, p, timeout);
-        if (r) wait_until_due(start, frames, p.fps);
-      }
+      if (r && frame && p.fps > 0) r = pacer.frames_sent(1, timeout);
       if (stopped_by_ctrl_c(r)) break;
       if (!r) return fail("play", r.error().message);
     }
   }
-  auto end = end_play(*c, start, timeout);
+  auto end = end_play(*c, pacer, timeout);
   if (!end) return fail("play", end.error().message);
   const auto [seconds, interrupted] = *end;
   if (g.json) {
@@ -319,13 +290,12 @@ int run_play(const GlobalOptions& g, const ClientOptions& o, const PlayOptions& 
   if (!stream) return fail("play", stream.error().message);
   auto c = open_client(g, o, "gpubridge play");
   if (!c) return fail("play", c.error().message);
-  if (auto r = check_device_kind(*c, p.trace, protocol::DeviceKind::Spigpu); !r) return fail("play", r.error().message);
+  if (auto r = client::require_device_kind(*c, p.trace, protocol::DeviceKind::Spigpu); !r) return fail("play", r.error().message);
   const client::Timeout timeout{o.timeout_ms};
   if (auto r = start_play(*c, p, timeout); !r) return fail("play", r.error().message);
   auto stopped = stopped_by_ctrl_c;
   const unsigned window = p.sync ? 0 : p.window;
-  auto pace = [&](client::Client& cl) { return pace_swap(cl, p, timeout); };
-  const auto start = Clock::now();
+  client::FramePacer pacer(*c, pace_options(p), &g_interrupted);
   std::uint64_t frames = 0, swaps = 0, commands = 0, passes = 0;
   nlohmann::json reads = nlohmann::json::array();
   for (unsigned pass = 0; (p.loop || pass < p.repeat) && !g_interrupted; ++pass, ++passes) {
@@ -338,19 +308,16 @@ int run_play(const GlobalOptions& g, const ClientOptions& o, const PlayOptions& 
         frames += f->size();
         const auto n = count_swaps(f->view());
         swaps += n;
-        if (r && n && p.fps > 0) {
-          // Pace on swaps: the next swap may not happen before swaps/fps seconds after the start.
-          // Pipelined: a fence marks the swap and at most `window` swaps are in flight, so a link
-          // with latency costs no round trip per frame; --sync waits for each swap to execute.
-          r = pace(*c);
-          if (r) wait_until_due(start, swaps, p.fps);
-        }
+        // Pace on swaps: the next swap may not happen before swaps/fps seconds after the start.
+        // Pipelined: a fence marks the swap and at most `window` swaps are in flight, so a link
+        // with latency costs no round trip per frame; --sync waits for each swap to execute.
+        if (r && n && p.fps > 0) r = pacer.frames_sent(n, timeout);
       } else if (auto* u = std::get_if<protocol::UploadCmd>(&tc.command)) {
         // Pipelined, an upload is not a round trip either (its ACK is taken when it arrives).
         r = p.sync ? c->upload(u->address, u->data, {}, timeout) : c->upload_async(u->address, u->data, timeout);
       } else if (auto* fe = std::get_if<protocol::FenceCmd>(&tc.command)) {
         (void)fe;
-        r = pace(*c);
+        r = pacer.fence(timeout);
       } else if (auto* rr = std::get_if<protocol::ReadRegCmd>(&tc.command)) {
         auto v = c->read_register(rr->index, timeout);
         if (v) {
@@ -368,7 +335,7 @@ int run_play(const GlobalOptions& g, const ClientOptions& o, const PlayOptions& 
       if (!r) return fail("play", r.error().message);
     }
   }
-  auto end = end_play(*c, start, timeout);
+  auto end = end_play(*c, pacer, timeout);
   if (!end) return fail("play", end.error().message);
   const auto [seconds, interrupted] = *end;
   if (g.json) {

@@ -124,6 +124,9 @@ void DaemonFrameSource::run(std::stop_token stop) {
     std::tie(status.backend, status.board) = backend_and_board(session->device_json);
     status.mirror = mirror_enabled(session->device_json);
     status.frames_note = frames_note(session->device_json);
+    status.device = session->device_kind == protocol::DeviceKind::Spigpu
+                        ? std::string()
+                        : std::string(protocol::device_kind_info(session->device_kind).label);
     const auto max_fps = static_cast<std::uint16_t>(std::min(config_.max_fps, 65535u));
     const auto subscribe = [&](protocol::FrameSource p) {
       // The board in the original 3-byte form, which daemons without mirror mode understand too.

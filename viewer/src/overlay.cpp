@@ -5,9 +5,11 @@
 namespace gpubridge::viewer {
 namespace {
 
+// "sim", "usb/ulx3s"; a device other than spigpu says its kind first: "DMC-1 sim".
 std::string device_name(const SourceStatus& s) {
   if (s.backend.empty()) return "?";
-  return s.board.empty() ? s.backend : s.backend + "/" + s.board;
+  const std::string kind = s.device.empty() ? "" : s.device + " ";
+  return kind + (s.board.empty() ? s.backend : s.backend + "/" + s.board);
 }
 
 // The picture on screen: the shown frame's own source once one arrived, else the one asked for.

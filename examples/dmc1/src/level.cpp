@@ -146,16 +146,18 @@ std::vector<std::uint64_t> frame_commands(const Level& lv, const Camera& cam) {
 std::vector<std::uint64_t> path_commands(const Level& lv, unsigned frames) {
   std::vector<std::uint64_t> out;
   for (unsigned f = 0; f < frames; ++f) {
-    const auto words = frame_commands(lv, camera_path(lv, static_cast<double>(f) / frames));
+    const auto words = lap_frame_commands(lv, f, frames);
     out.insert(out.end(), words.begin(), words.end());
   }
   return out;
 }
 
-std::vector<std::uint64_t> golden_frame_commands(unsigned frame) {
-  const Level lv = hall();
-  return frame_commands(lv, camera_path(lv, static_cast<double>(frame % kPathFrames) / kPathFrames));
+std::vector<std::uint64_t> lap_frame_commands(const Level& lv, unsigned n, unsigned path_frames) {
+  path_frames = std::max(path_frames, 1u);
+  return frame_commands(lv, camera_path(lv, static_cast<double>(n % path_frames) / path_frames));
 }
+
+std::vector<std::uint64_t> golden_frame_commands(unsigned frame) { return lap_frame_commands(hall(), frame, kPathFrames); }
 
 std::string golden_name(unsigned frame) {
   char name[32];

@@ -29,6 +29,7 @@ struct SourceStatus {
   std::string address;  // what the source reads from ("unix:/run/...", "test pattern")
   std::string backend;  // "sim", "usb", ... (empty until known)
   std::string board;    // board name when the backend has one
+  std::string device;   // the device kind's label when it is not spigpu ("DMC-1"), else empty
   std::string frames_note;  // whose frames they are when not the device's own (a DMC-1 board: its simulator's)
   std::string message;  // for Waiting/Failed: the last error, one line
   // Mirror mode (gpubridged --mirror): which picture is subscribed and how many swaps so far had a

@@ -36,6 +36,9 @@ Camera camera_path(const Level& level, double t);
 std::vector<std::uint64_t> frame_commands(const Level& level, const Camera& camera);
 // `frames` frames evenly spaced along the camera path.
 std::vector<std::uint64_t> path_commands(const Level& level, unsigned frames);
+// Frame n of a lap of `path_frames` frames (n taken modulo the lap): what the client sends for its
+// n-th frame, written to a file (`gpubridge-dmc1-demo write`) or streamed to a daemon (`stream`).
+std::vector<std::uint64_t> lap_frame_commands(const Level& level, unsigned n, unsigned path_frames);
 
 // The golden frames (examples/dmc1/golden/): positions on a lap of kPathFrames frames, chosen to show
 // the window and terrain, a pillar close up and the brick walls.
