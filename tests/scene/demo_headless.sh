@@ -1,6 +1,8 @@
 #!/bin/sh
 # The README's main job without a display (scripts/demo-run.sh on this build): every demo scene
-# streams through a real gpubridged, and every swap leaves a PNG that decodes.
+# streams through a real gpubridged, and every swap leaves a PNG that decodes; the DMC-1 example
+# level streams through a second gpubridged (--backend dmc1), and its first frame, the chip's first
+# after reset, is the committed golden examples/dmc1/golden/level-00.png.
 # Usage: demo_headless.sh SOURCE_DIR BUILD_DIR WORK_DIR
 set -eu
 src=$1 build=$2 work=$3
@@ -18,4 +20,11 @@ for f in "$work/out"/frame_*.png; do
   grep -q "  $f\$" "$work/log" || { echo "$f was written but not listed"; exit 1; }
   "$build/tools/gpubridge" compare "$f" "$f" > /dev/null || { echo "$f does not decode as a PNG"; exit 1; }
 done
-echo "demo headless: $count frames written, listed and decodable"
+dmc1=$(ls "$work/out/dmc1"/frame_*.png | wc -l)
+[ "$dmc1" -eq $frames ] || { echo "expected $frames DMC-1 PNG frames, found $dmc1"; exit 1; }
+for f in "$work/out/dmc1"/frame_*.png; do
+  grep -q "  $f\$" "$work/log" || { echo "$f was written but not listed"; exit 1; }
+done
+"$build/tools/gpubridge" compare "$src/examples/dmc1/golden/level-00.png" "$work/out/dmc1/frame_000000.png" --tolerance 0 ||
+  { echo "the DMC-1 level's first frame is not examples/dmc1/golden/level-00.png"; exit 1; }
+echo "demo headless: $count frames written, listed and decodable; $dmc1 DMC-1 frames, the first its golden"
