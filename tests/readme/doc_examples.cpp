@@ -40,6 +40,16 @@ Step stream_to_dmc1_board() {
 Step serve_dmc1() {
   return daemon("build/daemon/gpubridged --backend dmc1 &").prints("listening on " + kDefaultSocket).prints("ready");
 }
+// The DMC-1's frames in a window, and the example client streaming its level live (as fast as 30
+// frames/s: 64 frames take over 2 s).
+Step view_dmc1() {
+  return viewer("build/viewer/gpubridge-view &", {"gpubridge-view - " + kDefaultSocket + R"( - DMC-1 sim - 320x240)"});
+}
+Step stream_level_dmc1() {
+  return run("build/examples/dmc1/gpubridge-dmc1-demo stream")
+      .prints(R"(streamed 64 frame\(s\) of the DMC-1 level to )" + kDefaultSocket + R"(: \d+ commands, \d+ bytes in)")
+      .within(120);
+}
 Step play_mixed_dmc1() {
   return alongside("build/tools/gpubridge play tests/dmc1/data/streams/mixed.dmc1 --fps 10 --repeat 30 &")
       .prints(R"(played tests/dmc1/data/streams/mixed\.dmc1: \d+ DMC-1 command words, 30 frames)")
@@ -131,6 +141,8 @@ std::vector<Example> make() {
       list_dmc1_fields(),
       stream_to_dmc1_board(),
       serve_dmc1(),
+      view_dmc1(),
+      stream_level_dmc1(),
       play_mixed_dmc1(),
       screenshot_dmc1(),
 
@@ -215,6 +227,17 @@ std::vector<Example> make() {
       skip("build/daemon/gpubridged --backend icebreaker-dmc1 &",
            "needs an iCEBreaker on USB; DaemonDmc1.BoardBackendStreamsToItsPortAndShowsTheSimulatorsFrames serves a "
            "board profile whose port is a pseudo-terminal, the SOC's receiver model on its other end"),
+  }});
+
+  all.push_back({"docs/dmc1.md", "Example client", 0, "docs_dmc1_ExampleClientLive", {
+      serve_dmc1(),
+      view_dmc1(),
+      stream_level_dmc1(),
+      run("build/examples/dmc1/gpubridge-dmc1-demo stream --fps 0 --frames 256 --json")
+          .prints(R"("frames": 256)")
+          .prints(R"("commands": \d+)")
+          .prints(R"("interrupted": false)")
+          .within(120),
   }});
 
   all.push_back({"docs/dmc1.md", "Board path", 0, "docs_dmc1_BoardPath", {
