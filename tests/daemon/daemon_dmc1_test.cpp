@@ -1,8 +1,10 @@
 // The DMC-1 behind gpubridged (docs/dmc1.md "Behind the daemon", docs/protocol.md 17.7): every RTL
 // golden of tests/dmc1/data played through a real daemon with `gpubridge play` and taken back with
 // `gpubridge screenshot` (and as raw RGB565 words by a subscriber), bit for bit; device kinds in
-// WELCOME and STATUS; WRONG_DEVICE for the other kind's commands; the board backend streaming to a
-// pseudo-terminal whose other end is the SOC's receiver model feeding a second simulator.
+// WELCOME and STATUS; WRONG_DEVICE for the other kind's commands; recordings (played, dumped,
+// converted); the board backend streaming to a pseudo-terminal whose other end is the SOC's receiver
+// model feeding a second simulator.
+#include <algorithm>
 #include <atomic>
 #include <future>
 #include <thread>
@@ -16,6 +18,7 @@
 #include "daemon_process.hpp"
 #include "gpubridge/client/client.hpp"
 #include "gpubridge/common/image.hpp"
+#include "gpubridge/dmc1/command.hpp"
 #include "gpubridge/dmc1/device.hpp"
 #include "gpubridge/dmc1/dmc1_backend.hpp"
 #include "gpubridge/dmc1/uart.hpp"
@@ -206,6 +209,32 @@ TEST_F(DaemonDmc1, RecordingsSayTheirDeviceKindAndPlayBack) {
   auto f = sub.next_frame(5000ms);
   ASSERT_TRUE(f) << f.error().message;
   EXPECT_TRUE(f->pixels == dmc1::frame_rows_rgb565(golden::golden_pixels("planes")));
+
+  // `gpubridge trace`: the recording's words decoded, frame ends marked; converted to a .dmc1 stream
+  // file holding the recorded words; any other output refused by name.
+  const auto planes = golden::golden_stream("planes");
+  const auto dump = run_process({GPUBRIDGE_CLI_PATH, "trace", "dump", traces[0].string()}, 30s);
+  ASSERT_EQ(dump.exit_code, 0) << dump.err;
+  EXPECT_NE(dump.out.find(traces[0].string() + ": DMC-1 recording\n"), std::string::npos) << dump.out.substr(0, 200);
+  EXPECT_NE(dump.out.find(dmc1::describe(planes[0])), std::string::npos) << dump.out.substr(0, 400);
+  EXPECT_NE(dump.out.find("-- end of frame 0\n"), std::string::npos);
+  EXPECT_NE(dump.out.find(std::to_string(planes.size()) + " command words: 1 frames\n"), std::string::npos)
+      << dump.out.substr(dump.out.size() - std::min<std::size_t>(dump.out.size(), 200));
+  const auto out = dir_ / "planes-again.dmc1";
+  const auto conv = run_process({GPUBRIDGE_CLI_PATH, "trace", "convert", traces[0].string(), out.string()}, 30s);
+  ASSERT_EQ(conv.exit_code, 0) << conv.err;
+  EXPECT_NE(conv.out.find("(DMC-1 dmc1 format, " + std::to_string(planes.size()) + " command words, 1 frames)"),
+            std::string::npos)
+      << conv.out;
+  auto back = dmc1::load_stream(out);
+  ASSERT_TRUE(back) << back.error().message;
+  EXPECT_TRUE(back->words == planes) << "the converted stream is not the recorded words";
+  const auto refused = run_process({GPUBRIDGE_CLI_PATH, "trace", "convert", traces[0].string(), (dir_ / "x.gbt").string()}, 30s);
+  EXPECT_EQ(refused.exit_code, 2);
+  EXPECT_NE(refused.err.find("holds DMC-1 command words, which convert to a DMC-1 stream file: name the output .dmc1 "
+                             "(text) or .nfo (tinygpus lines)"),
+            std::string::npos)
+      << refused.err;
 }
 
 TEST_F(DaemonDmc1, MissingTexturesSayWhatToSet) {

@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "client_common.hpp"
+#include "command_input.hpp"
 #include "gpubridge/client/pacing.hpp"
 #include "gpubridge/common/image.hpp"
 #include "gpubridge/common/trace_files.hpp"
@@ -269,18 +270,6 @@ int run_play_dmc1(const GlobalOptions& g, const ClientOptions& o, const PlayOpti
                 static_cast<unsigned long long>(words), static_cast<unsigned long long>(frames), seconds);
   }
   return 0;
-}
-
-// True for a binary trace whose metadata says "device_kind": "dmc1" (a recorded DMC-1 session);
-// only its header and metadata are read.
-bool is_dmc1_binary_trace(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::vector<std::uint8_t> head(protocol::kTraceHeaderBytes + protocol::kMaxTraceJson);
-  in.read(reinterpret_cast<char*>(head.data()), static_cast<std::streamsize>(head.size()));
-  head.resize(static_cast<std::size_t>(in.gcount()));
-  if (!protocol::looks_like_binary_trace(head)) return false;
-  const auto kind = protocol::binary_trace_device_kind(head, path);
-  return kind && *kind == protocol::DeviceKind::Dmc1;
 }
 
 int run_play(const GlobalOptions& g, const ClientOptions& o, const PlayOptions& p) {

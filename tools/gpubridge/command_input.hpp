@@ -3,9 +3,12 @@
 // whose command stream is built by the scene loader (docs/scene-format.md, "Command stream").
 #include <cstdint>
 #include <filesystem>
+#include <fstream>
 #include <string>
+#include <vector>
 
 #include "gpubridge/common/trace_files.hpp"
+#include "gpubridge/protocol/trace.hpp"
 #include "gpubridge/scene/scene.hpp"
 
 namespace gpubridge::cli {
@@ -26,6 +29,18 @@ inline Result<protocol::CommandStream> load_commands(const std::string& input, s
   }
   kind = "trace";
   return load_trace(p);
+}
+
+// True for a binary trace whose metadata says "device_kind": "dmc1" (a recorded DMC-1 session,
+// read by dmc1::load_stream); only its header and metadata are read.
+inline bool is_dmc1_binary_trace(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::vector<std::uint8_t> head(protocol::kTraceHeaderBytes + protocol::kMaxTraceJson);
+  in.read(reinterpret_cast<char*>(head.data()), static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<std::size_t>(in.gcount()));
+  if (!protocol::looks_like_binary_trace(head)) return false;
+  const auto kind = protocol::binary_trace_device_kind(head, path);
+  return kind && *kind == protocol::DeviceKind::Dmc1;
 }
 
 }  // namespace gpubridge::cli
