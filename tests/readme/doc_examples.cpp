@@ -314,7 +314,7 @@ std::vector<Example> make() {
           .leaves("forced/torus-0012.png"),
       run("build/examples/gpubridge-demo fit --timing --markdown")
           .prints(R"(\| example \| ch341a-generic \|)")
-          .prints(R"(\| terrain \| 0\.5 \|)")
+          .prints(R"(\| terrain \| 1\.0 \|)")
           .within(120),
   }});
 

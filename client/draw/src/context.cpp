@@ -84,6 +84,7 @@ Result<void> Context::set_scissor(unsigned x0, unsigned y0, unsigned x1, unsigne
   if (!w) return w.error();
   if (*w != scissor_) write(Reg::SCISSOR, *w);
   scissor_ = *w;
+  scissor_rect_ = geometry::visible_rect(options_.width, options_.height, x0, y0, x1, y1);
   return {};
 }
 
@@ -91,6 +92,8 @@ void Context::reset_scissor() {
   const auto full = *geometry::scissor_word(0, 0, protocol::kMaxFramebufferDim, protocol::kMaxFramebufferDim);
   if (full != scissor_) write(Reg::SCISSOR, full);  // scissor_ starts at 0, so creation writes it
   scissor_ = full;
+  scissor_rect_ = geometry::visible_rect(options_.width, options_.height, 0, 0, protocol::kMaxFramebufferDim,
+                                         protocol::kMaxFramebufferDim);
 }
 
 Result<Texture> Context::create_texture(const Image& image, const TextureOptions& o) {
@@ -191,6 +194,7 @@ Result<void> Context::apply_state(geometry::PipelineOptions& opt) {
   opt.cull = cull_;
   opt.front_face = front_;
   opt.textured = s.textured;
+  if (options_.skip_invisible) opt.visible = scissor_rect_;
   if (texture_) {
     const std::uint64_t fmt = *geometry::tex_fmt_word(texture_->format);  // validated at creation
     if (sent_tex_base_ != texture_->address) write(Reg::TEX_BASE, texture_->address);

@@ -140,6 +140,10 @@ class Emitter {
         return {};
       }
     }
+    if (opt_.visible && covers_no_pixel(*dev, *opt_.visible)) {
+      ++st_.outside;
+      return {};
+    }
     out_.push_back(*dev);
     ++st_.emitted;
     return {};
@@ -157,6 +161,22 @@ class Emitter {
 std::int64_t signed_area2(const DeviceTriangle& t) {
   const std::int64_t x0 = t[0].x, y0 = t[0].y, x1 = t[1].x, y1 = t[1].y, x2 = t[2].x, y2 = t[2].y;
   return (x1 - x0) * (y2 - y0) - (x2 - x0) * (y1 - y0);
+}
+
+PixelRect visible_rect(unsigned width, unsigned height, unsigned sx0, unsigned sy0, unsigned sx1, unsigned sy1) {
+  // Every value the registers hold is at most 1024: the casts are exact.
+  return PixelRect{static_cast<int>(sx0), static_cast<int>(sy0), static_cast<int>(std::min(width, sx1)),
+                   static_cast<int>(std::min(height, sy1))};
+}
+
+bool covers_no_pixel(const DeviceTriangle& t, const PixelRect& rect) {
+  if (rect.x1 <= rect.x0 || rect.y1 <= rect.y0) return true;
+  const std::int64_t min_x = std::min({t[0].x, t[1].x, t[2].x}), max_x = std::max({t[0].x, t[1].x, t[2].x});
+  const std::int64_t min_y = std::min({t[0].y, t[1].y, t[2].y}), max_y = std::max({t[0].y, t[1].y, t[2].y});
+  // Sample points of the first and last pixel column (row) of the rectangle, in 1/16 pixel.
+  const std::int64_t first_x = 16 * std::int64_t{rect.x0} + 8, last_x = 16 * (std::int64_t{rect.x1} - 1) + 8;
+  const std::int64_t first_y = 16 * std::int64_t{rect.y0} + 8, last_y = 16 * (std::int64_t{rect.y1} - 1) + 8;
+  return max_x < first_x || min_x > last_x || max_y < first_y || min_y > last_y;
 }
 
 Vertex from_screen(const ScreenVertex& v) {

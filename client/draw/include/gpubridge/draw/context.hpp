@@ -57,6 +57,11 @@ struct ContextOptions {
   // the program runs ahead of the device). Costs no memory in the program: the frames in flight
   // are in the socket buffers.
   unsigned frames_in_flight = 4;
+  // Triangles that cannot cover a pixel of the framebuffer and scissor after snapping (wholly
+  // off-screen, geometry::covers_no_pixel) are not sent: the device would draw nothing for them,
+  // so the frames are the same with fewer bytes (docs/protocol.md 16.7). false sends them all,
+  // e.g. to exercise a device's own rejection; PipelineStats::outside counts those skipped.
+  bool skip_invisible = true;
 };
 
 // A vertex of an indexed mesh, in model space.
@@ -168,6 +173,7 @@ class Context {
   std::optional<geometry::Viewport> viewport_;
   std::optional<Texture> texture_;
   std::uint64_t scissor_ = 0;
+  geometry::PixelRect scissor_rect_;  // scissor_ as a rectangle
   // Last values written, to skip redundant register writes.
   std::optional<std::uint64_t> sent_tri_mode_, sent_tex_base_, sent_tex_fmt_;
   std::vector<protocol::Frame> pending_;

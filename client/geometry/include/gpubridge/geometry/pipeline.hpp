@@ -7,6 +7,7 @@
 //     → guard-band clip when a vertex lies outside the band (2D lines as homogeneous planes)
 //     → texture-precision subdivision (textured triangles only, see below)
 //     → perspective divide → snap/convert (convert_triangle) → back-face / zero-area cull
+//     → rejection of triangles that cannot cover a pixel of the visible rectangle (when given)
 //
 // Screen-space input (scene files, draw::Context::draw_screen) enters through
 // process_screen_triangle: the same pipeline on (x·w, y·w, z·w, w), except that every vertex the
@@ -26,6 +27,7 @@
 // still over the bound at the limit are
 // emitted anyway and counted in PipelineStats::precision_exceeded.
 #include <cstddef>
+#include <optional>
 #include <vector>
 
 #include "gpubridge/common/result.hpp"
@@ -37,6 +39,21 @@ namespace gpubridge::geometry {
 enum class CullMode { None, Back, Front };
 // Which on-screen winding is the front face, as seen on the display (y down).
 enum class FrontFace { CounterClockwise, Clockwise };
+
+// The pixels the device considers for a triangle (docs/protocol.md 8.5): x in [x0, x1), y in
+// [y0, y1), i.e. the framebuffer intersected with SCISSOR. Empty when x1 <= x0 or y1 <= y0.
+struct PixelRect {
+  int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+  friend bool operator==(const PixelRect&, const PixelRect&) = default;
+};
+// [max(0, scissor x0), min(width, scissor x1)) and the same for y.
+PixelRect visible_rect(unsigned width, unsigned height, unsigned sx0, unsigned sy0, unsigned sx1, unsigned sy1);
+
+// True when no pixel of `rect` can be covered by the snapped triangle: every covered pixel's
+// sample point (16x + 8, 16y + 8) lies inside the closed triangle (section 8.4: all three edge
+// functions >= 0), hence inside its bounding box, so a triangle whose bounding box holds no
+// sample point of the rectangle draws nothing there. Exact integer test, no false positives.
+bool covers_no_pixel(const DeviceTriangle& t, const PixelRect& rect);
 
 struct PipelineOptions {
   CullMode cull = CullMode::None;
@@ -52,6 +69,10 @@ struct PipelineOptions {
                                    // bound scales by 1024 / texture_size (docs section 16.6)
   double max_uv_extent = 3.0;      // bound on max−min of U and of V: keeps |u − u_off| < 4
   unsigned max_subdivision_depth = 6;  // at most 4^depth triangles per clipped triangle
+  // When set, triangles that cannot cover a pixel of this rectangle (covers_no_pixel: wholly
+  // left, right, above or below it after snapping) are not sent; the device would draw nothing
+  // for them (docs/protocol.md 16.7). Unset: every triangle the planes keep is sent.
+  std::optional<PixelRect> visible;
 };
 
 struct PipelineStats {
@@ -61,6 +82,7 @@ struct PipelineStats {
   std::size_t subdivided = 0;          // triangles split for texture precision
   std::size_t precision_exceeded = 0;  // emitted although over the precision bound (depth limit)
   std::size_t culled = 0;              // back/front-facing or zero area after snapping
+  std::size_t outside = 0;             // not culled but covering no pixel of opt.visible
   std::size_t emitted = 0;             // device triangles produced
 };
 
