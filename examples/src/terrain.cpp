@@ -5,6 +5,7 @@
 #include "examples_internal.hpp"
 #include "fallbacks.hpp"
 #include "mesh.hpp"
+#include "terrain_lod.hpp"
 
 namespace gpubridge::examples {
 namespace {
@@ -13,6 +14,11 @@ constexpr int kGrid = 64;        // vertices per side
 constexpr double kCell = 1.0;    // world units per cell
 constexpr double kSize = (kGrid - 1) * kCell;
 constexpr unsigned kTex = 256;   // colour map texels per side
+// Level of detail: a 2x2-cell block whose centre is farther than this from the eye (across the
+// ground) is drawn from its corners, as one cell twice the size: about 15 pixels across there and 5
+// at the far plane (320x240, the projection below), where the colour map carries the detail. It
+// halves what a frame sends (docs/daemon.md "Remote benchmark": 60 fps within 20 Mbit/s).
+constexpr double kLodDistance = 30.0;
 
 double height_at(double x, double z) {
   return 7.0 * value_noise(x / 9.0, z / 9.0, 11) + 2.5 * value_noise(x / 3.5, z / 3.5, 12) - 2.0;
@@ -87,8 +93,11 @@ class Terrain final : public Example {
     } else {
       ctx.unbind_texture();
     }
-    if (!config().painter()) return ctx.draw_indexed(mesh_.vertices, mesh_.indices);
-    return ctx.draw_indexed(mesh_.vertices, painter_order(eye));
+    if (config().painter()) return ctx.draw_indexed(mesh_.vertices, painter_order(eye));
+    // Far blocks coarser (the grid's own vertices, so textured only: a baked mesh has its own).
+    if (config().texturing())
+      return ctx.draw_indexed(mesh_.vertices, terrain_lod_indices(kGrid, eye.x / kCell, eye.z / kCell, kLodDistance / kCell));
+    return ctx.draw_indexed(mesh_.vertices, mesh_.indices);
   }
 
  private:
