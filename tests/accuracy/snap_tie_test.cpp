@@ -81,7 +81,8 @@ std::vector<DeviceTriangle> through_scene(const std::vector<ScreenVertex>& verti
 // What draw::Context::draw_screen sends for the same vertices.
 std::vector<DeviceTriangle> through_draw_screen(const std::vector<ScreenVertex>& vertices, unsigned size) {
   draw::RecordingSink sink;
-  auto ctx = draw::Context::create(sink, {.width = size, .height = size, .depth_buffer = false});
+  // Every triangle sent, also those beside the framebuffer: this compares snapping, not visibility.
+  auto ctx = draw::Context::create(sink, {.width = size, .height = size, .depth_buffer = false, .skip_invisible = false});
   EXPECT_TRUE(ctx) << ctx.error().message;
   if (!ctx) return {};
   auto r = ctx->draw_screen(vertices);
