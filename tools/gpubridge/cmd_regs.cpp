@@ -33,9 +33,13 @@ int run_dmc1_fields(const GlobalOptions& g, bool markdown) {
   return 0;
 }
 
-int run_regs(const GlobalOptions& g, bool markdown, protocol::DeviceKind device) {
+int run_regs(const GlobalOptions& g, bool markdown, bool verilog, protocol::DeviceKind device) {
   if (device == protocol::DeviceKind::Dmc1) return run_dmc1_fields(g, markdown);
   using namespace protocol;
+  if (verilog) {
+    std::fputs(register_table_verilog().c_str(), stdout);
+    return 0;
+  }
   if (markdown) {
     std::fputs(register_table_markdown().c_str(), stdout);
     return 0;
@@ -69,10 +73,19 @@ GPUBRIDGE_COMMAND("regs", 90, [](CLI::App& app, GlobalOptions& g, auto& runners)
                                  "list the spigpu v1 registers (the table docs/protocol.md is generated from), or with "
                                  "--device dmc1 the DMC-1's command fields (docs/dmc1.md)");
   auto markdown = std::make_shared<bool>(false);
+  auto verilog = std::make_shared<bool>(false);
   auto device = std::make_shared<protocol::DeviceKind>(protocol::DeviceKind::Spigpu);
   sub->add_flag("--markdown", *markdown, "print the Markdown tables used in docs/protocol.md (docs/dmc1.md for dmc1)");
+  sub->add_flag("--verilog", *verilog, "print the Verilog header the gateware includes (gateware/rtl/soc/spigpu_regs.vh)")
+      ->excludes(sub->get_option("--markdown"));
   add_device_option(sub, *device);
-  runners.emplace_back(sub, [&g, markdown, device] { return run_regs(g, *markdown, *device); });
+  runners.emplace_back(sub, [&g, markdown, verilog, device] {
+    if (*verilog && *device != protocol::DeviceKind::Spigpu) {
+      std::fputs("gpubridge regs: --verilog prints the spigpu register header; the DMC-1 has no gateware here\n", stderr);
+      return 1;
+    }
+    return run_regs(g, *markdown, *verilog, *device);
+  });
 });
 
 }  // namespace gpubridge::cli

@@ -1,0 +1,276 @@
+// Command executor (docs/protocol.md sections 5, 7, 12 and 13): takes the oldest released entry of
+// the command FIFO, validates it (reserved bits -> enumerations -> register ranges -> features the
+// profile lacks, in that order), applies it to the render state and primitive assembly, and starts
+// what it commands:
+//   - VERTEX forms a vertex from the latched COLOR and TEXCOORD; a completed triangle (LIST, STRIP,
+//     FAN) becomes one TRIANGLE command to the render core with the render state of that moment;
+//   - CLEAR / CLEAR_Z become core commands; FB_DISPLAY a swap request to the scanout (after the core
+//     has written everything and the previous swap has been scanned out);
+//   - MEM_ADDR / MEM_DATA become operations of the memory-access unit (after the core is idle);
+//   - FENCE records its ID when everything before it has completed.
+// Plain register writes take one clock each. Read-write registers are also written, validated, to
+// the register file's shadow RAM (through a one-entry buffer, so core handshakes never wait on it).
+module command_exec #(
+  parameter [7:0] FEATURES = 8'h3F,
+  parameter       MAX_WIDTH = 1024,
+  parameter       MAX_HEIGHT = 1024
+) (
+  input  wire         clk,
+  input  wire         rst,           // power-on or RESET
+  // command FIFO
+  input  wire         in_valid,
+  input  wire [70:0]  in_entry,
+  output wire         in_pop,
+  // shadow RAM of the register file
+  output wire         sh_wr_req,
+  output wire [4:0]   sh_wr_idx,
+  output wire [63:0]  sh_wr_data,
+  input  wire         sh_wr_ack,
+  output reg  [6:0]   err_set,       // {.., BAD_VALUE (bit 4), RESERVED_BITS (bit 3), ..}
+  input  wire         core_drain,
+  // render core command port (docs: soc <-> core interface)
+  output wire         cmd_valid,
+  input  wire         cmd_ready,
+  output wire [1:0]   cmd_op,
+  output wire [31:0]  cmd_tri_mode,
+  output wire [27:0]  cmd_tex_base,
+  output wire [17:0]  cmd_tex_fmt,
+  output wire [43:0]  cmd_scissor,
+  output wire [27:0]  cmd_fb_draw,
+  output wire [27:0]  cmd_fb_z,
+  output wire [1:0]   cmd_fb_format,
+  output wire [10:0]  cmd_fb_width,
+  output wire [10:0]  cmd_fb_height,
+  output wire [31:0]  cmd_clear_color,
+  output wire [23:0]  cmd_clear_depth,
+  output wire [183:0] cmd_v0,
+  output wire [183:0] cmd_v1,
+  output wire [183:0] cmd_v2,
+  input  wire         core_idle,
+  // memory-access unit
+  output wire         mem_set_addr,  // MEM_ADDR executes
+  output wire         mem_write,     // MEM_DATA write executes
+  output wire [63:0]  mem_op_data,
+  input  wire         mem_idle,      // no MEM_ADDR / MEM_DATA operation of the executor in progress
+  // scanout
+  output wire         swap_req,      // FB_DISPLAY executes
+  output wire [27:0]  swap_addr,
+  input  wire         swap_ready,    // no swap pending or being scanned
+  output wire         waiting_vsync, // an FB_DISPLAY waits for the previous swap's scan
+  output reg  [31:0]  executed       // FIFO entries executed (timing-model counter C)
+);
+`include "spigpu_regs.vh"
+
+  // --- validation (section 5) ---
+  wire [6:0]  idx = in_entry[70:64];
+  wire [63:0] raw = in_entry[63:0];
+  wire [63:0] rsv = reg_reserved(idx);
+  wire        rsv_err = (raw & rsv) != 64'h0;
+  wire [64:0] enum_fix = reg_enum_fix(idx, raw & ~rsv);
+  localparam [10:0] MAXW = MAX_WIDTH[10:0];
+  localparam [10:0] MAXH = MAX_HEIGHT[10:0];
+
+  function automatic [3:0] clamp_log2(input [3:0] v);
+    clamp_log2 = v < 4'd3 ? 4'd3 : v > 4'd10 ? 4'd10 : v;
+  endfunction
+  function automatic [10:0] clamp_dim(input [10:0] v, input [10:0] max);
+    clamp_dim = v == 11'd0 ? 11'd1 : v > max ? max : v;
+  endfunction
+  function automatic [10:0] clamp_1024(input [10:0] v);
+    clamp_1024 = v > 11'd1024 ? 11'd1024 : v;
+  endfunction
+  function automatic format_ok(input [1:0] f);
+    format_ok = !((f == 2'd1 && !FEATURES[4]) || (f == 2'd2 && !FEATURES[5]));
+  endfunction
+
+  reg [63:0] d;     // validated value
+  reg        bad;   // ERR_BAD_VALUE
+  always @* begin
+    d = enum_fix[63:0];
+    bad = enum_fix[64];
+    case (idx)
+      `SPIGPU_REG_TEX_FMT: begin
+        d[3:0] = clamp_log2(d[3:0]);
+        d[7:4] = clamp_log2(d[7:4]);
+        if (d[7:0] != enum_fix[7:0]) bad = 1'b1;
+        if (d[12] && !FEATURES[0]) begin d[12] = 1'b0; bad = 1'b1; end
+        if (!format_ok(d[17:16])) begin d[17:16] = 2'd0; bad = 1'b1; end
+      end
+      `SPIGPU_REG_FB_FORMAT: begin
+        d[10:0] = clamp_dim(d[10:0], MAXW);
+        d[26:16] = clamp_dim(d[26:16], MAXH);
+        if (d[10:0] != enum_fix[10:0] || d[26:16] != enum_fix[26:16]) bad = 1'b1;
+        if (!format_ok(d[33:32])) begin d[33:32] = 2'd0; bad = 1'b1; end
+      end
+      `SPIGPU_REG_SCISSOR: begin
+        d[10:0] = clamp_1024(d[10:0]);
+        d[26:16] = clamp_1024(d[26:16]);
+        d[42:32] = clamp_1024(d[42:32]);
+        d[58:48] = clamp_1024(d[58:48]);
+        if (d != enum_fix[63:0]) bad = 1'b1;
+      end
+      `SPIGPU_REG_TRI_MODE: begin
+        if (d[8:7] != 2'd0 && !FEATURES[1]) begin d[8:7] = 2'd0; bad = 1'b1; end
+        if (d[9] && !FEATURES[2]) begin d[9] = 1'b0; bad = 1'b1; end
+      end
+      default: ;
+    endcase
+  end
+
+  localparam [63:0] RESET_TEX_FMT     = reg_reset(`SPIGPU_REG_TEX_FMT);
+  localparam [63:0] RESET_SCISSOR     = reg_reset(`SPIGPU_REG_SCISSOR);
+  localparam [63:0] RESET_FB_FORMAT   = reg_reset(`SPIGPU_REG_FB_FORMAT);
+  localparam [63:0] RESET_CLEAR_COLOR = reg_reset(`SPIGPU_REG_CLEAR_COLOR);
+  localparam [63:0] RESET_CLEAR_DEPTH = reg_reset(`SPIGPU_REG_CLEAR_DEPTH);
+  localparam [63:0] RESET_COLOR       = reg_reset(`SPIGPU_REG_COLOR);
+  localparam [63:0] RESET_TEXCOORD    = reg_reset(`SPIGPU_REG_TEXCOORD);
+
+  // --- state ---
+  reg [63:0]  color, texcoord;
+  reg [1:0]   prim_type;
+  reg [1:0]   vcount;
+  reg [183:0] stored0, stored1;
+  reg [31:0]  tri_mode;
+  reg [27:0]  tex_base, fb_draw, fb_z;
+  reg [17:0]  tex_fmt;
+  reg [43:0]  scissor;
+  reg [1:0]   fb_format;
+  reg [10:0]  fb_width, fb_height;
+  reg [31:0]  clear_color;
+  reg [23:0]  clear_depth;
+  // one-entry shadow write buffer
+  reg         shb_valid;
+  reg [4:0]   shb_idx;
+  reg [63:0]  shb_data;
+
+  wire [183:0] vertex = {texcoord[31:0], texcoord[63:32], color[63:32], color[31:0], d[55:32], d[31:16], d[15:0]};
+
+  wire is_vertex  = idx == `SPIGPU_REG_VERTEX;
+  wire is_clear   = idx == `SPIGPU_REG_CLEAR;
+  wire is_clear_z = idx == `SPIGPU_REG_CLEAR_Z;
+  wire is_display = idx == `SPIGPU_REG_FB_DISPLAY;
+  wire is_memaddr = idx == `SPIGPU_REG_MEM_ADDR;
+  wire is_memdata = idx == `SPIGPU_REG_MEM_DATA;
+  wire is_fence   = idx == `SPIGPU_REG_FENCE;
+  wire kick       = is_vertex && vcount == 2'd2;
+  wire to_core    = kick || is_clear || is_clear_z;
+  wire to_shadow  = idx[6:5] == 2'b00 && reg_is_rw(idx);
+
+  // Conditions for executing the entry now.
+  wire quiet      = core_idle && mem_idle && !core_drain;      // everything before has completed
+  wire core_ok    = !to_core || (cmd_ready && mem_idle && !core_drain);
+  wire wait_ok    = !(is_display || is_memaddr || is_memdata || is_fence) || quiet;
+  wire swap_ok    = !is_display || swap_ready;
+  wire shadow_ok  = !to_shadow || !shb_valid;
+  wire go         = in_valid && core_ok && wait_ok && swap_ok && shadow_ok;
+
+  assign in_pop    = go;
+  // Stable until cmd_ready: mem_idle and shadow_ok only become true while the entry waits, and
+  // core_drain only becomes false.
+  assign cmd_valid = in_valid && to_core && mem_idle && !core_drain && shadow_ok;
+  assign cmd_op    = is_clear ? 2'd1 : is_clear_z ? 2'd2 : 2'd0;
+  assign cmd_tri_mode = tri_mode;
+  assign cmd_tex_base = tex_base;
+  assign cmd_tex_fmt = tex_fmt;
+  assign cmd_scissor = scissor;
+  assign cmd_fb_draw = fb_draw;
+  assign cmd_fb_z = fb_z;
+  assign cmd_fb_format = fb_format;
+  assign cmd_fb_width = fb_width;
+  assign cmd_fb_height = fb_height;
+  assign cmd_clear_color = clear_color;
+  assign cmd_clear_depth = clear_depth;
+  assign cmd_v0 = stored0;
+  assign cmd_v1 = stored1;
+  assign cmd_v2 = vertex;
+
+  assign mem_set_addr = go && is_memaddr;
+  assign mem_write    = go && is_memdata;
+  assign mem_op_data  = d;
+  assign swap_req     = go && is_display;
+  assign swap_addr    = d[31:4];
+  assign waiting_vsync = in_valid && is_display && quiet && !swap_ready;
+
+  assign sh_wr_req  = shb_valid;
+  assign sh_wr_idx  = shb_idx;
+  assign sh_wr_data = shb_data;
+
+  always @(posedge clk) begin
+    err_set <= 7'd0;
+    if (rst) begin
+      color <= RESET_COLOR;
+      texcoord <= RESET_TEXCOORD;
+      prim_type <= 2'd0;
+      vcount <= 2'd0;
+      stored0 <= 184'd0;
+      stored1 <= 184'd0;
+      tri_mode <= 32'd0;
+      tex_base <= 28'd0;
+      tex_fmt <= RESET_TEX_FMT[17:0];
+      scissor <= {RESET_SCISSOR[58:48], RESET_SCISSOR[42:32], RESET_SCISSOR[26:16], RESET_SCISSOR[10:0]};
+      fb_draw <= 28'd0;
+      fb_z <= 28'd0;
+      fb_format <= RESET_FB_FORMAT[33:32];
+      fb_width <= RESET_FB_FORMAT[10:0];
+      fb_height <= RESET_FB_FORMAT[26:16];
+      clear_color <= RESET_CLEAR_COLOR[31:0];
+      clear_depth <= RESET_CLEAR_DEPTH[23:0];
+      shb_valid <= 1'b0;
+      shb_idx <= 5'd0;
+      shb_data <= 64'd0;
+      executed <= 32'd0;
+    end else begin
+      if (sh_wr_ack) shb_valid <= 1'b0;
+      if (go) begin
+        executed <= executed + 32'd1;
+        err_set[3] <= rsv_err;
+        err_set[4] <= bad;
+        if (to_shadow) begin
+          shb_valid <= 1'b1;
+          shb_idx <= idx[4:0];
+          shb_data <= d;
+        end
+        case (idx)
+          `SPIGPU_REG_COLOR: color <= d;
+          `SPIGPU_REG_TEXCOORD: texcoord <= d;
+          `SPIGPU_REG_PRIM: begin
+            prim_type <= d[1:0];
+            vcount <= 2'd0;
+          end
+          `SPIGPU_REG_VERTEX: begin
+            if (vcount == 2'd0) begin
+              stored0 <= vertex;
+              vcount <= 2'd1;
+            end else if (vcount == 2'd1) begin
+              stored1 <= vertex;
+              vcount <= 2'd2;
+            end else if (prim_type == 2'd1) begin        // STRIP: (v1, v) become the stored pair
+              stored0 <= stored1;
+              stored1 <= vertex;
+            end else if (prim_type == 2'd2) begin        // FAN: the first vertex stays
+              stored1 <= vertex;
+            end else begin                               // LIST
+              vcount <= 2'd0;
+            end
+          end
+          `SPIGPU_REG_TRI_MODE: tri_mode <= d[31:0];
+          `SPIGPU_REG_TEX_BASE: tex_base <= d[31:4];
+          `SPIGPU_REG_TEX_FMT: tex_fmt <= d[17:0];
+          `SPIGPU_REG_SCISSOR: scissor <= {d[58:48], d[42:32], d[26:16], d[10:0]};
+          `SPIGPU_REG_FB_DRAW: fb_draw <= d[31:4];
+          `SPIGPU_REG_FB_Z: fb_z <= d[31:4];
+          `SPIGPU_REG_FB_FORMAT: begin
+            fb_format <= d[33:32];
+            fb_width <= d[10:0];
+            fb_height <= d[26:16];
+          end
+          `SPIGPU_REG_CLEAR_COLOR: clear_color <= d[31:0];
+          `SPIGPU_REG_CLEAR_DEPTH: clear_depth <= d[23:0];
+          default: ;
+        endcase
+      end
+    end
+  end
+
+  wire unused_ok = &{1'b0, is_fence};
+endmodule

@@ -1,0 +1,157 @@
+// MEM_ADDR / MEM_DATA (docs/protocol.md section 2.4): the memory pointer, the 64-bit prefetch
+// buffer and STATUS.MEM_READY.
+//   - MEM_ADDR (queued) sets the pointer and loads the prefetch buffer;
+//   - MEM_DATA write (queued) stores 8 bytes, advances the pointer by 8 and reloads;
+//   - a MEM_DATA read reaching bit 64 returns the buffer (register file), raises ERR_MEM_RANGE if
+//     those bytes lay beyond VRAM, advances the pointer, clears MEM_READY and reloads. Reloads have
+//     the highest memory priority and complete within a few clocks (SPRAM: 3; SDRAM: a refresh and a
+//     row miss at worst), long before the next frame's bit 64 at any SCK the SPI slave allows.
+// Accesses beyond VRAM never reach the memory: writes are dropped (ERR_MEM_RANGE), loads give 0.
+// Events are taken one per clock (a read, then MEM_ADDR, then MEM_DATA write); a reload started
+// while another is in flight discards the older one's responses.
+module mem_access #(
+  parameter [28:0] VRAM_UNITS = 29'd16384   // VRAM size / 8 bytes
+) (
+  input  wire        clk,
+  input  wire        rst,          // power-on
+  input  wire        soft_reset,   // RESET: pointer 0, buffer 0, MEM_READY 0 (the beyond flag stays, as in the simulator)
+  // executor (only while ex_idle)
+  input  wire        set_addr,
+  input  wire        write,
+  input  wire [63:0] op_data,
+  output wire        ex_idle,      // no executor operation (write or its reload) in progress
+  // SPI: a MEM_DATA read reached bit 64
+  input  wire        read_strobe,
+  // state
+  output reg  [28:0] addr,
+  output reg  [63:0] prefetch,
+  output reg         mem_ready,
+  output reg         err_range,
+  // memory port (arbiter)
+  output wire        req_valid,
+  input  wire        req_ready,
+  output wire        req_we,
+  output wire [29:0] req_addr,
+  output wire [31:0] req_wdata,
+  input  wire        rsp_valid,
+  input  wire [31:0] rsp_rdata
+);
+  localparam IDLE = 3'd0, WR0 = 3'd1, WR1 = 3'd2, RD0 = 3'd3, RD1 = 3'd4, WAIT = 3'd5;
+  reg  [2:0]  phase;
+  reg  [28:0] op_addr;      // 8-byte unit being accessed
+  reg  [63:0] wdata;
+  reg         pend_read, pend_set, pend_write;
+  reg  [28:0] set_value;
+  reg         owner_ex;     // the access in progress belongs to an executor operation
+  reg         beyond;       // the buffer holds bytes from beyond VRAM
+  reg  [1:0]  outstanding;  // reads issued, responses not yet seen
+  reg  [1:0]  discard;      // responses of a superseded load still to come
+  reg         got_first;
+
+  assign ex_idle   = !(pend_set || pend_write || (phase != IDLE && owner_ex));
+  assign req_valid = phase == WR0 || phase == WR1 || phase == RD0 || phase == RD1;
+  assign req_we    = phase == WR0 || phase == WR1;
+  assign req_addr  = {op_addr, phase == WR1 || phase == RD1};
+  assign req_wdata = phase == WR0 ? wdata[63:32] : wdata[31:0];
+
+  wire issued   = req_valid && req_ready;
+  wire reading  = issued && !req_we;
+  wire writing  = phase == WR0 || phase == WR1;
+  wire in_vram  = addr < VRAM_UNITS;
+  wire [1:0] outstanding_next = outstanding + {1'b0, reading} - {1'b0, rsp_valid};
+  wire [1:0] discard_next = discard - {1'b0, rsp_valid && discard != 2'd0};
+
+  // One control event per clock, never in the middle of a write.
+  wire do_read  = !writing && pend_read;
+  wire do_set   = !writing && !pend_read && pend_set;
+  wire do_write = !writing && !pend_read && !pend_set && pend_write;
+  wire wr_done  = phase == WR1 && issued;
+  reg  [28:0] load_addr;
+  reg         do_load;
+  always @* begin
+    do_load = 1'b1;
+    load_addr = addr + 29'd1;
+    if (do_set) load_addr = set_value;
+    else if (do_write && in_vram) do_load = 1'b0;
+    else if (!(do_read || do_write || wr_done)) do_load = 1'b0;
+  end
+
+  always @(posedge clk) begin
+    err_range <= 1'b0;
+    if (rst || soft_reset) begin
+      addr <= 29'd0;
+      prefetch <= 64'd0;
+      mem_ready <= 1'b0;
+      phase <= IDLE;
+      pend_read <= 1'b0;
+      pend_set <= 1'b0;
+      pend_write <= 1'b0;
+      owner_ex <= 1'b0;
+      got_first <= 1'b0;
+      // reads still in flight answer after a RESET; their data must not be taken
+      outstanding <= rst ? 2'd0 : outstanding_next;
+      discard <= rst ? 2'd0 : outstanding_next;
+      if (rst) beyond <= 1'b0;
+    end else begin
+      outstanding <= outstanding_next;
+      discard <= discard_next;
+      if (read_strobe) pend_read <= 1'b1;
+      if (set_addr) begin
+        pend_set <= 1'b1;
+        set_value <= op_data[31:3];
+      end
+      if (write) begin
+        pend_write <= 1'b1;
+        wdata <= op_data;
+      end
+      // responses of the current load
+      if (rsp_valid && discard == 2'd0) begin
+        got_first <= !got_first;
+        if (!got_first) prefetch[63:32] <= rsp_rdata;
+        else begin
+          prefetch[31:0] <= rsp_rdata;
+          mem_ready <= 1'b1;
+          phase <= IDLE;
+        end
+      end
+      case (phase)
+        WR0: if (issued) phase <= WR1;
+        RD0: if (issued) phase <= RD1;
+        RD1: if (issued) phase <= WAIT;
+        default: ;
+      endcase
+      if (do_read) begin
+        pend_read <= 1'b0;
+        if (beyond) err_range <= 1'b1;
+      end
+      if (do_set) pend_set <= 1'b0;
+      if (do_write) begin
+        pend_write <= 1'b0;
+        if (in_vram) begin
+          op_addr <= addr;
+          phase <= WR0;
+          owner_ex <= 1'b1;
+        end else begin
+          err_range <= 1'b1;
+        end
+      end
+      if (do_load) begin
+        addr <= load_addr;
+        mem_ready <= 1'b0;
+        got_first <= 1'b0;
+        discard <= outstanding_next;
+        owner_ex <= !do_read;   // a read's reload supersedes an executor reload
+        if (load_addr < VRAM_UNITS) begin
+          op_addr <= load_addr;
+          phase <= RD0;
+          beyond <= 1'b0;
+        end else begin
+          prefetch <= 64'd0;
+          beyond <= 1'b1;
+          mem_ready <= 1'b1;
+          phase <= IDLE;
+        end
+      end
+    end
+  end
+endmodule

@@ -1,0 +1,126 @@
+// Memory arbiter: one video-memory port shared by the memory-access unit (MEM_ADDR / MEM_DATA), the
+// scanout reader and the render core, in that priority (the scanout reader wins over the core after
+// waiting 16 clocks). One request per clock; responses return in request order to whoever asked.
+//
+// VRAM bounds (docs/protocol.md section 6) for the core: a write beyond VRAM is dropped and a read
+// beyond returns 0, both raising ERR_MEM_RANGE. Such a read waits until no other read is in flight
+// so that its zero can be answered in order. (The other clients never ask beyond VRAM.)
+//
+// Swap protection (docs/gateware.md "Scanout"): from the FB_DISPLAY write's execution until the
+// frame has been read, writes into the part of the display buffer the scanout has not read yet wait.
+// The scanned frame is therefore the buffer as it was when FB_DISPLAY executed, exactly the
+// simulator's frame; rendering into another buffer never waits.
+module mem_arbiter #(
+  parameter [29:0] VRAM_WORDS = 30'd32768,
+  parameter        AW = 15                  // back-end word address bits
+) (
+  input  wire        clk,
+  input  wire        rst,
+  // memory-access unit (32-bit words, all bytes)
+  input  wire        m_req_valid,
+  output wire        m_req_ready,
+  input  wire        m_req_we,
+  input  wire [29:0] m_req_addr,
+  input  wire [31:0] m_req_wdata,
+  output wire        m_rsp_valid,
+  // scanout reader (reads)
+  input  wire        s_req_valid,
+  output wire        s_req_ready,
+  input  wire [29:0] s_req_addr,
+  output wire        s_rsp_valid,
+  // render core
+  input  wire        c_req_valid,
+  output wire        c_req_ready,
+  input  wire        c_req_we,
+  input  wire [29:0] c_req_addr,
+  input  wire [31:0] c_req_wdata,
+  input  wire [3:0]  c_req_be,
+  output wire        c_rsp_valid,
+  output wire [31:0] rsp_rdata,       // data of whichever response is valid
+  output reg         c_range_err,
+  // swap protection window [prot_lo, prot_hi) in words
+  input  wire        prot_active,
+  input  wire [29:0] prot_lo,
+  input  wire [29:0] prot_hi,
+  // back end (SPRAM or SDRAM controller): in-order read responses
+  output wire          b_req_valid,
+  input  wire          b_req_ready,
+  output wire          b_req_we,
+  output wire [AW-1:0] b_req_addr,
+  output wire [31:0]   b_req_wdata,
+  output wire [3:0]    b_req_be,
+  input  wire          b_rsp_valid,
+  input  wire [31:0]   b_rsp_rdata,
+  // counters
+  output reg  [31:0]   core_stall_cycles  // core request waiting (protection, priority, back end)
+);
+  // in-flight reads: the client of each, oldest first
+  reg [1:0] tag [0:7];
+  reg [2:0] tag_rd, tag_wr;
+  reg [3:0] tag_count;
+  reg       zero_rsp;     // answer a core read beyond VRAM with 0 in this cycle
+  reg [3:0] scan_wait;
+
+  wire tags_room  = tag_count < 4'd8;
+  wire tags_empty = tag_count == 4'd0;
+  wire m_block = prot_active && m_req_we && m_req_addr >= prot_lo && m_req_addr < prot_hi;
+  wire c_block = prot_active && c_req_we && c_req_addr >= prot_lo && c_req_addr < prot_hi;
+  wire c_oor   = c_req_addr >= VRAM_WORDS;
+
+  wire m_ok  = m_req_valid && !m_block && (m_req_we || tags_room);
+  wire s_ok  = s_req_valid && tags_room;
+  wire c_zero = c_req_valid && c_oor && (c_req_we || (tags_empty && !b_rsp_valid));
+  wire c_ok  = c_req_valid && !c_oor && !c_block && (c_req_we || tags_room);
+
+  // choice (independent of b_req_ready)
+  wire pick_m = m_ok;
+  wire pick_s = !pick_m && s_ok && (scan_wait == 4'd15 || !(c_ok || c_zero));
+  wire pick_c = !pick_m && !pick_s && c_ok;
+  wire pick_z = !pick_m && !pick_s && !c_ok && c_zero;
+
+  assign b_req_valid = pick_m || pick_s || pick_c;
+  assign b_req_we    = pick_m ? m_req_we : pick_c ? c_req_we : 1'b0;
+  wire [29:0] addr   = pick_m ? m_req_addr : pick_s ? s_req_addr : c_req_addr;
+  assign b_req_addr  = addr[AW-1:0];
+  assign b_req_wdata = pick_m ? m_req_wdata : c_req_wdata;
+  assign b_req_be    = pick_c ? c_req_be : 4'hF;
+
+  assign m_req_ready = pick_m && b_req_ready;
+  assign s_req_ready = pick_s && b_req_ready;
+  assign c_req_ready = (pick_c && b_req_ready) || pick_z;
+
+  wire granted_read = b_req_valid && b_req_ready && !b_req_we;
+  wire [1:0] granted_client = pick_m ? 2'd0 : pick_s ? 2'd1 : 2'd2;
+  wire [1:0] head = tag[tag_rd];
+
+  assign m_rsp_valid = b_rsp_valid && head == 2'd0;
+  assign s_rsp_valid = b_rsp_valid && head == 2'd1;
+  assign c_rsp_valid = (b_rsp_valid && head == 2'd2) || zero_rsp;
+  assign rsp_rdata   = zero_rsp ? 32'd0 : b_rsp_rdata;
+
+  always @(posedge clk) begin
+    c_range_err <= pick_z;
+    zero_rsp <= pick_z && !c_req_we;
+    if (rst) begin
+      tag_rd <= 3'd0;
+      tag_wr <= 3'd0;
+      tag_count <= 4'd0;
+      scan_wait <= 4'd0;
+      zero_rsp <= 1'b0;
+      c_range_err <= 1'b0;
+      core_stall_cycles <= 32'd0;
+    end else begin
+      if (granted_read) begin
+        tag[tag_wr] <= granted_client;
+        tag_wr <= tag_wr + 3'd1;
+      end
+      if (b_rsp_valid) tag_rd <= tag_rd + 3'd1;
+      tag_count <= tag_count + {3'd0, granted_read} - {3'd0, b_rsp_valid};
+      if (s_req_valid && !s_req_ready) scan_wait <= scan_wait == 4'd15 ? scan_wait : scan_wait + 4'd1;
+      else scan_wait <= 4'd0;
+      if (c_req_valid && !c_req_ready) core_stall_cycles <= core_stall_cycles + 32'd1;
+    end
+  end
+
+  wire unused_ok = &{1'b0, addr[29:AW]};
+endmodule

@@ -1,0 +1,188 @@
+// Register file front end (docs/protocol.md sections 3, 5 and 13): what happens when a frame
+// completes or a read reaches bit 64.
+//   - writes: undefined / read-only index -> ERR_BAD_REGISTER; immediate registers (ERR_CLEAR,
+//     LINK_CTRL, LINK_CHECK, HOST_TAG, RESET) act at once after their validation; queued writes go
+//     to the command FIFO (dropped while the link is DISCARDING, ERR_OVERFLOW when full), and are
+//     validated when they execute (command_exec);
+//   - reads: live registers (STATUS, FRAME_CRC, LINK_STATUS, MEM_ADDR, MEM_DATA, CAPS, ID) from a
+//     small multiplexer in the bit-64 cycle; every other read-write register from a 32 x 64 shadow
+//     RAM that holds the last validated value (written by the executor and the immediate writes),
+//     one cycle later; write-only registers read 0;
+//   - the sticky error flags and ERR_CLEAR; RESET's soft reset pulse and the sequencer that writes
+//     the reset values into the shadow RAM (32 cycles; the next frame cannot complete sooner).
+// A RESET while the render core is still busy lets the core finish (the simulator finishes every
+// executed command too) but drops the memory-range errors it raises after the reset; the executor
+// starts no new core command until the core is idle again (core_drain).
+module register_file #(
+  parameter [63:0] CAPS = 64'h0,
+  parameter [63:0] ID = 64'h0,
+  parameter [7:0]  FEATURES = 8'h3F
+) (
+  input  wire        clk,
+  input  wire        rst,
+  // frames from the SPI slave
+  input  wire        frame_valid,
+  input  wire        frame_rw,
+  input  wire [6:0]  frame_idx,
+  input  wire [63:0] frame_data,
+  input  wire        frame_abort,
+  input  wire        rd_strobe,
+  input  wire [6:0]  rd_idx,
+  output reg  [63:0] rd_live,
+  output wire        rd_from_ram,
+  output wire [63:0] rd_ram,
+  output wire [5:0]  status_flags,
+  // command FIFO
+  output wire        fifo_push,
+  output wire        fifo_push_held,
+  output wire [70:0] fifo_entry,
+  input  wire        fifo_full,
+  input  wire        fifo_nearly_full,
+  input  wire [10:0] fifo_level,
+  input  wire        fifo_held,
+  // link integrity
+  input  wire        link_strict,
+  input  wire        link_discarding,
+  input  wire [63:0] link_status,
+  input  wire        err_link_crc,
+  output wire        drop_overflow,
+  output wire        link_check_strobe,
+  output wire [31:0] link_check_crc,
+  output wire        link_ctrl_strobe,
+  output wire        link_ctrl_strict,
+  // soft reset (RESET with its magic value), one cycle
+  output wire        soft_reset,
+  // executor: shadow RAM writes of validated read-write registers, error flags
+  input  wire        ex_wr_req,
+  input  wire [4:0]  ex_wr_idx,
+  input  wire [63:0] ex_wr_data,
+  output wire        ex_wr_ack,
+  input  wire [6:0]  err_set,        // flags raised elsewhere (executor, memory, scanout)
+  input  wire        core_range_err, // the core's access fell beyond VRAM
+  input  wire        core_idle,
+  output reg         core_drain,     // after a RESET: wait for the core before new commands
+  // live state
+  input  wire        busy,
+  input  wire        vblank,
+  input  wire        swap_pending,
+  input  wire [15:0] frame_count,
+  input  wire [47:0] frame_crc,
+  input  wire        mem_ready,
+  input  wire [28:0] mem_addr,
+  input  wire [63:0] prefetch,
+  output wire        mem_read_strobe, // a MEM_DATA read reached bit 64
+  output reg  [6:0]  errors
+);
+`include "spigpu_regs.vh"
+
+  localparam ERR_FRAMING = 0, ERR_OVERFLOW = 1, ERR_LINK_CRC = 2, ERR_RESERVED = 3, ERR_BAD_VALUE = 4,
+             ERR_BAD_REGISTER = 5, ERR_MEM_RANGE = 6;
+  localparam [63:0] RESET_MAGIC = 64'h0000005245534554;
+
+  // --- writes arriving ---
+  wire [1:0]  wclass   = reg_class(frame_idx);
+  wire        wr       = frame_valid && !frame_rw;
+  wire        wr_bad   = wr && (wclass == 2'd0 || wclass == 2'd1);
+  wire        wr_queue = wr && wclass == 2'd2;
+  wire        wr_imm   = wr && wclass == 2'd3;
+  wire [63:0] rsv_mask = reg_reserved(frame_idx);
+  wire        imm_rsv  = wr_imm && (frame_data & rsv_mask) != 64'h0;
+  wire [63:0] imm_data = frame_data & ~rsv_mask;
+
+  wire is_err_clear = frame_idx == `SPIGPU_REG_ERR_CLEAR;
+  wire is_link_ctrl = frame_idx == `SPIGPU_REG_LINK_CTRL;
+  wire is_check     = frame_idx == `SPIGPU_REG_LINK_CHECK;
+  wire is_host_tag  = frame_idx == `SPIGPU_REG_HOST_TAG;
+  wire is_reset     = frame_idx == `SPIGPU_REG_RESET;
+
+  wire strict_refused = is_link_ctrl && imm_data[0] && !FEATURES[3];
+  wire reset_ok       = wr_imm && is_reset && frame_data == RESET_MAGIC;
+  wire imm_bad_value  = wr_imm && ((is_reset && frame_data != RESET_MAGIC) || strict_refused);
+
+  assign fifo_push      = wr_queue && !link_discarding && !fifo_full;
+  assign fifo_push_held = link_strict;
+  assign fifo_entry     = {frame_idx, frame_data};
+  assign drop_overflow  = wr_queue && !link_discarding && fifo_full;
+  assign link_check_strobe = wr_imm && is_check;
+  assign link_check_crc    = imm_data[31:0];
+  assign link_ctrl_strobe  = wr_imm && is_link_ctrl;
+  assign link_ctrl_strict  = imm_data[0] && FEATURES[3];
+  assign soft_reset        = reset_ok;
+
+  // --- shadow RAM of the read-write registers (indices 0x00..0x1F) ---
+  reg  [63:0] shadow [0:31];
+  reg  [63:0] shadow_q;
+  reg         seq_active;
+  reg  [4:0]  seq_idx;
+  wire        imm_wr = wr_imm && (is_host_tag || is_link_ctrl);
+  wire        sh_we  = seq_active || imm_wr || ex_wr_req;
+  wire [4:0]  sh_wa  = seq_active ? seq_idx : imm_wr ? frame_idx[4:0] : ex_wr_idx;
+  wire [63:0] sh_wd  = seq_active ? reg_reset({2'b00, seq_idx})
+                     : imm_wr ? (is_link_ctrl ? {63'd0, link_ctrl_strict} : imm_data) : ex_wr_data;
+  assign ex_wr_ack = ex_wr_req && !seq_active && !imm_wr;
+
+  always @(posedge clk) begin
+    if (sh_we) shadow[sh_wa] <= sh_wd;
+    shadow_q <= shadow[rd_idx[4:0]];
+  end
+  always @(posedge clk) begin
+    if (rst || reset_ok) begin
+      seq_active <= 1'b1;
+      seq_idx <= 5'd0;
+    end else if (seq_active) begin
+      seq_idx <= seq_idx + 5'd1;
+      if (seq_idx == 5'd31) seq_active <= 1'b0;
+    end
+  end
+
+  // --- reads at bit 64 ---
+  wire [1:0] rclass   = reg_class(rd_idx);
+  assign rd_from_ram = rd_idx[6:5] == 2'b00 && reg_is_rw(rd_idx);
+  assign rd_ram      = shadow_q;
+  assign mem_read_strobe = rd_strobe && rd_idx == `SPIGPU_REG_MEM_DATA;
+  wire   link_pending = link_strict && fifo_held;
+  wire   [63:0] status_value = {9'd0, errors, frame_count, 11'd0, link_pending, swap_pending, mem_ready, vblank, busy,
+                                5'd0, fifo_level};
+  always @* begin
+    case (rd_idx)
+      `SPIGPU_REG_STATUS:      rd_live = status_value;
+      `SPIGPU_REG_FRAME_CRC:   rd_live = {16'd0, frame_crc};
+      `SPIGPU_REG_LINK_STATUS: rd_live = link_status;
+      `SPIGPU_REG_MEM_ADDR:    rd_live = {32'd0, mem_addr, 3'd0};
+      `SPIGPU_REG_MEM_DATA:    rd_live = prefetch;
+      `SPIGPU_REG_CAPS:        rd_live = CAPS;
+      `SPIGPU_REG_ID:          rd_live = ID;
+      default:                 rd_live = 64'h0;
+    endcase
+  end
+  wire rd_undefined = rd_strobe && rclass == 2'd0;
+
+  assign status_flags = {fifo_nearly_full, errors != 7'd0, busy, vblank, swap_pending, mem_ready};
+
+  // --- sticky errors ---
+  reg [6:0] set_now;
+  always @* begin
+    set_now = err_set;
+    if (frame_abort) set_now[ERR_FRAMING] = 1'b1;
+    if (drop_overflow) set_now[ERR_OVERFLOW] = 1'b1;
+    if (err_link_crc) set_now[ERR_LINK_CRC] = 1'b1;
+    if (imm_rsv) set_now[ERR_RESERVED] = 1'b1;
+    if (imm_bad_value) set_now[ERR_BAD_VALUE] = 1'b1;
+    if (wr_bad || rd_undefined) set_now[ERR_BAD_REGISTER] = 1'b1;
+    if (core_range_err && !core_drain) set_now[ERR_MEM_RANGE] = 1'b1;
+  end
+
+  always @(posedge clk) begin
+    if (rst) begin
+      errors <= 7'd0;
+      core_drain <= 1'b0;
+    end else if (reset_ok) begin
+      errors <= 7'd0;
+      core_drain <= !core_idle;
+    end else begin
+      if (core_idle) core_drain <= 1'b0;
+      if (wr_imm && is_err_clear) errors <= (errors & ~imm_data[6:0]) | set_now;
+      else errors <= errors | set_now;
+    end
+  end
+endmodule

@@ -1,0 +1,243 @@
+// Scanout (docs/protocol.md section 12): display timing, the swap at vertical sync, FRAME_CRC,
+// STATUS.VBLANK / SWAP_PENDING and the frame counter.
+//
+// An executed FB_DISPLAY write asks for a swap with its address and the FB_FORMAT of that moment;
+// the buffer length W x H x bpp is computed (a shift-add multiply, 11 clocks) and the swap becomes
+// pending. At the next vertical sync (start of vertical blanking) the pending swap is latched and the
+// frame is read, in address order, into the CRC-32 and out of the frame port (the video output of a
+// board, and what the co-simulation captures). When its last byte has been read the frame is
+// "scanned out": FRAME_COUNT advances, FRAME_CRC = {frame number, CRC} and SWAP_PENDING clears, so a
+// host that sees SWAP_PENDING = 0 reads the CRC of that frame. Bytes beyond VRAM read as 0 and
+// raise ERR_MEM_RANGE when the swap is requested (the simulator raises it when FB_DISPLAY executes).
+// Until the reader has passed them, the not-yet-read words of the pending frame are write-protected
+// (mem_arbiter), so the frame is the buffer as it was when FB_DISPLAY executed.
+// Timing is in core clocks: LINE_CLOCKS per line, V_ACTIVE visible lines of V_TOTAL.
+module scanout #(
+  parameter [29:0] VRAM_WORDS = 30'd32768,
+  parameter        LINE_CLOCKS = 800,
+  parameter        V_ACTIVE = 480,
+  parameter        V_TOTAL = 525,
+  parameter        CRC_BYTES = 1           // bytes folded into the CRC per clock: 1 or 4
+) (
+  input  wire        clk,
+  input  wire        rst,
+  input  wire        soft_reset,   // RESET: the pending swap and a frame being read are dropped, counters 0
+  // swap request from the executor
+  input  wire        swap_req,
+  input  wire [27:0] swap_addr,    // byte address / 16
+  input  wire [1:0]  swap_format,
+  input  wire [10:0] swap_width,
+  input  wire [10:0] swap_height,
+  output wire        swap_ready,   // no swap being computed, pending or read
+  output wire        swap_pending, // STATUS.SWAP_PENDING
+  output reg         err_range,
+  // timing
+  output wire        vblank,
+  output wire        vsync,        // one clock at the start of vertical blanking
+  // memory (reads, in VRAM only)
+  output wire        req_valid,
+  input  wire        req_ready,
+  output wire [29:0] req_addr,
+  input  wire        rsp_valid,
+  input  wire [31:0] rsp_rdata,
+  // write protection of the frame not yet read
+  output wire        prot_active,
+  output wire [29:0] prot_lo,
+  output wire [29:0] prot_hi,
+  // registers
+  output reg  [15:0] frame_count,
+  output wire [47:0] frame_crc,
+  // the frame's bytes, in order: the top frame_nbytes bytes of frame_word
+  output reg         frame_valid,
+  output reg  [31:0] frame_word,
+  output reg  [2:0]  frame_nbytes,
+  output reg         frame_start,  // one clock when a frame's reading starts (with its format)
+  output reg         frame_end,    // one clock after its last byte
+  output reg  [1:0]  frame_format,
+  output reg  [10:0] frame_width,
+  output reg  [10:0] frame_height
+);
+  // --- display timing ---
+  reg [10:0] hcount;
+  reg [10:0] vcount;
+  wire line_end = hcount == LINE_CLOCKS[10:0] - 11'd1;
+  assign vblank = vcount >= V_ACTIVE[10:0];
+  assign vsync  = line_end && vcount == V_ACTIVE[10:0] - 11'd1;
+  always @(posedge clk) begin
+    if (rst) begin
+      hcount <= 11'd0;
+      vcount <= 11'd0;
+    end else begin
+      hcount <= line_end ? 11'd0 : hcount + 11'd1;
+      if (line_end) vcount <= vcount == V_TOTAL[10:0] - 11'd1 ? 11'd0 : vcount + 11'd1;
+    end
+  end
+
+  // --- swap request: length and range ---
+  reg        computing, pending, reading;
+  reg [3:0]  mul_step;
+  reg [23:0] mul_acc;          // width x height
+  reg [10:0] mul_h;
+  reg [27:0] base16;           // byte address / 16
+  reg [24:0] len_bytes;        // <= 1024 x 1024 x 4
+  reg [31:0] crc, crc_value;
+  reg [15:0] crc_frame;
+  assign swap_ready   = !computing && !pending && !reading;
+  assign swap_pending = computing || pending || reading;
+  assign frame_crc    = {crc_frame, crc_value};
+
+  wire [29:0] base_word = {base16, 2'b00};
+  wire [32:0] end_byte  = {1'b0, base16, 4'd0} + {8'd0, len_bytes};
+  wire [30:0] end_word  = end_byte[32:2] + {30'd0, end_byte[1:0] != 2'd0};   // words touched
+  wire [30:0] vram_w31  = {1'b0, VRAM_WORDS};
+  wire [29:0] hi_word   = end_word > vram_w31 ? VRAM_WORDS : end_word[29:0];
+  wire [24:0] bytes_of_format = frame_format == 2'd0 ? {mul_acc[22:0], 2'b00}
+                              : frame_format == 2'd1 ? {1'b0, mul_acc[22:0], 1'b0} : {2'b00, mul_acc[22:0]};
+
+  // --- frame reading ---
+  reg  [29:0] issue_addr;      // next word to read
+  reg  [29:0] issue_end;       // first word not read from memory (VRAM end or frame end)
+  reg  [24:0] bytes_left;      // bytes still to fold, in frame order
+  reg  [2:0]  outstanding;     // reads issued, answer not yet seen (<= 4: the buffer's room)
+  reg  [2:0]  drop;            // answers to ignore after a RESET
+  reg  [31:0] buf_word [0:3];
+  reg  [1:0]  buf_rd, buf_wr;
+  reg  [2:0]  buf_count;
+  reg  [1:0]  byte_in_word;    // CRC_BYTES = 1: next byte of the head word
+
+  assign req_valid   = reading && issue_addr < issue_end && outstanding + buf_count < 3'd4;
+  assign req_addr    = issue_addr;
+  assign prot_active = pending || computing || (reading && issue_addr < issue_end);
+  assign prot_lo     = reading ? issue_addr : base_word;
+  assign prot_hi     = hi_word;
+
+  // the head word: from memory while there are answers, zeros beyond VRAM
+  wire        mem_words_done = issue_addr >= issue_end && outstanding == 3'd0 && buf_count == 3'd0;
+  wire        have_word = buf_count != 3'd0 || (mem_words_done && bytes_left != 25'd0);
+  wire [31:0] head_word = buf_count != 3'd0 ? buf_word[buf_rd] : 32'd0;
+
+  function automatic [31:0] crc_byte(input [31:0] c, input [7:0] b);
+    integer i;
+    reg [31:0] x;
+    begin
+      x = c ^ {24'd0, b};
+      for (i = 0; i < 8; i = i + 1) x = x[0] ? ({1'b0, x[31:1]} ^ 32'hEDB88320) : {1'b0, x[31:1]};
+      crc_byte = x;
+    end
+  endfunction
+
+  // fold step: how many bytes and which
+  reg  [2:0]  n_fold;
+  reg  [31:0] fold_word;       // bytes to fold, first one in [31:24]
+  reg  [31:0] crc_next;
+  reg         word_done;
+  always @* begin
+    if (CRC_BYTES == 4) begin
+      fold_word = head_word;
+      n_fold = bytes_left >= 25'd4 ? 3'd4 : bytes_left[2:0];
+      word_done = 1'b1;
+    end else begin
+      fold_word = head_word << {byte_in_word, 3'b000};
+      n_fold = 3'd1;
+      word_done = byte_in_word == 2'd3 || bytes_left == 25'd1;
+    end
+    crc_next = crc;
+    if (n_fold >= 3'd1) crc_next = crc_byte(crc_next, fold_word[31:24]);
+    if (n_fold >= 3'd2) crc_next = crc_byte(crc_next, fold_word[23:16]);
+    if (n_fold >= 3'd3) crc_next = crc_byte(crc_next, fold_word[15:8]);
+    if (n_fold >= 3'd4) crc_next = crc_byte(crc_next, fold_word[7:0]);
+  end
+  wire folding = reading && have_word && bytes_left != 25'd0;
+  wire popping = folding && word_done && buf_count != 3'd0;
+  wire issued  = req_valid && req_ready;
+  wire take    = rsp_valid && drop == 3'd0;
+
+  always @(posedge clk) begin
+    err_range <= 1'b0;
+    frame_valid <= 1'b0;
+    frame_start <= 1'b0;
+    frame_end <= 1'b0;
+    if (rst || soft_reset) begin
+      computing <= 1'b0;
+      pending <= 1'b0;
+      reading <= 1'b0;
+      frame_count <= 16'd0;
+      crc_value <= 32'd0;
+      crc_frame <= 16'd0;
+      buf_rd <= 2'd0;
+      buf_wr <= 2'd0;
+      buf_count <= 3'd0;
+      byte_in_word <= 2'd0;
+      issue_addr <= 30'd0;
+      issue_end <= 30'd0;
+      // answers to reads in flight still arrive after a RESET
+      drop <= rst ? 3'd0 : drop - {2'd0, rsp_valid && drop != 3'd0} + outstanding - {2'd0, take};
+      outstanding <= 3'd0;
+    end else begin
+      if (rsp_valid && drop != 3'd0) drop <= drop - 3'd1;
+      outstanding <= outstanding + {2'd0, issued} - {2'd0, take};
+      if (issued) issue_addr <= issue_addr + 30'd1;
+      if (take) begin
+        buf_word[buf_wr] <= rsp_rdata;
+        buf_wr <= buf_wr + 2'd1;
+      end
+      buf_count <= buf_count + {2'd0, take} - {2'd0, popping};
+      if (popping) buf_rd <= buf_rd + 2'd1;
+
+      if (swap_req) begin
+        computing <= 1'b1;
+        base16 <= swap_addr;
+        frame_format <= swap_format;
+        frame_width <= swap_width;
+        frame_height <= swap_height;
+        mul_h <= swap_height;
+        mul_acc <= 24'd0;
+        mul_step <= 4'd0;
+      end else if (computing) begin
+        // mul_acc = width x height, one bit of the height per clock (MSB first)
+        if (mul_step < 4'd11) begin
+          mul_acc <= {mul_acc[22:0], 1'b0} + (mul_h[10] ? {13'd0, frame_width} : 24'd0);
+          mul_h <= {mul_h[9:0], 1'b0};
+          mul_step <= mul_step + 4'd1;
+        end else if (mul_step == 4'd11) begin
+          len_bytes <= bytes_of_format;
+          mul_step <= 4'd12;
+        end else begin
+          computing <= 1'b0;
+          pending <= 1'b1;
+          if (end_byte > {1'b0, VRAM_WORDS, 2'b00}) err_range <= 1'b1;
+        end
+      end
+
+      if (vsync && pending) begin
+        pending <= 1'b0;
+        reading <= 1'b1;
+        frame_start <= 1'b1;
+        crc <= 32'hFFFFFFFF;
+        bytes_left <= len_bytes;
+        byte_in_word <= 2'd0;
+        issue_addr <= base_word;
+        issue_end <= base_word >= VRAM_WORDS ? base_word : hi_word;
+      end else if (folding) begin
+        crc <= crc_next;
+        bytes_left <= bytes_left - {22'd0, n_fold};
+        byte_in_word <= word_done ? 2'd0 : byte_in_word + 2'd1;
+        frame_valid <= 1'b1;
+        frame_word <= fold_word;
+        frame_nbytes <= n_fold;
+        if (bytes_left == {22'd0, n_fold}) begin
+          reading <= 1'b0;
+          frame_end <= 1'b1;
+          frame_count <= frame_count + 16'd1;
+          crc_frame <= frame_count + 16'd1;
+          crc_value <= ~crc_next;
+        end
+      end else if (reading && bytes_left == 25'd0) begin
+        // an empty frame cannot occur (width and height are at least 1); kept for safety
+        reading <= 1'b0;
+      end
+    end
+  end
+
+  wire unused_ok = &{1'b0, mul_acc[23]};
+endmodule

@@ -1,0 +1,107 @@
+// spigpu v1 device (docs/protocol.md sections 2-13), one clock domain. The profile parameter picks
+// what the device has; CAPS reports exactly that (docs/gateware.md "Profiles"):
+//   PROFILE 0 "up5k": iCE40 UP5K, 128 KiB SPRAM as VRAM, 320 x 240 at most, FIFO 64;
+//   PROFILE 1 "ecp5": ECP5-85F, 32 MiB SDR SDRAM as VRAM, 1024 x 768 at most, FIFO 1023, every feature.
+// Display timing is in core clocks (LINE_CLOCKS x V_TOTAL lines, V_ACTIVE visible); the board top
+// levels set it for 640 x 480 at 60 Hz, the co-simulation uses a short frame.
+module spigpu_top #(
+  parameter PROFILE     = 0,
+  parameter CLK_MHZ     = PROFILE == 0 ? 25 : 50,
+  parameter LINE_CLOCKS = PROFILE == 0 ? 800 : 1600,
+  parameter V_ACTIVE    = 480,
+  parameter V_TOTAL     = 525
+) (
+  input  wire        clk,
+  input  wire        rst,
+  input  wire        spi_sck,
+  input  wire        spi_cs_n,
+  input  wire        spi_mosi,
+  output wire        spi_miso,
+  output wire        spi_miso_oe,
+  output wire        busy_pin,
+  output wire        sd_cke,
+  output wire        sd_cs_n,
+  output wire        sd_ras_n,
+  output wire        sd_cas_n,
+  output wire        sd_we_n,
+  output wire [1:0]  sd_ba,
+  output wire [12:0] sd_a,
+  output wire [1:0]  sd_dqm,
+  output wire [15:0] sd_dq_o,
+  output wire        sd_dq_oe,
+  input  wire [15:0] sd_dq_i,
+  output wire        vblank,
+  output wire        vsync,
+  output wire        frame_valid,
+  output wire [31:0] frame_word,
+  output wire [2:0]  frame_nbytes,
+  output wire        frame_start,
+  output wire        frame_end,
+  output wire [1:0]  frame_format,
+  output wire [10:0] frame_width,
+  output wire [10:0] frame_height,
+  output wire [31:0] perf_cycles,
+  output wire [31:0] perf_work_cycles,
+  output wire [31:0] perf_cmds,
+  output wire [31:0] perf_frames,
+  output wire [31:0] perf_core_stalls,
+  output wire [31:0] perf_refreshes,
+  output wire [31:0] perf_core_busy
+);
+  // CAPS.FEATURES: bit 0 bilinear, 1 blend, 2 dither, 3 strict link, 4 RGB565, 5 RGBA2222
+  localparam [7:0]  FEATURES   = PROFILE == 0 ? 8'h3C : 8'h3F;
+  localparam        MAX_WIDTH  = PROFILE == 0 ? 320 : 1024;
+  localparam        MAX_HEIGHT = PROFILE == 0 ? 240 : 768;
+  localparam        FIFO_DEPTH = PROFILE == 0 ? 64 : 1023;
+  localparam        FIFO_AW    = PROFILE == 0 ? 7 : 10;
+  localparam        VRAM_KIB   = PROFILE == 0 ? 128 : 32768;
+  localparam [15:0] VARIANT    = PROFILE == 0 ? 16'h0001 : 16'h0002;
+  localparam        CRC_BYTES  = PROFILE == 0 ? 1 : 4;
+
+  wire         cmd_valid, cmd_ready, core_idle;
+  wire [1:0]   cmd_op, cmd_fb_format;
+  wire [31:0]  cmd_tri_mode, cmd_clear_color;
+  wire [27:0]  cmd_tex_base, cmd_fb_draw, cmd_fb_z;
+  wire [17:0]  cmd_tex_fmt;
+  wire [43:0]  cmd_scissor;
+  wire [10:0]  cmd_fb_width, cmd_fb_height;
+  wire [23:0]  cmd_clear_depth;
+  wire [183:0] cmd_v0, cmd_v1, cmd_v2;
+  wire         mem_req_valid, mem_req_ready, mem_req_we, mem_rsp_valid;
+  wire [29:0]  mem_req_addr;
+  wire [31:0]  mem_req_wdata, mem_rsp_rdata;
+  wire [3:0]   mem_req_be;
+
+  spigpu_soc #(
+    .PROFILE(PROFILE), .FEATURES(FEATURES), .MAX_WIDTH(MAX_WIDTH), .MAX_HEIGHT(MAX_HEIGHT),
+    .FIFO_DEPTH(FIFO_DEPTH), .FIFO_AW(FIFO_AW), .VRAM_KIB(VRAM_KIB), .VARIANT(VARIANT), .CLK_MHZ(CLK_MHZ),
+    .LINE_CLOCKS(LINE_CLOCKS), .V_ACTIVE(V_ACTIVE), .V_TOTAL(V_TOTAL), .CRC_BYTES(CRC_BYTES)
+  ) u_soc (
+    .clk(clk), .rst(rst), .spi_sck(spi_sck), .spi_cs_n(spi_cs_n), .spi_mosi(spi_mosi), .spi_miso(spi_miso),
+    .spi_miso_oe(spi_miso_oe), .busy_pin(busy_pin), .sd_cke(sd_cke), .sd_cs_n(sd_cs_n), .sd_ras_n(sd_ras_n),
+    .sd_cas_n(sd_cas_n), .sd_we_n(sd_we_n), .sd_ba(sd_ba), .sd_a(sd_a), .sd_dqm(sd_dqm), .sd_dq_o(sd_dq_o),
+    .sd_dq_oe(sd_dq_oe), .sd_dq_i(sd_dq_i), .cmd_valid(cmd_valid), .cmd_ready(cmd_ready), .cmd_op(cmd_op),
+    .cmd_tri_mode(cmd_tri_mode), .cmd_tex_base(cmd_tex_base), .cmd_tex_fmt(cmd_tex_fmt), .cmd_scissor(cmd_scissor),
+    .cmd_fb_draw(cmd_fb_draw), .cmd_fb_z(cmd_fb_z), .cmd_fb_format(cmd_fb_format), .cmd_fb_width(cmd_fb_width),
+    .cmd_fb_height(cmd_fb_height), .cmd_clear_color(cmd_clear_color), .cmd_clear_depth(cmd_clear_depth),
+    .cmd_v0(cmd_v0), .cmd_v1(cmd_v1), .cmd_v2(cmd_v2), .core_idle(core_idle), .mem_req_valid(mem_req_valid),
+    .mem_req_ready(mem_req_ready), .mem_req_we(mem_req_we), .mem_req_addr(mem_req_addr),
+    .mem_req_wdata(mem_req_wdata), .mem_req_be(mem_req_be), .mem_rsp_valid(mem_rsp_valid),
+    .mem_rsp_rdata(mem_rsp_rdata), .vblank(vblank), .vsync(vsync), .frame_valid(frame_valid),
+    .frame_word(frame_word), .frame_nbytes(frame_nbytes), .frame_start(frame_start), .frame_end(frame_end),
+    .frame_format(frame_format), .frame_width(frame_width), .frame_height(frame_height), .perf_cycles(perf_cycles),
+    .perf_work_cycles(perf_work_cycles), .perf_cmds(perf_cmds), .perf_frames(perf_frames),
+    .perf_core_stalls(perf_core_stalls), .perf_refreshes(perf_refreshes));
+
+  spigpu_core #(
+    .PROFILE(PROFILE), .FEATURES(FEATURES), .MAX_WIDTH(MAX_WIDTH), .MAX_HEIGHT(MAX_HEIGHT)
+  ) u_core (
+    .clk(clk), .rst(rst), .cmd_valid(cmd_valid), .cmd_ready(cmd_ready), .cmd_op(cmd_op),
+    .cmd_tri_mode(cmd_tri_mode), .cmd_tex_base(cmd_tex_base), .cmd_tex_fmt(cmd_tex_fmt), .cmd_scissor(cmd_scissor),
+    .cmd_fb_draw(cmd_fb_draw), .cmd_fb_z(cmd_fb_z), .cmd_fb_format(cmd_fb_format), .cmd_fb_width(cmd_fb_width),
+    .cmd_fb_height(cmd_fb_height), .cmd_clear_color(cmd_clear_color), .cmd_clear_depth(cmd_clear_depth),
+    .cmd_v0(cmd_v0), .cmd_v1(cmd_v1), .cmd_v2(cmd_v2), .core_idle(core_idle), .mem_req_valid(mem_req_valid),
+    .mem_req_ready(mem_req_ready), .mem_req_we(mem_req_we), .mem_req_addr(mem_req_addr),
+    .mem_req_wdata(mem_req_wdata), .mem_req_be(mem_req_be), .mem_rsp_valid(mem_rsp_valid),
+    .mem_rsp_rdata(mem_rsp_rdata), .perf_busy_cycles(perf_core_busy));
+endmodule
