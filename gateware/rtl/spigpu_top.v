@@ -9,7 +9,8 @@ module spigpu_top #(
   parameter CLK_MHZ     = PROFILE == 0 ? 25 : 50,
   parameter LINE_CLOCKS = PROFILE == 0 ? 800 : 1600,
   parameter V_ACTIVE    = 480,
-  parameter V_TOTAL     = 525
+  parameter V_TOTAL     = 525,
+  parameter PERF        = 0       // 1: performance counters for the co-simulation
 ) (
   input  wire        clk,
   input  wire        rst,
@@ -57,6 +58,7 @@ module spigpu_top #(
   localparam        VRAM_KIB   = PROFILE == 0 ? 128 : 32768;
   localparam [15:0] VARIANT    = PROFILE == 0 ? 16'h0001 : 16'h0002;
   localparam        CRC_BYTES  = PROFILE == 0 ? 1 : 4;
+  localparam        SCAN_BUF   = PROFILE == 0 ? 2 : 4;
 
   wire         cmd_valid, cmd_ready, core_idle;
   wire [1:0]   cmd_op, cmd_fb_format;
@@ -75,7 +77,8 @@ module spigpu_top #(
   spigpu_soc #(
     .PROFILE(PROFILE), .FEATURES(FEATURES), .MAX_WIDTH(MAX_WIDTH), .MAX_HEIGHT(MAX_HEIGHT),
     .FIFO_DEPTH(FIFO_DEPTH), .FIFO_AW(FIFO_AW), .VRAM_KIB(VRAM_KIB), .VARIANT(VARIANT), .CLK_MHZ(CLK_MHZ),
-    .LINE_CLOCKS(LINE_CLOCKS), .V_ACTIVE(V_ACTIVE), .V_TOTAL(V_TOTAL), .CRC_BYTES(CRC_BYTES)
+    .LINE_CLOCKS(LINE_CLOCKS), .V_ACTIVE(V_ACTIVE), .V_TOTAL(V_TOTAL), .CRC_BYTES(CRC_BYTES),
+    .SCAN_BUF(SCAN_BUF), .PERF(PERF)
   ) u_soc (
     .clk(clk), .rst(rst), .spi_sck(spi_sck), .spi_cs_n(spi_cs_n), .spi_mosi(spi_mosi), .spi_miso(spi_miso),
     .spi_miso_oe(spi_miso_oe), .busy_pin(busy_pin), .sd_cke(sd_cke), .sd_cs_n(sd_cs_n), .sd_ras_n(sd_ras_n),

@@ -136,7 +136,7 @@ module sdram_model #(
     // refresh interval (checked once the part is in service)
     if (mode_set && now - t_ref > 32'd8 * REFI + RFC) violate(2, "refresh interval above 8 x tREFI");
     if (!cke) violate(3, "CKE low (not supported)");
-    else if (cmd[3] == 1'b0) begin
+    else if (cmd[3] == 1'b0 && cmd != 4'b0111) begin   // a command other than NOP
       if (now - t_mrs < T_MRD && mode_set) violate(4, "command within tMRD of MRS");
       if (now - t_ref < RFC) violate(5, "command within tRFC of REFRESH");
       case (cmd)

@@ -9,7 +9,9 @@
 //   - MEM_ADDR / MEM_DATA become operations of the memory-access unit (after the core is idle);
 //   - FENCE records its ID when everything before it has completed.
 // Plain register writes take one clock each. Read-write registers are also written, validated, to
-// the register file's shadow RAM (through a one-entry buffer, so core handshakes never wait on it).
+// the register file's shadow RAM when they execute (a clock later if the SPI side is writing it); a
+// kicking VERTEX writes it first and then offers the triangle to the core, so cmd_valid, once high,
+// stays high until cmd_ready.
 module command_exec #(
   parameter [7:0] FEATURES = 8'h3F,
   parameter       MAX_WIDTH = 1024,
@@ -47,17 +49,18 @@ module command_exec #(
   output wire [183:0] cmd_v1,
   output wire [183:0] cmd_v2,
   input  wire         core_idle,
-  // memory-access unit
-  output wire         mem_set_addr,  // MEM_ADDR executes
-  output wire         mem_write,     // MEM_DATA write executes
+  // memory-access unit: the operation's data stays in the FIFO head until mem_op_ack
+  output wire         mem_set_addr,  // MEM_ADDR offered
+  output wire         mem_write,     // MEM_DATA write offered
   output wire [63:0]  mem_op_data,
+  input  wire         mem_op_ack,    // taken (MEM_ADDR: at once; MEM_DATA: both words written)
   input  wire         mem_idle,      // no MEM_ADDR / MEM_DATA operation of the executor in progress
   // scanout
   output wire         swap_req,      // FB_DISPLAY executes
   output wire [27:0]  swap_addr,
   input  wire         swap_ready,    // no swap pending or being scanned
   output wire         waiting_vsync, // an FB_DISPLAY waits for the previous swap's scan
-  output reg  [31:0]  executed       // FIFO entries executed (timing-model counter C)
+  output wire         executed       // one clock per FIFO entry executed (timing-model counter C)
 );
 `include "spigpu_regs.vh"
 
@@ -138,10 +141,7 @@ module command_exec #(
   reg [10:0]  fb_width, fb_height;
   reg [31:0]  clear_color;
   reg [23:0]  clear_depth;
-  // one-entry shadow write buffer
-  reg         shb_valid;
-  reg [4:0]   shb_idx;
-  reg [63:0]  shb_data;
+  reg         kick_shadowed;   // the kicking VERTEX has written its shadow entry
 
   wire [183:0] vertex = {texcoord[31:0], texcoord[63:32], color[63:32], color[31:0], d[55:32], d[31:16], d[15:0]};
 
@@ -157,17 +157,20 @@ module command_exec #(
   wire to_shadow  = idx[6:5] == 2'b00 && reg_is_rw(idx);
 
   // Conditions for executing the entry now.
-  wire quiet      = core_idle && mem_idle && !core_drain;      // everything before has completed
-  wire core_ok    = !to_core || (cmd_ready && mem_idle && !core_drain);
-  wire wait_ok    = !(is_display || is_memaddr || is_memdata || is_fence) || quiet;
+  wire core_quiet = core_idle && !core_drain;                  // every earlier core command completed
+  wire quiet      = core_quiet && mem_idle;                    // ... and every earlier memory operation
+  wire is_mem     = is_memaddr || is_memdata;
+  wire core_ok    = !to_core || (cmd_ready && mem_idle && !core_drain && (!to_shadow || kick_shadowed));
+  wire mem_ok     = !is_mem || mem_op_ack;                     // the unit waits for its own idle
+  wire wait_ok    = is_mem ? core_quiet : (is_display || is_fence) ? quiet : 1'b1;
   wire swap_ok    = !is_display || swap_ready;
-  wire shadow_ok  = !to_shadow || !shb_valid;
-  wire go         = in_valid && core_ok && wait_ok && swap_ok && shadow_ok;
+  wire shadow_ok  = !to_shadow || sh_wr_ack || kick_shadowed;
+  wire go         = in_valid && core_ok && wait_ok && swap_ok && shadow_ok && mem_ok;
 
   assign in_pop    = go;
-  // Stable until cmd_ready: mem_idle and shadow_ok only become true while the entry waits, and
-  // core_drain only becomes false.
-  assign cmd_valid = in_valid && to_core && mem_idle && !core_drain && shadow_ok;
+  // Stable until cmd_ready: mem_idle and kick_shadowed only become true while the entry waits, and
+  // core_drain only becomes false. A kick offers its triangle once its shadow entry is written.
+  assign cmd_valid = in_valid && to_core && mem_idle && !core_drain && (!to_shadow || kick_shadowed);
   assign cmd_op    = is_clear ? 2'd1 : is_clear_z ? 2'd2 : 2'd0;
   assign cmd_tri_mode = tri_mode;
   assign cmd_tex_base = tex_base;
@@ -184,16 +187,20 @@ module command_exec #(
   assign cmd_v1 = stored1;
   assign cmd_v2 = vertex;
 
-  assign mem_set_addr = go && is_memaddr;
-  assign mem_write    = go && is_memdata;
+  wire   mem_offer    = in_valid && core_quiet;
+  assign mem_set_addr = mem_offer && is_memaddr;
+  assign mem_write    = mem_offer && is_memdata;
   assign mem_op_data  = d;
   assign swap_req     = go && is_display;
   assign swap_addr    = d[31:4];
   assign waiting_vsync = in_valid && is_display && quiet && !swap_ready;
 
-  assign sh_wr_req  = shb_valid;
-  assign sh_wr_idx  = shb_idx;
-  assign sh_wr_data = shb_data;
+  // the shadow write happens in the cycle the entry executes (or, for a kick, before it is offered)
+  assign sh_wr_req  = in_valid && to_shadow && !kick_shadowed && (kick ? (mem_idle && !core_drain) :
+                      core_ok && wait_ok && swap_ok && mem_ok);
+  assign sh_wr_idx  = idx[4:0];
+  assign sh_wr_data = d;
+  assign executed   = go;
 
   always @(posedge clk) begin
     err_set <= 7'd0;
@@ -215,21 +222,13 @@ module command_exec #(
       fb_height <= RESET_FB_FORMAT[26:16];
       clear_color <= RESET_CLEAR_COLOR[31:0];
       clear_depth <= RESET_CLEAR_DEPTH[23:0];
-      shb_valid <= 1'b0;
-      shb_idx <= 5'd0;
-      shb_data <= 64'd0;
-      executed <= 32'd0;
+      kick_shadowed <= 1'b0;
     end else begin
-      if (sh_wr_ack) shb_valid <= 1'b0;
+      if (kick && sh_wr_ack && !go) kick_shadowed <= 1'b1;
       if (go) begin
-        executed <= executed + 32'd1;
+        kick_shadowed <= 1'b0;
         err_set[3] <= rsv_err;
         err_set[4] <= bad;
-        if (to_shadow) begin
-          shb_valid <= 1'b1;
-          shb_idx <= idx[4:0];
-          shb_data <= d;
-        end
         case (idx)
           `SPIGPU_REG_COLOR: color <= d;
           `SPIGPU_REG_TEXCOORD: texcoord <= d;
@@ -272,5 +271,4 @@ module command_exec #(
     end
   end
 
-  wire unused_ok = &{1'b0, is_fence};
 endmodule

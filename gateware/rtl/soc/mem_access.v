@@ -7,18 +7,19 @@
 //     the highest memory priority and complete within a few clocks (SPRAM: 3; SDRAM: a refresh and a
 //     row miss at worst), long before the next frame's bit 64 at any SCK the SPI slave allows.
 // Accesses beyond VRAM never reach the memory: writes are dropped (ERR_MEM_RANGE), loads give 0.
-// Events are taken one per clock (a read, then MEM_ADDR, then MEM_DATA write); a reload started
-// while another is in flight discards the older one's responses.
+// The executor offers an operation with its data (the head of the command FIFO) until op_ack; a
+// read is taken first. A reload started while another is in flight discards the older responses.
 module mem_access #(
   parameter [28:0] VRAM_UNITS = 29'd16384   // VRAM size / 8 bytes
 ) (
   input  wire        clk,
   input  wire        rst,          // power-on
   input  wire        soft_reset,   // RESET: pointer 0, buffer 0, MEM_READY 0 (the beyond flag stays, as in the simulator)
-  // executor (only while ex_idle)
+  // executor
   input  wire        set_addr,
   input  wire        write,
   input  wire [63:0] op_data,
+  output wire        op_ack,
   output wire        ex_idle,      // no executor operation (write or its reload) in progress
   // SPI: a MEM_DATA read reached bit 64
   input  wire        read_strobe,
@@ -39,20 +40,18 @@ module mem_access #(
   localparam IDLE = 3'd0, WR0 = 3'd1, WR1 = 3'd2, RD0 = 3'd3, RD1 = 3'd4, WAIT = 3'd5;
   reg  [2:0]  phase;
   reg  [28:0] op_addr;      // 8-byte unit being accessed
-  reg  [63:0] wdata;
-  reg         pend_read, pend_set, pend_write;
-  reg  [28:0] set_value;
+  reg         pend_read;
   reg         owner_ex;     // the access in progress belongs to an executor operation
   reg         beyond;       // the buffer holds bytes from beyond VRAM
   reg  [1:0]  outstanding;  // reads issued, responses not yet seen
   reg  [1:0]  discard;      // responses of a superseded load still to come
   reg         got_first;
 
-  assign ex_idle   = !(pend_set || pend_write || (phase != IDLE && owner_ex));
   assign req_valid = phase == WR0 || phase == WR1 || phase == RD0 || phase == RD1;
   assign req_we    = phase == WR0 || phase == WR1;
   assign req_addr  = {op_addr, phase == WR1 || phase == RD1};
-  assign req_wdata = phase == WR0 ? wdata[63:32] : wdata[31:0];
+  assign req_wdata = phase == WR0 ? op_data[63:32] : op_data[31:0];
+  assign ex_idle   = !(phase != IDLE && owner_ex);
 
   wire issued   = req_valid && req_ready;
   wire reading  = issued && !req_we;
@@ -61,20 +60,14 @@ module mem_access #(
   wire [1:0] outstanding_next = outstanding + {1'b0, reading} - {1'b0, rsp_valid};
   wire [1:0] discard_next = discard - {1'b0, rsp_valid && discard != 2'd0};
 
-  // One control event per clock, never in the middle of a write.
+  // One event per clock, never in the middle of a write: a read, else an executor operation.
   wire do_read  = !writing && pend_read;
-  wire do_set   = !writing && !pend_read && pend_set;
-  wire do_write = !writing && !pend_read && !pend_set && pend_write;
+  wire do_set   = !writing && !pend_read && set_addr && ex_idle;
+  wire do_write = !writing && !pend_read && !set_addr && write && ex_idle;
   wire wr_done  = phase == WR1 && issued;
-  reg  [28:0] load_addr;
-  reg         do_load;
-  always @* begin
-    do_load = 1'b1;
-    load_addr = addr + 29'd1;
-    if (do_set) load_addr = set_value;
-    else if (do_write && in_vram) do_load = 1'b0;
-    else if (!(do_read || do_write || wr_done)) do_load = 1'b0;
-  end
+  assign op_ack = do_set || (do_write && !in_vram) || wr_done;
+  wire        do_load   = do_read || do_set || (do_write && !in_vram) || wr_done;
+  wire [28:0] load_addr = do_set ? op_data[31:3] : addr + 29'd1;
 
   always @(posedge clk) begin
     err_range <= 1'b0;
@@ -84,8 +77,6 @@ module mem_access #(
       mem_ready <= 1'b0;
       phase <= IDLE;
       pend_read <= 1'b0;
-      pend_set <= 1'b0;
-      pend_write <= 1'b0;
       owner_ex <= 1'b0;
       got_first <= 1'b0;
       // reads still in flight answer after a RESET; their data must not be taken
@@ -96,14 +87,6 @@ module mem_access #(
       outstanding <= outstanding_next;
       discard <= discard_next;
       if (read_strobe) pend_read <= 1'b1;
-      if (set_addr) begin
-        pend_set <= 1'b1;
-        set_value <= op_data[31:3];
-      end
-      if (write) begin
-        pend_write <= 1'b1;
-        wdata <= op_data;
-      end
       // responses of the current load
       if (rsp_valid && discard == 2'd0) begin
         got_first <= !got_first;
@@ -124,9 +107,7 @@ module mem_access #(
         pend_read <= 1'b0;
         if (beyond) err_range <= 1'b1;
       end
-      if (do_set) pend_set <= 1'b0;
       if (do_write) begin
-        pend_write <= 1'b0;
         if (in_vram) begin
           op_addr <= addr;
           phase <= WR0;

@@ -51,8 +51,7 @@ module mem_arbiter #(
   output wire [3:0]    b_req_be,
   input  wire          b_rsp_valid,
   input  wire [31:0]   b_rsp_rdata,
-  // counters
-  output reg  [31:0]   core_stall_cycles  // core request waiting (protection, priority, back end)
+  output wire          core_stall      // a core request waits this clock (protection, priority, back end)
 );
   // in-flight reads: the client of each, oldest first
   reg [1:0] tag [0:7];
@@ -97,6 +96,7 @@ module mem_arbiter #(
   assign s_rsp_valid = b_rsp_valid && head == 2'd1;
   assign c_rsp_valid = (b_rsp_valid && head == 2'd2) || zero_rsp;
   assign rsp_rdata   = zero_rsp ? 32'd0 : b_rsp_rdata;
+  assign core_stall  = c_req_valid && !c_req_ready;
 
   always @(posedge clk) begin
     c_range_err <= pick_z;
@@ -108,7 +108,6 @@ module mem_arbiter #(
       scan_wait <= 4'd0;
       zero_rsp <= 1'b0;
       c_range_err <= 1'b0;
-      core_stall_cycles <= 32'd0;
     end else begin
       if (granted_read) begin
         tag[tag_wr] <= granted_client;
@@ -118,7 +117,6 @@ module mem_arbiter #(
       tag_count <= tag_count + {3'd0, granted_read} - {3'd0, b_rsp_valid};
       if (s_req_valid && !s_req_ready) scan_wait <= scan_wait == 4'd15 ? scan_wait : scan_wait + 4'd1;
       else scan_wait <= 4'd0;
-      if (c_req_valid && !c_req_ready) core_stall_cycles <= core_stall_cycles + 32'd1;
     end
   end
 

@@ -17,7 +17,8 @@ module scanout #(
   parameter        LINE_CLOCKS = 800,
   parameter        V_ACTIVE = 480,
   parameter        V_TOTAL = 525,
-  parameter        CRC_BYTES = 1           // bytes folded into the CRC per clock: 1 or 4
+  parameter        CRC_BYTES = 1,          // bytes folded into the CRC per clock: 1 or 4
+  parameter        BUF_WORDS = 2           // read-ahead words (2 or 4)
 ) (
   input  wire        clk,
   input  wire        rst,
@@ -47,12 +48,12 @@ module scanout #(
   // registers
   output reg  [15:0] frame_count,
   output wire [47:0] frame_crc,
-  // the frame's bytes, in order: the top frame_nbytes bytes of frame_word
-  output reg         frame_valid,
-  output reg  [31:0] frame_word,
-  output reg  [2:0]  frame_nbytes,
-  output reg         frame_start,  // one clock when a frame's reading starts (with its format)
-  output reg         frame_end,    // one clock after its last byte
+  // the frame's bytes, in order: the top frame_nbytes bytes of frame_word (combinational)
+  output wire        frame_valid,
+  output wire [31:0] frame_word,
+  output wire [2:0]  frame_nbytes,
+  output wire        frame_start,  // the clock a frame's reading starts (frame_format/width/height valid)
+  output wire        frame_end,    // the clock of its last byte
   output reg  [1:0]  frame_format,
   output reg  [10:0] frame_width,
   output reg  [10:0] frame_height
@@ -98,14 +99,16 @@ module scanout #(
   reg  [29:0] issue_addr;      // next word to read
   reg  [29:0] issue_end;       // first word not read from memory (VRAM end or frame end)
   reg  [24:0] bytes_left;      // bytes still to fold, in frame order
-  reg  [2:0]  outstanding;     // reads issued, answer not yet seen (<= 4: the buffer's room)
+  reg  [2:0]  outstanding;     // reads issued, answer not yet seen (<= BUF_WORDS: the buffer's room)
   reg  [2:0]  drop;            // answers to ignore after a RESET
-  reg  [31:0] buf_word [0:3];
-  reg  [1:0]  buf_rd, buf_wr;
+  reg  [31:0] buf_word [0:BUF_WORDS-1];
+  localparam       BAW = BUF_WORDS == 4 ? 2 : 1;
+  reg  [BAW-1:0] buf_rd, buf_wr;
   reg  [2:0]  buf_count;
+  localparam [2:0] BUFW = BUF_WORDS[2:0];
   reg  [1:0]  byte_in_word;    // CRC_BYTES = 1: next byte of the head word
 
-  assign req_valid   = reading && issue_addr < issue_end && outstanding + buf_count < 3'd4;
+  assign req_valid   = reading && issue_addr < issue_end && outstanding + buf_count < BUFW;
   assign req_addr    = issue_addr;
   assign prot_active = pending || computing || (reading && issue_addr < issue_end);
   assign prot_lo     = reading ? issue_addr : base_word;
@@ -151,12 +154,15 @@ module scanout #(
   wire popping = folding && word_done && buf_count != 3'd0;
   wire issued  = req_valid && req_ready;
   wire take    = rsp_valid && drop == 3'd0;
+  wire last    = folding && bytes_left == {22'd0, n_fold};
+  assign frame_valid  = folding;
+  assign frame_word   = fold_word;
+  assign frame_nbytes = n_fold;
+  assign frame_start  = vsync && pending;
+  assign frame_end    = last;
 
   always @(posedge clk) begin
     err_range <= 1'b0;
-    frame_valid <= 1'b0;
-    frame_start <= 1'b0;
-    frame_end <= 1'b0;
     if (rst || soft_reset) begin
       computing <= 1'b0;
       pending <= 1'b0;
@@ -164,8 +170,8 @@ module scanout #(
       frame_count <= 16'd0;
       crc_value <= 32'd0;
       crc_frame <= 16'd0;
-      buf_rd <= 2'd0;
-      buf_wr <= 2'd0;
+      buf_rd <= {BAW{1'b0}};
+      buf_wr <= {BAW{1'b0}};
       buf_count <= 3'd0;
       byte_in_word <= 2'd0;
       issue_addr <= 30'd0;
@@ -179,10 +185,10 @@ module scanout #(
       if (issued) issue_addr <= issue_addr + 30'd1;
       if (take) begin
         buf_word[buf_wr] <= rsp_rdata;
-        buf_wr <= buf_wr + 2'd1;
+        buf_wr <= buf_wr + 1'b1;
       end
       buf_count <= buf_count + {2'd0, take} - {2'd0, popping};
-      if (popping) buf_rd <= buf_rd + 2'd1;
+      if (popping) buf_rd <= buf_rd + 1'b1;
 
       if (swap_req) begin
         computing <= 1'b1;
@@ -212,7 +218,6 @@ module scanout #(
       if (vsync && pending) begin
         pending <= 1'b0;
         reading <= 1'b1;
-        frame_start <= 1'b1;
         crc <= 32'hFFFFFFFF;
         bytes_left <= len_bytes;
         byte_in_word <= 2'd0;
@@ -222,12 +227,8 @@ module scanout #(
         crc <= crc_next;
         bytes_left <= bytes_left - {22'd0, n_fold};
         byte_in_word <= word_done ? 2'd0 : byte_in_word + 2'd1;
-        frame_valid <= 1'b1;
-        frame_word <= fold_word;
-        frame_nbytes <= n_fold;
-        if (bytes_left == {22'd0, n_fold}) begin
+        if (last) begin
           reading <= 1'b0;
-          frame_end <= 1'b1;
           frame_count <= frame_count + 16'd1;
           crc_frame <= frame_count + 16'd1;
           crc_value <= ~crc_next;

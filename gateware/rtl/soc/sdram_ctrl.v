@@ -45,7 +45,7 @@ module sdram_ctrl #(
   output reg         sd_dq_oe,
   input  wire [15:0] sd_dq_i,
   output reg         init_done,
-  output reg  [31:0] refreshes       // auto refreshes issued
+  output wire        refresh         // one clock per auto refresh issued
 );
   function integer cycles(input integer ns);
     begin
@@ -66,13 +66,15 @@ module sdram_ctrl #(
   localparam [7:0] RFC = RFC_I[7:0];
   localparam [7:0] TURN = TURN_I[7:0];      // READ -> WRITE: read data off the bus
   localparam [15:0] REFI = REFI_I[15:0];
-  localparam [17:0] INIT = INIT_US * CLK_MHZ;
+  localparam integer INIT_I = INIT_US * CLK_MHZ;
+  localparam [17:0] INIT = INIT_I[17:0];
   localparam [2:0]  CL3 = CL;
 
   localparam [3:0] C_NOP = 4'b0111, C_ACT = 4'b0011, C_READ = 4'b0101, C_WRITE = 4'b0100,
                    C_PRE = 4'b0010, C_REF = 4'b0001, C_MRS = 4'b0000;
   reg [3:0] cmd;
-  assign {sd_cs_n, sd_ras_n, sd_cas_n, sd_we_n} = cmd;
+  // NOP while in reset (also before the first clock edge: the register may hold anything)
+  assign {sd_cs_n, sd_ras_n, sd_cas_n, sd_we_n} = rst ? C_NOP : cmd;
   assign sd_cke = 1'b1;
 
   // --- bank state and timers ---
@@ -116,6 +118,7 @@ module sdram_ctrl #(
   wire do_prea  = init_done && ref_due && open != 4'd0 && all_pre_ok;
   wire do_ref   = init_done && ref_due && open == 4'd0 && all_act_ok;
   assign req_ready = init_done && !ref_due && (!cur_valid || do_rw);
+  assign refresh   = do_ref;
 
   // read data capture: rd_pipe[k] is set k clocks after a READ was registered
   reg [CL+1:0] rd_pipe;
@@ -152,7 +155,6 @@ module sdram_ctrl #(
       refi <= REFI;
       rd_pipe <= {(CL + 2){1'b0}};
       wr_beat1 <= 1'b0;
-      refreshes <= 32'd0;
       {t_rcd0, t_rcd1, t_rcd2, t_rcd3} <= 32'd0;
       {t_pre0, t_pre1, t_pre2, t_pre3} <= 32'd0;
       {t_act0, t_act1, t_act2, t_act3} <= 32'd0;
@@ -209,7 +211,6 @@ module sdram_ctrl #(
         end else if (do_ref) begin
           cmd <= C_REF;
           ref_due <= 1'b0;
-          refreshes <= refreshes + 32'd1;
           t_act0 <= RFC; t_act1 <= RFC; t_act2 <= RFC; t_act3 <= RFC;
         end else if (do_rw) begin
           cmd <= cur_we ? C_WRITE : C_READ;

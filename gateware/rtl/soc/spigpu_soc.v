@@ -14,7 +14,9 @@ module spigpu_soc #(
   parameter        LINE_CLOCKS = 800,        // display timing in core clocks
   parameter        V_ACTIVE    = 480,
   parameter        V_TOTAL     = 525,
-  parameter        CRC_BYTES   = 1
+  parameter        CRC_BYTES   = 1,
+  parameter        SCAN_BUF    = 2,          // scanout read-ahead words
+  parameter        PERF        = 0           // 1: the perf_* counters exist (co-simulation), 0: they read 0
 ) (
   input  wire         clk,
   input  wire         rst,
@@ -75,11 +77,11 @@ module spigpu_soc #(
   output wire [1:0]   frame_format,
   output wire [10:0]  frame_width,
   output wire [10:0]  frame_height,
-  // counters for the co-simulation and the timing model
-  output reg  [31:0]  perf_cycles,        // clocks since power-on
-  output reg  [31:0]  perf_work_cycles,   // clocks with work (a released command, the core, MEM_*)
+  // counters for the co-simulation and the timing model (PERF = 1)
+  output wire [31:0]  perf_cycles,        // clocks since power-on
+  output wire [31:0]  perf_work_cycles,   // clocks with work (a released command, the core, MEM_*)
   output wire [31:0]  perf_cmds,          // FIFO entries executed
-  output reg  [31:0]  perf_frames,        // SPI frames completed
+  output wire [31:0]  perf_frames,        // SPI frames completed
   output wire [31:0]  perf_core_stalls,   // clocks a core memory request waited
   output wire [31:0]  perf_refreshes      // SDRAM auto refreshes
 );
@@ -162,7 +164,7 @@ module spigpu_soc #(
   assign busy_pin = fifo_nearly_full;
 
   // --- executor ---
-  wire        mem_set_addr, mem_write;
+  wire        mem_set_addr, mem_write, mem_op_ack, executed, core_stall;
   wire [63:0] mem_op_data;
   wire        swap_req, swap_ready, waiting_vsync;
   wire [27:0] swap_addr;
@@ -174,8 +176,9 @@ module spigpu_soc #(
     .cmd_fb_draw(cmd_fb_draw), .cmd_fb_z(cmd_fb_z), .cmd_fb_format(cmd_fb_format), .cmd_fb_width(cmd_fb_width),
     .cmd_fb_height(cmd_fb_height), .cmd_clear_color(cmd_clear_color), .cmd_clear_depth(cmd_clear_depth),
     .cmd_v0(cmd_v0), .cmd_v1(cmd_v1), .cmd_v2(cmd_v2), .core_idle(core_idle), .mem_set_addr(mem_set_addr),
-    .mem_write(mem_write), .mem_op_data(mem_op_data), .mem_idle(mem_ex_idle), .swap_req(swap_req),
-    .swap_addr(swap_addr), .swap_ready(swap_ready), .waiting_vsync(waiting_vsync), .executed(perf_cmds));
+    .mem_write(mem_write), .mem_op_data(mem_op_data), .mem_op_ack(mem_op_ack), .mem_idle(mem_ex_idle),
+    .swap_req(swap_req), .swap_addr(swap_addr), .swap_ready(swap_ready), .waiting_vsync(waiting_vsync),
+    .executed(executed));
 
   // --- memory-access unit, scanout, arbiter ---
   wire        m_req_valid, m_req_ready, m_req_we, m_rsp_valid;
@@ -188,13 +191,13 @@ module spigpu_soc #(
   wire [29:0] prot_lo, prot_hi;
   mem_access #(.VRAM_UNITS(VRAM_UNITS)) u_mem (
     .clk(clk), .rst(rst), .soft_reset(soft_reset), .set_addr(mem_set_addr), .write(mem_write),
-    .op_data(mem_op_data), .ex_idle(mem_ex_idle), .read_strobe(mem_read_strobe), .addr(mem_addr),
+    .op_data(mem_op_data), .op_ack(mem_op_ack), .ex_idle(mem_ex_idle), .read_strobe(mem_read_strobe), .addr(mem_addr),
     .prefetch(prefetch), .mem_ready(mem_ready), .err_range(mem_err), .req_valid(m_req_valid),
     .req_ready(m_req_ready), .req_we(m_req_we), .req_addr(m_req_addr), .req_wdata(m_req_wdata),
     .rsp_valid(m_rsp_valid), .rsp_rdata(rsp_rdata));
 
   scanout #(.VRAM_WORDS(VRAM_WORDS), .LINE_CLOCKS(LINE_CLOCKS), .V_ACTIVE(V_ACTIVE), .V_TOTAL(V_TOTAL),
-            .CRC_BYTES(CRC_BYTES)) u_scan (
+            .CRC_BYTES(CRC_BYTES), .BUF_WORDS(SCAN_BUF)) u_scan (
     .clk(clk), .rst(rst), .soft_reset(soft_reset), .swap_req(swap_req), .swap_addr(swap_addr),
     .swap_format(cmd_fb_format), .swap_width(cmd_fb_width), .swap_height(cmd_fb_height), .swap_ready(swap_ready),
     .swap_pending(swap_pending_w), .err_range(scan_err), .vblank(vblank), .vsync(vsync),
@@ -216,9 +219,10 @@ module spigpu_soc #(
     .c_req_be(mem_req_be), .c_rsp_valid(mem_rsp_valid), .rsp_rdata(rsp_rdata), .c_range_err(core_range_err),
     .prot_active(prot_active), .prot_lo(prot_lo), .prot_hi(prot_hi), .b_req_valid(b_req_valid),
     .b_req_ready(b_req_ready), .b_req_we(b_req_we), .b_req_addr(b_req_addr), .b_req_wdata(b_req_wdata),
-    .b_req_be(b_req_be), .b_rsp_valid(b_rsp_valid), .b_rsp_rdata(b_rsp_rdata), .core_stall_cycles(perf_core_stalls));
+    .b_req_be(b_req_be), .b_rsp_valid(b_rsp_valid), .b_rsp_rdata(b_rsp_rdata), .core_stall(core_stall));
   assign mem_rsp_rdata = rsp_rdata;
 
+  wire refresh_pulse;
   generate
     if (PROFILE == 0) begin : g_spram
       vram_spram u_vram (
@@ -230,7 +234,7 @@ module spigpu_soc #(
       assign sd_dqm = 2'b11;
       assign sd_dq_o = 16'd0;
       assign sd_dq_oe = 1'b0;
-      assign perf_refreshes = 32'd0;
+      assign refresh_pulse = 1'b0;
       wire unused_sd = &{1'b0, sd_dq_i};
     end else begin : g_sdram
       wire sd_init_done;
@@ -239,23 +243,34 @@ module spigpu_soc #(
         .req_addr(b_req_addr), .req_wdata(b_req_wdata), .req_be(b_req_be), .rsp_valid(b_rsp_valid),
         .rsp_rdata(b_rsp_rdata), .sd_cke(sd_cke), .sd_cs_n(sd_cs_n), .sd_ras_n(sd_ras_n), .sd_cas_n(sd_cas_n),
         .sd_we_n(sd_we_n), .sd_ba(sd_ba), .sd_a(sd_a), .sd_dqm(sd_dqm), .sd_dq_o(sd_dq_o), .sd_dq_oe(sd_dq_oe),
-        .sd_dq_i(sd_dq_i), .init_done(sd_init_done), .refreshes(perf_refreshes));
+        .sd_dq_i(sd_dq_i), .init_done(sd_init_done), .refresh(refresh_pulse));
       wire unused_init = &{1'b0, sd_init_done};
     end
   endgenerate
 
-  // --- counters ---
-  always @(posedge clk) begin
-    if (rst) begin
-      perf_cycles <= 32'd0;
-      perf_work_cycles <= 32'd0;
-      perf_frames <= 32'd0;
-    end else begin
-      perf_cycles <= perf_cycles + 32'd1;
-      if ((fifo_out_valid && !waiting_vsync) || !core_idle || !mem_ex_idle) perf_work_cycles <= perf_work_cycles + 32'd1;
-      if (f_valid) perf_frames <= perf_frames + 32'd1;
+  // --- counters (co-simulation only: 192 flip-flops and adders a board does not need) ---
+  generate
+    if (PERF != 0) begin : g_perf
+      reg [31:0] cycles, work, cmds, frames, stalls, refreshes;
+      always @(posedge clk) begin
+        if (rst) begin
+          {cycles, work, cmds, frames, stalls, refreshes} <= 192'd0;
+        end else begin
+          cycles <= cycles + 32'd1;
+          if ((fifo_out_valid && !waiting_vsync) || !core_idle || !mem_ex_idle) work <= work + 32'd1;
+          if (executed) cmds <= cmds + 32'd1;
+          if (f_valid) frames <= frames + 32'd1;
+          if (core_stall) stalls <= stalls + 32'd1;
+          if (refresh_pulse) refreshes <= refreshes + 32'd1;
+        end
+      end
+      assign {perf_cycles, perf_work_cycles, perf_cmds, perf_frames, perf_core_stalls, perf_refreshes} =
+             {cycles, work, cmds, frames, stalls, refreshes};
+    end else begin : g_noperf
+      assign {perf_cycles, perf_work_cycles, perf_cmds, perf_frames, perf_core_stalls, perf_refreshes} = 192'd0;
+      wire unused_perf = &{1'b0, executed, core_stall, refresh_pulse, waiting_vsync};
     end
-  end
+  endgenerate
 
   wire unused_ok = &{1'b0, errors, swap_req};
 endmodule
