@@ -1,0 +1,44 @@
+// Decides whether a draw must run in serial mode: when a buffer it reads overlaps one it writes
+// (colour and depth buffers, or the texture and either), the simulator's pixel order is
+// observable and the core must finish each pixel before starting the next and emit rows left to
+// right. Whole buffers are compared (W * H pixels), as the simulator does; 64-bit style bounds
+// (no wrap at 4 GiB). Registered in three steps; the inputs are held during triangle setup,
+// which takes longer.
+module core_alias (
+    input  wire        clk,
+    input  wire [27:0] fb_draw16,
+    input  wire [27:0] fb_z16,
+    input  wire [27:0] tex16,
+    input  wire [10:0] width,
+    input  wire [10:0] height,
+    input  wire [1:0]  fmt,       // colour buffer format
+    input  wire [1:0]  tex_fmt,
+    input  wire [3:0]  tex_wl,
+    input  wire [3:0]  tex_hl,
+    input  wire        colour_on,  // colour written
+    input  wire        depth_on,   // depth read or written
+    input  wire        z_write,
+    input  wire        textured,   // texture sampled
+    output reg         serial
+);
+  reg  [21:0] wh;
+  reg  [32:0] c0, c1, z0, z1, t0, t1;
+  wire [1:0]  cbl = (fmt == 2'd0) ? 2'd2 : (fmt == 2'd1) ? 2'd1 : 2'd0;
+  wire [1:0]  tbl = (tex_fmt == 2'd0) ? 2'd2 : (tex_fmt == 2'd1) ? 2'd1 : 2'd0;
+  wire [4:0]  tl = 5'(tex_wl) + 5'(tex_hl) + 5'(tbl);
+  function ov(input [32:0] a0, input [32:0] a1, input [32:0] b0, input [32:0] b1);
+    ov = (a0 < b1) && (b0 < a1);
+  endfunction
+  always @(posedge clk) begin
+    wh <= 22'(width * height);
+    c0 <= {1'b0, fb_draw16, 4'd0};
+    c1 <= {1'b0, fb_draw16, 4'd0} + ({11'd0, wh} << cbl);
+    z0 <= {1'b0, fb_z16, 4'd0};
+    z1 <= {1'b0, fb_z16, 4'd0} + ({11'd0, wh} << 2);
+    t0 <= {1'b0, tex16, 4'd0};
+    t1 <= {1'b0, tex16, 4'd0} + (33'd1 << tl);
+    serial <= (depth_on && colour_on && ov(c0, c1, z0, z1)) ||
+              (textured && ov(t0, t1, c0, c1)) ||
+              (textured && z_write && ov(t0, t1, z0, z1));
+  end
+endmodule

@@ -1,0 +1,192 @@
+// Colour stage (docs/protocol.md section 11 steps 4-6): destination read when blending or
+// merging a write mask into a packed pixel, blend, quantise with the ordered dither, pack, write
+// mask, and one word write with byte enables. Pixel i of the colour buffer is at byte
+// FB_DRAW + i * bpp (big-endian pixels; byte 4k of a word is wdata[31:24], enable be[3]).
+module core_color #(
+    parameter integer AW = 2,            // log2 of destination reads in flight
+    parameter [7:0]   FEATURES = 8'hFF   // CAPS.FEATURES: blend, dither, RGB565, RGBA2222 logic
+) (
+    input  wire        clk,
+    input  wire        rst,
+    input  wire [1:0]  fmt,        // 0 RGBA8888, 1 RGB565, 2 RGBA2222
+    input  wire [27:0] fb_draw16,
+    input  wire [1:0]  blend,      // 0 OFF, 1 ALPHA, 2 ADD, 3 MULTIPLY
+    input  wire        dither,
+    input  wire [3:0]  keep,       // 1 = keep the stored channel: bit 0 R .. bit 3 A
+    input  wire        need_dst,   // read the destination (blend, or mask on a packed format)
+    // pixels in: {yl[1:0], xl[1:0], idx[21:0], rgba[31:0]}
+    input  wire        in_valid,
+    output wire        in_ready,
+    input  wire [57:0] in_pix,
+    // memory
+    output wire        rd_valid,
+    input  wire        rd_ready,
+    output wire [29:0] rd_addr,
+    input  wire        rsp_valid,
+    input  wire [31:0] rsp_data,
+    output reg         wr_valid,
+    input  wire        wr_ready,
+    output reg  [29:0] wr_addr,
+    output reg  [31:0] wr_data,
+    output reg  [3:0]  wr_be,
+    output wire        idle
+);
+  localparam F_BLEND = 1, F_DITHER = 2, F_RGB565 = 4, F_RGBA2222 = 5;
+
+  // byte address of pixel idx: FB_DRAW + idx * bpp; beyond 4 GiB saturates to an address no
+  // VRAM has
+  function [31:0] caddr(input [27:0] base, input [21:0] idx, input [1:0] f);
+    reg [32:0] a;
+    begin
+      a = {1'b0, base, 4'b0} + ((f == 2'd0) ? {9'd0, idx, 2'b0} : (f == 2'd1) ? {10'd0, idx, 1'b0}
+                                                                             : {11'd0, idx});
+      caddr = a[32] ? 32'hFFFFFFFF : a[31:0];
+    end
+  endfunction
+
+  wire [31:0] in_addr = caddr(fb_draw16, in_pix[53:32], fmt);
+
+  // ---- destination read queue ----
+  wire        q_full, q_empty, q_head;
+  wire [57:0] q_item;
+  wire [31:0] q_data;
+  wire        take;
+  core_rdq #(.IW(58), .DW(32), .AW(AW)) queue (
+      .clk(clk), .rst(rst),
+      .push(rd_valid && rd_ready), .push_item(in_pix),
+      .full(q_full), .empty(q_empty),
+      .rsp_valid(rsp_valid), .rsp_data(rsp_data),
+      .head_valid(q_head), .head_item(q_item), .head_data(q_data), .pop(need_dst && take));
+  assign rd_valid = need_dst && in_valid && !q_full;
+  assign rd_addr  = in_addr[31:2];
+
+  wire [57:0] cur = need_dst ? q_item : in_pix;
+  wire        cur_valid = need_dst ? q_head : in_valid;
+  wire [31:0] dword = q_data;
+  wire [31:0] addr = caddr(fb_draw16, cur[53:32], fmt);
+  wire [1:0]  lane = addr[1:0];
+  wire [1:0]  xl = cur[55:54], yl = cur[57:56];
+
+  // ---- destination pixel, expanded to 8 bits per channel ----
+  wire [15:0] d16 = lane[1] ? dword[15:0] : dword[31:16];
+  wire [7:0]  d8 = (lane == 2'd0) ? dword[31:24] : (lane == 2'd1) ? dword[23:16] :
+                   (lane == 2'd2) ? dword[15:8] : dword[7:0];
+  reg  [7:0]  dr, dg, db, da;
+  always @(*) begin
+    case (fmt)
+      2'd1: begin
+        dr = {d16[15:11], d16[15:13]};
+        dg = {d16[10:5], d16[10:9]};
+        db = {d16[4:0], d16[4:2]};
+        da = 8'hFF;
+      end
+      2'd2: begin
+        dr = {4{d8[7:6]}};
+        dg = {4{d8[5:4]}};
+        db = {4{d8[3:2]}};
+        da = {4{d8[1:0]}};
+      end
+      default: {dr, dg, db, da} = dword;
+    endcase
+  end
+
+  // ---- blend ----
+  function [7:0] div255(input [16:0] x);
+    reg [16:0] y;
+    begin
+      y = x + 17'd128;
+      div255 = 8'((y + {8'd0, y[16:8]}) >> 8);
+    end
+  endfunction
+  wire [7:0] sa = cur[7:0];
+  function [7:0] blend_ch(input [1:0] m, input [7:0] s, input [7:0] d, input [7:0] a);
+    reg signed [17:0] p;
+    reg [8:0] sum;
+    begin
+      case (m)
+        2'd1: begin  // ALPHA: s*a + d*(255-a) = d*255 + a*(s-d)
+          p = $signed({1'b0, d, 8'd0}) - $signed({10'd0, d}) +
+              $signed({10'd0, a}) * ($signed({10'd0, s}) - $signed({10'd0, d}));
+          blend_ch = div255(p[16:0]);
+        end
+        2'd2: begin
+          sum = {1'b0, s} + {1'b0, d};
+          blend_ch = sum[8] ? 8'hFF : sum[7:0];
+        end
+        2'd3: blend_ch = div255({1'b0, 16'(s) * 16'(d)});
+        default: blend_ch = s;
+      endcase
+    end
+  endfunction
+  wire [1:0] bm = FEATURES[F_BLEND] ? blend : 2'd0;
+  wire [7:0] cr = blend_ch(bm, cur[31:24], dr, sa);
+  wire [7:0] cg = blend_ch(bm, cur[23:16], dg, sa);
+  wire [7:0] cb = blend_ch(bm, cur[15:8], db, sa);
+  wire [7:0] ca = blend_ch(bm, cur[7:0], da, sa);
+
+  // ---- quantise and dither (4x4 Bayer at screen position) ----
+  reg [3:0] bayer;
+  always @(*) begin
+    case ({yl, xl})
+      4'h0: bayer = 4'd0;  4'h1: bayer = 4'd8;  4'h2: bayer = 4'd2;  4'h3: bayer = 4'd10;
+      4'h4: bayer = 4'd12; 4'h5: bayer = 4'd4;  4'h6: bayer = 4'd14; 4'h7: bayer = 4'd6;
+      4'h8: bayer = 4'd3;  4'h9: bayer = 4'd11; 4'hA: bayer = 4'd1;  4'hB: bayer = 4'd9;
+      4'hC: bayer = 4'd15; 4'hD: bayer = 4'd7;  4'hE: bayer = 4'd13; default: bayer = 4'd5;
+    endcase
+  end
+  wire dith = FEATURES[F_DITHER] && dither;
+  // v + ((B << (8 - n)) >> 4), saturated
+  function [7:0] dadd(input [7:0] v, input [7:0] add);
+    reg [8:0] s;
+    begin
+      s = {1'b0, v} + {1'b0, add};
+      dadd = s[8] ? 8'hFF : s[7:0];
+    end
+  endfunction
+  wire [7:0] add5 = dith ? {5'd0, bayer[3:1]} : 8'd0;   // (B << 3) >> 4
+  wire [7:0] add6 = dith ? {6'd0, bayer[3:2]} : 8'd0;   // (B << 2) >> 4
+  wire [7:0] add2 = dith ? {2'd0, bayer, 2'd0} : 8'd0;  // (B << 6) >> 4
+  wire [7:0] r5v = dadd(cr, add5), g6v = dadd(cg, add6), b5v = dadd(cb, add5);
+  wire [7:0] r2v = dadd(cr, add2), g2v = dadd(cg, add2), b2v = dadd(cb, add2), a2v = dadd(ca, add2);
+
+  // ---- pack, write mask ----
+  wire [4:0] r5 = keep[0] ? d16[15:11] : r5v[7:3];
+  wire [5:0] g6 = keep[1] ? d16[10:5] : g6v[7:2];
+  wire [4:0] b5 = keep[2] ? d16[4:0] : b5v[7:3];
+  wire [1:0] r2 = keep[0] ? d8[7:6] : r2v[7:6];
+  wire [1:0] g2 = keep[1] ? d8[5:4] : g2v[7:6];
+  wire [1:0] b2 = keep[2] ? d8[3:2] : b2v[7:6];
+  wire [1:0] a2 = keep[3] ? d8[1:0] : a2v[7:6];
+  reg [31:0] data_n;
+  reg [3:0]  be_n;
+  always @(*) begin
+    if (FEATURES[F_RGB565] && fmt == 2'd1) begin
+      data_n = {2{r5, g6, b5}};
+      be_n   = lane[1] ? 4'b0011 : 4'b1100;
+    end else if (FEATURES[F_RGBA2222] && fmt == 2'd2) begin
+      data_n = {4{r2, g2, b2, a2}};
+      be_n   = 4'b1000 >> lane;
+    end else begin
+      data_n = {cr, cg, cb, ca};
+      be_n   = {~keep[0], ~keep[1], ~keep[2], ~keep[3]};
+    end
+  end
+
+  // ---- write register ----
+  wire wfree = !wr_valid || wr_ready;
+  assign take = cur_valid && wfree;
+  assign in_ready = need_dst ? (!q_full && rd_ready) : take;
+  always @(posedge clk) begin
+    if (rst) begin
+      wr_valid <= 1'b0;
+    end else if (wfree) begin
+      wr_valid <= cur_valid;
+      if (cur_valid) begin
+        wr_addr <= addr[31:2];
+        wr_data <= data_n;
+        wr_be   <= be_n;
+      end
+    end
+  end
+  assign idle = q_empty && !wr_valid;
+endmodule

@@ -1,0 +1,96 @@
+// Depth stage (docs/protocol.md section 11 steps 1-2): reads the stored depth of each pixel
+// (Z_TEST), compares, writes the new depth of passing pixels (Z_WRITE) and drops failing ones.
+// Reads are issued as pixels arrive and resolved in order from a read queue, so several are in
+// flight. Depth word of pixel i: FB_Z / 4 + i (word address), bits [23:0].
+// Memory requests depend on registered state only (never on a ready), as the core's memory
+// arbiter requires.
+module core_depth #(
+    parameter integer PW = 178,  // pixel record bits: {..., z[23:0] at ZLSB, idx[21:0] at 0}
+    parameter integer ZLSB = 22,
+    parameter integer AW = 2     // log2 of the reads in flight
+) (
+    input  wire          clk,
+    input  wire          rst,
+    input  wire          z_test,
+    input  wire [2:0]    z_func,
+    input  wire          z_write,
+    input  wire [27:0]   fb_z16,   // FB_Z byte address / 16
+    // pixels in (from a register)
+    input  wire          in_valid,
+    output wire          in_ready,
+    input  wire [PW-1:0] in_pix,
+    // pixels out (passed)
+    output wire          out_valid,
+    input  wire          out_ready,
+    output wire [PW-1:0] out_pix,
+    // memory: depth reads
+    output wire          rd_valid,
+    input  wire          rd_ready,
+    output wire [29:0]   rd_addr,
+    input  wire          rsp_valid,
+    input  wire [31:0]   rsp_data,
+    // memory: depth writes
+    output wire          wr_valid,
+    input  wire          wr_ready,
+    output wire [29:0]   wr_addr,
+    output wire [31:0]   wr_data,
+    output wire          idle,
+    output wire          passed    // a pixel passed this cycle (counter)
+);
+  function [29:0] zaddr(input [27:0] base, input [21:0] idx);
+    reg [30:0] a;
+    begin
+      a = {1'b0, base, 2'b00} + {9'd0, idx};
+      zaddr = a[30] ? 30'h3FFFFFFF : a[29:0];  // beyond 4 GiB: an address no VRAM has
+    end
+  endfunction
+
+  function passes(input [2:0] f, input [23:0] z, input [23:0] d);
+    case (f)
+      3'd0: passes = 1'b0;      // NEVER
+      3'd1: passes = z < d;     // LESS
+      3'd2: passes = z == d;    // EQUAL
+      3'd3: passes = z <= d;    // LEQUAL
+      3'd4: passes = z > d;     // GREATER
+      3'd5: passes = z != d;    // NOTEQUAL
+      3'd6: passes = z >= d;    // GEQUAL
+      default: passes = 1'b1;   // ALWAYS
+    endcase
+  endfunction
+
+  // ---- read queue (Z_TEST) ----
+  wire          q_full, q_empty, q_head;
+  wire [PW-1:0] q_item;
+  wire [31:0]   q_data;
+  wire          take;
+  core_rdq #(.IW(PW), .DW(32), .AW(AW)) queue (
+      .clk(clk), .rst(rst),
+      .push(rd_valid && rd_ready), .push_item(in_pix),
+      .full(q_full), .empty(q_empty),
+      .rsp_valid(rsp_valid), .rsp_data(rsp_data),
+      .head_valid(q_head), .head_item(q_item), .head_data(q_data), .pop(z_test && take));
+
+  assign rd_valid = z_test && in_valid && !q_full;
+  assign rd_addr  = zaddr(fb_z16, in_pix[21:0]);
+
+  // the pixel being resolved: the queue head (Z_TEST) or the input (no test)
+  wire [PW-1:0] cur = z_test ? q_item : in_pix;
+  wire          cur_valid = z_test ? q_head : in_valid;
+  wire [23:0]   cur_z = cur[ZLSB+23:ZLSB];
+  wire          pass = !z_test || passes(z_func, cur_z, q_data[23:0]);
+
+  wire room;
+  // a pixel is resolved when it fails, or passes with room behind and its depth write accepted
+  assign take     = cur_valid && (!pass || (room && (!z_write || wr_ready)));
+  assign wr_valid = cur_valid && pass && z_write && room;
+  assign wr_addr  = zaddr(fb_z16, cur[21:0]);
+  assign wr_data  = {8'd0, cur_z};
+  assign in_ready = z_test ? (!q_full && rd_ready) : take;
+  assign passed   = take && pass;
+
+  core_fifo2 #(.W(PW)) out_fifo (
+      .clk(clk), .rst(rst), .push(take && pass), .din(cur), .room(room),
+      .valid(out_valid), .dout(out_pix), .pop(out_ready));
+
+  assign idle = q_empty && !out_valid;
+endmodule

@@ -1,0 +1,156 @@
+// The core's one memory request stream (the soc's arbiter port): a fixed-priority choice among
+// the stages' requests, a write combiner on colour writes, the order of outstanding reads, and
+// a two-entry output queue so no ready reaches back combinationally into the stages.
+//
+// Priority, highest first: clear writes, colour writes, colour reads, texel reads, depth
+// writes, depth reads - later pipeline stages first, so the pipeline drains. Reads complete in
+// request order; a small tag queue routes each response to the stage that asked.
+//
+// Colour writes to the same word merge (RGB565 and RGBA2222 pixels share words; byte enables
+// OR together) while the pipeline keeps producing them; the pending word is sent when a write to
+// another word arrives or on `flush`. No read of a draw can observe the pending bytes: within a
+// draw the buffers are disjoint unless the core runs in serial mode, which flushes after every
+// pixel, and the core drains (flushes) between draws.
+module core_memport #(
+    parameter integer TAGS_AW = 3,   // log2 of reads in flight
+    parameter integer COMBINE = 1
+) (
+    input  wire        clk,
+    input  wire        rst,
+    input  wire        flush,
+    // clear writes
+    input  wire        clr_valid,
+    output wire        clr_ready,
+    input  wire [29:0] clr_addr,
+    input  wire [31:0] clr_data,
+    input  wire [3:0]  clr_be,
+    // colour writes
+    input  wire        cw_valid,
+    output wire        cw_ready,
+    input  wire [29:0] cw_addr,
+    input  wire [31:0] cw_data,
+    input  wire [3:0]  cw_be,
+    // colour reads
+    input  wire        cr_valid,
+    output wire        cr_ready,
+    input  wire [29:0] cr_addr,
+    output wire        cr_rsp,
+    // texel reads
+    input  wire        tr_valid,
+    output wire        tr_ready,
+    input  wire [29:0] tr_addr,
+    output wire        tr_rsp,
+    // depth writes
+    input  wire        zw_valid,
+    output wire        zw_ready,
+    input  wire [29:0] zw_addr,
+    input  wire [31:0] zw_data,
+    // depth reads
+    input  wire        zr_valid,
+    output wire        zr_ready,
+    input  wire [29:0] zr_addr,
+    output wire        zr_rsp,
+    // the soc's port
+    output wire        mem_req_valid,
+    input  wire        mem_req_ready,
+    output wire        mem_req_we,
+    output wire [29:0] mem_req_addr,
+    output wire [31:0] mem_req_wdata,
+    output wire [3:0]  mem_req_be,
+    input  wire        mem_rsp_valid,
+    output wire        idle,
+    output wire        pending_write  // the combiner holds a word
+);
+  // ---- write combiner ----
+  reg        p_valid;
+  reg [29:0] p_addr;
+  reg [31:0] p_data;
+  reg [3:0]  p_be;
+  wire same = p_valid && (p_addr == cw_addr) && (COMBINE != 0);
+  wire p_req = p_valid && ((cw_valid && !same) || flush || COMBINE == 0);
+  wire p_gnt;
+  // an incoming colour write merges, fills an empty combiner, or replaces the word being sent
+  assign cw_ready = same || !p_valid || p_gnt;
+  wire [31:0] merged = {cw_be[3] ? cw_data[31:24] : p_data[31:24], cw_be[2] ? cw_data[23:16] : p_data[23:16],
+                        cw_be[1] ? cw_data[15:8] : p_data[15:8], cw_be[0] ? cw_data[7:0] : p_data[7:0]};
+  always @(posedge clk) begin
+    if (rst) begin
+      p_valid <= 1'b0;
+    end else if (cw_valid && cw_ready) begin
+      p_valid <= 1'b1;
+      p_addr  <= cw_addr;
+      p_data  <= (same && !p_gnt) ? merged : cw_data;
+      p_be    <= (same && !p_gnt) ? (p_be | cw_be) : cw_be;
+    end else if (p_gnt) begin
+      p_valid <= 1'b0;
+    end
+  end
+  assign pending_write = p_valid;
+
+  // ---- tag queue: who asked for each outstanding read ----
+  localparam [1:0] T_CR = 2'd0, T_TR = 2'd1, T_ZR = 2'd2;
+  localparam integer NT = 1 << TAGS_AW;
+  reg [1:0] tags[0:NT-1];
+  reg [TAGS_AW:0] tw, tr;
+  wire tag_room = (tw - tr) != NT[TAGS_AW:0];
+  wire [1:0] rsp_tag = tags[tr[TAGS_AW-1:0]];
+  assign cr_rsp = mem_rsp_valid && rsp_tag == T_CR;
+  assign tr_rsp = mem_rsp_valid && rsp_tag == T_TR;
+  assign zr_rsp = mem_rsp_valid && rsp_tag == T_ZR;
+
+  // ---- output queue ----
+  wire       o_room;
+  reg        g_we;
+  reg [29:0] g_addr;
+  reg [31:0] g_data;
+  reg [3:0]  g_be;
+  reg        g_any, g_read;
+  reg [1:0]  g_tag;
+  reg [5:0]  gnt;  // one-hot: clr, cw (combiner), cr, tr, zw, zr
+  always @(*) begin
+    gnt = 6'd0;
+    if (o_room) begin
+      if (clr_valid) gnt[0] = 1'b1;
+      else if (p_req) gnt[1] = 1'b1;
+      else if (cr_valid && tag_room) gnt[2] = 1'b1;
+      else if (tr_valid && tag_room) gnt[3] = 1'b1;
+      else if (zw_valid) gnt[4] = 1'b1;
+      else if (zr_valid && tag_room) gnt[5] = 1'b1;
+    end
+    g_any  = |gnt;
+    g_read = gnt[2] | gnt[3] | gnt[5];
+    g_tag  = gnt[2] ? T_CR : gnt[3] ? T_TR : T_ZR;
+    g_we   = gnt[0] | gnt[1] | gnt[4];
+    g_addr = gnt[0] ? clr_addr : gnt[1] ? p_addr : gnt[2] ? cr_addr : gnt[3] ? tr_addr :
+             gnt[4] ? zw_addr : zr_addr;
+    g_data = gnt[0] ? clr_data : gnt[1] ? p_data : zw_data;
+    g_be   = gnt[0] ? clr_be : gnt[1] ? p_be : 4'b1111;
+  end
+  assign clr_ready = gnt[0];
+  assign p_gnt     = gnt[1];
+  assign cr_ready  = gnt[2];
+  assign tr_ready  = gnt[3];
+  assign zw_ready  = gnt[4];
+  assign zr_ready  = gnt[5];
+
+  always @(posedge clk) begin
+    if (rst) begin
+      tw <= 0;
+      tr <= 0;
+    end else begin
+      if (g_any && g_read) begin
+        tags[tw[TAGS_AW-1:0]] <= g_tag;
+        tw <= tw + 1'b1;
+      end
+      if (mem_rsp_valid) tr <= tr + 1'b1;
+    end
+  end
+
+  wire [66:0] o_dout;
+  core_fifo2 #(.W(67)) out_q (
+      .clk(clk), .rst(rst), .push(g_any), .din({g_we, g_addr, g_data, g_be}), .room(o_room),
+      .valid(mem_req_valid), .dout(o_dout), .pop(mem_req_ready));
+  assign {mem_req_we, mem_req_addr, mem_req_wdata, mem_req_be} = o_dout;
+
+  assign idle = !p_valid && !mem_req_valid && (tw == tr);
+endmodule

@@ -1,0 +1,210 @@
+// Rasteriser (docs/protocol.md section 8): walks the covered pixels of a set-up triangle inside
+// its clipped bounding box and tells the attribute steppers how to follow.
+//
+// The walk is boundary following, not a box scan: each row is entered at the column where the
+// previous row ended; from there it moves (without emitting) to the end of the row's covered
+// span, then emits the span one pixel per cycle. Rows alternate direction (serpentine), so the
+// cost per triangle is its covered pixels plus about one cycle per row plus the horizontal
+// length of its boundary, never the empty half of the box. With `ltr` every row is emitted left
+// to right (the simulator's pixel order), which the core needs when the buffers a draw reads
+// and writes alias.
+//
+// Coverage of the next pixel is known before moving: one adder per edge computes E + step for
+// the direction under consideration, and the move is committed only when wanted. A row's
+// covered pixels are contiguous (convexity), and a failing edge tells which side they lie on:
+// an edge with E < 0 that grows to the right (ex > 0) puts them to the right.
+//
+// Outputs form a two-stage pipeline with the steppers: `op` (stepper move), `emit` and the
+// pixel position are registered together; the steppers apply `op` in the next enabled cycle.
+module core_raster (
+    input  wire               clk,
+    input  wire               rst,
+    input  wire               start,   // pulse: begin a triangle (setup outputs valid)
+    input  wire signed [35:0] e0_i, e1_i, e2_i,
+    input  wire signed [21:0] ex0_i, ex1_i, ex2_i,
+    input  wire signed [21:0] ey0_i, ey1_i, ey2_i,
+    input  wire [10:0]        box_x0, box_y0, box_x1, box_y1,
+    input  wire [10:0]        fb_width,
+    input  wire               ltr,     // emit every row left to right
+    input  wire               adv,     // the whole raster/stepper pipeline may advance
+    input  wire               hold,    // raster itself must not move this cycle (serial mode)
+    output wire               active,  // walking a triangle
+    output reg  [1:0]         op,      // OP_NONE / OP_RIGHT / OP_LEFT / OP_DOWN
+    output reg                emit,    // the pixel reached by `op` is covered: emit it
+    output reg  [10:0]        px,
+    output reg  [10:0]        py,
+    output reg  [21:0]        pidx     // py * fb_width + px
+);
+  localparam [1:0] OP_NONE = 2'd0, OP_RIGHT = 2'd1, OP_LEFT = 2'd2, OP_DOWN = 2'd3;
+  localparam [2:0] R_IDLE = 3'd0, R_ENTRY = 3'd1, R_SEEK = 3'd2, R_TOEND = 3'd3, R_EMIT = 3'd4,
+                   R_DOWN = 3'd5;
+  localparam DIR_R = 1'b0, DIR_L = 1'b1;
+
+  reg [2:0] st;
+  reg signed [35:0] e0, e1, e2;
+  reg signed [21:0] ex0, ex1, ex2, ey0, ey1, ey2;
+  reg [10:0] x, y, xlo, xhi, yhi, w;
+  reg [21:0] rowb;       // y * fb_width
+  reg        mdir;       // direction of the current move / emission
+  reg        last_dir;   // emission direction of the previous row
+  reg        order;      // ltr latched
+
+  assign active = (st != R_IDLE);
+
+  // one adder per edge: E + (ex | -ex | ey)
+  reg  [1:0] sel;
+  wire signed [35:0] s0 = (sel == OP_DOWN) ? 36'(ey0) : (sel == OP_LEFT) ? -(36'(ex0)) : 36'(ex0);
+  wire signed [35:0] s1 = (sel == OP_DOWN) ? 36'(ey1) : (sel == OP_LEFT) ? -(36'(ex1)) : 36'(ex1);
+  wire signed [35:0] s2 = (sel == OP_DOWN) ? 36'(ey2) : (sel == OP_LEFT) ? -(36'(ex2)) : 36'(ex2);
+  wire signed [35:0] n0 = e0 + s0, n1 = e1 + s1, n2 = e2 + s2;
+  wire ncov = !n0[35] && !n1[35] && !n2[35];
+  wire cov = !e0[35] && !e1[35] && !e2[35];
+  // sides on which covered pixels of this row can lie, from the failing edges
+  wire right_ok = !(e0[35] && ex0 <= 0) && !(e1[35] && ex1 <= 0) && !(e2[35] && ex2 <= 0);
+  wire left_ok  = !(e0[35] && ex0 >= 0) && !(e1[35] && ex1 >= 0) && !(e2[35] && ex2 >= 0);
+  wire can_r = (x != xhi);
+  wire can_l = (x != xlo);
+  wire last_row = (y == yhi);
+
+  // ---- decision for this cycle ----
+  reg       go;         // commit the move `sel`
+  reg       emit_n;
+  reg [2:0] st_n;
+  reg       mdir_n, last_dir_n;
+  wire      pd_entry = order ? DIR_R : ~last_dir;  // emission direction when entering covered
+  always @(*) begin
+    sel        = OP_NONE;
+    go         = 1'b0;
+    emit_n     = 1'b0;
+    st_n       = st;
+    mdir_n     = mdir;
+    last_dir_n = last_dir;
+    case (st)
+      R_ENTRY: begin
+        if (cov) begin
+          // walk to the end of the span behind the emission direction first
+          sel = (pd_entry == DIR_R) ? OP_LEFT : OP_RIGHT;
+          if (((pd_entry == DIR_R) ? can_l : can_r) && ncov) begin
+            go     = 1'b1;
+            st_n   = R_TOEND;
+            mdir_n = ~pd_entry;
+          end else begin
+            emit_n = 1'b1;
+            st_n   = R_EMIT;
+            mdir_n = pd_entry;
+          end
+        end else if (right_ok && can_r) begin
+          sel    = OP_RIGHT;
+          go     = 1'b1;
+          mdir_n = DIR_R;
+          emit_n = ncov;
+          st_n   = ncov ? R_EMIT : R_SEEK;
+        end else if (left_ok && can_l) begin
+          sel    = OP_LEFT;
+          go     = 1'b1;
+          mdir_n = DIR_L;
+          // arriving at the right end: emit from here, or (left-to-right order) walk on to the left end
+          emit_n = ncov && !order;
+          st_n   = !ncov ? R_SEEK : order ? R_TOEND : R_EMIT;
+        end else if (last_row) begin
+          st_n = R_IDLE;  // empty row, last row
+        end else begin
+          sel  = OP_DOWN;  // empty row
+          go   = 1'b1;
+          st_n = R_ENTRY;
+        end
+      end
+      R_SEEK: begin
+        sel = (mdir == DIR_R) ? OP_RIGHT : OP_LEFT;
+        if ((mdir == DIR_R) ? (right_ok && can_r) : (left_ok && can_l)) begin
+          go = 1'b1;
+          if (ncov) begin
+            emit_n = !(order && mdir == DIR_L);
+            st_n   = (order && mdir == DIR_L) ? R_TOEND : R_EMIT;
+          end
+        end else if (last_row) begin
+          st_n = R_IDLE;
+        end else begin
+          sel  = OP_DOWN;  // nothing covered on this row
+          go   = 1'b1;
+          st_n = R_ENTRY;
+        end
+      end
+      R_TOEND: begin
+        sel = (mdir == DIR_R) ? OP_RIGHT : OP_LEFT;
+        if (((mdir == DIR_R) ? can_r : can_l) && ncov) begin
+          go = 1'b1;
+        end else begin
+          emit_n = 1'b1;
+          st_n   = R_EMIT;
+          mdir_n = ~mdir;
+        end
+      end
+      R_EMIT: begin
+        sel = (mdir == DIR_R) ? OP_RIGHT : OP_LEFT;
+        if (((mdir == DIR_R) ? can_r : can_l) && ncov) begin
+          go     = 1'b1;
+          emit_n = 1'b1;
+        end else begin
+          last_dir_n = mdir;
+          st_n       = last_row ? R_IDLE : R_DOWN;
+        end
+      end
+      R_DOWN: begin
+        sel  = OP_DOWN;
+        go   = 1'b1;
+        st_n = R_ENTRY;
+      end
+      default: ;
+    endcase
+  end
+
+  wire [10:0] x_n = !go ? x : (sel == OP_RIGHT) ? x + 11'd1 : (sel == OP_LEFT) ? x - 11'd1 : x;
+  wire [10:0] y_n = (go && sel == OP_DOWN) ? y + 11'd1 : y;
+  wire [21:0] rowb_n = (go && sel == OP_DOWN) ? rowb + {11'd0, w} : rowb;
+
+  always @(posedge clk) begin
+    if (rst) begin
+      st   <= R_IDLE;
+      op   <= OP_NONE;
+      emit <= 1'b0;
+    end else if (start) begin
+      st       <= R_ENTRY;
+      e0 <= e0_i; e1 <= e1_i; e2 <= e2_i;
+      ex0 <= ex0_i; ex1 <= ex1_i; ex2 <= ex2_i;
+      ey0 <= ey0_i; ey1 <= ey1_i; ey2 <= ey2_i;
+      x        <= box_x0;
+      y        <= box_y0;
+      xlo      <= box_x0;
+      xhi      <= box_x1 - 11'd1;
+      yhi      <= box_y1 - 11'd1;
+      w        <= fb_width;
+      rowb     <= 22'(box_y0 * fb_width);
+      last_dir <= DIR_L;
+      mdir     <= DIR_R;
+      order    <= ltr;
+      op       <= OP_NONE;
+      emit     <= 1'b0;
+    end else if (adv) begin
+      if (hold || st == R_IDLE) begin
+        op   <= OP_NONE;
+        emit <= 1'b0;
+      end else begin
+        st       <= st_n;
+        mdir     <= mdir_n;
+        last_dir <= last_dir_n;
+        if (go) begin
+          e0 <= n0; e1 <= n1; e2 <= n2;
+        end
+        x    <= x_n;
+        y    <= y_n;
+        rowb <= rowb_n;
+        op   <= go ? sel : OP_NONE;
+        emit <= emit_n;
+        px   <= x_n;
+        py   <= y_n;
+        pidx <= rowb_n + {11'd0, x_n};
+      end
+    end
+  end
+endmodule

@@ -1,0 +1,285 @@
+// Texture unit (docs/protocol.md section 10), one pixel per cycle when memory keeps up:
+//   reciprocal of q: count leading zeros, normalise, table of 1/midpoint (b = 10), one
+//   Newton-Raphson step (k = 1);  texel coordinates tu = (s*y) >> (43 - n - wl) (1/4096 texel);
+//   addressing REPEAT / CLAMP / MIRROR per axis;  nearest (one texel) or bilinear (four texels,
+//   each index addressed separately) fetches;  texels expanded to 8 bits;  the bilinear weights
+//   of section 10.4, done as two exact linear steps;  MODULATE (div255 of texel * colour) or
+//   DECAL.
+// Pixels flow through a stalling pipeline (coordinates, addresses) into a fetch step that issues
+// the texel reads, then wait in a read queue for their words. Pixel record in: the depth stage's
+// {q, t, s, rgba, yl, xl, z, idx}; out: the colour stage's {yl, xl, idx, rgba}.
+module core_texture #(
+    parameter integer AW = 2  // log2 of pixels whose texels are in flight
+) (
+    input  wire         clk,
+    input  wire         rst,
+    input  wire [27:0]  tex16,       // TEX_BASE / 16
+    input  wire [3:0]   wl,          // log2 width, 3..10
+    input  wire [3:0]   hl,
+    input  wire [1:0]   wrap_s,      // 0 REPEAT, 1 CLAMP, 2 MIRROR
+    input  wire [1:0]   wrap_t,
+    input  wire         bilinear,
+    input  wire [1:0]   tfmt,        // 0 RGBA8888, 1 RGB565, 2 RGBA2222
+    input  wire         decal,
+    input  wire         in_valid,
+    output wire         in_ready,
+    input  wire [177:0] in_pix,
+    output reg          out_valid,
+    input  wire         out_ready,
+    output reg  [57:0]  out_pix,
+    output wire         rd_valid,
+    input  wire         rd_ready,
+    output wire [29:0]  rd_addr,
+    input  wire         rsp_valid,
+    input  wire [31:0]  rsp_data,
+    output wire         idle,
+    output wire         textured     // a pixel left the unit this cycle
+);
+  // ---------------------------------------------------------------- coordinate pipeline
+  wire en;  // the coordinate pipeline advances
+
+  wire [31:0] in_q = in_pix[177:146];
+  wire [31:0] in_t = in_pix[145:114];
+  wire [31:0] in_s = in_pix[113:82];
+  wire [57:0] in_pay = {in_pix[49:46], in_pix[21:0], in_pix[81:50]};  // {yl, xl, idx, rgba}
+
+  function [5:0] clz32(input [31:0] v);
+    integer k;
+    begin
+      clz32 = 6'd32;
+      for (k = 0; k < 32; k = k + 1)
+        if (v[k]) clz32 = 6'(31 - k);
+    end
+  endfunction
+  wire [5:0]  in_n = clz32(in_q);
+  wire [31:0] in_m = in_q << in_n[4:0];
+
+  wire [31:0] y0;
+  core_recip_rom rom (.clk(clk), .en(en), .addr(in_m[30:21]), .y(y0));
+
+  // stage 1: normalised q; the table entry arrives with it
+  reg        v1, qz1;
+  reg [4:0]  n1;
+  reg [31:0] m1, s1, t1;
+  reg [57:0] pay1;
+  // stage 2: p = m * y0
+  reg        v2, qz2;
+  reg [4:0]  n2;
+  reg [63:0] p2;
+  reg [31:0] y02, s2, t2;
+  reg [57:0] pay2;
+  // stage 3: y0 * (2 - M y0)
+  reg        v3, qz3;
+  reg [4:0]  n3;
+  reg [63:0] yt3;
+  reg [31:0] s3, t3;
+  reg [57:0] pay3;
+  // stage 4: s * y, t * y
+  reg        v4, qz4;
+  reg [4:0]  n4;
+  reg signed [63:0] su4, tv4;
+  reg [57:0] pay4;
+
+  wire [63:0] negp = 64'd0 - p2;
+  wire [31:0] tnr = negp[63:32];                            // 2 - M y as u1.31
+  wire [32:0] ysh = yt3[63:31];
+  wire [31:0] y = ysh[32] ? 32'hFFFFFFFF : ysh[31:0];     // min(2^32 - 1, (y t) >> 31)
+
+  always @(posedge clk) begin
+    if (rst) begin
+      v1 <= 1'b0; v2 <= 1'b0; v3 <= 1'b0; v4 <= 1'b0;
+    end else if (en) begin
+      v1 <= in_valid; qz1 <= (in_q == 32'd0); n1 <= in_n[4:0]; m1 <= in_m; s1 <= in_s; t1 <= in_t;
+      pay1 <= in_pay;
+      v2 <= v1; qz2 <= qz1; n2 <= n1; p2 <= {32'd0, m1} * {32'd0, y0}; y02 <= y0; s2 <= s1; t2 <= t1;
+      pay2 <= pay1;
+      v3 <= v2; qz3 <= qz2; n3 <= n2; yt3 <= {32'd0, y02} * {32'd0, tnr}; s3 <= s2; t3 <= t2;
+      pay3 <= pay2;
+      v4 <= v3; qz4 <= qz3; n4 <= n3; su4 <= $signed(s3) * $signed({32'd0, y});
+      tv4 <= $signed(t3) * $signed({32'd0, y}); pay4 <= pay3;
+    end
+  end
+
+  // ---------------------------------------------------------------- addressing (stage 5)
+  wire [5:0] shu = 6'd43 - {1'b0, n4} - {2'd0, wl};
+  wire [5:0] shv = 6'd43 - {1'b0, n4} - {2'd0, hl};
+  wire signed [63:0] tu = qz4 ? 64'sd0 : (su4 >>> shu);
+  wire signed [63:0] tv = qz4 ? 64'sd0 : (tv4 >>> shv);
+  wire signed [63:0] up = bilinear ? tu - 64'sd2048 : tu;
+  wire signed [63:0] vp = bilinear ? tv - 64'sd2048 : tv;
+  wire signed [51:0] i0 = 52'(up >>> 12), j0 = 52'(vp >>> 12);
+  wire signed [51:0] i1 = i0 + 52'sd1, j1 = j0 + 52'sd1;
+  wire [7:0] fu = bilinear ? up[11:4] : 8'd0;
+  wire [7:0] fv = bilinear ? vp[11:4] : 8'd0;
+
+  function [9:0] wrap(input signed [51:0] i, input [1:0] mode, input [3:0] lg);
+    reg [10:0] size, k;
+    reg big;
+    begin
+      size = 11'd1 << lg;
+      big = (i >>> lg) != 52'sd0;
+      case (mode)
+        2'd1: wrap = i[51] ? 10'd0 : big ? 10'(size - 11'd1) : i[9:0];
+        2'd2: begin
+          k = i[10:0] & ((size << 1) - 11'd1);
+          wrap = (k < size) ? k[9:0] : 10'((size << 1) - 11'd1 - k);
+        end
+        default: wrap = i[9:0] & 10'(size - 11'd1);
+      endcase
+    end
+  endfunction
+  wire [9:0] ia = wrap(i0, wrap_s, wl), ib = wrap(i1, wrap_s, wl);
+  wire [9:0] ja = wrap(j0, wrap_t, hl), jb = wrap(j1, wrap_t, hl);
+
+  function [31:0] taddr(input [27:0] base, input [9:0] i, input [9:0] j, input [3:0] lg, input [1:0] f);
+    reg [19:0] off;
+    reg [32:0] a;
+    begin
+      off = ({10'd0, j} << lg) | {10'd0, i};
+      a = {1'b0, base, 4'd0} + ((f == 2'd0) ? {11'd0, off, 2'd0} : (f == 2'd1) ? {12'd0, off, 1'd0}
+                                                                              : {13'd0, off});
+      taddr = a[32] ? 32'hFFFFFFFF : a[31:0];
+    end
+  endfunction
+  wire [31:0] a00 = taddr(tex16, ia, ja, wl, tfmt), a10 = taddr(tex16, ib, ja, wl, tfmt);
+  wire [31:0] a01 = taddr(tex16, ia, jb, wl, tfmt), a11 = taddr(tex16, ib, jb, wl, tfmt);
+
+  // stage 5 registers: the fetch step's work
+  reg         v5, bil5;
+  reg [29:0]  w00, w10, w01, w11;
+  reg [7:0]   lanes5, fu5, fv5;
+  reg [57:0]  pay5;
+  reg [1:0]   fi;   // next texel of this pixel to request
+  wire        q_full;
+  wire        last = !bil5 || fi == 2'd3;
+  wire        issue = v5 && (fi != 2'd0 || !q_full);
+  assign rd_valid = issue;
+  assign rd_addr  = (fi == 2'd0) ? w00 : (fi == 2'd1) ? w10 : (fi == 2'd2) ? w01 : w11;
+  wire        done5 = issue && rd_ready && last;
+  assign en = !v5 || done5;
+  assign in_ready = en;
+
+  always @(posedge clk) begin
+    if (rst) begin
+      v5 <= 1'b0;
+      fi <= 2'd0;
+    end else begin
+      if (issue && rd_ready) fi <= last ? 2'd0 : fi + 2'd1;
+      if (en) begin
+        v5     <= v4;
+        bil5   <= bilinear;
+        w00    <= a00[31:2];
+        w10    <= a10[31:2];
+        w01    <= a01[31:2];
+        w11    <= a11[31:2];
+        lanes5 <= {a00[1:0], a10[1:0], a01[1:0], a11[1:0]};
+        fu5    <= fu;
+        fv5    <= fv;
+        pay5   <= pay4;
+      end
+    end
+  end
+
+  // ---------------------------------------------------------------- texel read queue
+  localparam integer N = 1 << AW;
+  localparam integer IW = 58 + 8 + 8 + 8 + 1;
+  reg [IW-1:0]  items[0:N-1];
+  reg [127:0]   words[0:N-1];
+  reg [AW:0]    wp, dp, rp;
+  reg [1:0]     sub;
+  assign q_full = (wp - rp) == N[AW:0];
+  wire [IW-1:0] hitem = items[rp[AW-1:0]];
+  wire [127:0]  hword = words[rp[AW-1:0]];
+  wire          hvalid = (dp != rp);
+  wire          dbil = items[dp[AW-1:0]][IW-1];
+  wire          pop;
+  always @(posedge clk) begin
+    if (rst) begin
+      wp <= 0; dp <= 0; rp <= 0; sub <= 2'd0;
+    end else begin
+      if (issue && rd_ready && fi == 2'd0) begin
+        items[wp[AW-1:0]] <= {bil5, lanes5, fu5, fv5, pay5};
+        wp <= wp + 1'b1;
+      end
+      if (rsp_valid) begin
+        case (sub)
+          2'd0: words[dp[AW-1:0]][127:96] <= rsp_data;
+          2'd1: words[dp[AW-1:0]][95:64] <= rsp_data;
+          2'd2: words[dp[AW-1:0]][63:32] <= rsp_data;
+          default: words[dp[AW-1:0]][31:0] <= rsp_data;
+        endcase
+        if (!dbil || sub == 2'd3) begin
+          sub <= 2'd0;
+          dp  <= dp + 1'b1;
+        end else begin
+          sub <= sub + 2'd1;
+        end
+      end
+      if (pop) rp <= rp + 1'b1;
+    end
+  end
+
+  // ---------------------------------------------------------------- filter and combine
+  function [31:0] texel(input [31:0] w, input [1:0] lane, input [1:0] f);
+    reg [15:0] h;
+    reg [7:0] b;
+    begin
+      h = lane[1] ? w[15:0] : w[31:16];
+      b = (lane == 2'd0) ? w[31:24] : (lane == 2'd1) ? w[23:16] : (lane == 2'd2) ? w[15:8] : w[7:0];
+      case (f)
+        2'd1: texel = {h[15:11], h[15:13], h[10:5], h[10:9], h[4:0], h[4:2], 8'hFF};
+        2'd2: texel = {{4{b[7:6]}}, {4{b[5:4]}}, {4{b[3:2]}}, {4{b[1:0]}}};
+        default: texel = w;
+      endcase
+    end
+  endfunction
+  wire        hbil = hitem[IW-1];
+  wire [7:0]  hl00 = hitem[IW-2:IW-9];
+  wire [7:0]  hfu = hitem[73:66], hfv = hitem[65:58];
+  wire [57:0] hpay = hitem[57:0];
+  wire [31:0] c00 = texel(hword[127:96], hl00[7:6], tfmt);
+  wire [31:0] c10 = hbil ? texel(hword[95:64], hl00[5:4], tfmt) : c00;
+  wire [31:0] c01 = hbil ? texel(hword[63:32], hl00[3:2], tfmt) : c00;
+  wire [31:0] c11 = hbil ? texel(hword[31:0], hl00[1:0], tfmt) : c00;
+
+  // (c00 (256-fu) + c10 fu) (256-fv) + (c01 (256-fu) + c11 fu) fv, rounded: section 10.4 exactly
+  function [7:0] bilerp(input [7:0] p00, input [7:0] p10, input [7:0] p01, input [7:0] p11,
+                        input [7:0] u, input [7:0] v);
+    reg [16:0] a, b;
+    reg [33:0] c;
+    begin
+      a = 17'(p00) * (17'd256 - 17'(u)) + 17'(p10) * 17'(u);
+      b = 17'(p01) * (17'd256 - 17'(u)) + 17'(p11) * 17'(u);
+      c = 34'(a) * (34'd256 - 34'(v)) + 34'(b) * 34'(v) + 34'd32768;
+      bilerp = c[23:16];
+    end
+  endfunction
+  function [7:0] div255(input [15:0] x);
+    reg [16:0] y;
+    begin
+      y = 17'(x) + 17'd128;
+      div255 = 8'((y + {8'd0, y[16:8]}) >> 8);
+    end
+  endfunction
+  wire [7:0] tr = bilerp(c00[31:24], c10[31:24], c01[31:24], c11[31:24], hfu, hfv);
+  wire [7:0] tg = bilerp(c00[23:16], c10[23:16], c01[23:16], c11[23:16], hfu, hfv);
+  wire [7:0] tb = bilerp(c00[15:8], c10[15:8], c01[15:8], c11[15:8], hfu, hfv);
+  wire [7:0] ta = bilerp(c00[7:0], c10[7:0], c01[7:0], c11[7:0], hfu, hfv);
+  wire [31:0] col = hpay[31:0];
+  wire [31:0] comb = decal ? {tr, tg, tb, ta} :
+                     {div255(16'(tr) * 16'(col[31:24])), div255(16'(tg) * 16'(col[23:16])),
+                      div255(16'(tb) * 16'(col[15:8])), div255(16'(ta) * 16'(col[7:0]))};
+
+  wire ofree = !out_valid || out_ready;
+  assign pop = hvalid && ofree;
+  always @(posedge clk) begin
+    if (rst) begin
+      out_valid <= 1'b0;
+    end else if (ofree) begin
+      out_valid <= hvalid;
+      if (hvalid) out_pix <= {hpay[57:32], comb};
+    end
+  end
+  assign textured = pop;
+  assign idle = !v1 && !v2 && !v3 && !v4 && !v5 && (wp == rp) && !out_valid;
+endmodule

@@ -1,0 +1,391 @@
+// spigpu render core: triangle setup -> rasteriser -> attribute steppers -> depth stage ->
+// texture unit -> colour stage -> one memory request stream; plus CLEAR / CLEAR_Z.
+// docs/protocol.md sections 8-12 are the specification; the C++ simulator (backends/sim) is the
+// bit-exact reference. Interface to the soc: docs/gateware.md ("soc <-> core").
+//
+// Commands execute in order. A triangle is set up while the command waits on the port (the soc
+// holds cmd_* stable while cmd_valid && !cmd_ready); the core then copies the render state it
+// needs, accepts the command and rasterises while the soc moves on. Memory order between
+// commands is kept by draining the pixel pipeline before a draw's first request and before a
+// clear; the next triangle's setup overlaps that drain.
+module spigpu_core #(
+    parameter integer PROFILE  = 1,        // 0 up5k, 1 ecp5
+    parameter [7:0]   FEATURES = 8'h7F     // CAPS.FEATURES (bit 6: texturing)
+) (
+    input  wire         clk,
+    input  wire         rst,
+    // command port
+    input  wire         cmd_valid,
+    output wire         cmd_ready,
+    input  wire [1:0]   cmd_op,           // 0 TRIANGLE, 1 CLEAR, 2 CLEAR_Z
+    input  wire [31:0]  cmd_tri_mode,
+    input  wire [27:0]  cmd_tex_base,
+    input  wire [17:0]  cmd_tex_fmt,
+    input  wire [43:0]  cmd_scissor,      // {Y1, X1, Y0, X0}
+    input  wire [27:0]  cmd_fb_draw,
+    input  wire [27:0]  cmd_fb_z,
+    input  wire [1:0]   cmd_fb_format,
+    input  wire [10:0]  cmd_fb_width,
+    input  wire [10:0]  cmd_fb_height,
+    input  wire [31:0]  cmd_clear_color,
+    input  wire [23:0]  cmd_clear_depth,
+    input  wire [183:0] cmd_v0,
+    input  wire [183:0] cmd_v1,
+    input  wire [183:0] cmd_v2,
+    output wire         core_idle,
+    // memory port
+    output wire         mem_req_valid,
+    input  wire         mem_req_ready,
+    output wire         mem_req_we,
+    output wire [29:0]  mem_req_addr,
+    output wire [31:0]  mem_req_wdata,
+    output wire [3:0]   mem_req_be,
+    input  wire         mem_rsp_valid,
+    input  wire [31:0]  mem_rsp_rdata,
+    // counters
+    output reg  [31:0]  perf_triangles,   // triangles rasterised (non-empty after setup)
+    output reg  [31:0]  perf_pixels,      // covered pixels emitted by the rasteriser
+    output reg  [31:0]  perf_passed,      // pixels that passed the depth stage
+    output reg  [31:0]  perf_textured,    // pixels through the texture unit
+    output reg  [31:0]  perf_busy,        // cycles not idle
+    output reg  [31:0]  perf_setup,       // cycles in triangle setup
+    output reg  [31:0]  perf_raster       // cycles the rasteriser walked
+);
+  localparam F_TEXTURE = 6;
+  localparam [1:0] OP_TRI = 2'd0, OP_CLEAR = 2'd1, OP_CLEAR_Z = 2'd2;
+
+  // ---------------------------------------------------------------- command decode
+  wire [10:0] sc_x0 = cmd_scissor[10:0], sc_y0 = cmd_scissor[21:11];
+  wire [10:0] sc_x1 = cmd_scissor[32:22], sc_y1 = cmd_scissor[43:33];
+  wire [10:0] clip_x1 = (sc_x1 < cmd_fb_width) ? sc_x1 : cmd_fb_width;
+  wire [10:0] clip_y1 = (sc_y1 < cmd_fb_height) ? sc_y1 : cmd_fb_height;
+  wire        clip_empty = (clip_x1 <= sc_x0) || (clip_y1 <= sc_y0);
+
+  wire       m_gouraud = cmd_tri_mode[0];
+  wire       m_tex     = cmd_tri_mode[1] && FEATURES[F_TEXTURE];
+  wire       m_ztest   = cmd_tri_mode[2];
+  wire [2:0] m_zfunc   = cmd_tri_mode[5:3];
+  wire       m_zwrite  = cmd_tri_mode[6];
+  wire [3:0] m_keep    = cmd_tri_mode[13:10];
+  wire [3:0] stored    = (cmd_fb_format == 2'd1) ? 4'b0111 : 4'b1111;
+  wire       all_masked  = (m_keep & stored) == stored;
+  wire       some_masked = (m_keep & stored) != 4'd0;
+  wire       writes_nothing = (m_ztest && m_zfunc == 3'd0) || (all_masked && !m_zwrite);
+  wire       colour_on = !all_masked;
+  wire       tex_on = m_tex && colour_on;
+  wire [7:0] need = {{3{tex_on}}, m_ztest || m_zwrite, {4{m_gouraud && colour_on}}};
+
+  wire serial_n;
+  core_alias alias_check (
+      .clk(clk), .fb_draw16(cmd_fb_draw), .fb_z16(cmd_fb_z), .tex16(cmd_tex_base),
+      .width(cmd_fb_width), .height(cmd_fb_height), .fmt(cmd_fb_format), .tex_fmt(cmd_tex_fmt[17:16]),
+      .tex_wl(cmd_tex_fmt[3:0]), .tex_hl(cmd_tex_fmt[7:4]), .colour_on(colour_on),
+      .depth_on(m_ztest || m_zwrite), .z_write(m_zwrite), .textured(tex_on), .serial(serial_n));
+
+  // ---------------------------------------------------------------- setup
+  wire        su_busy, su_done, su_draw;
+  wire signed [35:0] su_e0, su_e1, su_e2;
+  wire signed [21:0] su_ex0, su_ex1, su_ex2, su_ey0, su_ey1, su_ey2;
+  wire [10:0] su_bx0, su_by0, su_bx1, su_by1;
+  wire [34:0] su_den;
+  wire        pl_we;
+  wire [2:0]  pl_id;
+  wire [31:0] pl_q0, pl_qx, pl_qxl, pl_qy;
+  wire [34:0] pl_r0, pl_rx, pl_rxl, pl_ry;
+  reg         su_go;
+  core_setup setup (
+      .clk(clk), .rst(rst), .start(su_go), .busy(su_busy), .done(su_done),
+      .v0(cmd_v0), .v1(cmd_v1), .v2(cmd_v2),
+      .clip_x0(sc_x0), .clip_y0(sc_y0), .clip_x1(clip_x1), .clip_y1(clip_y1), .need(need),
+      .draw(su_draw), .e0(su_e0), .e1(su_e1), .e2(su_e2), .ex0(su_ex0), .ex1(su_ex1), .ex2(su_ex2),
+      .ey0(su_ey0), .ey1(su_ey1), .ey2(su_ey2),
+      .box_x0(su_bx0), .box_y0(su_by0), .box_x1(su_bx1), .box_y1(su_by1), .den(su_den),
+      .plane_we(pl_we), .plane_id(pl_id), .pq0(pl_q0), .pqx(pl_qx), .pqxl(pl_qxl), .pqy(pl_qy),
+      .pr0(pl_r0), .prx(pl_rx), .prxl(pl_rxl), .pry(pl_ry));
+
+  // ---------------------------------------------------------------- render state of the draw
+  reg        r_gouraud, r_tex, r_ztest, r_zwrite, r_dither, r_decal, r_serial, r_need_dst;
+  reg [2:0]  r_zfunc;
+  reg [1:0]  r_blend, r_fmt;
+  reg [3:0]  r_keep;
+  reg [27:0] r_fb_draw, r_fb_z, r_tex_base;
+  reg [17:0] r_tex_fmt;
+  reg [31:0] r_flat;
+  // clear state
+  reg [27:0] k_base;
+  reg [1:0]  k_bpp;
+  reg [31:0] k_pattern;
+  reg [10:0] k_w, k_x0, k_y0, k_x1, k_y1;
+
+  // ---------------------------------------------------------------- rasteriser + steppers
+  wire        ras_active;
+  wire [1:0]  ras_op;
+  wire        ras_emit;
+  wire [10:0] ras_x, ras_y;
+  wire [21:0] ras_idx;
+  reg         ras_go;
+  wire        adv, hold;
+  core_raster raster (
+      .clk(clk), .rst(rst), .start(ras_go),
+      .e0_i(su_e0), .e1_i(su_e1), .e2_i(su_e2), .ex0_i(su_ex0), .ex1_i(su_ex1), .ex2_i(su_ex2),
+      .ey0_i(su_ey0), .ey1_i(su_ey1), .ey2_i(su_ey2),
+      .box_x0(su_bx0), .box_y0(su_by0), .box_x1(su_bx1), .box_y1(su_by1), .fb_width(cmd_fb_width),
+      .ltr(serial_n), .adv(adv), .hold(hold), .active(ras_active), .op(ras_op), .emit(ras_emit),
+      .px(ras_x), .py(ras_y), .pidx(ras_idx));
+
+  wire [7:0]  a_r, a_g, a_b, a_a;
+  wire [23:0] a_z;
+  wire [31:0] a_s, a_t, a_q;
+  genvar gi;
+  generate
+    for (gi = 0; gi < 4; gi = gi + 1) begin : colour_steppers
+      wire [7:0] qv;
+      core_stepper #(.QW(8), .RW(35)) st (
+          .clk(clk), .load(pl_we && pl_id == gi), .q0(pl_q0[7:0]), .r0(pl_r0), .qx(pl_qx[7:0]), .rx(pl_rx),
+          .qxl(pl_qxl[7:0]), .rxl(pl_rxl), .qy(pl_qy[7:0]), .ry(pl_ry), .den(su_den), .en(adv),
+          .op(ras_op), .q(qv));
+    end
+  endgenerate
+  assign a_r = colour_steppers[0].qv;
+  assign a_g = colour_steppers[1].qv;
+  assign a_b = colour_steppers[2].qv;
+  assign a_a = colour_steppers[3].qv;
+  core_stepper #(.QW(24), .RW(35)) z_stepper (
+      .clk(clk), .load(pl_we && pl_id == 3'd4), .q0(pl_q0[23:0]), .r0(pl_r0), .qx(pl_qx[23:0]), .rx(pl_rx),
+      .qxl(pl_qxl[23:0]), .rxl(pl_rxl), .qy(pl_qy[23:0]), .ry(pl_ry), .den(su_den), .en(adv),
+      .op(ras_op), .q(a_z));
+  generate
+    if (FEATURES[F_TEXTURE]) begin : tex_steppers
+      wire [31:0] qs, qt, qq;
+      core_stepper #(.QW(32), .RW(35)) s_st (
+          .clk(clk), .load(pl_we && pl_id == 3'd5), .q0(pl_q0), .r0(pl_r0), .qx(pl_qx), .rx(pl_rx),
+          .qxl(pl_qxl), .rxl(pl_rxl), .qy(pl_qy), .ry(pl_ry), .den(su_den), .en(adv), .op(ras_op), .q(qs));
+      core_stepper #(.QW(32), .RW(35)) t_st (
+          .clk(clk), .load(pl_we && pl_id == 3'd6), .q0(pl_q0), .r0(pl_r0), .qx(pl_qx), .rx(pl_rx),
+          .qxl(pl_qxl), .rxl(pl_rxl), .qy(pl_qy), .ry(pl_ry), .den(su_den), .en(adv), .op(ras_op), .q(qt));
+      core_stepper #(.QW(32), .RW(35)) q_st (
+          .clk(clk), .load(pl_we && pl_id == 3'd7), .q0(pl_q0), .r0(pl_r0), .qx(pl_qx), .rx(pl_rx),
+          .qxl(pl_qxl), .rxl(pl_rxl), .qy(pl_qy), .ry(pl_ry), .den(su_den), .en(adv), .op(ras_op), .q(qq));
+      assign a_s = qs;
+      assign a_t = qt;
+      assign a_q = qq;
+    end else begin : no_tex_steppers
+      assign a_s = 32'd0;
+      assign a_t = 32'd0;
+      assign a_q = 32'd0;
+    end
+  endgenerate
+
+  // emitted pixel record, aligned with the steppers' values
+  reg        emit2;
+  reg [10:0] x2, y2;
+  reg [21:0] idx2;
+  always @(posedge clk) begin
+    if (rst) emit2 <= 1'b0;
+    else if (ras_go) emit2 <= 1'b0;
+    else if (adv) begin
+      emit2 <= ras_emit;
+      x2    <= ras_x;
+      y2    <= ras_y;
+      idx2  <= ras_idx;
+    end
+  end
+  wire [31:0] src_rgba = r_gouraud ? {a_r, a_g, a_b, a_a} : r_flat;
+  wire [177:0] pix = {a_q, a_t, a_s, src_rgba, y2[1:0], x2[1:0], a_z, idx2};
+
+  // ---------------------------------------------------------------- depth stage
+  wire         d_in_ready, d_out_valid, d_out_ready, d_idle, d_passed;
+  wire [177:0] d_out;
+  wire         zr_valid, zr_ready, zr_rsp, zw_valid, zw_ready;
+  wire [29:0]  zr_addr, zw_addr;
+  wire [31:0]  zw_data;
+  core_depth #(.PW(178), .ZLSB(22), .AW(2)) depth (
+      .clk(clk), .rst(rst), .z_test(r_ztest), .z_func(r_zfunc), .z_write(r_zwrite), .fb_z16(r_fb_z),
+      .in_valid(emit2), .in_ready(d_in_ready), .in_pix(pix),
+      .out_valid(d_out_valid), .out_ready(d_out_ready), .out_pix(d_out),
+      .rd_valid(zr_valid), .rd_ready(zr_ready), .rd_addr(zr_addr), .rsp_valid(zr_rsp), .rsp_data(mem_rsp_rdata),
+      .wr_valid(zw_valid), .wr_ready(zw_ready), .wr_addr(zw_addr), .wr_data(zw_data), .idle(d_idle),
+      .passed(d_passed));
+
+  // ---------------------------------------------------------------- texture unit
+  wire        c_in_valid, c_in_ready;
+  wire [57:0] c_in;
+  wire        tr_valid, tr_ready, tr_rsp;
+  wire [29:0] tr_addr;
+  wire        t_idle, t_count;
+  reg         colour_on_r;
+  generate
+    if (FEATURES[F_TEXTURE]) begin : texturing
+      wire        t_in_ready, t_out_valid;
+      wire [57:0] t_out;
+      core_texture #(.AW(2)) texture (
+          .clk(clk), .rst(rst), .tex16(r_tex_base), .wl(r_tex_fmt[3:0]), .hl(r_tex_fmt[7:4]),
+          .wrap_s(r_tex_fmt[9:8]), .wrap_t(r_tex_fmt[11:10]), .bilinear(r_tex_fmt[12] && FEATURES[0]),
+          .tfmt(r_tex_fmt[17:16]), .decal(r_decal),
+          .in_valid(d_out_valid && r_tex), .in_ready(t_in_ready), .in_pix(d_out),
+          .out_valid(t_out_valid), .out_ready(c_in_ready), .out_pix(t_out),
+          .rd_valid(tr_valid), .rd_ready(tr_ready), .rd_addr(tr_addr), .rsp_valid(tr_rsp),
+          .rsp_data(mem_rsp_rdata), .idle(t_idle), .textured(t_count));
+      assign c_in_valid  = r_tex ? t_out_valid : (d_out_valid && colour_on_r);
+      assign d_out_ready = r_tex ? t_in_ready : (colour_on_r ? c_in_ready : 1'b1);
+      assign c_in        = r_tex ? t_out : {d_out[49:46], d_out[21:0], d_out[81:50]};
+    end else begin : no_texturing
+      assign c_in_valid  = d_out_valid && colour_on_r;
+      assign d_out_ready = colour_on_r ? c_in_ready : 1'b1;
+      assign c_in        = {d_out[49:46], d_out[21:0], d_out[81:50]};
+      assign tr_valid    = 1'b0;
+      assign tr_addr     = 30'd0;
+      assign t_idle      = 1'b1;
+      assign t_count     = 1'b0;
+    end
+  endgenerate
+
+  // ---------------------------------------------------------------- colour stage
+  wire        cr_valid, cr_ready, cr_rsp, cw_valid, cw_ready, c_idle;
+  wire [29:0] cr_addr, cw_addr;
+  wire [31:0] cw_data;
+  wire [3:0]  cw_be;
+  core_color #(.AW(2), .FEATURES(FEATURES)) colour (
+      .clk(clk), .rst(rst), .fmt(r_fmt), .fb_draw16(r_fb_draw), .blend(r_blend), .dither(r_dither),
+      .keep(r_keep), .need_dst(r_need_dst),
+      .in_valid(c_in_valid), .in_ready(c_in_ready), .in_pix(c_in),
+      .rd_valid(cr_valid), .rd_ready(cr_ready), .rd_addr(cr_addr), .rsp_valid(cr_rsp), .rsp_data(mem_rsp_rdata),
+      .wr_valid(cw_valid), .wr_ready(cw_ready), .wr_addr(cw_addr), .wr_data(cw_data), .wr_be(cw_be),
+      .idle(c_idle));
+
+  // ---------------------------------------------------------------- clears
+  wire        k_busy, k_valid, k_ready;
+  wire [29:0] k_addr;
+  wire [31:0] k_data;
+  wire [3:0]  k_be;
+  reg         k_go;
+  core_clear clear (
+      .clk(clk), .rst(rst), .start(k_go), .base16(k_base), .bpp_log2(k_bpp), .pattern(k_pattern),
+      .width(k_w), .x0(k_x0), .y0(k_y0), .x1(k_x1), .y1(k_y1), .busy(k_busy),
+      .wr_valid(k_valid), .wr_ready(k_ready), .wr_addr(k_addr), .wr_data(k_data), .wr_be(k_be));
+
+  // ---------------------------------------------------------------- memory port
+  wire m_idle, m_pending;
+  wire pipe_idle = !ras_active && ras_op == 2'd0 && !ras_emit && !emit2;
+  wire stages_idle = d_idle && t_idle && c_idle;
+  wire drained = pipe_idle && stages_idle && m_idle && !k_busy;
+  core_memport #(.TAGS_AW(3), .COMBINE(1)) memport (
+      .clk(clk), .rst(rst), .flush(!ras_active || r_serial),
+      .clr_valid(k_valid), .clr_ready(k_ready), .clr_addr(k_addr), .clr_data(k_data), .clr_be(k_be),
+      .cw_valid(cw_valid), .cw_ready(cw_ready), .cw_addr(cw_addr), .cw_data(cw_data), .cw_be(cw_be),
+      .cr_valid(cr_valid), .cr_ready(cr_ready), .cr_addr(cr_addr), .cr_rsp(cr_rsp),
+      .tr_valid(tr_valid), .tr_ready(tr_ready), .tr_addr(tr_addr), .tr_rsp(tr_rsp),
+      .zw_valid(zw_valid), .zw_ready(zw_ready), .zw_addr(zw_addr), .zw_data(zw_data),
+      .zr_valid(zr_valid), .zr_ready(zr_ready), .zr_addr(zr_addr), .zr_rsp(zr_rsp),
+      .mem_req_valid(mem_req_valid), .mem_req_ready(mem_req_ready), .mem_req_we(mem_req_we),
+      .mem_req_addr(mem_req_addr), .mem_req_wdata(mem_req_wdata), .mem_req_be(mem_req_be),
+      .mem_rsp_valid(mem_rsp_valid), .idle(m_idle), .pending_write(m_pending));
+
+  // the raster pipeline advances unless an emitted pixel waits; in serial mode the rasteriser
+  // moves only when every earlier pixel has left the core
+  assign adv  = !emit2 || d_in_ready;
+  assign hold = r_serial && (ras_emit || emit2 || !stages_idle || !m_idle);
+
+  // ---------------------------------------------------------------- command sequencer
+  localparam [1:0] C_IDLE = 2'd0, C_SETUP = 2'd1, C_DRAIN = 2'd2;
+  reg [1:0] cst;
+  reg       accept;
+  assign cmd_ready = accept;
+
+  // clear values, truncated to the format (section 12)
+  wire [31:0] cc = cmd_clear_color;
+  wire [15:0] c565 = {cc[31:27], cc[23:18], cc[15:11]};
+  wire [7:0]  c2222 = {cc[31:30], cc[23:22], cc[15:14], cc[7:6]};
+  wire [31:0] cpat = (cmd_fb_format == 2'd1) ? {2{c565}} : (cmd_fb_format == 2'd2) ? {4{c2222}} : cc;
+
+  always @(posedge clk) begin
+    accept <= 1'b0;
+    su_go  <= 1'b0;
+    ras_go <= 1'b0;
+    k_go   <= 1'b0;
+    if (rst) begin
+      cst <= C_IDLE;
+      colour_on_r <= 1'b1;
+      r_serial <= 1'b0;
+    end else begin
+      case (cst)
+        C_IDLE: if (cmd_valid && !accept) begin
+          if (cmd_op == OP_TRI) begin
+            if (writes_nothing || clip_empty) begin
+              accept <= 1'b1;  // draws nothing, touches no memory
+            end else if (pipe_idle && !su_busy) begin
+              su_go <= 1'b1;
+              cst   <= C_SETUP;
+            end
+          end else begin
+            // CLEAR / CLEAR_Z after every earlier pixel is written
+            if (clip_empty || cmd_op == 2'd3) begin
+              accept <= 1'b1;
+            end else if (drained && !su_busy) begin
+              accept    <= 1'b1;
+              k_go      <= 1'b1;
+              k_base    <= (cmd_op == OP_CLEAR) ? cmd_fb_draw : cmd_fb_z;
+              k_bpp     <= (cmd_op == OP_CLEAR_Z || cmd_fb_format == 2'd0) ? 2'd2 :
+                           (cmd_fb_format == 2'd1) ? 2'd1 : 2'd0;
+              k_pattern <= (cmd_op == OP_CLEAR) ? cpat : {8'd0, cmd_clear_depth};
+              k_w       <= cmd_fb_width;
+              k_x0      <= sc_x0;
+              k_y0      <= sc_y0;
+              k_x1      <= clip_x1;
+              k_y1      <= clip_y1;
+            end
+          end
+        end
+        C_SETUP: if (su_done) cst <= su_draw ? C_DRAIN : C_IDLE;
+                 else if (!su_busy && !su_go) cst <= C_SETUP;
+        default: if (drained) begin  // C_DRAIN
+          accept      <= 1'b1;
+          ras_go      <= 1'b1;
+          cst         <= C_IDLE;
+          r_gouraud   <= m_gouraud;
+          r_tex       <= tex_on;
+          r_ztest     <= m_ztest;
+          r_zfunc     <= m_zfunc;
+          r_zwrite    <= m_zwrite;
+          r_blend     <= cmd_tri_mode[8:7];
+          r_dither    <= cmd_tri_mode[9];
+          r_keep      <= m_keep;
+          r_decal     <= cmd_tri_mode[14];
+          r_fmt       <= cmd_fb_format;
+          r_fb_draw   <= cmd_fb_draw;
+          r_fb_z      <= cmd_fb_z;
+          r_tex_base  <= cmd_tex_base;
+          r_tex_fmt   <= cmd_tex_fmt;
+          r_flat      <= cmd_v0[87:56];
+          r_serial    <= serial_n;
+          r_need_dst  <= (cmd_tri_mode[8:7] != 2'd0) || (some_masked && !all_masked && cmd_fb_format != 2'd0);
+          colour_on_r <= colour_on;
+        end
+      endcase
+      if (cst == C_SETUP && su_done && !su_draw) accept <= 1'b1;
+    end
+  end
+
+  assign core_idle = (cst == C_IDLE) && !cmd_valid && !accept && !su_busy && drained && !k_go && !ras_go;
+
+  // ---------------------------------------------------------------- counters
+  always @(posedge clk) begin
+    if (rst) begin
+      perf_triangles <= 32'd0;
+      perf_pixels    <= 32'd0;
+      perf_passed    <= 32'd0;
+      perf_textured  <= 32'd0;
+      perf_busy      <= 32'd0;
+      perf_setup     <= 32'd0;
+      perf_raster    <= 32'd0;
+    end else begin
+      if (su_done && su_draw) perf_triangles <= perf_triangles + 32'd1;
+      if (emit2 && d_in_ready) perf_pixels <= perf_pixels + 32'd1;
+      if (d_passed) perf_passed <= perf_passed + 32'd1;
+      if (t_count) perf_textured <= perf_textured + 32'd1;
+      if (!core_idle) perf_busy <= perf_busy + 32'd1;
+      if (su_busy) perf_setup <= perf_setup + 32'd1;
+      if (ras_active) perf_raster <= perf_raster + 32'd1;
+    end
+  end
+endmodule
