@@ -47,10 +47,20 @@ module spigpu_top #(
   output wire [31:0] perf_frames,
   output wire [31:0] perf_core_stalls,
   output wire [31:0] perf_refreshes,
-  output wire [31:0] perf_core_busy
+  // render core counters (gw-core's set, docs/gateware.md)
+  output wire [31:0] perf_triangles,
+  output wire [31:0] perf_pixels,
+  output wire [31:0] perf_passed,
+  output wire [31:0] perf_textured,
+  output wire [31:0] perf_core_busy,
+  output wire [31:0] perf_setup,
+  output wire [31:0] perf_raster
 );
-  // CAPS.FEATURES: bit 0 bilinear, 1 blend, 2 dither, 3 strict link, 4 RGB565, 5 RGBA2222
+  // CAPS.FEATURES: bit 0 bilinear, 1 blend, 2 dither, 3 strict link, 4 RGB565, 5 RGBA2222.
+  // The core's FEATURES bit 6 builds its texture unit; protocol v1.0 has no CAPS bit for a device
+  // without one, so every profile has it (a profile without texturing needs that bit first).
   localparam [7:0]  FEATURES   = PROFILE == 0 ? 8'h3C : 8'h3F;
+  localparam [7:0]  CORE_FEATURES = FEATURES | 8'h40;
   localparam        MAX_WIDTH  = PROFILE == 0 ? 320 : 1024;
   localparam        MAX_HEIGHT = PROFILE == 0 ? 240 : 768;
   localparam        FIFO_DEPTH = PROFILE == 0 ? 64 : 1023;
@@ -96,9 +106,7 @@ module spigpu_top #(
     .perf_work_cycles(perf_work_cycles), .perf_cmds(perf_cmds), .perf_frames(perf_frames),
     .perf_core_stalls(perf_core_stalls), .perf_refreshes(perf_refreshes));
 
-  spigpu_core #(
-    .PROFILE(PROFILE), .FEATURES(FEATURES), .MAX_WIDTH(MAX_WIDTH), .MAX_HEIGHT(MAX_HEIGHT)
-  ) u_core (
+  spigpu_core #(.PROFILE(PROFILE), .FEATURES(CORE_FEATURES)) u_core (
     .clk(clk), .rst(rst), .cmd_valid(cmd_valid), .cmd_ready(cmd_ready), .cmd_op(cmd_op),
     .cmd_tri_mode(cmd_tri_mode), .cmd_tex_base(cmd_tex_base), .cmd_tex_fmt(cmd_tex_fmt), .cmd_scissor(cmd_scissor),
     .cmd_fb_draw(cmd_fb_draw), .cmd_fb_z(cmd_fb_z), .cmd_fb_format(cmd_fb_format), .cmd_fb_width(cmd_fb_width),
@@ -106,5 +114,7 @@ module spigpu_top #(
     .cmd_v0(cmd_v0), .cmd_v1(cmd_v1), .cmd_v2(cmd_v2), .core_idle(core_idle), .mem_req_valid(mem_req_valid),
     .mem_req_ready(mem_req_ready), .mem_req_we(mem_req_we), .mem_req_addr(mem_req_addr),
     .mem_req_wdata(mem_req_wdata), .mem_req_be(mem_req_be), .mem_rsp_valid(mem_rsp_valid),
-    .mem_rsp_rdata(mem_rsp_rdata), .perf_busy_cycles(perf_core_busy));
+    .mem_rsp_rdata(mem_rsp_rdata), .perf_triangles(perf_triangles), .perf_pixels(perf_pixels),
+    .perf_passed(perf_passed), .perf_textured(perf_textured), .perf_busy(perf_core_busy), .perf_setup(perf_setup),
+    .perf_raster(perf_raster));
 endmodule

@@ -32,7 +32,13 @@ module spigpu_sim #(
   output wire [31:0] perf_frames,
   output wire [31:0] perf_core_stalls,
   output wire [31:0] perf_refreshes,
+  output wire [31:0] perf_triangles,
+  output wire [31:0] perf_pixels,
+  output wire [31:0] perf_passed,
+  output wire [31:0] perf_textured,
   output wire [31:0] perf_core_busy,
+  output wire [31:0] perf_setup,
+  output wire [31:0] perf_raster,
   output wire [31:0] sdram_violations
 );
   wire        sd_cke, sd_cs_n, sd_ras_n, sd_cas_n, sd_we_n, sd_dq_oe;
@@ -50,7 +56,9 @@ module spigpu_sim #(
     .frame_word(frame_word), .frame_nbytes(frame_nbytes), .frame_start(frame_start), .frame_end(frame_end),
     .frame_format(frame_format), .frame_width(frame_width), .frame_height(frame_height), .perf_cycles(perf_cycles),
     .perf_work_cycles(perf_work_cycles), .perf_cmds(perf_cmds), .perf_frames(perf_frames),
-    .perf_core_stalls(perf_core_stalls), .perf_refreshes(perf_refreshes), .perf_core_busy(perf_core_busy));
+    .perf_core_stalls(perf_core_stalls), .perf_refreshes(perf_refreshes), .perf_triangles(perf_triangles),
+    .perf_pixels(perf_pixels), .perf_passed(perf_passed), .perf_textured(perf_textured),
+    .perf_core_busy(perf_core_busy), .perf_setup(perf_setup), .perf_raster(perf_raster));
 
   generate
     if (PROFILE == 1) begin : g_sdram

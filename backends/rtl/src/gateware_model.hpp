@@ -18,7 +18,8 @@ struct ModelFrame {
 };
 
 struct ModelCounters {
-  std::uint32_t work_cycles = 0, cmds = 0, frames = 0, core_stalls = 0, refreshes = 0, core_busy = 0, sdram_violations = 0;
+  std::uint32_t work_cycles = 0, cmds = 0, frames = 0, core_stalls = 0, refreshes = 0, sdram_violations = 0;
+  std::uint32_t triangles = 0, pixels = 0, passed = 0, textured = 0, core_busy = 0, setup = 0, raster = 0;
 };
 
 class GatewareModel {

@@ -58,8 +58,14 @@ class ModelImpl : public GatewareModel {
     c.frames = m_->perf_frames;
     c.core_stalls = m_->perf_core_stalls;
     c.refreshes = m_->perf_refreshes;
-    c.core_busy = m_->perf_core_busy;
     c.sdram_violations = m_->sdram_violations;
+    c.triangles = m_->perf_triangles;
+    c.pixels = m_->perf_pixels;
+    c.passed = m_->perf_passed;
+    c.textured = m_->perf_textured;
+    c.core_busy = m_->perf_core_busy;
+    c.setup = m_->perf_setup;
+    c.raster = m_->perf_raster;
     return c;
   }
 

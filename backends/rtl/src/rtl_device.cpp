@@ -82,8 +82,14 @@ struct RtlDevice::Impl {
     acc.spi_frames += std::uint32_t(c.frames - last_raw.frames);
     acc.core_mem_stalls += std::uint32_t(c.core_stalls - last_raw.core_stalls);
     acc.refreshes += std::uint32_t(c.refreshes - last_raw.refreshes);
-    acc.core_busy_cycles += std::uint32_t(c.core_busy - last_raw.core_busy);
     acc.sdram_violations += std::uint32_t(c.sdram_violations - last_raw.sdram_violations);
+    acc.triangles += std::uint32_t(c.triangles - last_raw.triangles);
+    acc.pixels += std::uint32_t(c.pixels - last_raw.pixels);
+    acc.passed += std::uint32_t(c.passed - last_raw.passed);
+    acc.textured += std::uint32_t(c.textured - last_raw.textured);
+    acc.core_busy_cycles += std::uint32_t(c.core_busy - last_raw.core_busy);
+    acc.setup_cycles += std::uint32_t(c.setup - last_raw.setup);
+    acc.raster_cycles += std::uint32_t(c.raster - last_raw.raster);
     last_raw = c;
   }
 

@@ -300,6 +300,14 @@ Result<BoardProfile> parse_board_profile(std::string_view text, const std::strin
     GPUBRIDGE_TRY_SET(p.strict_link, l.boolean("strict", true));
     if (auto r = l.no_unknown_keys(); !r) return r.error();
   }
+  if (const json* gw = top.get("gateware")) {
+    if (!gw->is_object()) return top.fail("gateware", "expected an object");
+    Reader g(*gw, file, "gateware.");
+    GPUBRIDGE_TRY_SET(p.gateware, g.str("profile"));
+    if (p.gateware != "up5k" && p.gateware != "ecp5") return g.fail("profile", "expected \"up5k\" or \"ecp5\"");
+    GPUBRIDGE_TRY_SET(p.miso_delay_ns, g.uint("miso_delay_ns", 0, 1000, 20));
+    if (auto r = g.no_unknown_keys(); !r) return r.error();
+  }
   if (auto r = top.no_unknown_keys(); !r) return r.error();
   return p;
 }

@@ -41,8 +41,15 @@ struct RtlCounters {
   std::uint64_t work_cycles = 0;       // clocks with a released command, the core or MEM_* working
   std::uint64_t commands = 0;          // FIFO entries executed
   std::uint64_t spi_frames = 0;        // SPI frames completed
-  std::uint64_t core_busy_cycles = 0;  // the render core's own busy counter
   std::uint64_t core_mem_stalls = 0;   // clocks a core memory request waited
+  // the render core's counters (gateware/rtl/core/spigpu_core.v)
+  std::uint64_t triangles = 0;         // triangles rasterised (non-empty after setup)
+  std::uint64_t pixels = 0;            // covered pixels emitted by the rasteriser
+  std::uint64_t passed = 0;            // pixels that passed the depth stage
+  std::uint64_t textured = 0;          // pixels through the texture unit
+  std::uint64_t core_busy_cycles = 0;  // clocks the core was not idle
+  std::uint64_t setup_cycles = 0;      // clocks in triangle setup
+  std::uint64_t raster_cycles = 0;     // clocks the rasteriser walked
   std::uint64_t refreshes = 0;         // SDRAM auto refreshes
   std::uint64_t sdram_violations = 0;  // timing violations seen by the SDRAM model (must stay 0)
   std::uint64_t sck_edges_too_fast = 0;  // SCK half periods shorter than a core clock (pins outside spec)

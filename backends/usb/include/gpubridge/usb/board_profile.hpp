@@ -39,6 +39,11 @@ struct BoardProfile {
   unsigned clock_mhz = 50;    // core clock of the design, for the timing model (not sent anywhere)
   bool strict_link = true;
   ScanoutMode scanout = ScanoutMode::Readback;
+  // The gateware this board runs (gateware/, docs/gateware.md): its profile ("up5k", "ecp5"; empty
+  // when the profile names none) and the MISO timing the co-simulation (backend rtl:BOARD) applies:
+  // the device's clock-to-pad plus wiring plus the bridge's input setup time.
+  std::string gateware;
+  unsigned miso_delay_ns = 20;
 };
 
 struct CableInfo {

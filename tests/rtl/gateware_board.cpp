@@ -1,0 +1,117 @@
+#include "gateware_board.hpp"
+
+#include <fmt/format.h>
+
+#include "gpubridge/protocol/crc32.hpp"
+
+namespace gpubridge::test {
+
+using protocol::Reg;
+using protocol::index_of;
+
+sim::DeviceOptions sim_options_for(const rtl::GatewareCaps& c) {
+  sim::DeviceOptions o;
+  o.vram_bytes = std::uint64_t{c.vram_kib} * 1024;
+  o.max_width = c.max_width;
+  o.max_height = c.max_height;
+  o.fifo_depth = c.fifo_depth;
+  o.features = c.features;
+  o.variant = c.variant;
+  return o;
+}
+
+usb::BoardProfile board_profile(const std::string& name) {
+  auto p = usb::find_board_profile(GPUBRIDGE_CONFIG_DIR, name);
+  if (!p) throw std::runtime_error(p.error().message);
+  return *p;
+}
+
+usb::BoardProfile with_gateware(usb::BoardProfile p, const std::string& gateware, std::uint32_t spi_clock_hz) {
+  p.gateware = gateware;
+  p.spi_clock_hz = spi_clock_hz;
+  const auto caps = rtl::caps_of(*rtl::parse_gateware_profile(gateware));
+  p.vram_kib = caps.vram_kib;
+  p.max_width = caps.max_width;
+  p.max_height = caps.max_height;
+  p.fifo_depth = caps.fifo_depth;
+  return p;
+}
+
+Result<std::unique_ptr<GatewareBoard>> GatewareBoard::open(const usb::BoardProfile& profile, usb::BoardOptions opts) {
+  std::unique_ptr<GatewareBoard> g(new GatewareBoard);
+  const auto gp = rtl::parse_gateware_profile(profile.gateware);
+  if (!gp) return make_error("profile " + profile.name + " names no gateware");
+  auto s = sim::Device::create(sim_options_for(rtl::caps_of(*gp)));
+  if (!s) return s.error();
+  g->sim_ = std::move(*s);
+  g->sim_->set_scanout_callback([raw = g.get()](std::shared_ptr<const backends::ScanoutFrame> f) { raw->sim_frames_.push_back(*f); });
+  g->sim_pins_ = std::make_unique<usb::emu::SpiSlave>(*g->sim_, nullptr, nullptr);
+  // The stack must exist before the backend attaches (attach already talks to the device), so the
+  // shadow is connected through a stack opened first and a backend attached to it afterwards.
+  usb::emu::EmulationOptions eo;
+  eo.gateware = true;
+  auto stack = usb::emu::EmulatedStack::create(profile, eo);
+  if (!stack) return stack.error();
+  std::shared_ptr<usb::emu::EmulatedStack> shared = std::move(*stack);
+  GatewareBoard* raw = g.get();
+  shared->set_gateware_shadow(g->sim_pins_.get(), [raw](std::uint8_t index, std::uint64_t gw, std::uint64_t other) {
+    // registers whose value does not depend on when the read happens
+    const bool stable = index == index_of(Reg::ID) || index == index_of(Reg::CAPS) || index == index_of(Reg::HOST_TAG) ||
+                        index == index_of(Reg::LINK_STATUS);
+    if (!stable) return;
+    ++raw->reads_compared_;
+    if (gw != other && raw->read_mismatches_.size() < 8)
+      raw->read_mismatches_.push_back(fmt::format("read of 0x{:02X}: gateware 0x{:016X}, simulator 0x{:016X}", index, gw, other));
+  });
+  shared->gateware()->set_frame_callback([raw](const rtl::ScanFrame& f) { raw->gw_frames_.push_back(f); });
+  auto bridge = usb::emu::open_bridge(profile, shared->usb(), shared->hid());
+  if (!bridge) return bridge.error();
+  auto backend = usb::BoardBackend::attach(profile, shared, std::move(*bridge), opts);
+  if (!backend) return backend.error();
+  (*backend)->set_scanout_callback([raw](std::shared_ptr<const backends::ScanoutFrame> f) { raw->board_frames_.push_back(f); });
+  g->board_ = usb::emu::EmulatedBoard{shared, std::move(*backend)};
+  return g;
+}
+
+std::string GatewareBoard::compare(bool errors_too) {
+  std::string out;
+  if (auto r = board_.backend->flush(); !r) out += "flush: " + r.error().message + "\n";
+  for (const auto& m : read_mismatches_) out += m + "\n";
+  // video memory
+  const auto gw = gateware().vram();
+  const auto sm = sim_->memory();
+  std::size_t diffs = 0;
+  for (std::size_t i = 0; i < gw.size() && i < sm.size(); ++i) {
+    if (gw[i] == sm[i]) continue;
+    if (diffs++ < 4) out += fmt::format("VRAM byte 0x{:X}: gateware 0x{:02X}, simulator 0x{:02X}\n", i, gw[i], sm[i]);
+  }
+  if (diffs) out += fmt::format("VRAM: {} bytes differ\n", diffs);
+  // frames: the gateware's scanout and the board's reports, swap by swap
+  if (gw_frames_.size() != sim_frames_.size())
+    out += fmt::format("gateware scanned out {} frames, simulator {}\n", gw_frames_.size(), sim_frames_.size());
+  for (std::size_t i = 0; i < gw_frames_.size() && i < sim_frames_.size(); ++i) {
+    const auto& a = gw_frames_[i];
+    const auto& b = sim_frames_[i];
+    if (a.width != b.width || a.height != b.height || a.format != b.format || a.bytes != b.pixels)
+      out += fmt::format("frame {}: gateware {}x{} fmt {} crc {:08X}, simulator {}x{} fmt {} crc {:08X}\n", i + 1, a.width,
+                         a.height, int(a.format), protocol::crc32(a.bytes), b.width, b.height, int(b.format), b.crc);
+  }
+  for (std::size_t i = 0; i < board_frames_.size() && i < sim_frames_.size(); ++i) {
+    const auto& a = *board_frames_[i];
+    if (a.crc != sim_frames_[i].crc || (!a.pixels.empty() && a.pixels != sim_frames_[i].pixels))
+      out += fmt::format("board frame {}: FRAME_CRC {:08X}, simulator {:08X}\n", i + 1, a.crc, sim_frames_[i].crc);
+  }
+  if (board_frames_.size() > sim_frames_.size()) out += "the board reported more frames than the simulator swapped\n";
+  if (errors_too) {
+    auto st = board_.backend->read_register(index_of(Reg::STATUS));
+    if (!st) out += "STATUS read: " + st.error().message + "\n";
+    else if ((*st >> 48) != sim_->errors())
+      out += fmt::format("STATUS.ERRORS: gateware {}, simulator {}\n", protocol::describe_errors(std::uint16_t(*st >> 48)),
+                         protocol::describe_errors(sim_->errors()));
+  }
+  const auto c = gateware().counters();
+  if (c.sdram_violations) out += fmt::format("{} SDRAM timing violations\n", c.sdram_violations);
+  return out;
+}
+
+}  // namespace gpubridge::test

@@ -1,0 +1,55 @@
+#pragma once
+// A gateware board on the test bench: the full bridge path (driver -> libusb/hidapi-shaped
+// transport -> byte-exact chip model -> SPI pins -> Verilated gateware) and, on the same wires, the
+// simulator behind the C++ SPI-slave model configured with the gateware's CAPS. Both devices see
+// every CS edge and MOSI bit (bit errors included); afterwards their video memory, scanned-out frames,
+// error flags and every timing-independent register read must agree.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "gpubridge/rtl/rtl_device.hpp"
+#include "gpubridge/sim/device.hpp"
+#include "gpubridge/usb/board_profile.hpp"
+#include "gpubridge/usb/emu/emulated_stack.hpp"
+#include "gpubridge/usb/emu/spi_slave.hpp"
+
+namespace gpubridge::test {
+
+sim::DeviceOptions sim_options_for(const rtl::GatewareCaps& c);
+
+// The board profile a test uses: a profile from configs/boards, or a generic one given a gateware.
+usb::BoardProfile board_profile(const std::string& name);
+usb::BoardProfile with_gateware(usb::BoardProfile p, const std::string& gateware, std::uint32_t spi_clock_hz);
+
+class GatewareBoard {
+ public:
+  static Result<std::unique_ptr<GatewareBoard>> open(const usb::BoardProfile& profile, usb::BoardOptions opts = {});
+
+  backends::Backend& backend() { return *board_.backend; }
+  usb::BoardBackend& board() { return *board_.backend; }
+  usb::emu::EmulatedStack& stack() { return *board_.stack; }
+  rtl::RtlDevice& gateware() { return *stack().gateware(); }
+  sim::Device& sim() { return *sim_; }
+
+  // Empty when equal: video memory byte for byte, every frame the gateware scanned out against the
+  // simulator's frame of the same swap, the frames the board backend reported (CRC, and pixels when
+  // it read them back), the register reads compared on the wires, and STATUS.ERRORS (read through the
+  // board, compared with the simulator's flags).
+  std::string compare(bool errors_too = true);
+  const std::vector<rtl::ScanFrame>& gateware_frames() const { return gw_frames_; }
+  std::size_t reads_compared() const { return reads_compared_; }
+
+ private:
+  GatewareBoard() = default;
+  usb::emu::EmulatedBoard board_;
+  std::unique_ptr<sim::Device> sim_;
+  std::unique_ptr<usb::emu::SpiSlave> sim_pins_;
+  std::vector<rtl::ScanFrame> gw_frames_;
+  std::vector<backends::ScanoutFrame> sim_frames_;
+  std::vector<std::shared_ptr<const backends::ScanoutFrame>> board_frames_;
+  std::vector<std::string> read_mismatches_;
+  std::size_t reads_compared_ = 0;
+};
+
+}  // namespace gpubridge::test
