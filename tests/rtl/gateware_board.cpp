@@ -55,6 +55,7 @@ Result<std::unique_ptr<GatewareBoard>> GatewareBoard::open(const usb::BoardProfi
   std::shared_ptr<usb::emu::EmulatedStack> shared = std::move(*stack);
   GatewareBoard* raw = g.get();
   shared->set_gateware_shadow(g->sim_pins_.get(), [raw](std::uint8_t index, std::uint64_t gw, std::uint64_t other) {
+    raw->shadow_reads_[index & 0x7F] = other;
     // registers whose value does not depend on when the read happens
     const bool stable = index == index_of(Reg::ID) || index == index_of(Reg::CAPS) || index == index_of(Reg::HOST_TAG) ||
                         index == index_of(Reg::LINK_STATUS);

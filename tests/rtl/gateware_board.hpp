@@ -4,6 +4,7 @@
 // simulator behind the C++ SPI-slave model configured with the gateware's CAPS. Both devices see
 // every CS edge and MOSI bit (bit errors included); afterwards their video memory, scanned-out frames,
 // error flags and every timing-independent register read must agree.
+#include <array>
 #include <memory>
 #include <string>
 #include <vector>
@@ -39,6 +40,8 @@ class GatewareBoard {
   std::string compare(bool errors_too = true);
   const std::vector<rtl::ScanFrame>& gateware_frames() const { return gw_frames_; }
   std::size_t reads_compared() const { return reads_compared_; }
+  // What the simulator answered to the last read of `index` on the wires.
+  std::uint64_t last_shadow_read(std::uint8_t index) const { return shadow_reads_[index & 0x7F]; }
 
  private:
   GatewareBoard() = default;
@@ -50,6 +53,7 @@ class GatewareBoard {
   std::vector<std::shared_ptr<const backends::ScanoutFrame>> board_frames_;
   std::vector<std::string> read_mismatches_;
   std::size_t reads_compared_ = 0;
+  std::array<std::uint64_t, 128> shadow_reads_{};
 };
 
 }  // namespace gpubridge::test
