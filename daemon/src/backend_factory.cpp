@@ -8,10 +8,12 @@
 #include "gpubridge/common/log.hpp"
 #include "gpubridge/dmc1/dmc1_backend.hpp"
 #include "gpubridge/dmc1/serial_link.hpp"
+#include "gpubridge/rtl/rtl_device.hpp"
 #include "gpubridge/daemon/test_backends.hpp"
 #include "gpubridge/sim/sim_backend.hpp"
 #include "gpubridge/usb/board_factory.hpp"
 #include "gpubridge/usb/board_profile.hpp"
+#include "gpubridge/usb/emu/rtl_pins.hpp"
 #include "gpubridge/usb/hotplug_monitor.hpp"
 #include "gpubridge/usb/usb_tty.hpp"
 
@@ -83,26 +85,38 @@ Result<usb::BoardProfile> named_profile(const std::string& backend, const std::s
   return profile;
 }
 
-Result<BackendPtr> open_board(const usb::BoardProfile& profile, bool emulate, const std::string& presence_file = {}) {
+// What sits behind the board's driver: the real adapter, its bridge chip's model driving the
+// simulator, or its bridge chip's model driving the board's Verilated gateware (rtl:BOARD).
+enum class Attach { Real, Emulated, Gateware };
+
+std::string_view attach_note(Attach a) {
+  return a == Attach::Gateware ? ", gateware co-simulated" : a == Attach::Emulated ? ", emulated" : "";
+}
+
+Result<BackendPtr> open_board(const usb::BoardProfile& profile, Attach attach, const std::string& presence_file = {}) {
   usb::BoardOpenOptions opts;
-  opts.emulate = emulate;
+  opts.emulate = attach != Attach::Real;
   opts.emulated_presence_file = presence_file;
+  if (attach == Attach::Gateware) opts.emulated_pins = usb::emu::rtl_pins();
   auto board = usb::open_board(profile, opts);
   if (!board) {
     std::string msg = "board \"" + profile.name + "\" (" + std::string(usb::to_string(profile.chip)) + ")" +
-                      (emulate ? " (emulated)" : "") + ": " + board.error().message;
-    if (!emulate)
+                      (attach == Attach::Gateware ? " (gateware co-simulation)" : attach == Attach::Emulated ? " (emulated)" : "") +
+                      ": " + board.error().message;
+    if (attach == Attach::Real)
       msg += "; or run without it: --backend sim (simulator) or --backend emulated:" + profile.name +
              " (this board's driver against an emulated bridge)";
     return make_error(msg, board.error().code);
   }
-  logger("daemon")->info("backend: board {} ({}){}", profile.name, usb::to_string(profile.chip), emulate ? ", emulated" : "");
+  logger("daemon")->info("backend: board {} ({}){}", profile.name, usb::to_string(profile.chip), attach_note(attach));
   return BackendPtr(std::move(*board));
 }
 
-std::string describe_board(const usb::BoardProfile& profile, bool emulated, const DaemonConfig& cfg) {
-  return "board " + profile.name + " (" + std::string(usb::to_string(profile.chip)) + (emulated ? ", emulated" : "") +
-         ") from " + profile.file.string() + (cfg.mirror ? ", mirrored by the simulator" : "");
+std::string describe_board(const usb::BoardProfile& profile, Attach attach, const DaemonConfig& cfg) {
+  const std::string gateware = attach == Attach::Gateware ? ", gateware " + profile.gateware + " co-simulated" : "";
+  return "board " + profile.name + " (" + std::string(usb::to_string(profile.chip)) +
+         (attach == Attach::Emulated ? ", emulated" : "") + gateware + ") from " + profile.file.string() +
+         (cfg.mirror ? ", mirrored by the simulator" : "");
 }
 
 // The first board whose real bridge opens and attaches; nullptr when none does. Profiles whose
@@ -186,12 +200,35 @@ Result<BackendPtr> open_emulated(std::string_view spec, const DaemonConfig& cfg)
   if (!s) return s.error();
   auto profile = named_profile("emulated:" + s->profile, s->profile, cfg);
   if (!profile) return profile.error();
-  return open_board(*profile, true, s->presence_file);
+  return open_board(*profile, Attach::Emulated, s->presence_file);
 }
 Result<std::string> describe_emulated(std::string_view spec, const DaemonConfig& cfg) {
   auto profiles = profiles_emulated(spec, cfg);
   if (!profiles) return profiles.error();
-  return describe_board(profiles->front(), true, cfg);
+  return describe_board(profiles->front(), Attach::Emulated, cfg);
+}
+
+// rtl:BOARD: the board's driver on its bridge chip's model, in front of the board's gateware
+// Verilated (docs/gateware.md); needs Verilator in the build and a profile naming its gateware.
+Result<usb::BoardProfile> rtl_profile(std::string_view board, const DaemonConfig& cfg) {
+  const std::string backend = "rtl:" + std::string(board);
+  if (!rtl::RtlDevice::available()) return make_error("backend \"" + backend + "\": " + rtl::RtlDevice::unavailable_reason());
+  auto profile = named_profile(backend, std::string(board), cfg);
+  if (!profile) return profile.error();
+  if (profile->gateware.empty())
+    return make_error("backend \"" + backend + "\": board profile " + profile->file.string() +
+                      " names no gateware; add \"gateware\": {\"profile\": \"up5k\"} (or \"ecp5\") for the design it runs");
+  return profile;
+}
+Result<BackendPtr> open_rtl(std::string_view board, const DaemonConfig& cfg) {
+  auto profile = rtl_profile(board, cfg);
+  if (!profile) return profile.error();
+  return open_board(*profile, Attach::Gateware);
+}
+Result<std::string> describe_rtl(std::string_view board, const DaemonConfig& cfg) {
+  auto profile = rtl_profile(board, cfg);
+  if (!profile) return profile.error();
+  return describe_board(*profile, Attach::Gateware, cfg);
 }
 
 // dmc1: the DMC-1 simulator. Its texture image and palette come from the configuration, else from
@@ -272,13 +309,13 @@ Result<BackendPtr> open_real_board(std::string_view name, const DaemonConfig& cf
   if (auto uart = uart_board(name, cfg)) return open_uart_board(*uart, cfg);
   auto profile = named_profile(std::string(name), std::string(name), cfg);
   if (!profile) return profile.error();
-  return open_board(*profile, false);
+  return open_board(*profile, Attach::Real);
 }
 Result<std::string> describe_real_board(std::string_view name, const DaemonConfig& cfg) {
   if (auto uart = uart_board(name, cfg)) return describe_uart_board(*uart, cfg);
   auto profiles = profiles_board(name, cfg);
   if (!profiles) return profiles.error();
-  return describe_board(profiles->front(), false, cfg);
+  return describe_board(profiles->front(), Attach::Real, cfg);
 }
 
 // ---- the table ---------------------------------------------------------------------------
@@ -309,6 +346,7 @@ constexpr BackendKind kKinds[] = {
   {"sim",      Arg::None,      "sim",                            false, false, &open_sim,        &describe_sim},
   {"auto",     Arg::None,      "auto",                           true,  true,  &open_auto,       &describe_auto,       &profiles_auto, &reopen_auto},
   {"emulated", Arg::Required,  "emulated:BOARD[?presence=PATH]", true,  false, &open_emulated,   &describe_emulated},
+  {"rtl",      Arg::Required,  "rtl:BOARD",                      true,  false, &open_rtl,        &describe_rtl},
   {"fake",     Arg::Optional,  "fake[:WIDTHxHEIGHT]",            false, false, &open_fake,       &describe_fake},
   {"discard",  Arg::None,      "discard",                        false, false, &open_discard,    &describe_discard},
   {"dmc1",     Arg::None,      "dmc1",                           false, false, &open_dmc1,       &describe_dmc1},
@@ -359,7 +397,7 @@ Result<std::string> check_backend(const DaemonConfig& cfg) {
     return make_error("--mirror needs an spigpu board; \"" + cfg.backend +
                       "\" is a DMC-1 board, whose frames are already the simulator's (it sends none back)");
   if (cfg.mirror && !r.kind.board)
-    return make_error("--mirror needs a board backend (a board profile name, emulated:BOARD or auto), not \"" + cfg.backend +
+    return make_error("--mirror needs a board backend (a board profile name, emulated:BOARD, rtl:BOARD or auto), not \"" + cfg.backend +
                       "\": mirror mode compares a board with the simulator");
   return r.kind.describe(r.arg, cfg);
 }

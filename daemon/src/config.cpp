@@ -119,7 +119,7 @@ Result<DaemonConfig> parse_config(const json& doc, const std::string& source) {
   GPUBRIDGE_TRY(rd.read_string(doc, "", "token", cfg.token));
   GPUBRIDGE_TRY(rd.read_string(doc, "", "token_file", cfg.token_file));
   GPUBRIDGE_TRY(rd.read_string(doc, "", "backend", cfg.backend));
-  if (cfg.backend.empty()) return rd.fail("backend", "expected \"sim\", \"auto\", a board name or \"emulated:BOARD\", got \"\"");
+  if (cfg.backend.empty()) return rd.fail("backend", "expected \"sim\", \"auto\", a board name, \"emulated:BOARD\" or \"rtl:BOARD\", got \"\"");
   GPUBRIDGE_TRY(rd.read_bool(doc, "", "fallback_to_sim", cfg.fallback_to_sim));
   GPUBRIDGE_TRY(rd.read_bool(doc, "", "mirror", cfg.mirror));
   GPUBRIDGE_TRY(rd.read_uint(doc, "", "reattach_interval_ms", 0, kMaxReattachIntervalMs, cfg.reattach_interval_ms));

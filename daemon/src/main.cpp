@@ -233,7 +233,7 @@ int main(int argc, char** argv) {
                  gpubridge::daemon::backend_syntax() +
                      " (BOARD: a board profile name or .json file, a spigpu board or a DMC-1 UART board such as "
                      "icebreaker-dmc1; dmc1: the DMC-1 simulator; presence: the emulated adapter is plugged in while "
-                     "PATH exists)");
+                     "PATH exists; rtl: the board's gateware, Verilated, behind its bridge chip model)");
   app.add_option("--dmc1-textures", dmc1_textures,
                  "DMC-1 backends: the texture memory image (raw or .gz; default: the repository's tests/dmc1/data, "
                  "which its DMC-1 streams and goldens use)");

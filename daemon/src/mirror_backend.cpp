@@ -143,7 +143,7 @@ void MirrorBackend::emit_pairs() {
 Result<std::unique_ptr<backends::Backend>> make_mirror(std::unique_ptr<backends::Backend> board) {
   const auto info = board->info();
   if (info.backend != "board")
-    return make_error("--mirror needs a board backend (a board profile name or emulated:BOARD), not \"" + info.backend +
+    return make_error("--mirror needs a board backend (a board profile name, emulated:BOARD or rtl:BOARD), not \"" + info.backend +
                       "\": mirror mode compares a board with the simulator");
   sim::DeviceOptions o;
   // The model gets the board's memory and limits, so a command that does not fit the board does

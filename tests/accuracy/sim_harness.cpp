@@ -5,6 +5,15 @@
 #include <string>
 
 #include "gpubridge/protocol/frame.hpp"
+#if GPUBRIDGE_ACCURACY_GATEWARE
+#include <gtest/gtest.h>
+
+#include "gateware_board.hpp"
+#else
+namespace gpubridge::test {
+class GatewareBoard {};  // only the gateware build of the suite has one
+}  // namespace gpubridge::test
+#endif
 
 namespace gpubridge::accuracy {
 
@@ -47,14 +56,25 @@ std::uint32_t align16(std::uint64_t v) { return static_cast<std::uint32_t>((v + 
 }  // namespace
 
 SimHarness::SimHarness(const Setup& setup) : setup_(setup) {
+#if GPUBRIDGE_ACCURACY_GATEWARE
+  // the gateware has the hardware's accuracy; threads only change how the simulator works
+  if (!setup.knobs.exact()) throw std::runtime_error("accuracy knobs do not apply to the gateware");
+  gateware_ = must(test::GatewareBoard::open(test::board_profile("ulx3s")), "gateware board");
+  device_ = &gateware_->sim();
+#else
   sim::DeviceOptions opt;
   opt.vram_bytes = 16u << 20;
   opt.threads = setup.threads;
   opt.accuracy = setup.knobs;
-  device_ = must(sim::Device::create(opt), "sim::Device::create");
+  own_device_ = must(sim::Device::create(opt), "sim::Device::create");
+  device_ = own_device_.get();
+#endif
   const std::uint64_t fb_bytes = std::uint64_t{setup.width} * setup.height * protocol::bytes_per_pixel(setup.format);
   z_base_ = align16(fb_bytes);
   tex_base_ = align16(z_base_ + std::uint64_t{setup.width} * setup.height * 4);
+#if GPUBRIDGE_ACCURACY_GATEWARE
+  gateware_->limit_compare(tex_base_ + (4u << 20));  // buffers and the largest texture of the suite
+#endif
   write(Reg::FB_FORMAT, must(geometry::fb_format_word(setup.width, setup.height, setup.format), "FB_FORMAT"));
   write(Reg::FB_DRAW, must(geometry::address16_word(0), "FB_DRAW"));
   write(Reg::FB_Z, must(geometry::address16_word(z_base_), "FB_Z"));
@@ -62,7 +82,48 @@ SimHarness::SimHarness(const Setup& setup) : setup_(setup) {
   clear();
 }
 
-void SimHarness::write(Reg reg, std::uint64_t data) { device_->write(protocol::write_frame(reg, data)); }
+SimHarness::~SimHarness() = default;
+SimHarness::SimHarness(SimHarness&&) noexcept = default;
+
+void SimHarness::send(const protocol::Frame& f) {
+  if (!gateware_) {
+    device_->write(f);
+    return;
+  }
+  pending_.push_back(f);
+  dirty_ = true;
+  if (pending_.size() >= 4096) {
+#if GPUBRIDGE_ACCURACY_GATEWARE
+    std::vector<std::uint8_t> wire;
+    for (const auto& p : pending_) protocol::append(wire, p);
+    pending_.clear();
+    must(gateware_->backend().write_frames(protocol::FrameView{wire}), "write_frames");
+#endif
+  }
+}
+
+void SimHarness::sync() const {
+  dirty_ = false;
+#if GPUBRIDGE_ACCURACY_GATEWARE
+  if (!gateware_) return;
+  if (!pending_.empty()) {
+    std::vector<std::uint8_t> wire;
+    for (const auto& f : pending_) protocol::append(wire, f);
+    pending_.clear();
+    must(gateware_->backend().write_frames(protocol::FrameView{wire}), "write_frames");
+  }
+  // the part of video memory this harness uses (framebuffer, depth, textures) is compared
+  const std::string diff = gateware_->compare(/*errors_too=*/true);
+  if (!diff.empty()) ADD_FAILURE() << "gateware and simulator differ:\n" << diff;
+#endif
+}
+
+std::uint16_t SimHarness::device_errors() const {
+  if (dirty_) sync();
+  return device_->errors();
+}
+
+void SimHarness::write(Reg reg, std::uint64_t data) { send(protocol::write_frame(reg, data)); }
 
 void SimHarness::clear(std::uint32_t rgba, std::uint32_t depth) {
   write(Reg::CLEAR_COLOR, rgba);
@@ -95,18 +156,19 @@ void SimHarness::draw(std::span<const geometry::DeviceTriangle> tris) {
   // Encoded by the host library exactly as a client sends them.
   std::vector<protocol::Frame> frames;
   for (const auto& t : tris) geometry::encode_triangle(t, true, frames);
-  for (const auto& f : frames) device_->write(f);
+  for (const auto& f : frames) send(f);
 }
 
 void SimHarness::texture(const std::vector<std::uint8_t>& bytes, const geometry::TextureFormat& fmt) {
   std::vector<protocol::Frame> frames;
   must(geometry::encode_upload(tex_base_, bytes, frames), "texture upload");
-  for (const auto& f : frames) device_->write(f);
+  for (const auto& f : frames) send(f);
   write(Reg::TEX_BASE, must(geometry::address16_word(tex_base_), "TEX_BASE"));
   write(Reg::TEX_FMT, must(geometry::tex_fmt_word(fmt), "TEX_FMT"));
 }
 
 protocol::Rgba8 SimHarness::color(int x, int y) const {
+  if (dirty_) sync();
   device_->drain();
   const auto mem = static_cast<const sim::Device&>(*device_).memory();
   const unsigned bpp = protocol::bytes_per_pixel(setup_.format);
@@ -114,6 +176,7 @@ protocol::Rgba8 SimHarness::color(int x, int y) const {
 }
 
 std::uint32_t SimHarness::depth(int x, int y) const {
+  if (dirty_) sync();
   device_->drain();
   const auto mem = static_cast<const sim::Device&>(*device_).memory();
   const std::uint8_t* p = mem.data() + z_base_ + (std::size_t(y) * setup_.width + x) * 4;
@@ -121,6 +184,7 @@ std::uint32_t SimHarness::depth(int x, int y) const {
 }
 
 std::vector<std::uint8_t> SimHarness::color_bytes() const {
+  if (dirty_) sync();
   device_->drain();
   const auto mem = static_cast<const sim::Device&>(*device_).memory();
   const std::size_t n = std::size_t{setup_.width} * setup_.height * protocol::bytes_per_pixel(setup_.format);
@@ -128,6 +192,7 @@ std::vector<std::uint8_t> SimHarness::color_bytes() const {
 }
 
 std::vector<std::uint8_t> SimHarness::depth_bytes() const {
+  if (dirty_) sync();
   device_->drain();
   const auto mem = static_cast<const sim::Device&>(*device_).memory();
   const std::size_t n = std::size_t{setup_.width} * setup_.height * 4;

@@ -2,6 +2,9 @@
 // A simulator device driven only through register frames, as a client would drive a board:
 // FB_FORMAT / FB_DRAW / FB_Z / SCISSOR / CLEAR, TRI_MODE, PRIM, then COLOR / TEXCOORD / VERTEX per
 // vertex. Results are read from video memory. Used by every accuracy test.
+// Built with GPUBRIDGE_ACCURACY_GATEWARE (tests/rtl, `ctest -L rtl`), the same frames go through an
+// FT232H board backend to the Verilated gateware with the simulator on the same wires; before any
+// result is read, the gateware's video memory must equal the simulator's byte for byte.
 #include <cstdint>
 #include <memory>
 #include <span>
@@ -13,6 +16,10 @@
 #include "gpubridge/geometry/encode.hpp"
 #include "gpubridge/protocol/pixel.hpp"
 #include "gpubridge/sim/device.hpp"
+
+namespace gpubridge::test {
+class GatewareBoard;
+}
 
 namespace gpubridge::accuracy {
 
@@ -31,6 +38,8 @@ class SimHarness {
   };
   explicit SimHarness(const Setup& setup);
   SimHarness() : SimHarness(Setup{}) {}
+  ~SimHarness();
+  SimHarness(SimHarness&&) noexcept;
 
   unsigned width() const { return setup_.width; }
   unsigned height() const { return setup_.height; }
@@ -55,12 +64,19 @@ class SimHarness {
   // Hit counts: draws every triangle flat with ADD blending and colour R = 1 into a cleared
   // buffer, so R counts the triangles covering each pixel (saturates at 255).
   std::vector<int> hit_counts(std::span<const geometry::DeviceTriangle> tris);
-  std::uint16_t device_errors() const { return device_->errors(); }
+  std::uint16_t device_errors() const;
   sim::Device& device() { return *device_; }
 
  private:
+  void send(const protocol::Frame& f);
+  void sync() const;  // gateware builds: frames sent, devices idle, video memory compared
+
   Setup setup_;
-  std::unique_ptr<sim::Device> device_;
+  sim::Device* device_ = nullptr;
+  std::unique_ptr<sim::Device> own_device_;
+  std::unique_ptr<test::GatewareBoard> gateware_;
+  mutable std::vector<protocol::Frame> pending_;
+  mutable bool dirty_ = false;
   std::uint32_t z_base_ = 0, tex_base_ = 0;
 };
 

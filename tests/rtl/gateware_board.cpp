@@ -79,7 +79,9 @@ std::string GatewareBoard::compare(bool errors_too) {
   if (auto r = board_.backend->flush(); !r) out += "flush: " + r.error().message + "\n";
   for (const auto& m : read_mismatches_) out += m + "\n";
   // video memory
-  const auto gw = gateware().vram();
+  const std::uint64_t n = compare_limit_ ? std::min(compare_limit_, gateware().vram_bytes()) : gateware().vram_bytes();
+  std::vector<std::uint8_t> gw(n);
+  gateware().read_vram(0, gw.data(), gw.size());
   const auto sm = sim_->memory();
   std::size_t diffs = 0;
   for (std::size_t i = 0; i < gw.size() && i < sm.size(); ++i) {

@@ -38,6 +38,8 @@ class GatewareBoard {
   // it read them back), the register reads compared on the wires, and STATUS.ERRORS (read through the
   // board, compared with the simulator's flags).
   std::string compare(bool errors_too = true);
+  // Only the first `bytes` of video memory take part in compare() (what a test uses; 0 = all).
+  void limit_compare(std::uint64_t bytes) { compare_limit_ = bytes; }
   const std::vector<rtl::ScanFrame>& gateware_frames() const { return gw_frames_; }
   std::size_t reads_compared() const { return reads_compared_; }
   // What the simulator answered to the last read of `index` on the wires.
@@ -53,6 +55,7 @@ class GatewareBoard {
   std::vector<std::shared_ptr<const backends::ScanoutFrame>> board_frames_;
   std::vector<std::string> read_mismatches_;
   std::size_t reads_compared_ = 0;
+  std::uint64_t compare_limit_ = 0;
   std::array<std::uint64_t, 128> shadow_reads_{};
 };
 

@@ -1,6 +1,7 @@
 // `gpubridge probe` (which bridges are attached, and with --board the ID register) and
 // `gpubridge bringup --board NAME` (ID, register echo, memory test, SPI clock sweep, scenes vs
-// the simulator). Both run against an emulated board with --emulate.
+// the simulator). Both run against an emulated board with --emulate; bringup also against the
+// board's Verilated gateware behind the emulated bridge with --rtl.
 #include <cstdio>
 #include <unistd.h>
 
@@ -9,6 +10,7 @@
 #include "command.hpp"
 #include "gpubridge/usb/board_factory.hpp"
 #include "gpubridge/usb/bringup.hpp"
+#include "gpubridge/usb/emu/rtl_pins.hpp"
 #include "gpubridge/usb/hidapi_transport.hpp"
 #include "gpubridge/usb/libusb_transport.hpp"
 #include "gpubridge/usb/usb_tty.hpp"
@@ -168,6 +170,7 @@ struct BringupArgs {
   ProbeArgs probe;
   usb::BringupOptions opts;
   std::uint32_t emulated_limit = 0;
+  bool rtl = false;  // the board's gateware, co-simulated, behind the emulated bridge chip
 };
 
 int run_bringup(const GlobalOptions& g, const BringupArgs& a) {
@@ -177,8 +180,10 @@ int run_bringup(const GlobalOptions& g, const BringupArgs& a) {
     return 1;
   }
   usb::BoardOpenOptions o;
-  o.emulate = a.probe.emulate;
+  o.emulate = a.probe.emulate || a.rtl;
+  if (a.rtl) o.emulated_pins = usb::emu::rtl_pins();
   o.emulated_max_reliable_hz = a.emulated_limit;
+  const char* kind = a.rtl ? " (gateware co-simulation)" : a.probe.emulate ? " (emulated)" : "";
   // Attach at a conservative clock: the sweep finds how fast this board really goes.
   usb::BringupOptions opts = a.opts;
   opts.max_clock_hz = profile->spi_clock_hz;
@@ -195,11 +200,11 @@ int run_bringup(const GlobalOptions& g, const BringupArgs& a) {
     nlohmann::json steps = nlohmann::json::array();
     for (const auto& s : rep.steps)
       steps.push_back({{"name", s.name}, {"ok", s.ok}, {"skipped", s.skipped}, {"detail", s.detail}, {"seconds", s.seconds}});
-    const nlohmann::json report{{"board", profile->name}, {"emulated", a.probe.emulate}, {"ok", rep.ok()},
+    const nlohmann::json report{{"board", profile->name}, {"emulated", o.emulate}, {"gateware", a.rtl}, {"ok", rep.ok()},
                                 {"best_clock_hz", rep.best_clock_hz}, {"steps", steps}};
     std::puts(json_text(report, 2).c_str());
   } else {
-    std::printf("bring-up of %s%s\n", profile->name.c_str(), a.probe.emulate ? " (emulated)" : "");
+    std::printf("bring-up of %s%s\n", profile->name.c_str(), kind);
     for (const auto& s : rep.steps)
       std::printf("  %-14s %-5s %s\n", s.name.c_str(), s.skipped ? "skip" : s.ok ? "ok" : "FAIL", s.detail.c_str());
     std::printf("%s\n", rep.ok() ? "PASS" : "FAIL");
@@ -221,6 +226,9 @@ GPUBRIDGE_COMMAND("probe", 71, [](CLI::App& app, GlobalOptions& g, auto& runners
   auto* bringup = app.add_subcommand("bringup", "bring up a board: ID, register echo, memory test, SPI clock sweep, scenes vs the simulator");
   bringup->add_option("--board", b->probe.board, "board profile name or .json file")->required();
   bringup->add_flag("--emulate", b->probe.emulate, "run against the emulated bridge chip and simulator");
+  bringup->add_flag("--rtl", b->rtl,
+                    "run against the board's gateware (Verilated, docs/gateware.md) behind the emulated bridge chip")
+      ->excludes("--emulate");
   bringup->add_option("--config-dir", b->probe.config_dir, "directory holding boards/ and cables/");
   bringup->add_option("--mem-base", b->opts.mem_base, "memory test start address")->capture_default_str();
   bringup->add_option("--mem-bytes", b->opts.mem_bytes, "memory test length in bytes (clamped to video memory)")

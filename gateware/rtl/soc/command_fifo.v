@@ -23,7 +23,7 @@ module command_fifo #(
   output wire [70:0] out_entry,
   input  wire        pop
 );
-  reg [70:0] mem [0:(1 << AW) - 1];
+  (* no_rw_check *) reg [70:0] mem [0:(1 << AW) - 1];   // an entry is never read in the clock it is written
   reg [70:0] q;
   reg [AW-1:0] wr, rel, rd;
   reg [10:0]   count;     // DEPTH <= 1023

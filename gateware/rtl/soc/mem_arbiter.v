@@ -62,8 +62,13 @@ module mem_arbiter #(
 
   wire tags_room  = tag_count < 4'd8;
   wire tags_empty = tag_count == 4'd0;
-  wire m_block = prot_active && m_req_we && m_req_addr >= prot_lo && m_req_addr < prot_hi;
-  wire c_block = prot_active && c_req_we && c_req_addr >= prot_lo && c_req_addr < prot_hi;
+  // One comparator pair: the memory-access unit writes only while the core is idle (the executor
+  // starts MEM_* after the core finished and no core command during them).
+  wire        m_writes = m_req_valid && m_req_we;
+  wire [29:0] w_addr   = m_writes ? m_req_addr : c_req_addr;
+  wire        w_prot   = prot_active && w_addr >= prot_lo && w_addr < prot_hi;
+  wire m_block = m_writes && w_prot;
+  wire c_block = !m_writes && c_req_we && w_prot;
   wire c_oor   = c_req_addr >= VRAM_WORDS;
 
   wire m_ok  = m_req_valid && !m_block && (m_req_we || tags_room);

@@ -110,7 +110,7 @@ module register_file #(
   assign soft_reset        = reset_ok;
 
   // --- shadow RAM of the read-write registers (indices 0x00..0x1F) ---
-  reg  [63:0] shadow [0:31];
+  (* no_rw_check *) reg [63:0] shadow [0:31];   // a read in the clock of a write may return the old value
   reg  [63:0] shadow_q;
   reg         seq_active;
   reg  [4:0]  seq_idx;

@@ -2,7 +2,7 @@
 // STATUS.VBLANK / SWAP_PENDING and the frame counter.
 //
 // An executed FB_DISPLAY write asks for a swap with its address and the FB_FORMAT of that moment;
-// the buffer length W x H x bpp is computed (a shift-add multiply, 11 clocks) and the swap becomes
+// the buffer length W x H x bpp is computed (a shift-add multiply, 12 clocks) and the swap becomes
 // pending. At the next vertical sync (start of vertical blanking) the pending swap is latched and the
 // frame is read, in address order, into the CRC-32 and out of the frame port (the video output of a
 // board, and what the co-simulation captures). When its last byte has been read the frame is
@@ -13,12 +13,12 @@
 // (mem_arbiter), so the frame is the buffer as it was when FB_DISPLAY executed.
 // Timing is in core clocks: LINE_CLOCKS per line, V_ACTIVE visible lines of V_TOTAL.
 module scanout #(
-  parameter [29:0] VRAM_WORDS = 30'd32768,
+  parameter        VAW = 15,              // VRAM size = 2^VAW 32-bit words
   parameter        LINE_CLOCKS = 800,
   parameter        V_ACTIVE = 480,
   parameter        V_TOTAL = 525,
-  parameter        CRC_BYTES = 1,          // bytes folded into the CRC per clock: 1 or 4
-  parameter        BUF_WORDS = 2           // read-ahead words (2 or 4)
+  parameter        CRC_BYTES = 1,         // bytes folded into the CRC per clock: 1 or 4
+  parameter        BUF_WORDS = 2          // read-ahead words (2 or 4)
 ) (
   input  wire        clk,
   input  wire        rst,
@@ -74,49 +74,48 @@ module scanout #(
     end
   end
 
-  // --- swap request: length and range ---
+  // --- swap request: length, end and range ---
   reg        computing, pending, reading;
   reg [3:0]  mul_step;
-  reg [23:0] mul_acc;          // width x height
+  reg [21:0] mul_acc;          // width x height
   reg [10:0] mul_h;
-  reg [27:0] base16;           // byte address / 16
-  reg [24:0] len_bytes;        // <= 1024 x 1024 x 4
+  reg [29:0] rd_addr;          // next word to read (the frame's first word until reading starts)
+  reg [30:0] end_word;         // first word after the frame
+  reg [23:0] bytes_left;       // bytes still to fold
   reg [31:0] crc, crc_value;
   reg [15:0] crc_frame;
   assign swap_ready   = !computing && !pending && !reading;
   assign swap_pending = computing || pending || reading;
   assign frame_crc    = {crc_frame, crc_value};
 
-  wire [29:0] base_word = {base16, 2'b00};
-  wire [32:0] end_byte  = {1'b0, base16, 4'd0} + {8'd0, len_bytes};
-  wire [30:0] end_word  = end_byte[32:2] + {30'd0, end_byte[1:0] != 2'd0};   // words touched
-  wire [30:0] vram_w31  = {1'b0, VRAM_WORDS};
-  wire [29:0] hi_word   = end_word > vram_w31 ? VRAM_WORDS : end_word[29:0];
-  wire [24:0] bytes_of_format = frame_format == 2'd0 ? {mul_acc[22:0], 2'b00}
-                              : frame_format == 2'd1 ? {1'b0, mul_acc[22:0], 1'b0} : {2'b00, mul_acc[22:0]};
+  // words of the frame: ceil(W x H x bpp / 4)
+  wire [21:0] words = frame_format == 2'd0 ? mul_acc
+                    : frame_format == 2'd1 ? {1'b0, mul_acc[21:1]} + {21'd0, mul_acc[0]}
+                    : {2'b00, mul_acc[21:2]} + {21'd0, mul_acc[1:0] != 2'd0};
+  wire [23:0] bytes = frame_format == 2'd0 ? {mul_acc, 2'b00} : frame_format == 2'd1 ? {1'b0, mul_acc, 1'b0} : {2'b00, mul_acc};
 
   // --- frame reading ---
-  reg  [29:0] issue_addr;      // next word to read
-  reg  [29:0] issue_end;       // first word not read from memory (VRAM end or frame end)
-  reg  [24:0] bytes_left;      // bytes still to fold, in frame order
-  reg  [2:0]  outstanding;     // reads issued, answer not yet seen (<= BUF_WORDS: the buffer's room)
+  localparam       BAW = BUF_WORDS == 4 ? 2 : 1;
+  localparam [2:0] BUFW = BUF_WORDS[2:0];
+  reg  [2:0]  outstanding;     // reads issued, answer not yet seen
   reg  [2:0]  drop;            // answers to ignore after a RESET
   reg  [31:0] buf_word [0:BUF_WORDS-1];
-  localparam       BAW = BUF_WORDS == 4 ? 2 : 1;
   reg  [BAW-1:0] buf_rd, buf_wr;
   reg  [2:0]  buf_count;
-  localparam [2:0] BUFW = BUF_WORDS[2:0];
   reg  [1:0]  byte_in_word;    // CRC_BYTES = 1: next byte of the head word
 
-  assign req_valid   = reading && issue_addr < issue_end && outstanding + buf_count < BUFW;
-  assign req_addr    = issue_addr;
-  assign prot_active = pending || computing || (reading && issue_addr < issue_end);
-  assign prot_lo     = reading ? issue_addr : base_word;
-  assign prot_hi     = hi_word;
+  wire in_frame  = {1'b0, rd_addr} < end_word;
+  wire in_vram   = rd_addr[29:VAW] == {(30 - VAW){1'b0}};
+  assign req_valid   = reading && in_frame && in_vram && outstanding + buf_count < BUFW;
+  assign req_addr    = rd_addr;
+  assign prot_active = computing || pending || (reading && in_frame);
+  assign prot_lo     = rd_addr;
+  // while the end is being computed, everything from the frame's start up is protected
+  assign prot_hi     = computing || end_word[30] ? 30'h3FFFFFFF : end_word[29:0];
 
-  // the head word: from memory while there are answers, zeros beyond VRAM
-  wire        mem_words_done = issue_addr >= issue_end && outstanding == 3'd0 && buf_count == 3'd0;
-  wire        have_word = buf_count != 3'd0 || (mem_words_done && bytes_left != 25'd0);
+  // the head word: from memory while there are answers; zeros once the reader left VRAM
+  wire        mem_done  = !(in_frame && in_vram) && outstanding == 3'd0 && buf_count == 3'd0;
+  wire        have_word = buf_count != 3'd0 || mem_done;
   wire [31:0] head_word = buf_count != 3'd0 ? buf_word[buf_rd] : 32'd0;
 
   function automatic [31:0] crc_byte(input [31:0] c, input [7:0] b);
@@ -129,7 +128,6 @@ module scanout #(
     end
   endfunction
 
-  // fold step: how many bytes and which
   reg  [2:0]  n_fold;
   reg  [31:0] fold_word;       // bytes to fold, first one in [31:24]
   reg  [31:0] crc_next;
@@ -137,24 +135,30 @@ module scanout #(
   always @* begin
     if (CRC_BYTES == 4) begin
       fold_word = head_word;
-      n_fold = bytes_left >= 25'd4 ? 3'd4 : bytes_left[2:0];
+      n_fold = bytes_left >= 24'd4 ? 3'd4 : bytes_left[2:0];
       word_done = 1'b1;
+      crc_next = crc;
+      if (n_fold >= 3'd1) crc_next = crc_byte(crc_next, fold_word[31:24]);
+      if (n_fold >= 3'd2) crc_next = crc_byte(crc_next, fold_word[23:16]);
+      if (n_fold >= 3'd3) crc_next = crc_byte(crc_next, fold_word[15:8]);
+      if (n_fold >= 3'd4) crc_next = crc_byte(crc_next, fold_word[7:0]);
     end else begin
-      fold_word = head_word << {byte_in_word, 3'b000};
+      case (byte_in_word)
+        2'd0: fold_word = {head_word[31:24], 24'd0};
+        2'd1: fold_word = {head_word[23:16], 24'd0};
+        2'd2: fold_word = {head_word[15:8], 24'd0};
+        default: fold_word = {head_word[7:0], 24'd0};
+      endcase
       n_fold = 3'd1;
-      word_done = byte_in_word == 2'd3 || bytes_left == 25'd1;
+      word_done = byte_in_word == 2'd3 || bytes_left == 24'd1;
+      crc_next = crc_byte(crc, fold_word[31:24]);
     end
-    crc_next = crc;
-    if (n_fold >= 3'd1) crc_next = crc_byte(crc_next, fold_word[31:24]);
-    if (n_fold >= 3'd2) crc_next = crc_byte(crc_next, fold_word[23:16]);
-    if (n_fold >= 3'd3) crc_next = crc_byte(crc_next, fold_word[15:8]);
-    if (n_fold >= 3'd4) crc_next = crc_byte(crc_next, fold_word[7:0]);
   end
-  wire folding = reading && have_word && bytes_left != 25'd0;
+  wire folding = reading && have_word && bytes_left != 24'd0;
   wire popping = folding && word_done && buf_count != 3'd0;
   wire issued  = req_valid && req_ready;
   wire take    = rsp_valid && drop == 3'd0;
-  wire last    = folding && bytes_left == {22'd0, n_fold};
+  wire last    = folding && bytes_left == {21'd0, n_fold};
   assign frame_valid  = folding;
   assign frame_word   = fold_word;
   assign frame_nbytes = n_fold;
@@ -174,15 +178,13 @@ module scanout #(
       buf_wr <= {BAW{1'b0}};
       buf_count <= 3'd0;
       byte_in_word <= 2'd0;
-      issue_addr <= 30'd0;
-      issue_end <= 30'd0;
       // answers to reads in flight still arrive after a RESET
       drop <= rst ? 3'd0 : drop - {2'd0, rsp_valid && drop != 3'd0} + outstanding - {2'd0, take};
       outstanding <= 3'd0;
     end else begin
       if (rsp_valid && drop != 3'd0) drop <= drop - 3'd1;
       outstanding <= outstanding + {2'd0, issued} - {2'd0, take};
-      if (issued) issue_addr <= issue_addr + 30'd1;
+      if (issued) rd_addr <= rd_addr + 30'd1;
       if (take) begin
         buf_word[buf_wr] <= rsp_rdata;
         buf_wr <= buf_wr + 1'b1;
@@ -192,26 +194,25 @@ module scanout #(
 
       if (swap_req) begin
         computing <= 1'b1;
-        base16 <= swap_addr;
+        rd_addr <= {swap_addr, 2'b00};
         frame_format <= swap_format;
         frame_width <= swap_width;
         frame_height <= swap_height;
         mul_h <= swap_height;
-        mul_acc <= 24'd0;
+        mul_acc <= 22'd0;
         mul_step <= 4'd0;
       end else if (computing) begin
         // mul_acc = width x height, one bit of the height per clock (MSB first)
-        if (mul_step < 4'd11) begin
-          mul_acc <= {mul_acc[22:0], 1'b0} + (mul_h[10] ? {13'd0, frame_width} : 24'd0);
+        if (mul_step != 4'd11) begin
+          mul_acc <= {mul_acc[20:0], 1'b0} + (mul_h[10] ? {11'd0, frame_width} : 22'd0);
           mul_h <= {mul_h[9:0], 1'b0};
           mul_step <= mul_step + 4'd1;
-        end else if (mul_step == 4'd11) begin
-          len_bytes <= bytes_of_format;
-          mul_step <= 4'd12;
         end else begin
           computing <= 1'b0;
           pending <= 1'b1;
-          if (end_byte > {1'b0, VRAM_WORDS, 2'b00}) err_range <= 1'b1;
+          end_word <= {1'b0, rd_addr} + {9'd0, words};
+          bytes_left <= bytes;
+          if ({1'b0, rd_addr} + {9'd0, words} > (31'd1 << VAW)) err_range <= 1'b1;
         end
       end
 
@@ -219,13 +220,10 @@ module scanout #(
         pending <= 1'b0;
         reading <= 1'b1;
         crc <= 32'hFFFFFFFF;
-        bytes_left <= len_bytes;
         byte_in_word <= 2'd0;
-        issue_addr <= base_word;
-        issue_end <= base_word >= VRAM_WORDS ? base_word : hi_word;
       end else if (folding) begin
         crc <= crc_next;
-        bytes_left <= bytes_left - {22'd0, n_fold};
+        bytes_left <= bytes_left - {21'd0, n_fold};
         byte_in_word <= word_done ? 2'd0 : byte_in_word + 2'd1;
         if (last) begin
           reading <= 1'b0;
@@ -233,12 +231,7 @@ module scanout #(
           crc_frame <= frame_count + 16'd1;
           crc_value <= ~crc_next;
         end
-      end else if (reading && bytes_left == 25'd0) begin
-        // an empty frame cannot occur (width and height are at least 1); kept for safety
-        reading <= 1'b0;
       end
     end
   end
-
-  wire unused_ok = &{1'b0, mul_acc[23]};
 endmodule

@@ -196,7 +196,7 @@ module spigpu_soc #(
     .req_ready(m_req_ready), .req_we(m_req_we), .req_addr(m_req_addr), .req_wdata(m_req_wdata),
     .rsp_valid(m_rsp_valid), .rsp_rdata(rsp_rdata));
 
-  scanout #(.VRAM_WORDS(VRAM_WORDS), .LINE_CLOCKS(LINE_CLOCKS), .V_ACTIVE(V_ACTIVE), .V_TOTAL(V_TOTAL),
+  scanout #(.VAW(VAW), .LINE_CLOCKS(LINE_CLOCKS), .V_ACTIVE(V_ACTIVE), .V_TOTAL(V_TOTAL),
             .CRC_BYTES(CRC_BYTES), .BUF_WORDS(SCAN_BUF)) u_scan (
     .clk(clk), .rst(rst), .soft_reset(soft_reset), .swap_req(swap_req), .swap_addr(swap_addr),
     .swap_format(cmd_fb_format), .swap_width(cmd_fb_width), .swap_height(cmd_fb_height), .swap_ready(swap_ready),

@@ -4,7 +4,8 @@
 // "discard" and "fake[:WxH]" (test_backends.hpp), "auto" (the first board profile whose real
 // bridge opens, else the simulator), "emulated:PROFILE[?presence=PATH]" (that board's bridge-chip
 // model + simulator, same driver code; with presence the emulated adapter is plugged in only while
-// PATH exists), and any other name: a board profile name or .json path (the real board).
+// PATH exists), "rtl:PROFILE" (that board's bridge-chip model in front of the board's Verilated
+// gateware, docs/gateware.md), and any other name: a board profile name or .json path (the real board).
 #include <functional>
 #include <memory>
 #include <string>
