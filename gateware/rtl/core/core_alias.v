@@ -1,17 +1,19 @@
 // Decides whether a draw must run in serial mode: when a buffer it reads overlaps one it writes
 // (colour and depth buffers, or the texture and either), the simulator's pixel order is
 // observable and the core must finish each pixel before starting the next and emit rows left to
-// right. Whole buffers are compared (W * H pixels), as the simulator does; 64-bit style bounds
-// (no wrap at 4 GiB). Registered in three steps; the inputs are held during triangle setup,
-// which takes longer.
-module core_alias (
+// right. Whole buffers are compared (W * H pixels), as the simulator does, clipped at 2^ADDR_W
+// (accesses beyond it are dropped or read 0 in any order). Registered in three steps; the
+// inputs are held during triangle setup, which takes longer.
+module core_alias #(
+    parameter integer ADDR_W = 32
+) (
     input  wire        clk,
     input  wire [27:0] fb_draw16,
     input  wire [27:0] fb_z16,
     input  wire [27:0] tex16,
     input  wire [10:0] width,
     input  wire [10:0] height,
-    input  wire [1:0]  fmt,       // colour buffer format
+    input  wire [1:0]  fmt,        // colour buffer format
     input  wire [1:0]  tex_fmt,
     input  wire [3:0]  tex_wl,
     input  wire [3:0]  tex_hl,
@@ -21,22 +23,34 @@ module core_alias (
     input  wire        textured,   // texture sampled
     output reg         serial
 );
+  localparam integer BW = ((ADDR_W > 24) ? ADDR_W : 24) + 2;
+  localparam [BW-1:0] TOP = {{(BW - ADDR_W - 1){1'b0}}, 1'b1, {ADDR_W{1'b0}}};
   reg  [21:0] wh;
-  reg  [32:0] c0, c1, z0, z1, t0, t1;
+  reg  [BW-1:0] c0, c1, z0, z1, t0, t1;
   wire [1:0]  cbl = (fmt == 2'd0) ? 2'd2 : (fmt == 2'd1) ? 2'd1 : 2'd0;
   wire [1:0]  tbl = (tex_fmt == 2'd0) ? 2'd2 : (tex_fmt == 2'd1) ? 2'd1 : 2'd0;
   wire [4:0]  tl = 5'(tex_wl) + 5'(tex_hl) + 5'(tbl);
-  function ov(input [32:0] a0, input [32:0] a1, input [32:0] b0, input [32:0] b1);
+  function [BW-1:0] lo(input [27:0] b16);  // start, clipped at 2^ADDR_W
+    lo = ((b16 >> (ADDR_W - 4)) != 28'd0) ? TOP : {{(BW - ADDR_W){1'b0}}, b16[ADDR_W-5:0], 4'd0};
+  endfunction
+  function [BW-1:0] hi(input [BW-1:0] start, input [23:0] len);  // end, clipped
+    reg [BW-1:0] e;
+    begin
+      e = start + {{(BW - 24){1'b0}}, len};
+      hi = (e > TOP) ? TOP : e;
+    end
+  endfunction
+  function ov(input [BW-1:0] a0, input [BW-1:0] a1, input [BW-1:0] b0, input [BW-1:0] b1);
     ov = (a0 < b1) && (b0 < a1);
   endfunction
   always @(posedge clk) begin
     wh <= 22'(width * height);
-    c0 <= {1'b0, fb_draw16, 4'd0};
-    c1 <= {1'b0, fb_draw16, 4'd0} + ({11'd0, wh} << cbl);
-    z0 <= {1'b0, fb_z16, 4'd0};
-    z1 <= {1'b0, fb_z16, 4'd0} + ({11'd0, wh} << 2);
-    t0 <= {1'b0, tex16, 4'd0};
-    t1 <= {1'b0, tex16, 4'd0} + (33'd1 << tl);
+    c0 <= lo(fb_draw16);
+    c1 <= hi(lo(fb_draw16), {2'd0, wh} << cbl);
+    z0 <= lo(fb_z16);
+    z1 <= hi(lo(fb_z16), {2'd0, wh} << 2);
+    t0 <= lo(tex16);
+    t1 <= hi(lo(tex16), 24'd1 << tl);
     serial <= (depth_on && colour_on && ov(c0, c1, z0, z1)) ||
               (textured && ov(t0, t1, c0, c1)) ||
               (textured && z_write && ov(t0, t1, z0, z1));

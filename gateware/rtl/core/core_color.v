@@ -4,6 +4,8 @@
 // FB_DRAW + i * bpp (big-endian pixels; byte 4k of a word is wdata[31:24], enable be[3]).
 module core_color #(
     parameter integer AW = 2,            // log2 of destination reads in flight
+    parameter integer IDX_W = 20,
+    parameter integer ADDR_W = 32,
     parameter [7:0]   FEATURES = 8'hFF   // CAPS.FEATURES: blend, dither, RGB565, RGBA2222 logic
 ) (
     input  wire        clk,
@@ -14,10 +16,10 @@ module core_color #(
     input  wire        dither,
     input  wire [3:0]  keep,       // 1 = keep the stored channel: bit 0 R .. bit 3 A
     input  wire        need_dst,   // read the destination (blend, or mask on a packed format)
-    // pixels in: {yl[1:0], xl[1:0], idx[21:0], rgba[31:0]}
+    // pixels in: {yl[1:0], xl[1:0], idx, rgba[31:0]}
     input  wire        in_valid,
     output wire        in_ready,
-    input  wire [57:0] in_pix,
+    input  wire [IDX_W+35:0] in_pix,
     // memory
     output wire        rd_valid,
     input  wire        rd_ready,
@@ -33,39 +35,35 @@ module core_color #(
 );
   localparam F_BLEND = 1, F_DITHER = 2, F_RGB565 = 4, F_RGBA2222 = 5;
 
-  // byte address of pixel idx: FB_DRAW + idx * bpp; beyond 4 GiB saturates to an address no
-  // VRAM has
-  function [31:0] caddr(input [27:0] base, input [21:0] idx, input [1:0] f);
-    reg [32:0] a;
-    begin
-      a = {1'b0, base, 4'b0} + ((f == 2'd0) ? {9'd0, idx, 2'b0} : (f == 2'd1) ? {10'd0, idx, 1'b0}
-                                                                             : {11'd0, idx});
-      caddr = a[32] ? 32'hFFFFFFFF : a[31:0];
-    end
-  endfunction
-
-  wire [31:0] in_addr = caddr(fb_draw16, in_pix[53:32], fmt);
+`include "core_addr.vh"
+  // {word, lane} of pixel idx: FB_DRAW + idx * bpp
+  wire [IDX_W-1:0] in_idx = in_pix[IDX_W+31:32];
+  wire [23:0] in_off = (fmt == 2'd0) ? {{(22-IDX_W){1'b0}}, in_idx, 2'b0} :
+                       (fmt == 2'd1) ? {{(23-IDX_W){1'b0}}, in_idx, 1'b0} : {{(24-IDX_W){1'b0}}, in_idx};
+  wire [31:0] in_addr = byte_addr(fb_draw16, in_off);
+  // the item from here on: {yl, xl, word address and lane, rgba}
+  wire [67:0] in_item = {in_pix[IDX_W+35:IDX_W+32], in_addr, in_pix[31:0]};
 
   // ---- destination read queue ----
   wire        q_full, q_empty, q_head;
-  wire [57:0] q_item;
+  wire [67:0] q_item;
   wire [31:0] q_data;
   wire        take;
-  core_rdq #(.IW(58), .DW(32), .AW(AW)) queue (
+  core_rdq #(.IW(68), .DW(32), .AW(AW)) queue (
       .clk(clk), .rst(rst),
-      .push(rd_valid && rd_ready), .push_item(in_pix),
+      .push(rd_valid && rd_ready), .push_item(in_item),
       .full(q_full), .empty(q_empty),
       .rsp_valid(rsp_valid), .rsp_data(rsp_data),
       .head_valid(q_head), .head_item(q_item), .head_data(q_data), .pop(need_dst && take));
   assign rd_valid = need_dst && in_valid && !q_full;
   assign rd_addr  = in_addr[31:2];
 
-  wire [57:0] cur = need_dst ? q_item : in_pix;
+  wire [67:0] cur = need_dst ? q_item : in_item;
   wire        cur_valid = need_dst ? q_head : in_valid;
   wire [31:0] dword = q_data;
-  wire [31:0] addr = caddr(fb_draw16, cur[53:32], fmt);
+  wire [31:0] addr = cur[63:32];
   wire [1:0]  lane = addr[1:0];
-  wire [1:0]  xl = cur[55:54], yl = cur[57:56];
+  wire [1:0]  xl = cur[65:64], yl = cur[67:66];
 
   // ---- destination pixel, expanded to 8 bits per channel ----
   wire [15:0] d16 = lane[1] ? dword[15:0] : dword[31:16];

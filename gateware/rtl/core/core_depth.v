@@ -1,13 +1,15 @@
 // Depth stage (docs/protocol.md section 11 steps 1-2): reads the stored depth of each pixel
 // (Z_TEST), compares, writes the new depth of passing pixels (Z_WRITE) and drops failing ones.
-// Reads are issued as pixels arrive and resolved in order from a read queue, so several are in
-// flight. Depth word of pixel i: FB_Z / 4 + i (word address), bits [23:0].
-// Memory requests depend on registered state only (never on a ready), as the core's memory
-// arbiter requires.
+// Reads are issued as pixels arrive and resolved in order from a read queue (2^AW in flight).
+// Depth word of pixel i: FB_Z + 4i, bits [23:0]; bits [31:24] are written 0.
+// Without Z_TEST and Z_WRITE pixels pass straight through. Memory requests depend on registered
+// state only (never on a ready), as the core's memory port requires.
 module core_depth #(
-    parameter integer PW = 178,  // pixel record bits: {..., z[23:0] at ZLSB, idx[21:0] at 0}
-    parameter integer ZLSB = 22,
-    parameter integer AW = 2     // log2 of the reads in flight
+    parameter integer PW = 178,    // pixel record bits: {..., z[23:0] at ZLSB, idx at 0}
+    parameter integer ZLSB = 20,
+    parameter integer IDX_W = 20,
+    parameter integer AW = 2,
+    parameter integer ADDR_W = 32
 ) (
     input  wire          clk,
     input  wire          rst,
@@ -28,20 +30,21 @@ module core_depth #(
     input  wire          rd_ready,
     output wire [29:0]   rd_addr,
     input  wire          rsp_valid,
-    input  wire [31:0]   rsp_data,
+    input  wire [23:0]   rsp_data,
     // memory: depth writes
     output wire          wr_valid,
     input  wire          wr_ready,
     output wire [29:0]   wr_addr,
-    output wire [31:0]   wr_data,
+    output wire [23:0]   wr_data,
     output wire          idle,
     output wire          passed    // a pixel passed this cycle (counter)
 );
-  function [29:0] zaddr(input [27:0] base, input [21:0] idx);
-    reg [30:0] a;
+`include "core_addr.vh"
+  function [29:0] zaddr(input [27:0] base, input [IDX_W-1:0] idx);
+    reg [31:0] a;
     begin
-      a = {1'b0, base, 2'b00} + {9'd0, idx};
-      zaddr = a[30] ? 30'h3FFFFFFF : a[29:0];  // beyond 4 GiB: an address no VRAM has
+      a = byte_addr(base, {{(22-IDX_W){1'b0}}, idx, 2'b00});
+      zaddr = a[31:2];
     end
   endfunction
 
@@ -58,12 +61,14 @@ module core_depth #(
     endcase
   endfunction
 
+  wire active = z_test || z_write;
+
   // ---- read queue (Z_TEST) ----
   wire          q_full, q_empty, q_head;
   wire [PW-1:0] q_item;
-  wire [31:0]   q_data;
+  wire [23:0]   q_data;
   wire          take;
-  core_rdq #(.IW(PW), .DW(32), .AW(AW)) queue (
+  core_rdq #(.IW(PW), .DW(24), .AW(AW)) queue (
       .clk(clk), .rst(rst),
       .push(rd_valid && rd_ready), .push_item(in_pix),
       .full(q_full), .empty(q_empty),
@@ -71,26 +76,38 @@ module core_depth #(
       .head_valid(q_head), .head_item(q_item), .head_data(q_data), .pop(z_test && take));
 
   assign rd_valid = z_test && in_valid && !q_full;
-  assign rd_addr  = zaddr(fb_z16, in_pix[21:0]);
+  assign rd_addr  = zaddr(fb_z16, in_pix[IDX_W-1:0]);
 
-  // the pixel being resolved: the queue head (Z_TEST) or the input (no test)
+  // the pixel being resolved: the queue head (Z_TEST) or the input
   wire [PW-1:0] cur = z_test ? q_item : in_pix;
   wire          cur_valid = z_test ? q_head : in_valid;
   wire [23:0]   cur_z = cur[ZLSB+23:ZLSB];
-  wire          pass = !z_test || passes(z_func, cur_z, q_data[23:0]);
+  wire          pass = !z_test || passes(z_func, cur_z, q_data);
 
-  wire room;
+  // output register (depth active); room from registered state only
+  reg           o_valid;
+  reg [PW-1:0]  o_pix;
+  wire          room = !o_valid;
   // a pixel is resolved when it fails, or passes with room behind and its depth write accepted
   assign take     = cur_valid && (!pass || (room && (!z_write || wr_ready)));
-  assign wr_valid = cur_valid && pass && z_write && room;
-  assign wr_addr  = zaddr(fb_z16, cur[21:0]);
-  assign wr_data  = {8'd0, cur_z};
-  assign in_ready = z_test ? (!q_full && rd_ready) : take;
-  assign passed   = take && pass;
+  assign wr_valid = active && cur_valid && pass && z_write && room;
+  assign wr_addr  = zaddr(fb_z16, cur[IDX_W-1:0]);
+  assign wr_data  = cur_z;
+  assign in_ready = !active ? out_ready : z_test ? (!q_full && rd_ready) : take;
+  assign passed   = active ? (take && pass) : (in_valid && out_ready);
 
-  core_fifo2 #(.W(PW)) out_fifo (
-      .clk(clk), .rst(rst), .push(take && pass), .din(cur), .room(room),
-      .valid(out_valid), .dout(out_pix), .pop(out_ready));
+  always @(posedge clk) begin
+    if (rst) begin
+      o_valid <= 1'b0;
+    end else if (active && take && pass) begin
+      o_valid <= 1'b1;
+      o_pix   <= cur;
+    end else if (out_ready) begin
+      o_valid <= 1'b0;
+    end
+  end
+  assign out_valid = active ? o_valid : in_valid;
+  assign out_pix   = active ? o_pix : in_pix;
 
-  assign idle = q_empty && !out_valid;
+  assign idle = q_empty && !o_valid;
 endmodule

@@ -1,6 +1,8 @@
 // The core's one memory request stream (the soc's arbiter port): a fixed-priority choice among
 // the stages' requests, a write combiner on colour writes, the order of outstanding reads, and
-// a two-entry output queue so no ready reaches back combinationally into the stages.
+// an output register. The stages' requests depend only on their registered state; the grants
+// depend on those requests, the output register and mem_req_ready (which may depend on
+// mem_req_valid: that is a register).
 //
 // Priority, highest first: clear writes, colour writes, colour reads, texel reads, depth
 // writes, depth reads - later pipeline stages first, so the pipeline drains. Reads complete in
@@ -44,7 +46,7 @@ module core_memport #(
     input  wire        zw_valid,
     output wire        zw_ready,
     input  wire [29:0] zw_addr,
-    input  wire [31:0] zw_data,
+    input  wire [23:0] zw_data,
     // depth reads
     input  wire        zr_valid,
     output wire        zr_ready,
@@ -98,8 +100,9 @@ module core_memport #(
   assign tr_rsp = mem_rsp_valid && rsp_tag == T_TR;
   assign zr_rsp = mem_rsp_valid && rsp_tag == T_ZR;
 
-  // ---- output queue ----
-  wire       o_room;
+  // ---- output register ----
+  reg        o_valid;
+  wire       o_room = !o_valid || mem_req_ready;
   reg        g_we;
   reg [29:0] g_addr;
   reg [31:0] g_data;
@@ -123,7 +126,7 @@ module core_memport #(
     g_we   = gnt[0] | gnt[1] | gnt[4];
     g_addr = gnt[0] ? clr_addr : gnt[1] ? p_addr : gnt[2] ? cr_addr : gnt[3] ? tr_addr :
              gnt[4] ? zw_addr : zr_addr;
-    g_data = gnt[0] ? clr_data : gnt[1] ? p_data : zw_data;
+    g_data = gnt[0] ? clr_data : gnt[1] ? p_data : {8'd0, zw_data};
     g_be   = gnt[0] ? clr_be : gnt[1] ? p_be : 4'b1111;
   end
   assign clr_ready = gnt[0];
@@ -146,11 +149,28 @@ module core_memport #(
     end
   end
 
-  wire [66:0] o_dout;
-  core_fifo2 #(.W(67)) out_q (
-      .clk(clk), .rst(rst), .push(g_any), .din({g_we, g_addr, g_data, g_be}), .room(o_room),
-      .valid(mem_req_valid), .dout(o_dout), .pop(mem_req_ready));
-  assign {mem_req_we, mem_req_addr, mem_req_wdata, mem_req_be} = o_dout;
+  reg        o_we;
+  reg [29:0] o_addr;
+  reg [31:0] o_data;
+  reg [3:0]  o_be;
+  always @(posedge clk) begin
+    if (rst) begin
+      o_valid <= 1'b0;
+    end else if (o_room) begin
+      o_valid <= g_any;
+      if (g_any) begin
+        o_we   <= g_we;
+        o_addr <= g_addr;
+        o_data <= g_data;
+        o_be   <= g_be;
+      end
+    end
+  end
+  assign mem_req_valid = o_valid;
+  assign mem_req_we    = o_we;
+  assign mem_req_addr  = o_addr;
+  assign mem_req_wdata = o_data;
+  assign mem_req_be    = o_be;
 
-  assign idle = !p_valid && !mem_req_valid && (tw == tr);
+  assign idle = !p_valid && !o_valid && (tw == tr);
 endmodule

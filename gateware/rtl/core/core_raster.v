@@ -16,24 +16,28 @@
 //
 // Outputs form a two-stage pipeline with the steppers: `op` (stepper move), `emit` and the
 // pixel position are registered together; the steppers apply `op` in the next enabled cycle.
-module core_raster (
+module core_raster #(
+    parameter integer IDX_W = 20
+) (
     input  wire               clk,
     input  wire               rst,
     input  wire               start,   // pulse: begin a triangle (setup outputs valid)
-    input  wire signed [35:0] e0_i, e1_i, e2_i,
-    input  wire signed [21:0] ex0_i, ex1_i, ex2_i,
-    input  wire signed [21:0] ey0_i, ey1_i, ey2_i,
+    input  wire signed [35:0] e0_i, e1_i, e2_i,  // biased edge values at the origin
+    input  wire signed [16:0] dx0, dx1, dx2,     // edge deltas (held by setup while drawing):
+    input  wire signed [16:0] dy0, dy1, dy2,     //   E steps by -16 dy right, 16 dx down
     input  wire [10:0]        box_x0, box_y0, box_x1, box_y1,
+    input  wire [IDX_W-1:0]   origin_idx,        // box_y0 * fb_width + box_x0
     input  wire [10:0]        fb_width,
     input  wire               ltr,     // emit every row left to right
     input  wire               adv,     // the whole raster/stepper pipeline may advance
     input  wire               hold,    // raster itself must not move this cycle (serial mode)
     output wire               active,  // walking a triangle
     output reg  [1:0]         op,      // OP_NONE / OP_RIGHT / OP_LEFT / OP_DOWN
+    output wire [1:0]         op_next, // what `op` holds after this cycle's edge
     output reg                emit,    // the pixel reached by `op` is covered: emit it
     output reg  [10:0]        px,
     output reg  [10:0]        py,
-    output reg  [21:0]        pidx     // py * fb_width + px
+    output reg  [IDX_W-1:0]   pidx     // py * fb_width + px
 );
   localparam [1:0] OP_NONE = 2'd0, OP_RIGHT = 2'd1, OP_LEFT = 2'd2, OP_DOWN = 2'd3;
   localparam [2:0] R_IDLE = 3'd0, R_ENTRY = 3'd1, R_SEEK = 3'd2, R_TOEND = 3'd3, R_EMIT = 3'd4,
@@ -42,26 +46,34 @@ module core_raster (
 
   reg [2:0] st;
   reg signed [35:0] e0, e1, e2;
-  reg signed [21:0] ex0, ex1, ex2, ey0, ey1, ey2;
-  reg [10:0] x, y, xlo, xhi, yhi, w;
-  reg [21:0] rowb;       // y * fb_width
+  reg [10:0] x, y, xlo, xhi, yhi;
+  reg [IDX_W-1:0] idx;   // y * fb_width + x
   reg        mdir;       // direction of the current move / emission
   reg        last_dir;   // emission direction of the previous row
   reg        order;      // ltr latched
 
   assign active = (st != R_IDLE);
 
-  // one adder per edge: E + (ex | -ex | ey)
+  // one adder per edge: E - 16 dy (right), E + 16 dy (left), E + 16 dx (down)
   reg  [1:0] sel;
-  wire signed [35:0] s0 = (sel == OP_DOWN) ? 36'(ey0) : (sel == OP_LEFT) ? -(36'(ex0)) : 36'(ex0);
-  wire signed [35:0] s1 = (sel == OP_DOWN) ? 36'(ey1) : (sel == OP_LEFT) ? -(36'(ex1)) : 36'(ex1);
-  wire signed [35:0] s2 = (sel == OP_DOWN) ? 36'(ey2) : (sel == OP_LEFT) ? -(36'(ex2)) : 36'(ex2);
-  wire signed [35:0] n0 = e0 + s0, n1 = e1 + s1, n2 = e2 + s2;
+  wire sub = (sel != OP_LEFT && sel != OP_DOWN);
+  function signed [35:0] step(input signed [35:0] e, input signed [16:0] dx, input signed [16:0] dy,
+                              input [1:0] s, input sb);
+    reg signed [35:0] o;
+    begin
+      o = {{15{(s == OP_DOWN) ? dx[16] : dy[16]}}, (s == OP_DOWN) ? dx : dy, 4'd0};
+      step = sb ? e - o : e + o;
+    end
+  endfunction
+  wire signed [35:0] n0 = step(e0, dx0, dy0, sel, sub);
+  wire signed [35:0] n1 = step(e1, dx1, dy1, sel, sub);
+  wire signed [35:0] n2 = step(e2, dx2, dy2, sel, sub);
   wire ncov = !n0[35] && !n1[35] && !n2[35];
   wire cov = !e0[35] && !e1[35] && !e2[35];
   // sides on which covered pixels of this row can lie, from the failing edges
-  wire right_ok = !(e0[35] && ex0 <= 0) && !(e1[35] && ex1 <= 0) && !(e2[35] && ex2 <= 0);
-  wire left_ok  = !(e0[35] && ex0 >= 0) && !(e1[35] && ex1 >= 0) && !(e2[35] && ex2 >= 0);
+  // (ex = -16 dy: a failing edge with dy < 0 grows to the right)
+  wire right_ok = !(e0[35] && dy0 >= 0) && !(e1[35] && dy1 >= 0) && !(e2[35] && dy2 >= 0);
+  wire left_ok  = !(e0[35] && dy0 <= 0) && !(e1[35] && dy1 <= 0) && !(e2[35] && dy2 <= 0);
   wire can_r = (x != xhi);
   wire can_l = (x != xlo);
   wire last_row = (y == yhi);
@@ -161,7 +173,11 @@ module core_raster (
 
   wire [10:0] x_n = !go ? x : (sel == OP_RIGHT) ? x + 11'd1 : (sel == OP_LEFT) ? x - 11'd1 : x;
   wire [10:0] y_n = (go && sel == OP_DOWN) ? y + 11'd1 : y;
-  wire [21:0] rowb_n = (go && sel == OP_DOWN) ? rowb + {11'd0, w} : rowb;
+  wire [IDX_W-1:0] w = {{(IDX_W-11){1'b0}}, fb_width};
+  wire [IDX_W-1:0] idx_n = !go ? idx : (sel == OP_RIGHT) ? idx + 1'b1 : (sel == OP_LEFT) ? idx - 1'b1 :
+                           (sel == OP_DOWN) ? idx + w : idx;
+
+  assign op_next = (rst || start) ? OP_NONE : !adv ? op : (hold || st == R_IDLE || !go) ? OP_NONE : sel;
 
   always @(posedge clk) begin
     if (rst) begin
@@ -171,15 +187,12 @@ module core_raster (
     end else if (start) begin
       st       <= R_ENTRY;
       e0 <= e0_i; e1 <= e1_i; e2 <= e2_i;
-      ex0 <= ex0_i; ex1 <= ex1_i; ex2 <= ex2_i;
-      ey0 <= ey0_i; ey1 <= ey1_i; ey2 <= ey2_i;
       x        <= box_x0;
       y        <= box_y0;
       xlo      <= box_x0;
       xhi      <= box_x1 - 11'd1;
       yhi      <= box_y1 - 11'd1;
-      w        <= fb_width;
-      rowb     <= 22'(box_y0 * fb_width);
+      idx      <= origin_idx;
       last_dir <= DIR_L;
       mdir     <= DIR_R;
       order    <= ltr;
@@ -198,12 +211,12 @@ module core_raster (
         end
         x    <= x_n;
         y    <= y_n;
-        rowb <= rowb_n;
+        idx  <= idx_n;
         op   <= go ? sel : OP_NONE;
         emit <= emit_n;
         px   <= x_n;
         py   <= y_n;
-        pidx <= rowb_n + {11'd0, x_n};
+        pidx <= idx_n;
       end
     end
   end

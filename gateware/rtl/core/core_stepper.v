@@ -3,45 +3,62 @@
 //   (q, r) += (qs, rs); if r >= 2D: r -= 2D, q += 1
 // with (qs, rs) the plane's step right, left or down. The same integers as
 // floor((2N + D) / 2D) at every pixel, with no division per pixel and no drift.
+// The three steps live in registers, or (EBR = 1, for the iCE40) in a block RAM read one cycle
+// ahead with the rasteriser's next op as the address.
 module core_stepper #(
     parameter integer QW = 32,
-    parameter integer RW = 35
+    parameter integer RW = 35,
+    parameter integer EBR = 0
 ) (
     input  wire          clk,
-    input  wire          load,   // setup writes the plane (value at the box origin and steps)
-    input  wire [QW-1:0] q0,
-    input  wire [RW-1:0] r0,
-    input  wire [QW-1:0] qx,
-    input  wire [RW-1:0] rx,
-    input  wire [QW-1:0] qxl,
-    input  wire [RW-1:0] rxl,
-    input  wire [QW-1:0] qy,
-    input  wire [RW-1:0] ry,
+    input  wire          we,       // setup writes a field: 0 value at the origin, 1 right, 2 left, 3 down
+    input  wire [1:0]    field,
+    input  wire [QW-1:0] wq,
+    input  wire [RW-1:0] wr,
     input  wire [RW-1:0] den,
     input  wire          en,
-    input  wire [1:0]    op,     // 0 none, 1 right, 2 left, 3 down
+    input  wire [1:0]    op,       // 0 none, 1 right, 2 left, 3 down (the field numbers)
+    input  wire [1:0]    op_next,  // the op of the next enabled cycle (EBR read address)
     output reg  [QW-1:0] q
 );
-  reg [RW-1:0] r;
-  reg [QW-1:0] sxq, sxlq, syq;
-  reg [RW-1:0] sxr, sxlr, syr;
+  reg  [RW-1:0] r;
+  wire [QW-1:0] sq;
+  wire [RW-1:0] sr;
+  generate
+    if (EBR != 0) begin : ebr_steps
+      reg [QW+RW-1:0] steps[0:3];
+      reg [QW+RW-1:0] rd;
+      always @(posedge clk) begin
+        if (we && field != 2'd0) steps[field] <= {wq, wr};
+        rd <= steps[op_next];
+      end
+      assign {sq, sr} = rd;
+    end else begin : reg_steps
+      reg [QW-1:0] sxq, sxlq, syq;
+      reg [RW-1:0] sxr, sxlr, syr;
+      always @(posedge clk) begin
+        if (we) begin
+          case (field)
+            2'd1: begin sxq <= wq; sxr <= wr; end
+            2'd2: begin sxlq <= wq; sxlr <= wr; end
+            2'd3: begin syq <= wq; syr <= wr; end
+            default: ;
+          endcase
+        end
+      end
+      assign sq = (op == 2'd1) ? sxq : (op == 2'd2) ? sxlq : syq;
+      assign sr = (op == 2'd1) ? sxr : (op == 2'd2) ? sxlr : syr;
+    end
+  endgenerate
 
-  wire [QW-1:0] sq = (op == 2'd1) ? sxq : (op == 2'd2) ? sxlq : syq;
-  wire [RW-1:0] sr = (op == 2'd1) ? sxr : (op == 2'd2) ? sxlr : syr;
   wire [RW:0]   t = {1'b0, r} + {1'b0, sr};
   wire [RW+1:0] u = {1'b0, t} - {2'b0, den};
   wire          wrap = !u[RW+1];  // t >= 2D
 
   always @(posedge clk) begin
-    if (load) begin
-      q    <= q0;
-      r    <= r0;
-      sxq  <= qx;
-      sxr  <= rx;
-      sxlq <= qxl;
-      sxlr <= rxl;
-      syq  <= qy;
-      syr  <= ry;
+    if (we && field == 2'd0) begin
+      q <= wq;
+      r <= wr;
     end else if (en && op != 2'd0) begin
       q <= q + sq + {{(QW-1){1'b0}}, wrap};
       r <= wrap ? u[RW-1:0] : t[RW-1:0];

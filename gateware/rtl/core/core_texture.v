@@ -9,7 +9,9 @@
 // the texel reads, then wait in a read queue for their words. Pixel record in: the depth stage's
 // {q, t, s, rgba, yl, xl, z, idx}; out: the colour stage's {yl, xl, idx, rgba}.
 module core_texture #(
-    parameter integer AW = 2  // log2 of pixels whose texels are in flight
+    parameter integer AW = 2,  // log2 of pixels whose texels are in flight
+    parameter integer IDX_W = 20,
+    parameter integer ADDR_W = 32
 ) (
     input  wire         clk,
     input  wire         rst,
@@ -23,10 +25,10 @@ module core_texture #(
     input  wire         decal,
     input  wire         in_valid,
     output wire         in_ready,
-    input  wire [177:0] in_pix,
+    input  wire [IDX_W+155:0] in_pix,
     output reg          out_valid,
     input  wire         out_ready,
-    output reg  [57:0]  out_pix,
+    output reg  [IDX_W+35:0] out_pix,
     output wire         rd_valid,
     input  wire         rd_ready,
     output wire [29:0]  rd_addr,
@@ -38,10 +40,12 @@ module core_texture #(
   // ---------------------------------------------------------------- coordinate pipeline
   wire en;  // the coordinate pipeline advances
 
-  wire [31:0] in_q = in_pix[177:146];
-  wire [31:0] in_t = in_pix[145:114];
-  wire [31:0] in_s = in_pix[113:82];
-  wire [57:0] in_pay = {in_pix[49:46], in_pix[21:0], in_pix[81:50]};  // {yl, xl, idx, rgba}
+`include "core_addr.vh"
+  localparam integer PAY = IDX_W + 36;  // {yl, xl, idx, rgba}
+  wire [31:0] in_q = in_pix[IDX_W+155:IDX_W+124];
+  wire [31:0] in_t = in_pix[IDX_W+123:IDX_W+92];
+  wire [31:0] in_s = in_pix[IDX_W+91:IDX_W+60];
+  wire [PAY-1:0] in_pay = {in_pix[IDX_W+27:IDX_W+24], in_pix[IDX_W-1:0], in_pix[IDX_W+59:IDX_W+28]};
 
   function [5:0] clz32(input [31:0] v);
     integer k;
@@ -61,24 +65,24 @@ module core_texture #(
   reg        v1, qz1;
   reg [4:0]  n1;
   reg [31:0] m1, s1, t1;
-  reg [57:0] pay1;
+  reg [PAY-1:0] pay1;
   // stage 2: p = m * y0
   reg        v2, qz2;
   reg [4:0]  n2;
   reg [63:0] p2;
   reg [31:0] y02, s2, t2;
-  reg [57:0] pay2;
+  reg [PAY-1:0] pay2;
   // stage 3: y0 * (2 - M y0)
   reg        v3, qz3;
   reg [4:0]  n3;
   reg [63:0] yt3;
   reg [31:0] s3, t3;
-  reg [57:0] pay3;
+  reg [PAY-1:0] pay3;
   // stage 4: s * y, t * y
   reg        v4, qz4;
   reg [4:0]  n4;
   reg signed [63:0] su4, tv4;
-  reg [57:0] pay4;
+  reg [PAY-1:0] pay4;
 
   wire [63:0] negp = 64'd0 - p2;
   wire [31:0] tnr = negp[63:32];                            // 2 - M y as u1.31
@@ -133,12 +137,9 @@ module core_texture #(
 
   function [31:0] taddr(input [27:0] base, input [9:0] i, input [9:0] j, input [3:0] lg, input [1:0] f);
     reg [19:0] off;
-    reg [32:0] a;
     begin
       off = ({10'd0, j} << lg) | {10'd0, i};
-      a = {1'b0, base, 4'd0} + ((f == 2'd0) ? {11'd0, off, 2'd0} : (f == 2'd1) ? {12'd0, off, 1'd0}
-                                                                              : {13'd0, off});
-      taddr = a[32] ? 32'hFFFFFFFF : a[31:0];
+      taddr = byte_addr(base, (f == 2'd0) ? {2'd0, off, 2'd0} : (f == 2'd1) ? {3'd0, off, 1'd0} : {4'd0, off});
     end
   endfunction
   wire [31:0] a00 = taddr(tex16, ia, ja, wl, tfmt), a10 = taddr(tex16, ib, ja, wl, tfmt);
@@ -148,7 +149,7 @@ module core_texture #(
   reg         v5, bil5;
   reg [29:0]  w00, w10, w01, w11;
   reg [7:0]   lanes5, fu5, fv5;
-  reg [57:0]  pay5;
+  reg [PAY-1:0] pay5;
   reg [1:0]   fi;   // next texel of this pixel to request
   wire        q_full;
   wire        last = !bil5 || fi == 2'd3;
@@ -182,7 +183,7 @@ module core_texture #(
 
   // ---------------------------------------------------------------- texel read queue
   localparam integer N = 1 << AW;
-  localparam integer IW = 58 + 8 + 8 + 8 + 1;
+  localparam integer IW = PAY + 8 + 8 + 8 + 1;
   reg [IW-1:0]  items[0:N-1];
   reg [127:0]   words[0:N-1];
   reg [AW:0]    wp, dp, rp;
@@ -235,8 +236,8 @@ module core_texture #(
   endfunction
   wire        hbil = hitem[IW-1];
   wire [7:0]  hl00 = hitem[IW-2:IW-9];
-  wire [7:0]  hfu = hitem[73:66], hfv = hitem[65:58];
-  wire [57:0] hpay = hitem[57:0];
+  wire [7:0]  hfu = hitem[PAY+15:PAY+8], hfv = hitem[PAY+7:PAY];
+  wire [PAY-1:0] hpay = hitem[PAY-1:0];
   wire [31:0] c00 = texel(hword[127:96], hl00[7:6], tfmt);
   wire [31:0] c10 = hbil ? texel(hword[95:64], hl00[5:4], tfmt) : c00;
   wire [31:0] c01 = hbil ? texel(hword[63:32], hl00[3:2], tfmt) : c00;
@@ -277,7 +278,7 @@ module core_texture #(
       out_valid <= 1'b0;
     end else if (ofree) begin
       out_valid <= hvalid;
-      if (hvalid) out_pix <= {hpay[57:32], comb};
+      if (hvalid) out_pix <= {hpay[PAY-1:32], comb};
     end
   end
   assign textured = pop;

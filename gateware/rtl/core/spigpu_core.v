@@ -9,8 +9,12 @@
 // commands is kept by draining the pixel pipeline before a draw's first request and before a
 // clear; the next triangle's setup overlaps that drain.
 module spigpu_core #(
-    parameter integer PROFILE  = 1,        // 0 up5k, 1 ecp5
-    parameter [7:0]   FEATURES = 8'h7F     // CAPS.FEATURES (bit 6: texturing)
+    parameter integer PROFILE    = 1,       // 0 up5k (small: serial setup, steps in block RAM, one
+                                            // read in flight per stage), 1 ecp5 (parallel, deeper)
+    parameter [7:0]   FEATURES   = 8'hBF,   // CAPS.FEATURES; bit 7: texturing
+    parameter integer MAX_WIDTH  = 1024,    // CAPS.MAX_WIDTH / MAX_HEIGHT
+    parameter integer MAX_HEIGHT = 1024,
+    parameter integer VRAM_KIB   = 32768    // CAPS.VRAM_KIB
 ) (
     input  wire         clk,
     input  wire         rst,
@@ -51,7 +55,14 @@ module spigpu_core #(
     output reg  [31:0]  perf_setup,       // cycles in triangle setup
     output reg  [31:0]  perf_raster       // cycles the rasteriser walked
 );
-  localparam F_TEXTURE = 6;
+  localparam F_BILINEAR = 0, F_TEXTURE = 7;
+  localparam integer TEX    = FEATURES[F_TEXTURE] ? 1 : 0;
+  localparam integer SMALL  = (PROFILE == 0) ? 1 : 0;
+  localparam integer IDX_W  = $clog2(MAX_WIDTH * MAX_HEIGHT);     // pixel index bits
+  localparam integer ADDR_W = $clog2(VRAM_KIB) + 10;              // byte address bits of VRAM
+  localparam integer Q_AW   = (SMALL != 0) ? 0 : 2;                      // log2 reads in flight per stage
+  localparam integer PW     = IDX_W + 60 + ((TEX != 0) ? 96 : 0);        // pixel record
+  localparam integer CW     = IDX_W + 36;                         // colour stage record
   localparam [1:0] OP_TRI = 2'd0, OP_CLEAR = 2'd1, OP_CLEAR_Z = 2'd2;
 
   // ---------------------------------------------------------------- command decode
@@ -76,7 +87,7 @@ module spigpu_core #(
   wire [7:0] need = {{3{tex_on}}, m_ztest || m_zwrite, {4{m_gouraud && colour_on}}};
 
   wire serial_n;
-  core_alias alias_check (
+  core_alias #(.ADDR_W(ADDR_W)) alias_check (
       .clk(clk), .fb_draw16(cmd_fb_draw), .fb_z16(cmd_fb_z), .tex16(cmd_tex_base),
       .width(cmd_fb_width), .height(cmd_fb_height), .fmt(cmd_fb_format), .tex_fmt(cmd_tex_fmt[17:16]),
       .tex_wl(cmd_tex_fmt[3:0]), .tex_hl(cmd_tex_fmt[7:4]), .colour_on(colour_on),
@@ -85,23 +96,25 @@ module spigpu_core #(
   // ---------------------------------------------------------------- setup
   wire        su_busy, su_done, su_draw;
   wire signed [35:0] su_e0, su_e1, su_e2;
-  wire signed [21:0] su_ex0, su_ex1, su_ex2, su_ey0, su_ey1, su_ey2;
+  wire signed [16:0] su_dx0, su_dx1, su_dx2, su_dy0, su_dy1, su_dy2;
   wire [10:0] su_bx0, su_by0, su_bx1, su_by1;
+  wire [IDX_W-1:0] su_idx;
   wire [34:0] su_den;
-  wire        pl_we;
-  wire [2:0]  pl_id;
-  wire [31:0] pl_q0, pl_qx, pl_qxl, pl_qy;
-  wire [34:0] pl_r0, pl_rx, pl_rxl, pl_ry;
+  wire        pw_en;
+  wire [2:0]  pw_attr;
+  wire [1:0]  pw_field;
+  wire [31:0] pw_q;
+  wire [34:0] pw_r;
   reg         su_go;
-  core_setup setup (
-      .clk(clk), .rst(rst), .start(su_go), .busy(su_busy), .done(su_done),
+  core_setup #(.SERIAL(SMALL), .TEX(TEX), .IDX_W(IDX_W)) setup (
+      .clk(clk), .rst(rst), .start(su_go), .busy(su_busy), .done(su_done), .draw(su_draw),
       .v0(cmd_v0), .v1(cmd_v1), .v2(cmd_v2),
-      .clip_x0(sc_x0), .clip_y0(sc_y0), .clip_x1(clip_x1), .clip_y1(clip_y1), .need(need),
-      .draw(su_draw), .e0(su_e0), .e1(su_e1), .e2(su_e2), .ex0(su_ex0), .ex1(su_ex1), .ex2(su_ex2),
-      .ey0(su_ey0), .ey1(su_ey1), .ey2(su_ey2),
-      .box_x0(su_bx0), .box_y0(su_by0), .box_x1(su_bx1), .box_y1(su_by1), .den(su_den),
-      .plane_we(pl_we), .plane_id(pl_id), .pq0(pl_q0), .pqx(pl_qx), .pqxl(pl_qxl), .pqy(pl_qy),
-      .pr0(pl_r0), .prx(pl_rx), .prxl(pl_rxl), .pry(pl_ry));
+      .clip_x0(sc_x0), .clip_y0(sc_y0), .clip_x1(clip_x1), .clip_y1(clip_y1), .width(cmd_fb_width),
+      .need(need),
+      .dx0(su_dx0), .dx1(su_dx1), .dx2(su_dx2), .dy0(su_dy0), .dy1(su_dy1), .dy2(su_dy2),
+      .e0(su_e0), .e1(su_e1), .e2(su_e2),
+      .box_x0(su_bx0), .box_y0(su_by0), .box_x1(su_bx1), .box_y1(su_by1), .origin_idx(su_idx),
+      .den(su_den), .pw_en(pw_en), .pw_attr(pw_attr), .pw_field(pw_field), .pw_q(pw_q), .pw_r(pw_r));
 
   // ---------------------------------------------------------------- render state of the draw
   reg        r_gouraud, r_tex, r_ztest, r_zwrite, r_dither, r_decal, r_serial, r_need_dst;
@@ -111,6 +124,7 @@ module spigpu_core #(
   reg [27:0] r_fb_draw, r_fb_z, r_tex_base;
   reg [17:0] r_tex_fmt;
   reg [31:0] r_flat;
+  reg [10:0] r_width;
   // clear state
   reg [27:0] k_base;
   reg [1:0]  k_bpp;
@@ -119,120 +133,118 @@ module spigpu_core #(
 
   // ---------------------------------------------------------------- rasteriser + steppers
   wire        ras_active;
-  wire [1:0]  ras_op;
+  wire [1:0]  ras_op, ras_op_next;
   wire        ras_emit;
   wire [10:0] ras_x, ras_y;
-  wire [21:0] ras_idx;
+  wire [IDX_W-1:0] ras_idx;
   reg         ras_go;
   wire        adv, hold;
-  core_raster raster (
+  core_raster #(.IDX_W(IDX_W)) raster (
       .clk(clk), .rst(rst), .start(ras_go),
-      .e0_i(su_e0), .e1_i(su_e1), .e2_i(su_e2), .ex0_i(su_ex0), .ex1_i(su_ex1), .ex2_i(su_ex2),
-      .ey0_i(su_ey0), .ey1_i(su_ey1), .ey2_i(su_ey2),
-      .box_x0(su_bx0), .box_y0(su_by0), .box_x1(su_bx1), .box_y1(su_by1), .fb_width(cmd_fb_width),
-      .ltr(serial_n), .adv(adv), .hold(hold), .active(ras_active), .op(ras_op), .emit(ras_emit),
-      .px(ras_x), .py(ras_y), .pidx(ras_idx));
+      .e0_i(su_e0), .e1_i(su_e1), .e2_i(su_e2),
+      .dx0(su_dx0), .dx1(su_dx1), .dx2(su_dx2), .dy0(su_dy0), .dy1(su_dy1), .dy2(su_dy2),
+      .box_x0(su_bx0), .box_y0(su_by0), .box_x1(su_bx1), .box_y1(su_by1), .origin_idx(su_idx),
+      .fb_width(r_width), .ltr(r_serial), .adv(adv), .hold(hold), .active(ras_active), .op(ras_op),
+      .op_next(ras_op_next), .emit(ras_emit), .px(ras_x), .py(ras_y), .pidx(ras_idx));
 
   wire [7:0]  a_r, a_g, a_b, a_a;
   wire [23:0] a_z;
-  wire [31:0] a_s, a_t, a_q;
+  wire [95:0] a_stq;
   genvar gi;
   generate
     for (gi = 0; gi < 4; gi = gi + 1) begin : colour_steppers
       wire [7:0] qv;
-      core_stepper #(.QW(8), .RW(35)) st (
-          .clk(clk), .load(pl_we && pl_id == gi), .q0(pl_q0[7:0]), .r0(pl_r0), .qx(pl_qx[7:0]), .rx(pl_rx),
-          .qxl(pl_qxl[7:0]), .rxl(pl_rxl), .qy(pl_qy[7:0]), .ry(pl_ry), .den(su_den), .en(adv),
-          .op(ras_op), .q(qv));
+      core_stepper #(.QW(8), .RW(35), .EBR(SMALL)) st (
+          .clk(clk), .we(pw_en && pw_attr == gi), .field(pw_field), .wq(pw_q[7:0]), .wr(pw_r),
+          .den(su_den), .en(adv), .op(ras_op), .op_next(ras_op_next), .q(qv));
     end
   endgenerate
   assign a_r = colour_steppers[0].qv;
   assign a_g = colour_steppers[1].qv;
   assign a_b = colour_steppers[2].qv;
   assign a_a = colour_steppers[3].qv;
-  core_stepper #(.QW(24), .RW(35)) z_stepper (
-      .clk(clk), .load(pl_we && pl_id == 3'd4), .q0(pl_q0[23:0]), .r0(pl_r0), .qx(pl_qx[23:0]), .rx(pl_rx),
-      .qxl(pl_qxl[23:0]), .rxl(pl_rxl), .qy(pl_qy[23:0]), .ry(pl_ry), .den(su_den), .en(adv),
-      .op(ras_op), .q(a_z));
+  core_stepper #(.QW(24), .RW(35), .EBR(SMALL)) z_stepper (
+      .clk(clk), .we(pw_en && pw_attr == 3'd4), .field(pw_field), .wq(pw_q[23:0]), .wr(pw_r),
+      .den(su_den), .en(adv), .op(ras_op), .op_next(ras_op_next), .q(a_z));
   generate
-    if (FEATURES[F_TEXTURE]) begin : tex_steppers
-      wire [31:0] qs, qt, qq;
-      core_stepper #(.QW(32), .RW(35)) s_st (
-          .clk(clk), .load(pl_we && pl_id == 3'd5), .q0(pl_q0), .r0(pl_r0), .qx(pl_qx), .rx(pl_rx),
-          .qxl(pl_qxl), .rxl(pl_rxl), .qy(pl_qy), .ry(pl_ry), .den(su_den), .en(adv), .op(ras_op), .q(qs));
-      core_stepper #(.QW(32), .RW(35)) t_st (
-          .clk(clk), .load(pl_we && pl_id == 3'd6), .q0(pl_q0), .r0(pl_r0), .qx(pl_qx), .rx(pl_rx),
-          .qxl(pl_qxl), .rxl(pl_rxl), .qy(pl_qy), .ry(pl_ry), .den(su_den), .en(adv), .op(ras_op), .q(qt));
-      core_stepper #(.QW(32), .RW(35)) q_st (
-          .clk(clk), .load(pl_we && pl_id == 3'd7), .q0(pl_q0), .r0(pl_r0), .qx(pl_qx), .rx(pl_rx),
-          .qxl(pl_qxl), .rxl(pl_rxl), .qy(pl_qy), .ry(pl_ry), .den(su_den), .en(adv), .op(ras_op), .q(qq));
-      assign a_s = qs;
-      assign a_t = qt;
-      assign a_q = qq;
+    if (TEX != 0) begin : tex_steppers
+      for (gi = 5; gi < 8; gi = gi + 1) begin : stq
+        wire [31:0] qv;
+        core_stepper #(.QW(32), .RW(35), .EBR(SMALL)) st (
+            .clk(clk), .we(pw_en && pw_attr == gi), .field(pw_field), .wq(pw_q), .wr(pw_r),
+            .den(su_den), .en(adv), .op(ras_op), .op_next(ras_op_next), .q(qv));
+      end
+      assign a_stq = {stq[7].qv, stq[6].qv, stq[5].qv};
     end else begin : no_tex_steppers
-      assign a_s = 32'd0;
-      assign a_t = 32'd0;
-      assign a_q = 32'd0;
+      assign a_stq = 96'd0;
     end
   endgenerate
 
   // emitted pixel record, aligned with the steppers' values
   reg        emit2;
-  reg [10:0] x2, y2;
-  reg [21:0] idx2;
+  reg [1:0]  x2, y2;
+  reg [IDX_W-1:0] idx2;
   always @(posedge clk) begin
     if (rst) emit2 <= 1'b0;
     else if (ras_go) emit2 <= 1'b0;
     else if (adv) begin
       emit2 <= ras_emit;
-      x2    <= ras_x;
-      y2    <= ras_y;
+      x2    <= ras_x[1:0];
+      y2    <= ras_y[1:0];
       idx2  <= ras_idx;
     end
   end
   wire [31:0] src_rgba = r_gouraud ? {a_r, a_g, a_b, a_a} : r_flat;
-  wire [177:0] pix = {a_q, a_t, a_s, src_rgba, y2[1:0], x2[1:0], a_z, idx2};
+  wire [PW-1:0] pix;
+  generate
+    if (TEX != 0) begin : pix_tex
+      assign pix = {a_stq, src_rgba, y2, x2, a_z, idx2};
+    end else begin : pix_plain
+      assign pix = {src_rgba, y2, x2, a_z, idx2};
+    end
+  endgenerate
 
   // ---------------------------------------------------------------- depth stage
   wire         d_in_ready, d_out_valid, d_out_ready, d_idle, d_passed;
-  wire [177:0] d_out;
+  wire [PW-1:0] d_out;
   wire         zr_valid, zr_ready, zr_rsp, zw_valid, zw_ready;
   wire [29:0]  zr_addr, zw_addr;
-  wire [31:0]  zw_data;
-  core_depth #(.PW(178), .ZLSB(22), .AW(2)) depth (
+  wire [23:0]  zw_data;
+  core_depth #(.PW(PW), .ZLSB(IDX_W), .IDX_W(IDX_W), .AW(Q_AW), .ADDR_W(ADDR_W)) depth (
       .clk(clk), .rst(rst), .z_test(r_ztest), .z_func(r_zfunc), .z_write(r_zwrite), .fb_z16(r_fb_z),
       .in_valid(emit2), .in_ready(d_in_ready), .in_pix(pix),
       .out_valid(d_out_valid), .out_ready(d_out_ready), .out_pix(d_out),
-      .rd_valid(zr_valid), .rd_ready(zr_ready), .rd_addr(zr_addr), .rsp_valid(zr_rsp), .rsp_data(mem_rsp_rdata),
+      .rd_valid(zr_valid), .rd_ready(zr_ready), .rd_addr(zr_addr), .rsp_valid(zr_rsp), .rsp_data(mem_rsp_rdata[23:0]),
       .wr_valid(zw_valid), .wr_ready(zw_ready), .wr_addr(zw_addr), .wr_data(zw_data), .idle(d_idle),
       .passed(d_passed));
 
   // ---------------------------------------------------------------- texture unit
-  wire        c_in_valid, c_in_ready;
-  wire [57:0] c_in;
-  wire        tr_valid, tr_ready, tr_rsp;
-  wire [29:0] tr_addr;
-  wire        t_idle, t_count;
-  reg         colour_on_r;
+  wire          c_in_valid, c_in_ready;
+  wire [CW-1:0] c_in;
+  wire          tr_valid, tr_ready, tr_rsp;
+  wire [29:0]   tr_addr;
+  wire          t_idle, t_count;
+  reg           colour_on_r;
+  wire [CW-1:0] d_colour = {d_out[IDX_W+27:IDX_W+24], d_out[IDX_W-1:0], d_out[IDX_W+59:IDX_W+28]};
   generate
-    if (FEATURES[F_TEXTURE]) begin : texturing
-      wire        t_in_ready, t_out_valid;
-      wire [57:0] t_out;
-      core_texture #(.AW(2)) texture (
+    if (TEX != 0) begin : texturing
+      wire          t_in_ready, t_out_valid;
+      wire [CW-1:0] t_out;
+      core_texture #(.AW(Q_AW), .IDX_W(IDX_W), .ADDR_W(ADDR_W)) texture (
           .clk(clk), .rst(rst), .tex16(r_tex_base), .wl(r_tex_fmt[3:0]), .hl(r_tex_fmt[7:4]),
-          .wrap_s(r_tex_fmt[9:8]), .wrap_t(r_tex_fmt[11:10]), .bilinear(r_tex_fmt[12] && FEATURES[0]),
-          .tfmt(r_tex_fmt[17:16]), .decal(r_decal),
+          .wrap_s(r_tex_fmt[9:8]), .wrap_t(r_tex_fmt[11:10]),
+          .bilinear(r_tex_fmt[12] && FEATURES[F_BILINEAR]), .tfmt(r_tex_fmt[17:16]), .decal(r_decal),
           .in_valid(d_out_valid && r_tex), .in_ready(t_in_ready), .in_pix(d_out),
           .out_valid(t_out_valid), .out_ready(c_in_ready), .out_pix(t_out),
           .rd_valid(tr_valid), .rd_ready(tr_ready), .rd_addr(tr_addr), .rsp_valid(tr_rsp),
           .rsp_data(mem_rsp_rdata), .idle(t_idle), .textured(t_count));
       assign c_in_valid  = r_tex ? t_out_valid : (d_out_valid && colour_on_r);
       assign d_out_ready = r_tex ? t_in_ready : (colour_on_r ? c_in_ready : 1'b1);
-      assign c_in        = r_tex ? t_out : {d_out[49:46], d_out[21:0], d_out[81:50]};
+      assign c_in        = r_tex ? t_out : d_colour;
     end else begin : no_texturing
       assign c_in_valid  = d_out_valid && colour_on_r;
       assign d_out_ready = colour_on_r ? c_in_ready : 1'b1;
-      assign c_in        = {d_out[49:46], d_out[21:0], d_out[81:50]};
+      assign c_in        = d_colour;
       assign tr_valid    = 1'b0;
       assign tr_addr     = 30'd0;
       assign t_idle      = 1'b1;
@@ -245,7 +257,7 @@ module spigpu_core #(
   wire [29:0] cr_addr, cw_addr;
   wire [31:0] cw_data;
   wire [3:0]  cw_be;
-  core_color #(.AW(2), .FEATURES(FEATURES)) colour (
+  core_color #(.AW(Q_AW), .IDX_W(IDX_W), .ADDR_W(ADDR_W), .FEATURES(FEATURES)) colour (
       .clk(clk), .rst(rst), .fmt(r_fmt), .fb_draw16(r_fb_draw), .blend(r_blend), .dither(r_dither),
       .keep(r_keep), .need_dst(r_need_dst),
       .in_valid(c_in_valid), .in_ready(c_in_ready), .in_pix(c_in),
@@ -259,7 +271,7 @@ module spigpu_core #(
   wire [31:0] k_data;
   wire [3:0]  k_be;
   reg         k_go;
-  core_clear clear (
+  core_clear #(.ADDR_W(ADDR_W)) clear (
       .clk(clk), .rst(rst), .start(k_go), .base16(k_base), .bpp_log2(k_bpp), .pattern(k_pattern),
       .width(k_w), .x0(k_x0), .y0(k_y0), .x1(k_x1), .y1(k_y1), .busy(k_busy),
       .wr_valid(k_valid), .wr_ready(k_ready), .wr_addr(k_addr), .wr_data(k_data), .wr_be(k_be));
@@ -269,7 +281,7 @@ module spigpu_core #(
   wire pipe_idle = !ras_active && ras_op == 2'd0 && !ras_emit && !emit2;
   wire stages_idle = d_idle && t_idle && c_idle;
   wire drained = pipe_idle && stages_idle && m_idle && !k_busy;
-  core_memport #(.TAGS_AW(3), .COMBINE(1)) memport (
+  core_memport #(.TAGS_AW((SMALL != 0) ? 1 : 3), .COMBINE(1)) memport (
       .clk(clk), .rst(rst), .flush(!ras_active || r_serial),
       .clr_valid(k_valid), .clr_ready(k_ready), .clr_addr(k_addr), .clr_data(k_data), .clr_be(k_be),
       .cw_valid(cw_valid), .cw_ready(cw_ready), .cw_addr(cw_addr), .cw_data(cw_data), .cw_be(cw_be),
@@ -357,6 +369,7 @@ module spigpu_core #(
           r_tex_base  <= cmd_tex_base;
           r_tex_fmt   <= cmd_tex_fmt;
           r_flat      <= cmd_v0[87:56];
+          r_width     <= cmd_fb_width;
           r_serial    <= serial_n;
           r_need_dst  <= (cmd_tri_mode[8:7] != 2'd0) || (some_masked && !all_masked && cmd_fb_format != 2'd0);
           colour_on_r <= colour_on;

@@ -2,8 +2,9 @@
 
 #include <stdexcept>
 
-#include "Vspigpu_core.h"
+#include "rtl_config.hpp"
 #include "verilated.h"
+#include GPUBRIDGE_RTL_MODEL_HEADER
 
 namespace gpubridge::rtl {
 namespace {
@@ -25,7 +26,7 @@ void put_vertex(VlWide<6>& w, const CoreVertex& v) {
 
 CoreHarness::CoreHarness(std::uint64_t vram_bytes, std::uint32_t seed, MemoryTiming timing)
     : ctx_(std::make_unique<VerilatedContext>()), mem_(vram_bytes, 0), rng_(seed), timing_(timing) {
-  top_ = std::make_unique<Vspigpu_core>(ctx_.get());
+  top_ = std::make_unique<Model>(ctx_.get());
   top_->rst = 1;
   top_->cmd_valid = 0;
   top_->mem_req_ready = 0;

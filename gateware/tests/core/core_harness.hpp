@@ -8,8 +8,8 @@
 #include <random>
 #include <vector>
 
-class Vspigpu_core;
 class VerilatedContext;
+class GPUBRIDGE_RTL_MODEL;
 
 namespace gpubridge::rtl {
 
@@ -67,7 +67,8 @@ class CoreHarness {
   bool idle() const;
 
   std::unique_ptr<VerilatedContext> ctx_;
-  std::unique_ptr<Vspigpu_core> top_;
+  using Model = GPUBRIDGE_RTL_MODEL;
+  std::unique_ptr<Model> top_;
   std::vector<std::uint8_t> mem_;
   std::mt19937 rng_;
   MemoryTiming timing_;

@@ -25,8 +25,8 @@ std::uint32_t env_u32(const char* name, std::uint32_t fallback) {
 
 class RandomStream {
  public:
-  RandomStream(std::uint32_t seed, std::uint64_t vram, std::uint8_t features)
-      : rng_(seed), vram_(vram), features_(features) {}
+  RandomStream(std::uint32_t seed, std::uint64_t vram, std::uint8_t features, bool texture)
+      : rng_(seed), vram_(vram), features_(features), texture_(texture) {}
 
   unsigned pick(unsigned n) { return std::uniform_int_distribution<unsigned>(0, n - 1)(rng_); }
   bool chance(double p) { return std::uniform_real_distribution<double>(0, 1)(rng_) < p; }
@@ -72,6 +72,21 @@ class RandomStream {
     if (features_ & sim::FEATURE_DITHER) mode |= std::uint64_t{pick(2)} << 9;
     if (chance(0.25)) mode |= std::uint64_t{pick(16)} << 10;  // write masks
     mode |= std::uint64_t{pick(2)} << 14;  // TEX_DECAL
+    if (texture_ && chance(0.5)) {
+      mode |= 2;  // TEXTURED
+      const unsigned wl = 3 + pick(8), hl = 3 + pick(8);
+      unsigned tfmt = pick(3);
+      if (tfmt == 1 && !(features_ & sim::FEATURE_RGB565)) tfmt = 0;
+      if (tfmt == 2 && !(features_ & sim::FEATURE_RGBA2222)) tfmt = 0;
+      std::uint64_t tex_fmt = wl | (hl << 4) | (std::uint64_t{pick(3)} << 8) | (std::uint64_t{pick(3)} << 10) |
+                              (std::uint64_t{tfmt} << 16);
+      if ((features_ & sim::FEATURE_BILINEAR) && chance(0.5)) tex_fmt |= 1u << 12;
+      const unsigned tbpp = tfmt == 0 ? 4 : tfmt == 1 ? 2 : 1;
+      std::uint32_t tex = address((std::uint64_t{1} << (wl + hl)) * tbpp);
+      if (chance(0.05)) tex = draw;  // sampling the buffer being drawn: serial mode
+      cs.write(Reg::TEX_BASE, tex);
+      cs.write(Reg::TEX_FMT, tex_fmt);
+    }
     cs.write(Reg::TRI_MODE, mode);
   }
 
@@ -120,6 +135,7 @@ class RandomStream {
   std::mt19937 rng_;
   std::uint64_t vram_;
   std::uint8_t features_;
+  bool texture_;
   unsigned width_ = 16, height_ = 16;
 };
 
@@ -131,7 +147,14 @@ TEST(CoreRandom, DrawsAndClearsMatchSimulator) {
   o.vram_bytes = 64 * 1024;
   o.features = kCoreFeatures;
   Cosim cs(o, seed);
-  RandomStream r(seed, o.vram_bytes, o.features);
+  RandomStream r(seed, o.vram_bytes, o.features, kCoreTexture);
+  // memory starts random (texels, stale buffers)
+  {
+    std::mt19937 fill(seed ^ 0x5EEDu);
+    std::vector<std::uint8_t> bytes(o.vram_bytes);
+    for (auto& b : bytes) b = static_cast<std::uint8_t>(fill());
+    cs.upload(0, bytes.data(), bytes.size());
+  }
   for (unsigned b = 0; b < batches; ++b) {
     r.state(cs);
     cs.write(Reg::PRIM, 0);
