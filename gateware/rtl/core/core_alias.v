@@ -1,9 +1,10 @@
 // Decides whether a draw must run in serial mode: when a buffer it reads overlaps one it writes
 // (colour and depth buffers, or the texture and either), the simulator's pixel order is
 // observable and the core must finish each pixel before starting the next and emit rows left to
-// right. Whole buffers are compared (W * H pixels), as the simulator does, clipped at 2^ADDR_W
-// (accesses beyond it are dropped or read 0 in any order). Registered in three steps; the
-// inputs are held during triangle setup, which takes longer.
+// right. Whole buffers are compared (W * H pixels), as the simulator does, in 16-byte blocks
+// (buffers start on 16-byte boundaries; rounding their ends up can only add false alarms),
+// clipped at 2^ADDR_W (accesses beyond it are dropped or read 0 in any order). Registered in
+// three steps; the inputs are held during triangle setup, which takes longer.
 module core_alias #(
     parameter integer ADDR_W = 32
 ) (
@@ -23,21 +24,24 @@ module core_alias #(
     input  wire        textured,   // texture sampled
     output reg         serial
 );
-  localparam integer BW = ((ADDR_W > 24) ? ADDR_W : 24) + 2;
-  localparam [BW-1:0] TOP = {{(BW - ADDR_W - 1){1'b0}}, 1'b1, {ADDR_W{1'b0}}};
+  localparam integer BW = ADDR_W - 2;  // block address bits plus headroom for the end
+  localparam [BW-1:0] TOP = {2'b01, {(BW - 2){1'b0}}};  // 2^ADDR_W / 16
   reg  [21:0] wh;
   reg  [BW-1:0] c0, c1, z0, z1, t0, t1;
-  wire [1:0]  cbl = (fmt == 2'd0) ? 2'd2 : (fmt == 2'd1) ? 2'd1 : 2'd0;
+  // buffer lengths in 16-byte blocks, rounded up
+  wire [21:0] cblocks = (fmt == 2'd0) ? {wh[19:0], 2'd0} + 22'd15 : (fmt == 2'd1) ? {wh[20:0], 1'd0} + 22'd15 : wh + 22'd15;
+  wire [21:0] zblocks = {wh[19:0], 2'd0} + 22'd15;
   wire [1:0]  tbl = (tex_fmt == 2'd0) ? 2'd2 : (tex_fmt == 2'd1) ? 2'd1 : 2'd0;
-  wire [4:0]  tl = 5'(tex_wl) + 5'(tex_hl) + 5'(tbl);
+  wire [4:0]  tl = 5'(tex_wl) + 5'(tex_hl) + 5'(tbl) - 5'd4;  // >= 2
   function [BW-1:0] lo(input [27:0] b16);  // start, clipped at 2^ADDR_W
-    lo = ((b16 >> (ADDR_W - 4)) != 28'd0) ? TOP : {{(BW - ADDR_W){1'b0}}, b16[ADDR_W-5:0], 4'd0};
+    lo = ((b16 >> (ADDR_W - 4)) != 28'd0) ? TOP : BW'(b16[ADDR_W-5:0]);
   endfunction
-  function [BW-1:0] hi(input [BW-1:0] start, input [23:0] len);  // end, clipped
-    reg [BW-1:0] e;
+  localparam integer EW = ((BW > 18) ? BW : 18) + 1;
+  function [BW-1:0] hi(input [BW-1:0] start, input [17:0] len);  // end, clipped
+    reg [EW-1:0] e;
     begin
-      e = start + {{(BW - 24){1'b0}}, len};
-      hi = (e > TOP) ? TOP : e;
+      e = {{(EW - BW){1'b0}}, start} + {{(EW - 18){1'b0}}, len};
+      hi = (e > {{(EW - BW){1'b0}}, TOP}) ? TOP : e[BW-1:0];
     end
   endfunction
   function ov(input [BW-1:0] a0, input [BW-1:0] a1, input [BW-1:0] b0, input [BW-1:0] b1);
@@ -46,11 +50,11 @@ module core_alias #(
   always @(posedge clk) begin
     wh <= 22'(width * height);
     c0 <= lo(fb_draw16);
-    c1 <= hi(lo(fb_draw16), {2'd0, wh} << cbl);
+    c1 <= hi(lo(fb_draw16), cblocks[21:4]);
     z0 <= lo(fb_z16);
-    z1 <= hi(lo(fb_z16), {2'd0, wh} << 2);
+    z1 <= hi(lo(fb_z16), zblocks[21:4]);
     t0 <= lo(tex16);
-    t1 <= hi(lo(tex16), 24'd1 << tl);
+    t1 <= hi(lo(tex16), 18'd1 << tl);
     serial <= (depth_on && colour_on && ov(c0, c1, z0, z1)) ||
               (textured && ov(t0, t1, c0, c1)) ||
               (textured && z_write && ov(t0, t1, z0, z1));

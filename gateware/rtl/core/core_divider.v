@@ -19,7 +19,8 @@ module core_divider #(
     output wire                 busy,
     output reg                  done,   // one-cycle pulse: quo / rem valid (held until next start)
     output wire [QW-1:0]        quo,
-    output wire [DW-1:0]        rem
+    output wire [DW-1:0]        rem,
+    output wire [DW-1:0]        rem_c   // den - 1 - rem (the step left's remainder, see core_setup)
 );
   localparam integer MW = NW - 1;  // magnitude bits
   localparam integer CW = $clog2(MW + 1);
@@ -59,7 +60,7 @@ module core_divider #(
         done <= 1'b1;
         if (neg) begin
           qr <= ~qr;
-          pr <= dv - 1'b1 - pr;
+          pr <= rem_c;
         end
       end else if (skip) begin
         pr   <= pr4;
@@ -77,4 +78,5 @@ module core_divider #(
 
   assign quo = qr;
   assign rem = pr;
+  assign rem_c = dv - 1'b1 - pr;
 endmodule

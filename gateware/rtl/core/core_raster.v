@@ -29,6 +29,7 @@ module core_raster #(
     input  wire [IDX_W-1:0]   origin_idx,        // box_y0 * fb_width + box_x0
     input  wire [10:0]        fb_width,
     input  wire               ltr,     // emit every row left to right
+    input  wire               rect,    // every pixel of the box is covered (a clear)
     input  wire               adv,     // the whole raster/stepper pipeline may advance
     input  wire               hold,    // raster itself must not move this cycle (serial mode)
     output wire               active,  // walking a triangle
@@ -59,17 +60,18 @@ module core_raster #(
   wire sub = (sel != OP_LEFT && sel != OP_DOWN);
   function signed [35:0] step(input signed [35:0] e, input signed [16:0] dx, input signed [16:0] dy,
                               input [1:0] s, input sb);
-    reg signed [35:0] o;
+    reg [35:0] o;
     begin
       o = {{15{(s == OP_DOWN) ? dx[16] : dy[16]}}, (s == OP_DOWN) ? dx : dy, 4'd0};
-      step = sb ? e - o : e + o;
+      step = e + $signed(o ^ {36{sb}}) + $signed({35'd0, sb});  // one adder: e +/- o
     end
   endfunction
   wire signed [35:0] n0 = step(e0, dx0, dy0, sel, sub);
   wire signed [35:0] n1 = step(e1, dx1, dy1, sel, sub);
   wire signed [35:0] n2 = step(e2, dx2, dy2, sel, sub);
-  wire ncov = !n0[35] && !n1[35] && !n2[35];
-  wire cov = !e0[35] && !e1[35] && !e2[35];
+  reg  area;  // rect latched
+  wire ncov = area || (!n0[35] && !n1[35] && !n2[35]);
+  wire cov = area || (!e0[35] && !e1[35] && !e2[35]);
   // sides on which covered pixels of this row can lie, from the failing edges
   // (ex = -16 dy: a failing edge with dy < 0 grows to the right)
   wire right_ok = !(e0[35] && dy0 >= 0) && !(e1[35] && dy1 >= 0) && !(e2[35] && dy2 >= 0);
@@ -196,6 +198,7 @@ module core_raster #(
       last_dir <= DIR_L;
       mdir     <= DIR_R;
       order    <= ltr;
+      area     <= rect;
       op       <= OP_NONE;
       emit     <= 1'b0;
     end else if (adv) begin

@@ -51,7 +51,8 @@ module core_stepper #(
     end
   endgenerate
 
-  wire [RW:0]   t = {1'b0, r} + {1'b0, sr};
+  // a step left is stored as (~qx, 2D - 1 - rx) and taken with a carry in: (q, r) - (qx, rx)
+  wire [RW:0]   t = {1'b0, r} + {1'b0, sr} + {{RW{1'b0}}, op == 2'd2};
   wire [RW+1:0] u = {1'b0, t} - {2'b0, den};
   wire          wrap = !u[RW+1];  // t >= 2D
 

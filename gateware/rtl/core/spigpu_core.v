@@ -106,8 +106,9 @@ module spigpu_core #(
   wire [31:0] pw_q;
   wire [34:0] pw_r;
   reg         su_go;
+  wire        su_rect = (cmd_op != OP_TRI);  // small profile: clears are drawn as rectangles
   core_setup #(.SERIAL(SMALL), .TEX(TEX), .IDX_W(IDX_W)) setup (
-      .clk(clk), .rst(rst), .start(su_go), .busy(su_busy), .done(su_done), .draw(su_draw),
+      .clk(clk), .rst(rst), .start(su_go), .rect(su_rect), .busy(su_busy), .done(su_done), .draw(su_draw),
       .v0(cmd_v0), .v1(cmd_v1), .v2(cmd_v2),
       .clip_x0(sc_x0), .clip_y0(sc_y0), .clip_x1(clip_x1), .clip_y1(clip_y1), .width(cmd_fb_width),
       .need(need),
@@ -125,6 +126,9 @@ module spigpu_core #(
   reg [17:0] r_tex_fmt;
   reg [31:0] r_flat;
   reg [10:0] r_width;
+  reg [7:0]  r_need;
+  reg        r_rect, r_zsel;
+  reg [23:0] r_zflat;
   // clear state
   reg [27:0] k_base;
   reg [1:0]  k_bpp;
@@ -144,33 +148,47 @@ module spigpu_core #(
       .e0_i(su_e0), .e1_i(su_e1), .e2_i(su_e2),
       .dx0(su_dx0), .dx1(su_dx1), .dx2(su_dx2), .dy0(su_dy0), .dy1(su_dy1), .dy2(su_dy2),
       .box_x0(su_bx0), .box_y0(su_by0), .box_x1(su_bx1), .box_y1(su_by1), .origin_idx(su_idx),
-      .fb_width(r_width), .ltr(r_serial), .adv(adv), .hold(hold), .active(ras_active), .op(ras_op),
+      .fb_width(r_width), .ltr(r_serial), .rect(r_rect), .adv(adv), .hold(hold), .active(ras_active), .op(ras_op),
       .op_next(ras_op_next), .emit(ras_emit), .px(ras_x), .py(ras_y), .pidx(ras_idx));
 
   wire [7:0]  a_r, a_g, a_b, a_a;
   wire [23:0] a_z;
   wire [95:0] a_stq;
+  wire        pipe_ok;   // the emitted pixel record may change this cycle
   genvar gi;
   generate
-    for (gi = 0; gi < 4; gi = gi + 1) begin : colour_steppers
-      wire [7:0] qv;
-      core_stepper #(.QW(8), .RW(35), .EBR(SMALL)) st (
-          .clk(clk), .we(pw_en && pw_attr == gi), .field(pw_field), .wq(pw_q[7:0]), .wr(pw_r),
-          .den(su_den), .en(adv), .op(ras_op), .op_next(ras_op_next), .q(qv));
+    if (SMALL != 0) begin : tm_steppers
+      // one shared datapath, a cycle per interpolated attribute per move
+      wire [5*24-1:0] vals;
+      core_interp_tm #(.N(5), .QW(24), .RW(35)) interp (
+          .clk(clk), .rst(rst), .we(pw_en), .attr(pw_attr), .field(pw_field), .wq(pw_q[23:0]),
+          .wr(pw_r), .den(su_den), .mask(r_need[4:0]), .op(ras_op), .op_next(ras_op_next),
+          .pipe_ok(pipe_ok), .adv(adv), .values(vals));
+      assign a_r = vals[7:0];
+      assign a_g = vals[31:24];
+      assign a_b = vals[55:48];
+      assign a_a = vals[79:72];
+      assign a_z = vals[119:96];
+    end else begin : steppers
+      for (gi = 0; gi < 4; gi = gi + 1) begin : colour
+        wire [7:0] qv;
+        core_stepper #(.QW(8), .RW(35), .EBR(0)) st (
+            .clk(clk), .we(pw_en && pw_attr == gi), .field(pw_field), .wq(pw_q[7:0]), .wr(pw_r),
+            .den(su_den), .en(adv), .op(ras_op), .op_next(ras_op_next), .q(qv));
+      end
+      assign a_r = colour[0].qv;
+      assign a_g = colour[1].qv;
+      assign a_b = colour[2].qv;
+      assign a_a = colour[3].qv;
+      core_stepper #(.QW(24), .RW(35), .EBR(0)) z_stepper (
+          .clk(clk), .we(pw_en && pw_attr == 3'd4), .field(pw_field), .wq(pw_q[23:0]), .wr(pw_r),
+          .den(su_den), .en(adv), .op(ras_op), .op_next(ras_op_next), .q(a_z));
+      assign adv = pipe_ok;
     end
-  endgenerate
-  assign a_r = colour_steppers[0].qv;
-  assign a_g = colour_steppers[1].qv;
-  assign a_b = colour_steppers[2].qv;
-  assign a_a = colour_steppers[3].qv;
-  core_stepper #(.QW(24), .RW(35), .EBR(SMALL)) z_stepper (
-      .clk(clk), .we(pw_en && pw_attr == 3'd4), .field(pw_field), .wq(pw_q[23:0]), .wr(pw_r),
-      .den(su_den), .en(adv), .op(ras_op), .op_next(ras_op_next), .q(a_z));
-  generate
     if (TEX != 0) begin : tex_steppers
       for (gi = 5; gi < 8; gi = gi + 1) begin : stq
         wire [31:0] qv;
-        core_stepper #(.QW(32), .RW(35), .EBR(SMALL)) st (
+        core_stepper #(.QW(32), .RW(35), .EBR(0)) st (
             .clk(clk), .we(pw_en && pw_attr == gi), .field(pw_field), .wq(pw_q), .wr(pw_r),
             .den(su_den), .en(adv), .op(ras_op), .op_next(ras_op_next), .q(qv));
       end
@@ -180,7 +198,8 @@ module spigpu_core #(
     end
   endgenerate
 
-  // emitted pixel record, aligned with the steppers' values
+  // emitted pixel record, aligned with the steppers' values: set when the rasteriser advances,
+  // cleared when the depth stage takes it
   reg        emit2;
   reg [1:0]  x2, y2;
   reg [IDX_W-1:0] idx2;
@@ -192,15 +211,17 @@ module spigpu_core #(
       x2    <= ras_x[1:0];
       y2    <= ras_y[1:0];
       idx2  <= ras_idx;
+    end else if (d_in_ready) begin
+      emit2 <= 1'b0;
     end
   end
   wire [31:0] src_rgba = r_gouraud ? {a_r, a_g, a_b, a_a} : r_flat;
   wire [PW-1:0] pix;
   generate
     if (TEX != 0) begin : pix_tex
-      assign pix = {a_stq, src_rgba, y2, x2, a_z, idx2};
+      assign pix = {a_stq, src_rgba, y2, x2, r_zsel ? r_zflat : a_z, idx2};
     end else begin : pix_plain
-      assign pix = {src_rgba, y2, x2, a_z, idx2};
+      assign pix = {src_rgba, y2, x2, r_zsel ? r_zflat : a_z, idx2};
     end
   endgenerate
 
@@ -266,15 +287,26 @@ module spigpu_core #(
       .idle(c_idle));
 
   // ---------------------------------------------------------------- clears
+  // ecp5: a word per cycle; up5k: drawn as rectangles through the rasteriser and pixel stages
   wire        k_busy, k_valid, k_ready;
   wire [29:0] k_addr;
   wire [31:0] k_data;
   wire [3:0]  k_be;
   reg         k_go;
-  core_clear #(.ADDR_W(ADDR_W)) clear (
-      .clk(clk), .rst(rst), .start(k_go), .base16(k_base), .bpp_log2(k_bpp), .pattern(k_pattern),
-      .width(k_w), .x0(k_x0), .y0(k_y0), .x1(k_x1), .y1(k_y1), .busy(k_busy),
-      .wr_valid(k_valid), .wr_ready(k_ready), .wr_addr(k_addr), .wr_data(k_data), .wr_be(k_be));
+  generate
+    if (SMALL == 0) begin : clear_engine
+      core_clear #(.ADDR_W(ADDR_W)) clear (
+          .clk(clk), .rst(rst), .start(k_go), .base16(k_base), .bpp_log2(k_bpp), .pattern(k_pattern),
+          .width(k_w), .x0(k_x0), .y0(k_y0), .x1(k_x1), .y1(k_y1), .busy(k_busy),
+          .wr_valid(k_valid), .wr_ready(k_ready), .wr_addr(k_addr), .wr_data(k_data), .wr_be(k_be));
+    end else begin : no_clear_engine
+      assign k_busy  = 1'b0;
+      assign k_valid = 1'b0;
+      assign k_addr  = 30'd0;
+      assign k_data  = 32'd0;
+      assign k_be    = 4'd0;
+    end
+  endgenerate
 
   // ---------------------------------------------------------------- memory port
   wire m_idle, m_pending;
@@ -295,7 +327,7 @@ module spigpu_core #(
 
   // the raster pipeline advances unless an emitted pixel waits; in serial mode the rasteriser
   // moves only when every earlier pixel has left the core
-  assign adv  = !emit2 || d_in_ready;
+  assign pipe_ok = !emit2 || d_in_ready;
   assign hold = r_serial && (ras_emit || emit2 || !stages_idle || !m_idle);
 
   // ---------------------------------------------------------------- command sequencer
@@ -319,6 +351,9 @@ module spigpu_core #(
       cst <= C_IDLE;
       colour_on_r <= 1'b1;
       r_serial <= 1'b0;
+      r_rect <= 1'b0;
+      r_zsel <= 1'b0;
+      r_need <= 8'd0;
     end else begin
       case (cst)
         C_IDLE: if (cmd_valid && !accept) begin
@@ -333,6 +368,11 @@ module spigpu_core #(
             // CLEAR / CLEAR_Z after every earlier pixel is written
             if (clip_empty || cmd_op == 2'd3) begin
               accept <= 1'b1;
+            end else if (SMALL != 0) begin
+              if (pipe_idle && !su_busy) begin  // the clip rectangle, set up like a triangle
+                su_go <= 1'b1;
+                cst   <= C_SETUP;
+              end
             end else if (drained && !su_busy) begin
               accept    <= 1'b1;
               k_go      <= 1'b1;
@@ -354,25 +394,46 @@ module spigpu_core #(
           accept      <= 1'b1;
           ras_go      <= 1'b1;
           cst         <= C_IDLE;
-          r_gouraud   <= m_gouraud;
-          r_tex       <= tex_on;
-          r_ztest     <= m_ztest;
-          r_zfunc     <= m_zfunc;
-          r_zwrite    <= m_zwrite;
-          r_blend     <= cmd_tri_mode[8:7];
-          r_dither    <= cmd_tri_mode[9];
-          r_keep      <= m_keep;
-          r_decal     <= cmd_tri_mode[14];
           r_fmt       <= cmd_fb_format;
           r_fb_draw   <= cmd_fb_draw;
           r_fb_z      <= cmd_fb_z;
           r_tex_base  <= cmd_tex_base;
           r_tex_fmt   <= cmd_tex_fmt;
-          r_flat      <= cmd_v0[87:56];
           r_width     <= cmd_fb_width;
-          r_serial    <= serial_n;
-          r_need_dst  <= (cmd_tri_mode[8:7] != 2'd0) || (some_masked && !all_masked && cmd_fb_format != 2'd0);
-          colour_on_r <= colour_on;
+          r_zflat     <= cmd_clear_depth;
+          r_rect      <= (cmd_op != OP_TRI);
+          r_zsel      <= (cmd_op != OP_TRI);
+          if (cmd_op == OP_TRI) begin
+            r_gouraud   <= m_gouraud;
+            r_tex       <= tex_on;
+            r_ztest     <= m_ztest;
+            r_zfunc     <= m_zfunc;
+            r_zwrite    <= m_zwrite;
+            r_blend     <= cmd_tri_mode[8:7];
+            r_dither    <= cmd_tri_mode[9];
+            r_keep      <= m_keep;
+            r_decal     <= cmd_tri_mode[14];
+            r_flat      <= cmd_v0[87:56];
+            r_serial    <= serial_n;
+            r_need      <= need;
+            r_need_dst  <= (cmd_tri_mode[8:7] != 2'd0) || (some_masked && !all_masked && cmd_fb_format != 2'd0);
+            colour_on_r <= colour_on;
+          end else begin
+            // a clear drawn as a rectangle: CLEAR_COLOR truncated (no dither, blend or mask), or
+            // CLEAR_DEPTH written
+            r_gouraud   <= 1'b0;
+            r_tex       <= 1'b0;
+            r_ztest     <= 1'b0;
+            r_zwrite    <= (cmd_op == OP_CLEAR_Z);
+            r_blend     <= 2'd0;
+            r_dither    <= 1'b0;
+            r_keep      <= 4'd0;
+            r_flat      <= cmd_clear_color;
+            r_serial    <= 1'b0;
+            r_need      <= 8'd0;
+            r_need_dst  <= 1'b0;
+            colour_on_r <= (cmd_op == OP_CLEAR);
+          end
         end
       endcase
       if (cst == C_SETUP && su_done && !su_draw) accept <= 1'b1;
@@ -392,9 +453,9 @@ module spigpu_core #(
       perf_setup     <= 32'd0;
       perf_raster    <= 32'd0;
     end else begin
-      if (su_done && su_draw) perf_triangles <= perf_triangles + 32'd1;
-      if (emit2 && d_in_ready) perf_pixels <= perf_pixels + 32'd1;
-      if (d_passed) perf_passed <= perf_passed + 32'd1;
+      if (su_done && su_draw && cmd_op == OP_TRI) perf_triangles <= perf_triangles + 32'd1;
+      if (emit2 && d_in_ready && !r_rect) perf_pixels <= perf_pixels + 32'd1;
+      if (d_passed && !r_rect) perf_passed <= perf_passed + 32'd1;
       if (t_count) perf_textured <= perf_textured + 32'd1;
       if (!core_idle) perf_busy <= perf_busy + 32'd1;
       if (su_busy) perf_setup <= perf_setup + 32'd1;
