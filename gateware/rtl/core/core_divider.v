@@ -3,13 +3,15 @@
 //
 // Restoring long division, one quotient bit per cycle, on the magnitude of num: a negative num
 // is divided as ~num = -num - 1 and the result mapped back (floor(num/den) = ~floor(~num/den),
-// rem = den - 1 - rem'). While the partial remainder is below den / 16 the next four quotient
-// bits are known to be 0, so four numerator bits are taken at once: the leading bits of a
-// small numerator cost a quarter cycle each.
+// rem = den - 1 - rem'). The numerator register shifts left and takes the quotient bits in at
+// the bottom. With SKIP, while the partial remainder is below den / 16 the next four quotient
+// bits are known to be 0 and four numerator bits are taken at once (small numerators then cost
+// a quarter cycle per leading bit); without it a division takes NW cycles.
 module core_divider #(
     parameter integer NW = 72,  // numerator width (signed)
     parameter integer DW = 35,  // divisor / remainder width (unsigned)
-    parameter integer QW = 32   // quotient bits kept
+    parameter integer QW = 32,  // quotient bits kept
+    parameter integer SKIP = 1
 ) (
     input  wire                 clk,
     input  wire                 rst,
@@ -26,9 +28,8 @@ module core_divider #(
   localparam integer CW = $clog2(MW + 1);
   localparam [CW-1:0] MW_BITS = MW[CW-1:0];
 
-  reg [MW-1:0] nr;      // numerator bits not yet consumed, MSB first
+  reg [MW-1:0] nq;      // numerator bits not yet consumed (top), quotient bits so far (bottom)
   reg [DW-1:0] pr;      // partial remainder, < den
-  reg [QW-1:0] qr;      // quotient bits so far (low QW kept)
   reg [DW-1:0] dv;
   reg          neg;
   reg [CW-1:0] left;    // numerator bits left
@@ -36,11 +37,11 @@ module core_divider #(
 
   assign busy = run;
 
-  wire [DW:0]   trial = {pr, nr[MW-1]};
+  wire [DW:0]   trial = {pr, nq[MW-1]};
   wire [DW+1:0] diff = {1'b0, trial} - {2'b0, dv};
   wire          fits = !diff[DW+1];
-  wire          skip = (pr < (dv >> 4)) && (left >= 4);
-  wire [DW-1:0] pr4 = {pr[DW-5:0], nr[MW-1:MW-4]};
+  wire          skip = (SKIP != 0) && (pr < (dv >> 4)) && (left >= 4);
+  assign rem_c = dv - 1'b1 - pr;
 
   always @(posedge clk) begin
     done <= 1'b0;
@@ -48,9 +49,8 @@ module core_divider #(
       run <= 1'b0;
     end else if (start && !run) begin
       neg  <= num[NW-1];
-      nr   <= num[NW-1] ? ~num[MW-1:0] : num[MW-1:0];
+      nq   <= num[NW-1] ? ~num[MW-1:0] : num[MW-1:0];
       pr   <= {DW{1'b0}};
-      qr   <= {QW{1'b0}};
       dv   <= den;
       left <= MW_BITS;
       run  <= 1'b1;
@@ -59,24 +59,21 @@ module core_divider #(
         run  <= 1'b0;
         done <= 1'b1;
         if (neg) begin
-          qr <= ~qr;
-          pr <= rem_c;
+          nq[QW-1:0] <= ~nq[QW-1:0];
+          pr         <= rem_c;
         end
       end else if (skip) begin
-        pr   <= pr4;
-        nr   <= nr << 4;
-        qr   <= qr << 4;
+        pr   <= {pr[DW-5:0], nq[MW-1:MW-4]};
+        nq   <= nq << 4;
         left <= left - 4;
       end else begin
         pr   <= fits ? diff[DW-1:0] : trial[DW-1:0];
-        nr   <= nr << 1;
-        qr   <= {qr[QW-2:0], fits};
+        nq   <= {nq[MW-2:0], fits};
         left <= left - 1'b1;
       end
     end
   end
 
-  assign quo = qr;
+  assign quo = nq[QW-1:0];
   assign rem = pr;
-  assign rem_c = dv - 1'b1 - pr;
 endmodule

@@ -22,11 +22,14 @@ module core_raster #(
     input  wire               clk,
     input  wire               rst,
     input  wire               start,   // pulse: begin a triangle (setup outputs valid)
-    input  wire signed [35:0] e0_i, e1_i, e2_i,  // biased edge values at the origin
+    input  wire [2:0]         e_we,              // setup writes the edge values at the origin
+    input  wire signed [35:0] e_data,
+    output reg  signed [35:0] e0, e1, e2,        //   (and reads E20, E01 back for the planes)
     input  wire signed [16:0] dx0, dx1, dx2,     // edge deltas (held by setup while drawing):
     input  wire signed [16:0] dy0, dy1, dy2,     //   E steps by -16 dy right, 16 dx down
-    input  wire [10:0]        box_x0, box_y0, box_x1, box_y1,
-    input  wire [IDX_W-1:0]   origin_idx,        // box_y0 * fb_width + box_x0
+    input  wire [10:0]        box_x0, box_y0, box_x1, box_y1,  // columns and rows to walk
+    input  wire [10:0]        x_start,           // first column (of row box_y0)
+    input  wire [IDX_W-1:0]   origin_idx,        // box_y0 * fb_width + x_start
     input  wire [10:0]        fb_width,
     input  wire               ltr,     // emit every row left to right
     input  wire               rect,    // every pixel of the box is covered (a clear)
@@ -36,8 +39,8 @@ module core_raster #(
     output reg  [1:0]         op,      // OP_NONE / OP_RIGHT / OP_LEFT / OP_DOWN
     output wire [1:0]         op_next, // what `op` holds after this cycle's edge
     output reg                emit,    // the pixel reached by `op` is covered: emit it
-    output reg  [10:0]        px,
-    output reg  [10:0]        py,
+    output reg  [1:0]         px,      // low bits of the pixel position (dither)
+    output reg  [1:0]         py,
     output reg  [IDX_W-1:0]   pidx     // py * fb_width + px
 );
   localparam [1:0] OP_NONE = 2'd0, OP_RIGHT = 2'd1, OP_LEFT = 2'd2, OP_DOWN = 2'd3;
@@ -46,7 +49,6 @@ module core_raster #(
   localparam DIR_R = 1'b0, DIR_L = 1'b1;
 
   reg [2:0] st;
-  reg signed [35:0] e0, e1, e2;
   reg [10:0] x, y, xlo, xhi, yhi;
   reg [IDX_W-1:0] idx;   // y * fb_width + x
   reg        mdir;       // direction of the current move / emission
@@ -188,8 +190,7 @@ module core_raster #(
       emit <= 1'b0;
     end else if (start) begin
       st       <= R_ENTRY;
-      e0 <= e0_i; e1 <= e1_i; e2 <= e2_i;
-      x        <= box_x0;
+      x        <= x_start;
       y        <= box_y0;
       xlo      <= box_x0;
       xhi      <= box_x1 - 11'd1;
@@ -217,10 +218,14 @@ module core_raster #(
         idx  <= idx_n;
         op   <= go ? sel : OP_NONE;
         emit <= emit_n;
-        px   <= x_n;
-        py   <= y_n;
+        px   <= x_n[1:0];
+        py   <= y_n[1:0];
         pidx <= idx_n;
       end
     end
+    // setup's writes (the rasteriser is idle then)
+    if (e_we[0]) e0 <= e_data;
+    if (e_we[1]) e1 <= e_data;
+    if (e_we[2]) e2 <= e_data;
   end
 endmodule

@@ -21,7 +21,8 @@
 module core_setup #(
     parameter integer SERIAL = 0,
     parameter integer TEX = 1,       // S, T, Q planes exist (33-bit deltas)
-    parameter integer IDX_W = 20
+    parameter integer IDX_W = 20,
+    parameter integer SKIP = 1       // divider skips leading zero quotient bits (faster, larger)
 ) (
     input  wire         clk,
     input  wire         rst,
@@ -41,8 +42,15 @@ module core_setup #(
     input  wire [7:0]   need,         // planes to set up: R G B A Z S T Q (bit 0 = R)
     // held for the rasteriser: edges 1->2, 2->0, 0->1
     output reg  signed [16:0] dx0, dx1, dx2, dy0, dy1, dy2,
-    output reg  signed [35:0] e0, e1, e2,   // biased edge values at the origin's sample point
-    output reg  [10:0]  box_x0, box_y0, box_x1, box_y1,
+    // biased edge values at the origin's sample point, written into the rasteriser's registers
+    // (which keep them until the walk starts; E20 and E01 come back for the planes)
+    output reg  [2:0]   e_we,
+    output wire signed [35:0] e_data,
+    input  wire signed [35:0] e1,
+    input  wire signed [35:0] e2,
+    // the walk: rows box_y0 .. box_y1 - 1, columns box_x0 .. box_x1 - 1 (the clip rectangle's),
+    // starting at column x_start of row box_y0 (below the top vertex)
+    output reg  [10:0]  box_x0, box_y0, box_x1, box_y1, x_start,
     output reg  [IDX_W-1:0] origin_idx,
     output reg  [34:0]  den,          // 2D
     // plane writes: field 0 value at the origin, 1 step right, 2 step left, 3 step down
@@ -69,7 +77,7 @@ module core_setup #(
   wire tl1 = (dy1 == 0 && dx1 > 0) || dy1 < 0;
   wire tl2 = (dy2 == 0 && dx2 > 0) || dy2 < 0;
 
-  // ---------------------------------------------------------------- bounding box
+  // ---------------------------------------------------------------- rows and start column
   // vertex order along each axis from the signs of the deltas
   function signed [15:0] pick3(input [1:0] k, input signed [15:0] a, input signed [15:0] b,
                                input signed [15:0] c);
@@ -82,22 +90,25 @@ module core_setup #(
   function [1:0] argmax(input signed [16:0] d10, input signed [16:0] d21, input signed [16:0] d02);
     argmax = (d10 <= 0 && d02 >= 0) ? 2'd0 : (d10 > 0 && d21 <= 0) ? 2'd1 : 2'd2;
   endfunction
+  wire [1:0] top = argmin(dy2, dy0, dy1);
   wire signed [15:0] mnx = pick3(argmin(dx2, dx0, dx1), x0, x1, x2);
   wire signed [15:0] mxx = pick3(argmax(dx2, dx0, dx1), x0, x1, x2);
-  wire signed [15:0] mny = pick3(argmin(dy2, dy0, dy1), y0, y1, y2);
+  wire signed [15:0] mny = pick3(top, y0, y1, y2);
   wire signed [15:0] mxy = pick3(argmax(dy2, dy0, dy1), y0, y1, y2);
-  // first pixel whose sample 16p + 8 >= min: (min + 7) >> 4; one past the last <= max
+  wire signed [15:0] xtop = pick3(top, x0, x1, x2);
+  // samples 16p + 8 inside [min, max]: p from (min + 7) >> 4 to (max + 8) >> 4, exclusive
   wire signed [12:0] fx0 = 13'(($signed({mnx[15], mnx}) + 17'sd7) >>> 4);
   wire signed [12:0] fy0 = 13'(($signed({mny[15], mny}) + 17'sd7) >>> 4);
   wire signed [12:0] fx1 = 13'((($signed({mxx[15], mxx}) + 17'sd8) >>> 4));
   wire signed [12:0] fy1 = 13'((($signed({mxy[15], mxy}) + 17'sd8) >>> 4));
   wire signed [12:0] cx0 = $signed({2'b0, clip_x0}), cx1 = $signed({2'b0, clip_x1});
   wire signed [12:0] cy0 = $signed({2'b0, clip_y0}), cy1 = $signed({2'b0, clip_y1});
-  wire signed [12:0] bx0 = (fx0 > cx0) ? fx0 : cx0;
-  wire signed [12:0] bx1 = (fx1 < cx1) ? fx1 : cx1;
   wire signed [12:0] by0 = (fy0 > cy0) ? fy0 : cy0;
   wire signed [12:0] by1 = (fy1 < cy1) ? fy1 : cy1;
-  wire box_empty = (bx0 >= bx1) || (by0 >= by1);
+  wire box_empty = (fx0 >= cx1) || (fx1 <= cx0) || (by0 >= by1);
+  // the walk starts below the top vertex, inside the clip columns
+  wire signed [12:0] xt = 13'(xtop >>> 4);
+  wire [10:0] xs = (xt < cx0) ? clip_x0 : (xt >= cx1) ? clip_x1 - 11'd1 : xt[10:0];
 
   // ---------------------------------------------------------------- attribute deltas
   function [AW-1:0] attr(input [183:0] v, input [2:0] k);
@@ -135,7 +146,8 @@ module core_setup #(
   reg        mneg;  // negate both products
   reg [ACC_W-1:0] acc;
   wire signed [ACC_W-1:0] acc_s = $signed(acc);
-  wire signed [17:0] sx = $signed({3'b0, box_x0, 4'b1000});  // 16x + 8
+  assign e_data = acc_s[35:0];
+  wire signed [17:0] sx = $signed({3'b0, x_start, 4'b1000});  // 16x + 8
   wire signed [17:0] sy = $signed({3'b0, box_y0, 4'b1000});
   reg signed [15:0] xa, ya;  // the current edge's start vertex
   always @(*) begin
@@ -164,7 +176,7 @@ module core_setup #(
     n1 = 17'sd0; n2 = 17'sd0; w1 = 36'sd0; w2 = 36'sd0; wide = 1'b0; sh5 = 1'b0;
     case (msel)
       M_AREA:  begin n1 = dy2; n2 = dy1; end                  // dx20*dy01 - dx01*dy20
-      M_WIDTH: begin n1 = {6'd0, width}; n2 = {6'd0, box_x0}; end
+      M_WIDTH: begin n1 = {6'd0, width}; n2 = {6'd0, x_start}; end
       M_E0:    begin n1 = dx0; n2 = dy0; end
       M_E1:    begin n1 = dx1; n2 = dy1; end
       M_E2:    begin n1 = dx2; n2 = dy2; end
@@ -260,7 +272,7 @@ module core_setup #(
   wire [31:0]  div_q;
   wire [34:0]  div_r, div_rc;
   /* verilator lint_off PINCONNECTEMPTY */
-  core_divider #(.NW(ACC_W), .DW(35), .QW(32)) divider (
+  core_divider #(.NW(ACC_W), .DW(35), .QW(32), .SKIP(SKIP)) divider (
       .clk(clk), .rst(rst), .start(div_go), .num(acc_s), .den(den),
       .busy(), .done(div_done), .quo(div_q), .rem(div_r), .rem_c(div_rc));
   /* verilator lint_on PINCONNECTEMPTY */
@@ -295,6 +307,7 @@ module core_setup #(
     mac_go <= 1'b0;
     add_go <= 1'b0;
     add_clr <= 1'b0;
+    e_we <= 3'b000;
     if (rst) begin
       st          <= S_IDLE;
       flip        <= 1'b0;
@@ -317,13 +330,14 @@ module core_setup #(
       case (st)
         S_IDLE: if (start) begin
           flip <= 1'b0;
+          box_x0 <= clip_x0;
+          box_x1 <= clip_x1;
           if (rect) begin
-            box_x0 <= clip_x0;
-            box_x1 <= clip_x1;
-            box_y0 <= clip_y0;
-            box_y1 <= clip_y1;
-            draw   <= 1'b1;
-            st     <= S_ORIGIN;
+            box_y0  <= clip_y0;
+            box_y1  <= clip_y1;
+            x_start <= clip_x0;
+            draw    <= 1'b1;
+            st      <= S_ORIGIN;
           end else begin
             st  <= S_DELTA;
             ret <= S_AREA;
@@ -361,12 +375,11 @@ module core_setup #(
             draw <= 1'b0;
             st   <= S_END;
           end else begin
-            box_x0 <= bx0[10:0];
-            box_x1 <= bx1[10:0];
-            box_y0 <= by0[10:0];
-            box_y1 <= by1[10:0];
-            draw   <= 1'b1;
-            st     <= S_ORIGIN;
+            box_y0  <= by0[10:0];
+            box_y1  <= by1[10:0];
+            x_start <= xs;
+            draw    <= 1'b1;
+            st      <= S_ORIGIN;
           end
         end
         S_ORIGIN: begin
@@ -392,11 +405,7 @@ module core_setup #(
             msel <= M_ONE; add_go <= 1'b1; add_use2 <= 1'b0; add_neg <= 1'b1; add_dbl <= 1'b0;
             bflag <= 1'b1;
           end else if (!add_go) begin
-            case (ek)
-              2'd0: e0 <= 36'(acc_s);
-              2'd1: e1 <= 36'(acc_s);
-              default: e2 <= 36'(acc_s);
-            endcase
+            e_we <= (ek == 2'd0) ? 3'b001 : (ek == 2'd1) ? 3'b010 : 3'b100;
             ek <= ek + 2'd1;
             if (ek == 2'd2) begin
               todo <= need;

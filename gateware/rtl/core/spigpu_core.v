@@ -95,9 +95,10 @@ module spigpu_core #(
 
   // ---------------------------------------------------------------- setup
   wire        su_busy, su_done, su_draw;
-  wire signed [35:0] su_e0, su_e1, su_e2;
+  wire [2:0]  su_e_we;
+  wire signed [35:0] su_e_data, ras_e0, ras_e1, ras_e2;
   wire signed [16:0] su_dx0, su_dx1, su_dx2, su_dy0, su_dy1, su_dy2;
-  wire [10:0] su_bx0, su_by0, su_bx1, su_by1;
+  wire [10:0] su_bx0, su_by0, su_bx1, su_by1, su_xs;
   wire [IDX_W-1:0] su_idx;
   wire [34:0] su_den;
   wire        pw_en;
@@ -107,14 +108,15 @@ module spigpu_core #(
   wire [34:0] pw_r;
   reg         su_go;
   wire        su_rect = (cmd_op != OP_TRI);  // small profile: clears are drawn as rectangles
-  core_setup #(.SERIAL(SMALL), .TEX(TEX), .IDX_W(IDX_W)) setup (
+  core_setup #(.SERIAL(SMALL), .TEX(TEX), .IDX_W(IDX_W), .SKIP(1 - SMALL)) setup (
       .clk(clk), .rst(rst), .start(su_go), .rect(su_rect), .busy(su_busy), .done(su_done), .draw(su_draw),
       .v0(cmd_v0), .v1(cmd_v1), .v2(cmd_v2),
       .clip_x0(sc_x0), .clip_y0(sc_y0), .clip_x1(clip_x1), .clip_y1(clip_y1), .width(cmd_fb_width),
       .need(need),
       .dx0(su_dx0), .dx1(su_dx1), .dx2(su_dx2), .dy0(su_dy0), .dy1(su_dy1), .dy2(su_dy2),
-      .e0(su_e0), .e1(su_e1), .e2(su_e2),
-      .box_x0(su_bx0), .box_y0(su_by0), .box_x1(su_bx1), .box_y1(su_by1), .origin_idx(su_idx),
+      .e_we(su_e_we), .e_data(su_e_data), .e1(ras_e1), .e2(ras_e2),
+      .box_x0(su_bx0), .box_y0(su_by0), .box_x1(su_bx1), .box_y1(su_by1), .x_start(su_xs),
+      .origin_idx(su_idx),
       .den(su_den), .pw_en(pw_en), .pw_attr(pw_attr), .pw_field(pw_field), .pw_q(pw_q), .pw_r(pw_r));
 
   // ---------------------------------------------------------------- render state of the draw
@@ -139,15 +141,16 @@ module spigpu_core #(
   wire        ras_active;
   wire [1:0]  ras_op, ras_op_next;
   wire        ras_emit;
-  wire [10:0] ras_x, ras_y;
+  wire [1:0]  ras_x, ras_y;
   wire [IDX_W-1:0] ras_idx;
   reg         ras_go;
   wire        adv, hold;
   core_raster #(.IDX_W(IDX_W)) raster (
       .clk(clk), .rst(rst), .start(ras_go),
-      .e0_i(su_e0), .e1_i(su_e1), .e2_i(su_e2),
+      .e_we(su_e_we), .e_data(su_e_data), .e0(ras_e0), .e1(ras_e1), .e2(ras_e2),
       .dx0(su_dx0), .dx1(su_dx1), .dx2(su_dx2), .dy0(su_dy0), .dy1(su_dy1), .dy2(su_dy2),
-      .box_x0(su_bx0), .box_y0(su_by0), .box_x1(su_bx1), .box_y1(su_by1), .origin_idx(su_idx),
+      .box_x0(su_bx0), .box_y0(su_by0), .box_x1(su_bx1), .box_y1(su_by1), .x_start(su_xs),
+      .origin_idx(su_idx),
       .fb_width(r_width), .ltr(r_serial), .rect(r_rect), .adv(adv), .hold(hold), .active(ras_active), .op(ras_op),
       .op_next(ras_op_next), .emit(ras_emit), .px(ras_x), .py(ras_y), .pidx(ras_idx));
 
@@ -159,16 +162,12 @@ module spigpu_core #(
   generate
     if (SMALL != 0) begin : tm_steppers
       // one shared datapath, a cycle per interpolated attribute per move
-      wire [5*24-1:0] vals;
-      core_interp_tm #(.N(5), .QW(24), .RW(35)) interp (
+      wire [31:0] tm_rgba;
+      core_interp_tm #(.RW(35)) interp (
           .clk(clk), .rst(rst), .we(pw_en), .attr(pw_attr), .field(pw_field), .wq(pw_q[23:0]),
           .wr(pw_r), .den(su_den), .mask(r_need[4:0]), .op(ras_op), .op_next(ras_op_next),
-          .pipe_ok(pipe_ok), .adv(adv), .values(vals));
-      assign a_r = vals[7:0];
-      assign a_g = vals[31:24];
-      assign a_b = vals[55:48];
-      assign a_a = vals[79:72];
-      assign a_z = vals[119:96];
+          .pipe_ok(pipe_ok), .adv(adv), .rgba(tm_rgba), .z(a_z));
+      assign {a_r, a_g, a_b, a_a} = tm_rgba;
     end else begin : steppers
       for (gi = 0; gi < 4; gi = gi + 1) begin : colour
         wire [7:0] qv;
@@ -208,8 +207,8 @@ module spigpu_core #(
     else if (ras_go) emit2 <= 1'b0;
     else if (adv) begin
       emit2 <= ras_emit;
-      x2    <= ras_x[1:0];
-      y2    <= ras_y[1:0];
+      x2    <= ras_x;
+      y2    <= ras_y;
       idx2  <= ras_idx;
     end else if (d_in_ready) begin
       emit2 <= 1'b0;
