@@ -27,6 +27,7 @@ module core_raster #(
     output reg  signed [35:0] e0, e1, e2,        //   (and reads E20, E01 back for the planes)
     input  wire signed [16:0] dx0, dx1, dx2,     // edge deltas (held by setup while drawing):
     input  wire signed [16:0] dy0, dy1, dy2,     //   E steps by -16 dy right, 16 dx down
+    input  wire               flip,              //   ... negated (P1 and P2 exchanged, section 8.1)
     input  wire [10:0]        box_x0, box_y0, box_x1, box_y1,  // columns and rows to walk
     input  wire [10:0]        x_start,           // first column (of row box_y0)
     input  wire [IDX_W-1:0]   origin_idx,        // box_y0 * fb_width + x_start
@@ -68,16 +69,22 @@ module core_raster #(
       step = e + $signed(o ^ {36{sb}}) + $signed({35'd0, sb});  // one adder: e +/- o
     end
   endfunction
-  wire signed [35:0] n0 = step(e0, dx0, dy0, sel, sub);
-  wire signed [35:0] n1 = step(e1, dx1, dy1, sel, sub);
-  wire signed [35:0] n2 = step(e2, dx2, dy2, sel, sub);
+  wire signed [35:0] n0 = step(e0, dx0, dy0, sel, sub ^ flip);
+  wire signed [35:0] n1 = step(e1, dx1, dy1, sel, sub ^ flip);
+  wire signed [35:0] n2 = step(e2, dx2, dy2, sel, sub ^ flip);
   reg  area;  // rect latched
   wire ncov = area || (!n0[35] && !n1[35] && !n2[35]);
   wire cov = area || (!e0[35] && !e1[35] && !e2[35]);
   // sides on which covered pixels of this row can lie, from the failing edges
-  // (ex = -16 dy: a failing edge with dy < 0 grows to the right)
-  wire right_ok = !(e0[35] && dy0 >= 0) && !(e1[35] && dy1 >= 0) && !(e2[35] && dy2 >= 0);
-  wire left_ok  = !(e0[35] && dy0 <= 0) && !(e1[35] && dy1 <= 0) && !(e2[35] && dy2 <= 0);
+  // (ex = -16 dy, or 16 dy when exchanged: a failing edge with ex > 0 grows to the right)
+  function grows_r(input signed [16:0] dy, input f);  // ex > 0
+    grows_r = f ? (dy > 0) : (dy < 0);
+  endfunction
+  function grows_l(input signed [16:0] dy, input f);  // ex < 0
+    grows_l = f ? (dy < 0) : (dy > 0);
+  endfunction
+  wire right_ok = !(e0[35] && !grows_r(dy0, flip)) && !(e1[35] && !grows_r(dy1, flip)) && !(e2[35] && !grows_r(dy2, flip));
+  wire left_ok  = !(e0[35] && !grows_l(dy0, flip)) && !(e1[35] && !grows_l(dy1, flip)) && !(e2[35] && !grows_l(dy2, flip));
   wire can_r = (x != xhi);
   wire can_l = (x != xlo);
   wire last_row = (y == yhi);

@@ -1,23 +1,26 @@
-// Triangle setup (docs/protocol.md sections 8 and 9): a sequencer around one accumulator, a
-// dual multiply-accumulate and the exact divider.
-//   1. edge deltas dx, dy of the edges 1->2, 2->0, 0->1 (kept here; the rasteriser steps with
-//      them), the area D = dx20*dy01 - dx01*dy20 (section 8.1); D = 0 draws nothing; D < 0
-//      exchanges P1 and P2 and the deltas are taken again;
-//   2. bounding box of the sample points inside the vertices, clipped to the clip rectangle,
-//      and the linear index y0 * width + x0 of its origin pixel;
-//   3. each edge function E_ab(s) = dx*(sy - Ya) - dy*(sx - Xa) at the origin's sample point,
-//      minus 1 unless the edge is top or left (the bias);
-//   4. per interpolated attribute (d1 = a1 - a0, d2 = a2 - a0), the exact plane stepper of
-//      section 9: the numerator M = 2(d1*E20 + d2*E01) + D changes by
-//      Mx = -32(d1*dy20 + d2*dy01) per pixel right and My = 32(d1*dx20 + d2*dx01) per pixel down;
-//      each is split by the divider into a quotient and a remainder of 2D; the value at the
-//      origin is a0 + floor(M0 / 2D). The step left is written as (~qx, 2D - 1 - rx), which the
-//      steppers add with a carry in.
-// A clear (rect) only sets up the clip rectangle as the box and its origin index.
-// Multiplies are a1*m1 +/- a2*m2 into the accumulator: in parallel (SERIAL = 0), or bit-serially
-// by Horner's rule, two cycles per bit of the a operands (SERIAL = 1: small, for the iCE40).
-// A multiply overlaps the previous division. The vertex inputs are read while the command waits
-// on the port (held stable by the soc).
+// Triangle setup (docs/protocol.md sections 8 and 9): a sequencer around one accumulator with
+// one adder, a dual multiply-accumulate and the exact divider.
+//
+// Everything is computed in kick order. Section 8.1 exchanges P1 and P2 when D < 0; the three
+// edges of the exchanged triangle are the kick-order edges reversed, so the exchange is done by
+// negation instead of by moving vertices: the rasteriser steps the edge values with the opposite
+// sign (`flip`), the edge values and the plane steps are computed negated, the top-left biases
+// are taken on the reversed edges, and 2D is |2D|. The planes' numerator at the origin,
+//   M0 = 2(d1*E20 + d2*E01) + D   (d = a - a0, E raw edge values, section 9)
+// is then, in both cases, 2(d1*e1 + d2*e2) + (d1 if e1's bias is -1) + (d2 if e2's) + |D| with
+// the biased edge values e1, e2 the rasteriser holds; the steps are -32(d1*dy20 + d2*dy01) per
+// pixel right and 32(d1*dx20 + d2*dx01) per pixel down, negated with the exchange.
+//   1. edge deltas (dx, dy of 1->2, 2->0, 0->1), D = dx20*dy01 - dx01*dy20; D = 0 draws nothing;
+//   2. rows of the sample points inside the vertices, clipped; columns: the clip rectangle's, the
+//      walk starting below the top vertex; the index y0 * width + x_start of the first pixel;
+//   3. each edge value at the first pixel's sample point: dx*(sy - Ya) - dy*(sx - Xa), biased;
+//   4. per interpolated attribute: the three numerators divided by 2D into (quotient,
+//      remainder) plane fields; the step left is written as (~qx, 2D - 1 - rx), which the steppers
+//      add with a carry in. A clear (rect) sets up only the clip rectangle and its first index.
+// Multiplies are a1*m1 +/- a2*m2: in parallel (SERIAL = 0), or by Horner's rule, most
+// significant bit first, two cycles per bit of the a operands (SERIAL = 1, for the iCE40). A
+// multiply overlaps the previous division. The vertex inputs are read while the command waits on
+// the port (held stable by the soc).
 module core_setup #(
     parameter integer SERIAL = 0,
     parameter integer TEX = 1,       // S, T, Q planes exist (33-bit deltas)
@@ -40,19 +43,18 @@ module core_setup #(
     input  wire [10:0]  clip_y1,
     input  wire [10:0]  width,        // FB_FORMAT.WIDTH
     input  wire [7:0]   need,         // planes to set up: R G B A Z S T Q (bit 0 = R)
-    // held for the rasteriser: edges 1->2, 2->0, 0->1
+    // held for the rasteriser: kick-order edges 1->2, 2->0, 0->1 and the exchange
     output reg  signed [16:0] dx0, dx1, dx2, dy0, dy1, dy2,
-    // biased edge values at the origin's sample point, written into the rasteriser's registers
-    // (which keep them until the walk starts; E20 and E01 come back for the planes)
+    output reg          flip,
+    // biased edge values at the first pixel's sample point, written into the rasteriser's
+    // registers (which keep them until the walk starts; e1 and e2 come back for the planes)
     output reg  [2:0]   e_we,
     output wire signed [35:0] e_data,
     input  wire signed [35:0] e1,
     input  wire signed [35:0] e2,
-    // the walk: rows box_y0 .. box_y1 - 1, columns box_x0 .. box_x1 - 1 (the clip rectangle's),
-    // starting at column x_start of row box_y0 (below the top vertex)
-    output reg  [10:0]  box_x0, box_y0, box_x1, box_y1, x_start,
+    output reg  [10:0]  box_x0, box_y0, box_x1, box_y1, x_start,  // walk: clip columns, rows
     output reg  [IDX_W-1:0] origin_idx,
-    output reg  [34:0]  den,          // 2D
+    output reg  [34:0]  den,          // |2D|
     // plane writes: field 0 value at the origin, 1 step right, 2 step left, 3 step down
     output reg          pw_en,
     output reg  [2:0]   pw_attr,
@@ -63,22 +65,20 @@ module core_setup #(
   localparam integer AW = (TEX != 0) ? 33 : 25;     // attribute delta bits
   localparam integer ACC_W = (TEX != 0) ? 72 : 64;  // accumulator / numerator bits
 
-  // ---------------------------------------------------------------- vertices
-  reg flip;
+  // ---------------------------------------------------------------- vertices (kick order)
   wire signed [15:0] x0 = v0[15:0], y0 = v0[31:16];
-  wire signed [15:0] x1 = flip ? v2[15:0] : v1[15:0], y1 = flip ? v2[31:16] : v1[31:16];
-  wire signed [15:0] x2 = flip ? v1[15:0] : v2[15:0], y2 = flip ? v1[31:16] : v2[31:16];
+  wire signed [15:0] x1 = v1[15:0], y1 = v1[31:16];
+  wire signed [15:0] x2 = v2[15:0], y2 = v2[31:16];
   function signed [16:0] sub16(input signed [15:0] b, input signed [15:0] a);
     sub16 = $signed({b[15], b}) - $signed({a[15], a});
   endfunction
+  // top-left rule on the edge as drawn (reversed when exchanged): bias 0, otherwise -1
+  function tl(input signed [16:0] dx, input signed [16:0] dy, input f);
+    tl = f ? ((dy == 0 && dx < 0) || dy > 0) : ((dy == 0 && dx > 0) || dy < 0);
+  endfunction
+  wire tl0 = tl(dx0, dy0, flip), tl1 = tl(dx1, dy1, flip), tl2 = tl(dx2, dy2, flip);
 
-  // top or left edge: bias 0, otherwise -1
-  wire tl0 = (dy0 == 0 && dx0 > 0) || dy0 < 0;
-  wire tl1 = (dy1 == 0 && dx1 > 0) || dy1 < 0;
-  wire tl2 = (dy2 == 0 && dx2 > 0) || dy2 < 0;
-
-  // ---------------------------------------------------------------- rows and start column
-  // vertex order along each axis from the signs of the deltas
+  // ---------------------------------------------------------------- rows and first column
   function signed [15:0] pick3(input [1:0] k, input signed [15:0] a, input signed [15:0] b,
                                input signed [15:0] c);
     pick3 = (k == 2'd0) ? a : (k == 2'd1) ? b : c;
@@ -106,7 +106,6 @@ module core_setup #(
   wire signed [12:0] by0 = (fy0 > cy0) ? fy0 : cy0;
   wire signed [12:0] by1 = (fy1 < cy1) ? fy1 : cy1;
   wire box_empty = (fx0 >= cx1) || (fx1 <= cx0) || (by0 >= by1);
-  // the walk starts below the top vertex, inside the clip columns
   wire signed [12:0] xt = 13'(xtop >>> 4);
   wire [10:0] xs = (xt < cx0) ? clip_x0 : (xt >= cx1) ? clip_x1 - 11'd1 : xt[10:0];
 
@@ -128,143 +127,138 @@ module core_setup #(
     end
   endfunction
   reg  [2:0] ak;  // attribute being set up
-  wire [2:0] akv = (TEX != 0 || ak < 3'd5) ? ak : 3'd0;
-  wire signed [AW-1:0] a0 = attr(v0, akv), k1 = attr(v1, akv), k2 = attr(v2, akv);
-  wire signed [AW-1:0] kd1 = k1 - a0, kd2 = k2 - a0;        // kick order; |d| < 2^(AW-1)
-  wire signed [AW-1:0] d1 = flip ? kd2 : kd1, d2 = flip ? kd1 : kd2;
-  wire flat_attr = (kd1 == 0) && (kd2 == 0);
-  // multiplier width of the attribute's deltas: 9 (colour), 25 (Z), 33 (S, T, Q)
+  wire [2:0] akv = (TEX != 0 || ak < 3'd5) ? ak : 3'd4;
+  wire signed [AW-1:0] a0 = attr(v0, akv);
+  wire signed [AW-1:0] d1 = attr(v1, akv) - a0, d2 = attr(v2, akv) - a0;  // |d| < 2^(AW-1)
   wire [5:0] abits = (ak < 3'd4) ? 6'd9 : (ak == 3'd4) ? 6'd25 : 6'd33;
 
-  // ---------------------------------------------------------------- accumulator
-  localparam [2:0] A_AREA = 3'd0, A_ORIGIN = 3'd1, A_EDGE = 3'd2, A_ATTR = 3'd3;
-  localparam [3:0] M_AREA = 4'd0, M_WIDTH = 4'd1, M_E0 = 4'd2, M_E1 = 4'd3, M_E2 = 4'd4,
-                   M_GX = 4'd5, M_GY = 4'd6, M_M0 = 4'd7, M_D = 4'd8, M_ONE = 4'd9, M_DEN = 4'd10;
-  reg  [2:0] asel;
-  reg  [3:0] msel;
-  reg        msub;  // subtract the second product
-  reg        mneg;  // negate both products
-  reg [ACC_W-1:0] acc;
-  wire signed [ACC_W-1:0] acc_s = $signed(acc);
-  assign e_data = acc_s[35:0];
-  wire signed [17:0] sx = $signed({3'b0, x_start, 4'b1000});  // 16x + 8
-  wire signed [17:0] sy = $signed({3'b0, box_y0, 4'b1000});
-  reg signed [15:0] xa, ya;  // the current edge's start vertex
+  // ---------------------------------------------------------------- operands
+  // m operand (one bus): selected by `osel`, alternating between osel1 and osel2 in a multiply
+  localparam [3:0] O_DX0 = 4'd0, O_DY0 = 4'd1, O_DX1 = 4'd2, O_DY1 = 4'd3, O_DX2 = 4'd4,
+                   O_DY2 = 4'd5, O_W = 4'd6, O_XS = 4'd7, O_E1 = 4'd8, O_E2 = 4'd9, O_D1 = 4'd10,
+                   O_D2 = 4'd11, O_D = 4'd12, O_ONE = 4'd13;
+  reg  [3:0] osel;
+  reg        sh5;   // the delta operands times 32
+  reg signed [16:0] nop;
   always @(*) begin
-    case (msel)
-      M_E0: begin xa = x1; ya = y1; end
-      M_E1: begin xa = x2; ya = y2; end
-      default: begin xa = x0; ya = y0; end
+    case (osel)
+      O_DX0: nop = dx0;  O_DY0: nop = dy0;
+      O_DX1: nop = dx1;  O_DY1: nop = dy1;
+      O_DX2: nop = dx2;  O_DY2: nop = dy2;
+      O_W:   nop = {6'd0, width};
+      O_XS:  nop = {6'd0, x_start};
+      default: nop = 17'sd1;
     endcase
   end
+  wire signed [35:0] mop = (osel == O_E1) ? e1 : (osel == O_E2) ? e2 :
+                           (osel == O_D1) ? 36'(d1) : (osel == O_D2) ? 36'(d2) :
+                           (osel == O_D) ? {2'b0, den[34:1]} : sh5 ? (36'(nop) <<< 5) : 36'(nop);
+
+  // a operands (multiplier bits), by `asel`
+  localparam [1:0] A_AREA = 2'd0, A_ORIGIN = 2'd1, A_EDGE = 2'd2, A_ATTR = 2'd3;
+  reg  [1:0] asel;
+  wire signed [17:0] sx = $signed({3'b0, x_start, 4'b1000});  // 16x + 8
+  wire signed [17:0] sy = $signed({3'b0, box_y0, 4'b1000});
+  reg  [1:0] ek;    // edge being evaluated: its start vertex
+  wire signed [15:0] xa = (ek == 2'd0) ? x1 : (ek == 2'd1) ? x2 : x0;
+  wire signed [15:0] ya = (ek == 2'd0) ? y1 : (ek == 2'd1) ? y2 : y0;
   wire signed [17:0] ey_a = sy - 18'(ya), ex_a = sx - 18'(xa);  // sample point minus Pa
-  reg signed [32:0] ma1, ma2;   // a operands (sign-extended)
-  reg [5:0] mbits;              // bits in the a operands
+  reg signed [32:0] ma1, ma2;
+  reg [5:0] mbits;
   always @(*) begin
     case (asel)
-      A_AREA:   begin ma1 = 33'(dx1); ma2 = 33'(dx2); mbits = 6'd17; end
-      A_ORIGIN: begin ma1 = {21'd0, 1'b0, box_y0}; ma2 = 33'd1; mbits = 6'd12; end  // y0*w + x0
+      A_AREA:   begin ma1 = 33'(dx1); ma2 = 33'(dx2); mbits = 6'd17; end      // dx20*dy01 - dx01*dy20
+      A_ORIGIN: begin ma1 = {22'd0, box_y0}; ma2 = 33'd1; mbits = 6'd12; end  // y0*width + x_start
       A_EDGE:   begin ma1 = 33'(ey_a); ma2 = 33'(ex_a); mbits = 6'd18; end
       default:  begin ma1 = 33'(d1); ma2 = 33'(d2); mbits = abits; end
     endcase
   end
-  // m operands: a narrow (delta, width, constant) or a wide (edge value, attribute delta, D) one
-  reg signed [16:0] n1, n2;
-  reg signed [35:0] w1, w2;
-  reg               wide, sh5;
-  always @(*) begin
-    n1 = 17'sd0; n2 = 17'sd0; w1 = 36'sd0; w2 = 36'sd0; wide = 1'b0; sh5 = 1'b0;
-    case (msel)
-      M_AREA:  begin n1 = dy2; n2 = dy1; end                  // dx20*dy01 - dx01*dy20
-      M_WIDTH: begin n1 = {6'd0, width}; n2 = {6'd0, x_start}; end
-      M_E0:    begin n1 = dx0; n2 = dy0; end
-      M_E1:    begin n1 = dx1; n2 = dy1; end
-      M_E2:    begin n1 = dx2; n2 = dy2; end
-      M_GX:    begin n1 = dy1; n2 = dy2; sh5 = 1'b1; end       // negated: -32 Gx
-      M_GY:    begin n1 = dx1; n2 = dx2; sh5 = 1'b1; end
-      M_ONE:   begin n1 = 17'sd1; end
-      M_M0:    begin w1 = e1; w2 = e2; wide = 1'b1; end         // biased E20, E01
-      M_D:     begin w1 = 36'(d1); w2 = 36'(d2); wide = 1'b1; end
-      default: begin w1 = {2'b0, den[34:1]}; wide = 1'b1; end  // M_DEN: D
-    endcase
-  end
-  wire signed [35:0] mm1 = wide ? w1 : sh5 ? (36'(n1) <<< 5) : 36'(n1);
-  wire signed [35:0] mm2 = wide ? w2 : sh5 ? (36'(n2) <<< 5) : 36'(n2);
 
-  // acc <- A + (+/-)B: A = 0, acc or 2 acc; B = one of the m operands or 0
-  reg        s_clr, s_dbl, s_use1, s_use2, s_neg;
-  wire signed [ACC_W-1:0] bop = s_use1 ? ACC_W'(mm1) : s_use2 ? ACC_W'(mm2) : {ACC_W{1'b0}};
-  wire [ACC_W-1:0] aop = s_clr ? {ACC_W{1'b0}} : s_dbl ? (acc << 1) : acc;
-  wire [ACC_W-1:0] acc_sum = aop + (bop ^ {ACC_W{s_neg}}) + {{(ACC_W-1){1'b0}}, s_neg};
+  // ---------------------------------------------------------------- accumulator
+  // acc <- (dbl ? 2 acc : acc) +/- (use ? mop : 0); clear: acc <- 0
+  reg [ACC_W-1:0] acc;
+  wire signed [ACC_W-1:0] acc_s = $signed(acc);
+  assign e_data = acc_s[35:0];
+  reg        c_dbl, c_use, c_neg, c_en, c_clr;  // this cycle's accumulator operation
+  wire [ACC_W-1:0] bop = c_use ? ACC_W'(mop) : {ACC_W{1'b0}};
+  wire [ACC_W-1:0] acc_sum = (c_dbl ? acc << 1 : acc) + (bop ^ {ACC_W{c_neg}}) + {{(ACC_W-1){1'b0}}, c_neg};
 
-  // single additions requested by the sequencer (registered, applied in the next cycle)
-  reg        add_go;
-  reg        add_use2, add_neg, add_dbl, add_clr;  // add_clr: acc <- 0 (no operand)
-  reg        mac_go;   // pulse: start a multiply-accumulate into acc (from 0)
-  wire       mac_busy;
+  // multiply: osel1/osel2 sources, negate (mneg), subtract the second (msub)
+  reg  [3:0] osel1, osel2;
+  reg        mneg, msub;
+  reg        mac_go;     // pulse
+  reg        mac_run, ph;
+  reg  [5:0] k;
+  // single additions requested by the sequencer
+  reg        add_go, add_dbl, add_neg;
+  reg  [3:0] add_osel;
+
   generate
     if (SERIAL != 0) begin : serial_mac
-      // Horner's rule, most significant bit first, alternating the two products:
-      //   acc = 2 acc +/- a1[k] m1;  acc = acc +/- a2[k] m2   (bit k = mbits-1 weighs negative)
-      reg [5:0] k;
-      reg       ph, run, first;
-      wire      b1 = ma1[k - 6'd1], b2 = ma2[k - 6'd1];
-      wire      msb = (k == mbits);
-      assign mac_busy = run;
+      wire b1 = ma1[k - 6'd1], b2 = ma2[k - 6'd1];
+      wire msb = (k == mbits);
       always @(*) begin
-        s_clr  = run ? first : add_clr;
-        s_dbl  = run ? (!ph && !first) : add_dbl;
-        s_use1 = run ? (!ph && b1) : (!add_use2 && !add_clr);
-        s_use2 = run ? (ph && b2) : (add_use2 && !add_clr);
-        s_neg  = run ? (ph ? (mneg ^ msb ^ msub) : (mneg ^ msb)) : add_neg;
+        osel  = mac_run ? (ph ? osel2 : osel1) : add_osel;
+        c_en  = mac_run || add_go;
+        c_clr = 1'b0;
+        c_dbl = mac_run ? !ph : add_dbl;
+        c_use = mac_run ? (ph ? b2 : b1) : 1'b1;
+        c_neg = mac_run ? (mneg ^ msb ^ (ph & msub)) : add_neg;
       end
       always @(posedge clk) begin
         if (rst) begin
-          run <= 1'b0;
+          mac_run <= 1'b0;
         end else if (mac_go) begin
-          run   <= 1'b1;
-          k     <= mbits;
-          ph    <= 1'b0;
-          first <= 1'b1;
-        end else if (run) begin
-          acc   <= acc_sum;
-          first <= 1'b0;
-          ph    <= !ph;
-          if (ph) begin
-            k <= k - 6'd1;
-            if (k == 6'd1) run <= 1'b0;
+          mac_run <= 1'b1;
+          k       <= mbits;
+          ph      <= 1'b0;
+          acc     <= {ACC_W{1'b0}};
+        end else begin
+          if (c_en) acc <= acc_sum;
+          if (mac_run) begin
+            ph <= !ph;
+            if (ph) begin
+              k <= k - 6'd1;
+              if (k == 6'd1) mac_run <= 1'b0;
+            end
           end
-        end else if (add_go) begin
-          acc <= acc_sum;
         end
       end
     end else begin : parallel_mac
-      reg run;
-      wire signed [68:0] p1 = 69'(ma1) * 69'(mm1);
-      wire signed [68:0] p2 = 69'(ma2) * 69'(mm2);
+      // both products at once; the m operands are taken in two cycles (one bus)
+      reg signed [35:0] m1;
+      wire signed [68:0] p1 = 69'(ma1) * 69'(m1);
+      wire signed [68:0] p2 = 69'(ma2) * 69'(mop);
       wire signed [ACC_W-1:0] s12 = ACC_W'(p1) + (msub ? -(ACC_W'(p2)) : ACC_W'(p2));
-      assign mac_busy = run;
       always @(*) begin
-        s_clr  = add_clr;
-        s_dbl  = add_dbl;
-        s_use1 = !add_use2 && !add_clr;
-        s_use2 = add_use2 && !add_clr;
-        s_neg  = add_neg;
+        osel  = mac_run ? (ph ? osel2 : osel1) : add_osel;
+        c_en  = add_go && !mac_run;
+        c_clr = 1'b0;
+        c_dbl = add_dbl;
+        c_use = 1'b1;
+        c_neg = add_neg;
       end
       always @(posedge clk) begin
         if (rst) begin
-          run <= 1'b0;
+          mac_run <= 1'b0;
         end else if (mac_go) begin
-          run <= 1'b1;
-        end else if (run) begin
-          acc <= mneg ? -s12 : s12;
-          run <= 1'b0;
-        end else if (add_go) begin
+          mac_run <= 1'b1;
+          ph      <= 1'b0;
+        end else if (mac_run) begin
+          if (!ph) begin
+            m1 <= mop;
+            ph <= 1'b1;
+          end else begin
+            acc     <= mneg ? -s12 : s12;
+            mac_run <= 1'b0;
+          end
+        end else if (c_en) begin
           acc <= acc_sum;
         end
       end
     end
   endgenerate
+  wire mac_busy = mac_run || mac_go;
 
   // ---------------------------------------------------------------- divider
   reg          div_go;
@@ -281,24 +275,22 @@ module core_setup #(
   reg         div_pending;  // running, or its results not yet written
   reg         xl_next;      // the step left follows the step right's write
   reg  [31:0] div_a0;
+  wire        div_free = !div_pending && !div_go;
 
   // plane writes come from the divider's held results
   assign pw_q = (pw_field == 2'd0) ? div_a0 + div_q : (pw_field == 2'd2) ? ~div_q : div_q;
   assign pw_r = (pw_field == 2'd2) ? div_rc : div_r;
 
   // ---------------------------------------------------------------- sequencer
-  localparam [4:0] S_IDLE = 5'd0, S_DELTA = 5'd1, S_AREA = 5'd2, S_FLIP = 5'd3, S_BOX = 5'd4,
-                   S_ORIGIN = 5'd5, S_EDGE = 5'd6, S_EDGE_B = 5'd7, S_ANEXT = 5'd8, S_GX = 5'd9,
-                   S_GX_W = 5'd10, S_GY = 5'd11, S_GY_W = 5'd12, S_M0 = 5'd13, S_M0_C = 5'd14,
-                   S_M0_D = 5'd15, S_DRAIN = 5'd16, S_END = 5'd17, S_WAIT = 5'd18, S_ORIG_W = 5'd19;
+  localparam [4:0] S_IDLE = 5'd0, S_AREA = 5'd1, S_FLIP = 5'd2, S_BOX = 5'd3, S_ORIGIN = 5'd4,
+                   S_EDGE = 5'd5, S_BIAS = 5'd6, S_ANEXT = 5'd7, S_GX = 5'd8, S_GY = 5'd9,
+                   S_M0 = 5'd10, S_M0_C = 5'd11, S_M0_D = 5'd12, S_DRAIN = 5'd13, S_END = 5'd14,
+                   S_WAIT = 5'd15, S_GX_W = 5'd16;
   reg [4:0]  st, ret;   // S_WAIT: until the multiply is done, then ret
-  reg [1:0]  ek;        // edge being evaluated
   reg [1:0]  cstep;     // M0 corrections
-  reg        bflag;     // edge bias subtracted
   reg [7:0]  todo;
 
   assign busy = (st != S_IDLE);
-  wire div_free = !div_pending && !div_go;
 
   always @(posedge clk) begin
     done   <= 1'b0;
@@ -306,8 +298,8 @@ module core_setup #(
     div_go <= 1'b0;
     mac_go <= 1'b0;
     add_go <= 1'b0;
-    add_clr <= 1'b0;
-    e_we <= 3'b000;
+    e_we   <= 3'b000;
+    xl_next <= 1'b0;
     if (rst) begin
       st          <= S_IDLE;
       flip        <= 1'b0;
@@ -315,7 +307,6 @@ module core_setup #(
       div_pending <= 1'b0;
     end else begin
       // division results become plane writes: the step right is followed by the step left
-      xl_next <= 1'b0;
       if (div_done) begin
         pw_en    <= 1'b1;
         pw_attr  <= div_attr;
@@ -329,9 +320,11 @@ module core_setup #(
       end
       case (st)
         S_IDLE: if (start) begin
-          flip <= 1'b0;
           box_x0 <= clip_x0;
           box_x1 <= clip_x1;
+          flip  <= 1'b0;
+          sh5   <= 1'b0;
+          cstep <= 2'd0;
           if (rect) begin
             box_y0  <= clip_y0;
             box_y1  <= clip_y1;
@@ -339,35 +332,26 @@ module core_setup #(
             draw    <= 1'b1;
             st      <= S_ORIGIN;
           end else begin
-            st  <= S_DELTA;
-            ret <= S_AREA;
+            dx0 <= sub16(x2, x1); dy0 <= sub16(y2, y1);
+            dx1 <= sub16(x0, x2); dy1 <= sub16(y0, y2);
+            dx2 <= sub16(x1, x0); dy2 <= sub16(y1, y0);
+            st  <= S_AREA;
           end
         end
-        S_DELTA: begin  // edge deltas of the (possibly exchanged) vertices
-          dx0 <= sub16(x2, x1); dy0 <= sub16(y2, y1);
-          dx1 <= sub16(x0, x2); dy1 <= sub16(y0, y2);
-          dx2 <= sub16(x1, x0); dy2 <= sub16(y1, y0);
-          st  <= ret;
-        end
-        S_AREA: begin
-          asel <= A_AREA; msel <= M_AREA; msub <= 1'b1; mneg <= 1'b0;
+        S_AREA: begin  // D = dx20*dy01 - dx01*dy20
+          asel <= A_AREA; osel1 <= O_DY2; osel2 <= O_DY1; msub <= 1'b1; mneg <= 1'b0;
           mac_go <= 1'b1;
           st <= S_WAIT; ret <= S_FLIP;
         end
-        S_WAIT: if (!mac_busy && !mac_go) st <= ret;
+        S_WAIT: if (!mac_busy) st <= ret;
         S_FLIP: begin
           if (acc == 0) begin
             draw <= 1'b0;
             st   <= S_END;
           end else begin
-            den <= acc_s[ACC_W-1] ? 35'(-(acc_s <<< 1)) : 35'(acc_s <<< 1);
-            if (acc_s[ACC_W-1]) begin
-              flip <= 1'b1;
-              st   <= S_DELTA;
-              ret  <= S_BOX;
-            end else begin
-              st <= S_BOX;
-            end
+            flip <= acc_s[ACC_W-1];
+            den  <= acc_s[ACC_W-1] ? 35'(-(acc_s <<< 1)) : 35'(acc_s <<< 1);
+            st   <= S_BOX;
           end
         end
         S_BOX: begin
@@ -382,31 +366,34 @@ module core_setup #(
             st      <= S_ORIGIN;
           end
         end
-        S_ORIGIN: begin
-          asel <= A_ORIGIN; msel <= M_WIDTH; msub <= 1'b0; mneg <= 1'b0;
+        S_ORIGIN: begin  // y0 * width + x_start
+          asel <= A_ORIGIN; osel1 <= O_W; osel2 <= O_XS; msub <= 1'b0; mneg <= 1'b0;
           mac_go <= 1'b1;
           ek <= 2'd0;
-          st <= S_WAIT; ret <= S_ORIG_W;
-        end
-        S_ORIG_W: begin
-          origin_idx <= acc[IDX_W-1:0];
-          st <= rect ? S_END : S_EDGE;
+          st <= S_WAIT; ret <= S_EDGE;
         end
         S_EDGE: begin
-          bflag <= 1'b0;
-          asel <= A_EDGE; msel <= (ek == 2'd0) ? M_E0 : (ek == 2'd1) ? M_E1 : M_E2;
-          msub <= 1'b1; mneg <= 1'b0;
-          mac_go <= 1'b1;
-          st <= S_WAIT; ret <= S_EDGE_B;
+          if (ek == 2'd0) origin_idx <= acc[IDX_W-1:0];
+          if (rect) begin
+            st <= S_END;
+          end else begin
+            // dx*(sy - Ya) - dy*(sx - Xa), negated when exchanged
+            asel <= A_EDGE;
+            osel1 <= (ek == 2'd0) ? O_DX0 : (ek == 2'd1) ? O_DX1 : O_DX2;
+            osel2 <= (ek == 2'd0) ? O_DY0 : (ek == 2'd1) ? O_DY1 : O_DY2;
+            msub <= 1'b1; mneg <= flip;
+            mac_go <= 1'b1;
+            st <= S_WAIT; ret <= S_BIAS;
+          end
         end
-        S_EDGE_B: begin
-          // the bias: -1 unless the edge is top or left
-          if (!((ek == 2'd0) ? tl0 : (ek == 2'd1) ? tl1 : tl2) && !bflag) begin
-            msel <= M_ONE; add_go <= 1'b1; add_use2 <= 1'b0; add_neg <= 1'b1; add_dbl <= 1'b0;
-            bflag <= 1'b1;
+        S_BIAS: begin  // -1 unless the edge (as drawn) is top or left; then into the rasteriser
+          if (!cstep[0] && !((ek == 2'd0) ? tl0 : (ek == 2'd1) ? tl1 : tl2)) begin
+            add_go <= 1'b1; add_osel <= O_ONE; add_neg <= 1'b1; add_dbl <= 1'b0;
+            cstep[0] <= 1'b1;
           end else if (!add_go) begin
+            cstep[0] <= 1'b0;
             e_we <= (ek == 2'd0) ? 3'b001 : (ek == 2'd1) ? 3'b010 : 3'b100;
-            ek <= ek + 2'd1;
+            ek   <= ek + 2'd1;
             if (ek == 2'd2) begin
               todo <= need;
               st   <= S_ANEXT;
@@ -425,54 +412,42 @@ module core_setup #(
             st   <= S_GX;
           end
         end
-        S_GX: begin
-          asel <= A_ATTR; msel <= M_GX; msub <= 1'b0; mneg <= 1'b1;
-          if (flat_attr) begin
-            add_go <= 1'b1; add_clr <= 1'b1; add_dbl <= 1'b0; add_neg <= 1'b0; add_use2 <= 1'b0;
-            st <= S_GX_W;  // no products: acc <- 0
-          end else begin
-            mac_go <= 1'b1;
-            st <= S_WAIT; ret <= S_GX_W;
-          end
+        S_GX: begin  // -32 Gx (negated when exchanged)
+          asel <= A_ATTR; osel1 <= O_DY1; osel2 <= O_DY2; sh5 <= 1'b1; msub <= 1'b0;
+          mneg <= !flip;
+          mac_go <= 1'b1;
+          st <= S_GX_W;
         end
-        S_GX_W: if (div_free && !add_go) begin
+        S_GX_W: if (!mac_busy && div_free) begin
           div_go <= 1'b1; div_pending <= 1'b1; div_field <= 2'd1; div_attr <= ak;
           div_a0 <= 32'(a0);
-          msel <= M_GY; mneg <= 1'b0;
+          osel1 <= O_DX1; osel2 <= O_DX2; mneg <= flip;  // 32 Gy
           st <= S_GY;
         end
-        S_GY: begin  // the divider latches acc in this cycle
-          if (flat_attr) begin
-            st <= S_GY_W;
-          end else begin
-            mac_go <= 1'b1;
-            st <= S_WAIT; ret <= S_GY_W;
-          end
-        end
-        S_GY_W: if (div_free) begin
-          div_go <= 1'b1; div_pending <= 1'b1; div_field <= 2'd3;
-          msel <= M_M0;
+        S_GY: begin  // the divider latches acc this cycle; the step down's multiply follows
+          mac_go <= 1'b1;
           st <= S_M0;
         end
-        S_M0: begin
-          if (flat_attr) begin
-            cstep <= 2'd2;
-            st    <= S_M0_C;
-          end else begin
-            mac_go <= 1'b1;
-            cstep  <= 2'd0;
-            st <= S_WAIT; ret <= S_M0_C;
-          end
+        S_M0: if (!mac_busy && div_free) begin
+          div_go <= 1'b1; div_pending <= 1'b1; div_field <= 2'd3;
+          sh5 <= 1'b0; osel1 <= O_E1; osel2 <= O_E2; mneg <= 1'b0;
+          cstep <= 2'd0;
+          st <= S_M0_C;
         end
-        S_M0_C: if (!add_go) begin
-          // E20 and E01 were biased: add d1, d2 back where the bias was -1; then 2 acc + D
-          msel <= (cstep == 2'd2) ? M_DEN : M_D;
-          add_go   <= (cstep == 2'd0) ? !tl1 : (cstep == 2'd1) ? !tl2 : 1'b1;
-          add_use2 <= (cstep == 2'd1);
-          add_neg  <= 1'b0;
-          add_dbl  <= (cstep == 2'd2);
-          cstep    <= cstep + 2'd1;
-          if (cstep == 2'd2) st <= S_M0_D;
+        S_M0_C: begin
+          // (the divider latches acc in the first cycle here) 2(d1 e1 + d2 e2) + bias
+          // corrections + |D|: the products, d1 and d2 where the bias is -1, then 2 acc + D
+          if (cstep == 2'd0) begin
+            mac_go <= 1'b1;
+            cstep  <= 2'd1;
+          end else if (!mac_busy && !add_go) begin
+            add_go   <= (cstep == 2'd1) ? !tl1 : (cstep == 2'd2) ? !tl2 : 1'b1;
+            add_osel <= (cstep == 2'd1) ? O_D1 : (cstep == 2'd2) ? O_D2 : O_D;
+            add_neg  <= 1'b0;
+            add_dbl  <= (cstep == 2'd3);
+            cstep    <= cstep + 2'd1;
+            if (cstep == 2'd3) st <= S_M0_D;
+          end
         end
         S_M0_D: if (!add_go && div_free) begin
           div_go <= 1'b1; div_pending <= 1'b1; div_field <= 2'd0;
