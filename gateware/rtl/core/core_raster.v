@@ -182,11 +182,13 @@ module core_raster #(
     endcase
   end
 
-  wire [10:0] x_n = !go ? x : (sel == OP_RIGHT) ? x + 11'd1 : (sel == OP_LEFT) ? x - 11'd1 : x;
-  wire [10:0] y_n = (go && sel == OP_DOWN) ? y + 11'd1 : y;
-  wire [IDX_W-1:0] w = {{(IDX_W-11){1'b0}}, fb_width};
-  wire [IDX_W-1:0] idx_n = !go ? idx : (sel == OP_RIGHT) ? idx + 1'b1 : (sel == OP_LEFT) ? idx - 1'b1 :
-                           (sel == OP_DOWN) ? idx + w : idx;
+  // one adder each: x +/- 1, y + 1, idx + 1 / - 1 / + width
+  wire        hmove = go && (sel == OP_RIGHT || sel == OP_LEFT);
+  wire        vmove = go && (sel == OP_DOWN);
+  wire [10:0] x_n = x + (hmove ? ((sel == OP_LEFT) ? 11'h7FF : 11'd1) : 11'd0);
+  wire [10:0] y_n = y + {10'd0, vmove};
+  wire [IDX_W-1:0] idx_n = idx + (vmove ? {{(IDX_W-11){1'b0}}, fb_width} :
+                                  hmove ? ((sel == OP_LEFT) ? {IDX_W{1'b1}} : {{(IDX_W-1){1'b0}}, 1'b1}) : {IDX_W{1'b0}});
 
   assign op_next = (rst || start) ? OP_NONE : !adv ? op : (hold || st == R_IDLE || !go) ? OP_NONE : sel;
 
@@ -217,9 +219,6 @@ module core_raster #(
         st       <= st_n;
         mdir     <= mdir_n;
         last_dir <= last_dir_n;
-        if (go) begin
-          e0 <= n0; e1 <= n1; e2 <= n2;
-        end
         x    <= x_n;
         y    <= y_n;
         idx  <= idx_n;
@@ -230,9 +229,13 @@ module core_raster #(
         pidx <= idx_n;
       end
     end
-    // setup's writes (the rasteriser is idle then)
-    if (e_we[0]) e0 <= e_data;
-    if (e_we[1]) e1 <= e_data;
-    if (e_we[2]) e2 <= e_data;
+  end
+
+  // edge values: setup's writes (the rasteriser is idle then) or a committed move
+  wire commit = !rst && !start && adv && !hold && st != R_IDLE && go;
+  always @(posedge clk) begin
+    if (e_we[0] || commit) e0 <= e_we[0] ? e_data : n0;
+    if (e_we[1] || commit) e1 <= e_we[1] ? e_data : n1;
+    if (e_we[2] || commit) e2 <= e_we[2] ? e_data : n2;
   end
 endmodule
