@@ -29,8 +29,9 @@ module core_alias #(
   reg  [21:0] wh;
   reg  [BW-1:0] c0, c1, z0, z1, t0, t1;
   // buffer lengths in 16-byte blocks, rounded up
-  wire [21:0] cblocks = (fmt == 2'd0) ? {wh[19:0], 2'd0} + 22'd15 : (fmt == 2'd1) ? {wh[20:0], 1'd0} + 22'd15 : wh + 22'd15;
-  wire [21:0] zblocks = {wh[19:0], 2'd0} + 22'd15;
+  wire [23:0] cbytes = (fmt == 2'd0) ? {wh, 2'd0} : (fmt == 2'd1) ? {1'd0, wh, 1'd0} : {2'd0, wh};
+  wire [17:0] cblocks = 18'((cbytes + 24'd15) >> 4);
+  wire [17:0] zblocks = 18'(({wh, 2'd0} + 24'd15) >> 4);
   wire [1:0]  tbl = (tex_fmt == 2'd0) ? 2'd2 : (tex_fmt == 2'd1) ? 2'd1 : 2'd0;
   wire [4:0]  tl = 5'(tex_wl) + 5'(tex_hl) + 5'(tbl) - 5'd4;  // >= 2
   function [BW-1:0] lo(input [27:0] b16);  // start, clipped at 2^ADDR_W
@@ -50,9 +51,9 @@ module core_alias #(
   always @(posedge clk) begin
     wh <= 22'(width * height);
     c0 <= lo(fb_draw16);
-    c1 <= hi(lo(fb_draw16), cblocks[21:4]);
+    c1 <= hi(lo(fb_draw16), cblocks);
     z0 <= lo(fb_z16);
-    z1 <= hi(lo(fb_z16), zblocks[21:4]);
+    z1 <= hi(lo(fb_z16), zblocks);
     t0 <= lo(tex16);
     t1 <= hi(lo(tex16), 18'd1 << tl);
     serial <= (depth_on && colour_on && ov(c0, c1, z0, z1)) ||

@@ -14,6 +14,8 @@ module core_color #(
     input  wire [27:0] fb_draw16,
     input  wire [1:0]  blend,      // 0 OFF, 1 ALPHA, 2 ADD, 3 MULTIPLY
     input  wire        dither,
+    input  wire        temporal,   // TRI_MODE.TEMPORAL (with DITHER)
+    input  wire [3:0]  phase,      // TRI_MODE.DITHER_PHASE
     input  wire [3:0]  keep,       // 1 = keep the stored channel: bit 0 R .. bit 3 A
     input  wire        need_dst,   // read the destination (blend, or mask on a packed format)
     // pixels in: {yl[1:0], xl[1:0], idx, rgba[31:0]}
@@ -33,7 +35,7 @@ module core_color #(
     output reg  [3:0]  wr_be,
     output wire        idle
 );
-  localparam F_BLEND = 1, F_DITHER = 2, F_RGB565 = 4, F_RGBA2222 = 5;
+  localparam F_BLEND = 1, F_DITHER = 2, F_RGB565 = 4, F_RGBA2222 = 5, F_TEMPORAL = 6;
 
 `include "core_addr.vh"
   // {word, lane} of pixel idx: FB_DRAW + idx * bpp
@@ -98,23 +100,14 @@ module core_color #(
   endfunction
   wire [7:0] sa = cur[7:0];
   function [7:0] blend_ch(input [1:0] m, input [7:0] s, input [7:0] d, input [7:0] a);
-    reg signed [17:0] p;
-    reg [8:0] sum;
-    begin
-      case (m)
-        2'd1: begin  // ALPHA: s*a + d*(255-a) = d*255 + a*(s-d)
-          p = $signed({1'b0, d, 8'd0}) - $signed({10'd0, d}) +
-              $signed({10'd0, a}) * ($signed({10'd0, s}) - $signed({10'd0, d}));
-          blend_ch = div255(p[16:0]);
-        end
-        2'd2: begin
-          sum = {1'b0, s} + {1'b0, d};
-          blend_ch = sum[8] ? 8'hFF : sum[7:0];
-        end
-        2'd3: blend_ch = div255({1'b0, 16'(s) * 16'(d)});
-        default: blend_ch = s;
-      endcase
-    end
+    case (m)
+      // ALPHA: s*a + d*(255-a) = d*255 + a*(s-d), in [0, 65025]
+      2'd1: blend_ch = div255(17'($signed({1'b0, d, 8'd0}) - $signed({10'd0, d}) +
+                                 $signed({10'd0, a}) * ($signed({10'd0, s}) - $signed({10'd0, d}))));
+      2'd2: blend_ch = ({1'b0, s} + {1'b0, d} > 9'd255) ? 8'hFF : s + d;  // ADD
+      2'd3: blend_ch = div255({1'b0, 16'(s) * 16'(d)});                     // MULTIPLY
+      default: blend_ch = s;
+    endcase
   endfunction
   wire [1:0] bm = FEATURES[F_BLEND] ? blend : 2'd0;
   wire [7:0] cr = blend_ch(bm, cur[31:24], dr, sa);
@@ -133,28 +126,42 @@ module core_color #(
     endcase
   end
   wire dith = FEATURES[F_DITHER] && dither;
-  // v + ((B << (8 - n)) >> 4), saturated
-  function [7:0] dadd(input [7:0] v, input [7:0] add);
-    reg [8:0] s;
+  // temporal dither (protocol 1.1, CAPS bit 6): threshold t = B ^ reverse4(DITHER_PHASE), the
+  // channel scaled to 0..2^n-1 with a centred threshold
+  wire tdith = FEATURES[F_TEMPORAL] && dith && temporal;
+  wire [3:0] thr = bayer ^ (tdith ? {phase[0], phase[1], phase[2], phase[3]} : 4'd0);
+  // ordered: min(255, v + ((t << (8 - n)) >> 4)) >> (8 - n); without dither: v >> (8 - n)
+  function [7:0] sat8(input [8:0] x);
+    sat8 = x[8] ? 8'hFF : x[7:0];
+  endfunction
+  // temporal: a = (v << n) - v; (a + (a >> 8) + 16 t + 8) >> 8, never above 2^n - 1
+  function [5:0] temporal_q(input [7:0] v, input [2:0] n, input [3:0] t);
+    reg [13:0] a;
     begin
-      s = {1'b0, v} + {1'b0, add};
-      dadd = s[8] ? 8'hFF : s[7:0];
+      a = ({6'd0, v} << n) - {6'd0, v};
+      temporal_q = 6'((a + (a >> 8) + {6'd0, t, 4'd8}) >> 8);
     end
   endfunction
-  wire [7:0] add5 = dith ? {5'd0, bayer[3:1]} : 8'd0;   // (B << 3) >> 4
-  wire [7:0] add6 = dith ? {6'd0, bayer[3:2]} : 8'd0;   // (B << 2) >> 4
-  wire [7:0] add2 = dith ? {2'd0, bayer, 2'd0} : 8'd0;  // (B << 6) >> 4
-  wire [7:0] r5v = dadd(cr, add5), g6v = dadd(cg, add6), b5v = dadd(cb, add5);
-  wire [7:0] r2v = dadd(cr, add2), g2v = dadd(cg, add2), b2v = dadd(cb, add2), a2v = dadd(ca, add2);
+  wire [3:0] t5 = dith ? {1'b0, thr[3:1]} : 4'd0;  // (t << 3) >> 4
+  wire [3:0] t6 = dith ? {2'b0, thr[3:2]} : 4'd0;  // (t << 2) >> 4
+  wire [7:0] t2 = dith ? {2'd0, thr, 2'd0} : 8'd0; // (t << 6) >> 4
+  wire [4:0] r5q = tdith ? 5'(temporal_q(cr, 3'd5, thr)) : 5'(sat8({1'b0, cr} + {5'd0, t5}) >> 3);
+  wire [5:0] g6q = tdith ? temporal_q(cg, 3'd6, thr) : 6'(sat8({1'b0, cg} + {5'd0, t6}) >> 2);
+  wire [4:0] b5q = tdith ? 5'(temporal_q(cb, 3'd5, thr)) : 5'(sat8({1'b0, cb} + {5'd0, t5}) >> 3);
+  function [1:0] q2(input [7:0] v, input [7:0] add, input td, input [3:0] t);
+    q2 = td ? 2'(temporal_q(v, 3'd2, t)) : 2'(sat8({1'b0, v} + {1'b0, add}) >> 6);
+  endfunction
+  wire [1:0] r2q = q2(cr, t2, tdith, thr), g2q = q2(cg, t2, tdith, thr);
+  wire [1:0] b2q = q2(cb, t2, tdith, thr), a2q = q2(ca, t2, tdith, thr);
 
   // ---- pack, write mask ----
-  wire [4:0] r5 = keep[0] ? d16[15:11] : r5v[7:3];
-  wire [5:0] g6 = keep[1] ? d16[10:5] : g6v[7:2];
-  wire [4:0] b5 = keep[2] ? d16[4:0] : b5v[7:3];
-  wire [1:0] r2 = keep[0] ? d8[7:6] : r2v[7:6];
-  wire [1:0] g2 = keep[1] ? d8[5:4] : g2v[7:6];
-  wire [1:0] b2 = keep[2] ? d8[3:2] : b2v[7:6];
-  wire [1:0] a2 = keep[3] ? d8[1:0] : a2v[7:6];
+  wire [4:0] r5 = keep[0] ? d16[15:11] : r5q;
+  wire [5:0] g6 = keep[1] ? d16[10:5] : g6q;
+  wire [4:0] b5 = keep[2] ? d16[4:0] : b5q;
+  wire [1:0] r2 = keep[0] ? d8[7:6] : r2q;
+  wire [1:0] g2 = keep[1] ? d8[5:4] : g2q;
+  wire [1:0] b2 = keep[2] ? d8[3:2] : b2q;
+  wire [1:0] a2 = keep[3] ? d8[1:0] : a2q;
   reg [31:0] data_n;
   reg [3:0]  be_n;
   always @(*) begin

@@ -40,12 +40,8 @@ module core_depth #(
     output wire          passed    // a pixel passed this cycle (counter)
 );
 `include "core_addr.vh"
-  function [29:0] zaddr(input [27:0] base, input [IDX_W-1:0] idx);
-    reg [31:0] a;
-    begin
-      a = byte_addr(base, {{(22-IDX_W){1'b0}}, idx, 2'b00});
-      zaddr = a[31:2];
-    end
+  function [29:0] zaddr(input [27:0] base, input [IDX_W-1:0] idx);  // word address of pixel idx
+    zaddr = 30'(byte_addr(base, {{(22-IDX_W){1'b0}}, idx, 2'b00}) >> 2);
   endfunction
 
   function passes(input [2:0] f, input [23:0] z, input [23:0] d);

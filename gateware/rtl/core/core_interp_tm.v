@@ -30,7 +30,7 @@ module core_interp_tm #(
   localparam integer SW = 24 + RW;
 
   function [2:0] first_of(input [4:0] m);
-    first_of = m[0] ? 3'd0 : m[1] ? 3'd1 : m[2] ? 3'd2 : m[3] ? 3'd3 : 3'd4;
+    first_of = m[0] ? 3'd0 : m[1] ? 3'd1 : m[2] ? 3'd2 : m[3] ? 3'd3 : m[4] ? 3'd4 : 3'd0;
   endfunction
   function [3:0] next_of(input [4:0] m, input [2:0] a);  // {none, index} of the next after a
     integer i;

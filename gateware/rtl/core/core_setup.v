@@ -108,26 +108,22 @@ module core_setup #(
   wire [10:0] xs = (xt < cx0) ? clip_x0 : (xt >= cx1) ? clip_x1 - 11'd1 : xt[10:0];
 
   // ---------------------------------------------------------------- attribute deltas
-  function [AW-1:0] attr(input [183:0] v, input [2:0] k);
-    reg [32:0] a;
-    begin
-      case (k)
-        3'd0: a = {25'b0, v[87:80]};
-        3'd1: a = {25'b0, v[79:72]};
-        3'd2: a = {25'b0, v[71:64]};
-        3'd3: a = {25'b0, v[63:56]};
-        3'd4: a = {9'b0, v[55:32]};
-        3'd5: a = {v[151], v[151:120]};
-        3'd6: a = {v[183], v[183:152]};
-        default: a = {1'b0, v[119:88]};
-      endcase
-      attr = a[AW-1:0];
-    end
+  function [AW-1:0] attr(input [151:0] v, input [2:0] k);  // v: vertex bits [183:32]
+    case (k)
+      3'd0: attr = AW'({1'b0, v[55:48]});
+      3'd1: attr = AW'({1'b0, v[47:40]});
+      3'd2: attr = AW'({1'b0, v[39:32]});
+      3'd3: attr = AW'({1'b0, v[31:24]});
+      3'd4: attr = AW'({1'b0, v[23:0]});
+      3'd5: attr = AW'({v[119], v[119:88]});
+      3'd6: attr = AW'({v[151], v[151:120]});
+      default: attr = AW'({1'b0, v[87:56]});
+    endcase
   endfunction
   reg  [2:0] ak;  // attribute being set up
   wire [2:0] akv = (TEX != 0 || ak < 3'd5) ? ak : 3'd4;
-  wire signed [AW-1:0] a0 = attr(v0, akv);
-  wire signed [AW-1:0] d1 = attr(v1, akv) - a0, d2 = attr(v2, akv) - a0;  // |d| < 2^(AW-1)
+  wire signed [AW-1:0] a0 = attr(v0[183:32], akv);
+  wire signed [AW-1:0] d1 = attr(v1[183:32], akv) - a0, d2 = attr(v2[183:32], akv) - a0;  // |d| < 2^(AW-1)
   wire [5:0] abits = (ak < 3'd4) ? 6'd9 : (ak == 3'd4) ? 6'd25 : 6'd33;
 
   // ---------------------------------------------------------------- operands
@@ -177,7 +173,7 @@ module core_setup #(
   reg [ACC_W-1:0] acc;
   wire signed [ACC_W-1:0] acc_s = $signed(acc);
   assign e_data = acc_s[35:0];
-  reg        c_dbl, c_use, c_neg, c_en, c_clr;  // this cycle's accumulator operation
+  reg        c_dbl, c_use, c_neg, c_en;  // this cycle's accumulator operation
   wire [ACC_W-1:0] bop = c_use ? ACC_W'(mop) : {ACC_W{1'b0}};
   wire [ACC_W-1:0] acc_sum = (c_dbl ? acc << 1 : acc) + (bop ^ {ACC_W{c_neg}}) + {{(ACC_W-1){1'b0}}, c_neg};
 
@@ -186,19 +182,18 @@ module core_setup #(
   reg        mneg, msub;
   reg        mac_go;     // pulse
   reg        mac_run, ph;
-  reg  [5:0] k;
   // single additions requested by the sequencer
   reg        add_go, add_dbl, add_neg;
   reg  [3:0] add_osel;
 
   generate
     if (SERIAL != 0) begin : serial_mac
+      reg  [5:0] k;  // the bit of the a operands this step takes, plus one
       wire b1 = ma1[k - 6'd1], b2 = ma2[k - 6'd1];
       wire msb = (k == mbits);
       always @(*) begin
         osel  = mac_run ? (ph ? osel2 : osel1) : add_osel;
         c_en  = mac_run || add_go;
-        c_clr = 1'b0;
         c_dbl = mac_run ? !ph : add_dbl;
         c_use = mac_run ? (ph ? b2 : b1) : 1'b1;
         c_neg = mac_run ? (mneg ^ msb ^ (ph & msub)) : add_neg;
@@ -225,13 +220,13 @@ module core_setup #(
     end else begin : parallel_mac
       // both products at once; the m operands are taken in two cycles (one bus)
       reg signed [35:0] m1;
-      wire signed [68:0] p1 = 69'(ma1) * 69'(m1);
-      wire signed [68:0] p2 = 69'(ma2) * 69'(mop);
-      wire signed [ACC_W-1:0] s12 = ACC_W'(p1) + (msub ? -(ACC_W'(p2)) : ACC_W'(p2));
+      wire signed [ACC_W-1:0] p1 = ACC_W'(ma1) * ACC_W'(m1);   // |a| < 2^(AW-1), |m| < 2^35
+      wire signed [ACC_W-1:0] p2 = ACC_W'(ma2) * ACC_W'(mop);
+      wire signed [ACC_W-1:0] s12 = p1 + (msub ? -p2 : p2);
+      wire unused_mbits = &{1'b0, mbits};  // widths matter only bit by bit
       always @(*) begin
         osel  = mac_run ? (ph ? osel2 : osel1) : add_osel;
         c_en  = add_go && !mac_run;
-        c_clr = 1'b0;
         c_dbl = add_dbl;
         c_use = 1'b1;
         c_neg = add_neg;

@@ -47,6 +47,7 @@ module core_stepper #(
         end
       end
       assign sq = (op == 2'd1) ? sxq : (op == 2'd2) ? sxlq : syq;
+      wire unused_op_next = &{1'b0, op_next};  // read ahead only by block RAM steps
       assign sr = (op == 2'd1) ? sxr : (op == 2'd2) ? sxlr : syr;
     end
   endgenerate

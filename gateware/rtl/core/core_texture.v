@@ -87,7 +87,8 @@ module core_texture #(
   wire [63:0] negp = 64'd0 - p2;
   wire [31:0] tnr = negp[63:32];                            // 2 - M y as u1.31
   wire [32:0] ysh = yt3[63:31];
-  wire [31:0] y = ysh[32] ? 32'hFFFFFFFF : ysh[31:0];     // min(2^32 - 1, (y t) >> 31)
+  wire [31:0] ynr = ysh[32] ? 32'hFFFFFFFF : ysh[31:0];   // min(2^32 - 1, (y t) >> 31)
+  wire unused_low = &{1'b0, yt3[30:0], negp[31:0], in_n[5], in_pix[IDX_W+23:IDX_W]};  // depth: not here
 
   always @(posedge clk) begin
     if (rst) begin
@@ -99,8 +100,8 @@ module core_texture #(
       pay2 <= pay1;
       v3 <= v2; qz3 <= qz2; n3 <= n2; yt3 <= {32'd0, y02} * {32'd0, tnr}; s3 <= s2; t3 <= t2;
       pay3 <= pay2;
-      v4 <= v3; qz4 <= qz3; n4 <= n3; su4 <= $signed(s3) * $signed({32'd0, y});
-      tv4 <= $signed(t3) * $signed({32'd0, y}); pay4 <= pay3;
+      v4 <= v3; qz4 <= qz3; n4 <= n3; su4 <= $signed(s3) * $signed({32'd0, ynr});
+      tv4 <= $signed(t3) * $signed({32'd0, ynr}); pay4 <= pay3;
     end
   end
 
@@ -182,32 +183,33 @@ module core_texture #(
   end
 
   // ---------------------------------------------------------------- texel read queue
-  localparam integer N = 1 << AW;
+  localparam integer QA = (AW < 1) ? 1 : AW;  // at least two pixels in flight
+  localparam integer N = 1 << QA;
   localparam integer IW = PAY + 8 + 8 + 8 + 1;
   reg [IW-1:0]  items[0:N-1];
   reg [127:0]   words[0:N-1];
-  reg [AW:0]    wp, dp, rp;
+  reg [QA:0]    wp, dp, rp;
   reg [1:0]     sub;
-  assign q_full = (wp - rp) == N[AW:0];
-  wire [IW-1:0] hitem = items[rp[AW-1:0]];
-  wire [127:0]  hword = words[rp[AW-1:0]];
+  assign q_full = (wp - rp) == N[QA:0];
+  wire [IW-1:0] hitem = items[rp[QA-1:0]];
+  wire [127:0]  hword = words[rp[QA-1:0]];
   wire          hvalid = (dp != rp);
-  wire          dbil = items[dp[AW-1:0]][IW-1];
+  wire          dbil = items[dp[QA-1:0]][IW-1];
   wire          pop;
   always @(posedge clk) begin
     if (rst) begin
       wp <= 0; dp <= 0; rp <= 0; sub <= 2'd0;
     end else begin
       if (issue && rd_ready && fi == 2'd0) begin
-        items[wp[AW-1:0]] <= {bil5, lanes5, fu5, fv5, pay5};
+        items[wp[QA-1:0]] <= {bil5, lanes5, fu5, fv5, pay5};
         wp <= wp + 1'b1;
       end
       if (rsp_valid) begin
         case (sub)
-          2'd0: words[dp[AW-1:0]][127:96] <= rsp_data;
-          2'd1: words[dp[AW-1:0]][95:64] <= rsp_data;
-          2'd2: words[dp[AW-1:0]][63:32] <= rsp_data;
-          default: words[dp[AW-1:0]][31:0] <= rsp_data;
+          2'd0: words[dp[QA-1:0]][127:96] <= rsp_data;
+          2'd1: words[dp[QA-1:0]][95:64] <= rsp_data;
+          2'd2: words[dp[QA-1:0]][63:32] <= rsp_data;
+          default: words[dp[QA-1:0]][31:0] <= rsp_data;
         endcase
         if (!dbil || sub == 2'd3) begin
           sub <= 2'd0;
@@ -247,12 +249,10 @@ module core_texture #(
   function [7:0] bilerp(input [7:0] p00, input [7:0] p10, input [7:0] p01, input [7:0] p11,
                         input [7:0] u, input [7:0] v);
     reg [16:0] a, b;
-    reg [33:0] c;
     begin
       a = 17'(p00) * (17'd256 - 17'(u)) + 17'(p10) * 17'(u);
       b = 17'(p01) * (17'd256 - 17'(u)) + 17'(p11) * 17'(u);
-      c = 34'(a) * (34'd256 - 34'(v)) + 34'(b) * 34'(v) + 34'd32768;
-      bilerp = c[23:16];
+      bilerp = 8'((34'(a) * (34'd256 - 34'(v)) + 34'(b) * 34'(v) + 34'd32768) >> 16);
     end
   endfunction
   function [7:0] div255(input [15:0] x);

@@ -14,7 +14,9 @@ module spigpu_core #(
     parameter [7:0]   FEATURES   = 8'hBF,   // CAPS.FEATURES; bit 7: texturing
     parameter integer MAX_WIDTH  = 1024,    // CAPS.MAX_WIDTH / MAX_HEIGHT
     parameter integer MAX_HEIGHT = 1024,
-    parameter integer VRAM_KIB   = 32768    // CAPS.VRAM_KIB
+    parameter integer VRAM_KIB   = 32768,   // CAPS.VRAM_KIB
+    parameter integer PERF       = 1        // 1: the perf_* counters count (co-simulation); 0: they
+                                            // read 0 and cost nothing (boards)
 ) (
     input  wire         clk,
     input  wire         rst,
@@ -128,6 +130,8 @@ module spigpu_core #(
   reg [27:0] r_fb_draw, r_fb_z, r_tex_base;
   reg [17:0] r_tex_fmt;
   reg [31:0] r_flat;
+  reg        r_temporal;
+  reg [3:0]  r_phase;
   reg [10:0] r_width;
   reg [7:0]  r_need;
   reg        r_rect, r_zsel;
@@ -280,6 +284,7 @@ module spigpu_core #(
   wire [3:0]  cw_be;
   core_color #(.AW(Q_AW), .IDX_W(IDX_W), .ADDR_W(ADDR_W), .FEATURES(FEATURES)) colour (
       .clk(clk), .rst(rst), .fmt(r_fmt), .fb_draw16(r_fb_draw), .blend(r_blend), .dither(r_dither),
+      .temporal(r_temporal), .phase(r_phase),
       .keep(r_keep), .need_dst(r_need_dst),
       .in_valid(c_in_valid), .in_ready(c_in_ready), .in_pix(c_in),
       .rd_valid(cr_valid), .rd_ready(cr_ready), .rd_addr(cr_addr), .rsp_valid(cr_rsp), .rsp_data(mem_rsp_rdata),
@@ -411,6 +416,8 @@ module spigpu_core #(
             r_zwrite    <= m_zwrite;
             r_blend     <= cmd_tri_mode[8:7];
             r_dither    <= cmd_tri_mode[9];
+            r_temporal  <= cmd_tri_mode[15];
+            r_phase     <= cmd_tri_mode[19:16];
             r_keep      <= m_keep;
             r_decal     <= cmd_tri_mode[14];
             r_flat      <= cmd_v0[87:56];
@@ -427,6 +434,7 @@ module spigpu_core #(
             r_zwrite    <= (cmd_op == OP_CLEAR_Z);
             r_blend     <= 2'd0;
             r_dither    <= 1'b0;
+            r_temporal  <= 1'b0;
             r_keep      <= 4'd0;
             r_flat      <= cmd_clear_color;
             r_serial    <= 1'b0;
@@ -443,23 +451,41 @@ module spigpu_core #(
   assign core_idle = (cst == C_IDLE) && !cmd_valid && !accept && !su_busy && drained && !k_go && !ras_go;
 
   // ---------------------------------------------------------------- counters
-  always @(posedge clk) begin
-    if (rst) begin
-      perf_triangles <= 32'd0;
-      perf_pixels    <= 32'd0;
-      perf_passed    <= 32'd0;
-      perf_textured  <= 32'd0;
-      perf_busy      <= 32'd0;
-      perf_setup     <= 32'd0;
-      perf_raster    <= 32'd0;
-    end else begin
-      if (su_done && su_draw && cmd_op == OP_TRI) perf_triangles <= perf_triangles + 32'd1;
-      if (emit2 && d_in_ready && !r_rect) perf_pixels <= perf_pixels + 32'd1;
-      if (d_passed && !r_rect) perf_passed <= perf_passed + 32'd1;
-      if (t_count) perf_textured <= perf_textured + 32'd1;
-      if (!core_idle) perf_busy <= perf_busy + 32'd1;
-      if (su_busy) perf_setup <= perf_setup + 32'd1;
-      if (ras_active) perf_raster <= perf_raster + 32'd1;
+  generate
+    if (PERF != 0) begin : counters
+      always @(posedge clk) begin
+        if (rst) begin
+          perf_triangles <= 32'd0;
+          perf_pixels    <= 32'd0;
+          perf_passed    <= 32'd0;
+          perf_textured  <= 32'd0;
+          perf_busy      <= 32'd0;
+          perf_setup     <= 32'd0;
+          perf_raster    <= 32'd0;
+        end else begin
+          if (su_done && su_draw && cmd_op == OP_TRI) perf_triangles <= perf_triangles + 32'd1;
+          if (emit2 && d_in_ready && !r_rect) perf_pixels <= perf_pixels + 32'd1;
+          if (d_passed && !r_rect) perf_passed <= perf_passed + 32'd1;
+          if (t_count) perf_textured <= perf_textured + 32'd1;
+          if (!core_idle) perf_busy <= perf_busy + 32'd1;
+          if (su_busy) perf_setup <= perf_setup + 32'd1;
+          if (ras_active) perf_raster <= perf_raster + 32'd1;
+        end
+      end
+    end else begin : no_counters
+      always @(*) begin
+        perf_triangles = 32'd0;
+        perf_pixels    = 32'd0;
+        perf_passed    = 32'd0;
+        perf_textured  = 32'd0;
+        perf_busy      = 32'd0;
+        perf_setup     = 32'd0;
+        perf_raster    = 32'd0;
+      end
     end
-  end
+  endgenerate
+  // what a profile does not use (the generate blocks that read it are absent) or nothing reads
+  wire unused_ok = &{1'b0, ras_e0, pw_q[31:24], r_tex, r_decal, r_tex_base, r_tex_fmt, r_need, k_base,
+                     k_bpp, k_pattern, k_w, k_x0, k_y0, k_x1, k_y1, a_stq, d_passed, d_out, tr_ready,
+                     tr_rsp, t_count, cmd_tri_mode[31:20], k_ready, m_pending};
 endmodule
