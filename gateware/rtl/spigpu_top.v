@@ -57,10 +57,10 @@ module spigpu_top #(
   output wire [31:0] perf_raster
 );
   // CAPS.FEATURES: bit 0 bilinear, 1 blend, 2 dither, 3 strict link, 4 RGB565, 5 RGBA2222.
-  // The core's FEATURES bit 6 builds its texture unit; protocol v1.0 has no CAPS bit for a device
+  // The core's FEATURES bit 7 builds its texture unit; protocol v1.0 has no CAPS bit for a device
   // without one, so every profile has it (a profile without texturing needs that bit first).
   localparam [7:0]  FEATURES   = PROFILE == 0 ? 8'h3C : 8'h3F;
-  localparam [7:0]  CORE_FEATURES = FEATURES | 8'h40;
+  localparam [7:0]  CORE_FEATURES = FEATURES | 8'h80;
   localparam        MAX_WIDTH  = PROFILE == 0 ? 320 : 1024;
   localparam        MAX_HEIGHT = PROFILE == 0 ? 240 : 768;
   localparam        FIFO_DEPTH = PROFILE == 0 ? 64 : 1023;
@@ -106,7 +106,8 @@ module spigpu_top #(
     .perf_work_cycles(perf_work_cycles), .perf_cmds(perf_cmds), .perf_frames(perf_frames),
     .perf_core_stalls(perf_core_stalls), .perf_refreshes(perf_refreshes));
 
-  spigpu_core #(.PROFILE(PROFILE), .FEATURES(CORE_FEATURES)) u_core (
+  spigpu_core #(.PROFILE(PROFILE), .FEATURES(CORE_FEATURES), .MAX_WIDTH(MAX_WIDTH), .MAX_HEIGHT(MAX_HEIGHT),
+                .VRAM_KIB(VRAM_KIB), .PERF(PERF)) u_core (
     .clk(clk), .rst(rst), .cmd_valid(cmd_valid), .cmd_ready(cmd_ready), .cmd_op(cmd_op),
     .cmd_tri_mode(cmd_tri_mode), .cmd_tex_base(cmd_tex_base), .cmd_tex_fmt(cmd_tex_fmt), .cmd_scissor(cmd_scissor),
     .cmd_fb_draw(cmd_fb_draw), .cmd_fb_z(cmd_fb_z), .cmd_fb_format(cmd_fb_format), .cmd_fb_width(cmd_fb_width),
