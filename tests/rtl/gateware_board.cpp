@@ -2,6 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <cstdio>
+#include <cstdlib>
+
 #include "gpubridge/protocol/crc32.hpp"
 
 namespace gpubridge::test {
@@ -37,6 +40,36 @@ usb::BoardProfile with_gateware(usb::BoardProfile p, const std::string& gateware
   return p;
 }
 
+namespace {
+// GPUBRIDGE_RTL_TRACE=FILE: every frame the simulator receives on the wires, for debugging a seed.
+class TracingTarget final : public backends::SpiTarget {
+ public:
+  TracingTarget(backends::SpiTarget& t, const char* path) : t_(t), f_(std::fopen(path, "w")) {}
+  ~TracingTarget() override {
+    if (f_) std::fclose(f_);
+  }
+  std::uint8_t miso_status() override { return t_.miso_status(); }
+  std::uint64_t read_register(std::uint8_t i) override {
+    const auto v = t_.read_register(i);
+    if (f_) std::fprintf(f_, "read  %02X -> %016llX\n", i, static_cast<unsigned long long>(v));
+    return v;
+  }
+  void frame_complete(const protocol::Frame& fr) override {
+    if (f_ && !fr.read) std::fprintf(f_, "write %02X %016llX\n", fr.index, static_cast<unsigned long long>(fr.data));
+    t_.frame_complete(fr);
+  }
+  void frame_aborted() override {
+    if (f_) std::fprintf(f_, "abort\n");
+    t_.frame_aborted();
+  }
+  bool busy_pin() const override { return t_.busy_pin(); }
+
+ private:
+  backends::SpiTarget& t_;
+  std::FILE* f_;
+};
+}  // namespace
+
 Result<std::unique_ptr<GatewareBoard>> GatewareBoard::open(const usb::BoardProfile& profile, usb::BoardOptions opts) {
   std::unique_ptr<GatewareBoard> g(new GatewareBoard);
   const auto gp = rtl::parse_gateware_profile(profile.gateware);
@@ -45,7 +78,12 @@ Result<std::unique_ptr<GatewareBoard>> GatewareBoard::open(const usb::BoardProfi
   if (!s) return s.error();
   g->sim_ = std::move(*s);
   g->sim_->set_scanout_callback([raw = g.get()](std::shared_ptr<const backends::ScanoutFrame> f) { raw->sim_frames_.push_back(*f); });
-  g->sim_pins_ = std::make_unique<usb::emu::SpiSlave>(*g->sim_, nullptr, nullptr);
+  backends::SpiTarget* target = g->sim_.get();
+  if (const char* path = std::getenv("GPUBRIDGE_RTL_TRACE"); path && *path) {
+    g->trace_ = std::make_unique<TracingTarget>(*g->sim_, path);
+    target = g->trace_.get();
+  }
+  g->sim_pins_ = std::make_unique<usb::emu::SpiSlave>(*target, nullptr, nullptr);
   // The stack must exist before the backend attaches (attach already talks to the device), so the
   // shadow is connected through a stack opened first and a backend attached to it afterwards.
   usb::emu::EmulationOptions eo;
@@ -55,10 +93,11 @@ Result<std::unique_ptr<GatewareBoard>> GatewareBoard::open(const usb::BoardProfi
   std::shared_ptr<usb::emu::EmulatedStack> shared = std::move(*stack);
   GatewareBoard* raw = g.get();
   shared->set_gateware_shadow(g->sim_pins_.get(), [raw](std::uint8_t index, std::uint64_t gw, std::uint64_t other) {
-    raw->shadow_reads_[index & 0x7F] = other;
     // registers whose value does not depend on when the read happens
+    const bool timed = index == index_of(Reg::STATUS) || index == index_of(Reg::FRAME_CRC) ||
+                       index == index_of(Reg::MEM_ADDR) || index == index_of(Reg::MEM_DATA);
     const bool stable = index == index_of(Reg::ID) || index == index_of(Reg::CAPS) || index == index_of(Reg::HOST_TAG) ||
-                        index == index_of(Reg::LINK_STATUS);
+                        index == index_of(Reg::LINK_STATUS) || (raw->compare_all_reads_ && !timed);
     if (!stable) return;
     ++raw->reads_compared_;
     if (gw != other && raw->read_mismatches_.size() < 8)
@@ -95,9 +134,15 @@ std::string GatewareBoard::compare(bool errors_too) {
   for (std::size_t i = 0; i < gw_frames_.size() && i < sim_frames_.size(); ++i) {
     const auto& a = gw_frames_[i];
     const auto& b = sim_frames_[i];
-    if (a.width != b.width || a.height != b.height || a.format != b.format || a.bytes != b.pixels)
-      out += fmt::format("frame {}: gateware {}x{} fmt {} crc {:08X}, simulator {}x{} fmt {} crc {:08X}\n", i + 1, a.width,
+    if (a.width != b.width || a.height != b.height || a.format != b.format || a.bytes != b.pixels) {
+      out += fmt::format("frame {}: gateware {}x{} fmt {} crc {:08X}, simulator {}x{} fmt {} crc {:08X}", i + 1, a.width,
                          a.height, int(a.format), protocol::crc32(a.bytes), b.width, b.height, int(b.format), b.crc);
+      std::size_t k = 0;
+      while (k < a.bytes.size() && k < b.pixels.size() && a.bytes[k] == b.pixels[k]) ++k;
+      if (k < a.bytes.size() && k < b.pixels.size())
+        out += fmt::format("; first difference at byte {}: gateware 0x{:02X}, simulator 0x{:02X}", k, a.bytes[k], b.pixels[k]);
+      out += "\n";
+    }
   }
   for (std::size_t i = 0; i < board_frames_.size() && i < sim_frames_.size(); ++i) {
     const auto& a = *board_frames_[i];

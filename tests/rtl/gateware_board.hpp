@@ -4,7 +4,6 @@
 // simulator behind the C++ SPI-slave model configured with the gateware's CAPS. Both devices see
 // every CS edge and MOSI bit (bit errors included); afterwards their video memory, scanned-out frames,
 // error flags and every timing-independent register read must agree.
-#include <array>
 #include <memory>
 #include <string>
 #include <vector>
@@ -42,8 +41,10 @@ class GatewareBoard {
   void limit_compare(std::uint64_t bytes) { compare_limit_ = bytes; }
   const std::vector<rtl::ScanFrame>& gateware_frames() const { return gw_frames_; }
   std::size_t reads_compared() const { return reads_compared_; }
-  // What the simulator answered to the last read of `index` on the wires.
-  std::uint64_t last_shadow_read(std::uint8_t index) const { return shadow_reads_[index & 0x7F]; }
+  // While on, every read frame on the wires of a register whose value does not depend on timing
+  // (not STATUS, FRAME_CRC, MEM_ADDR, MEM_DATA) must return the same value from both devices; use it
+  // when the devices are idle.
+  void compare_reads(bool on) { compare_all_reads_ = on; }
 
  private:
   GatewareBoard() = default;
@@ -56,7 +57,8 @@ class GatewareBoard {
   std::vector<std::string> read_mismatches_;
   std::size_t reads_compared_ = 0;
   std::uint64_t compare_limit_ = 0;
-  std::array<std::uint64_t, 128> shadow_reads_{};
+  bool compare_all_reads_ = false;
+  std::unique_ptr<backends::SpiTarget> trace_;
 };
 
 }  // namespace gpubridge::test

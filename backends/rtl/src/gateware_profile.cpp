@@ -15,7 +15,7 @@ std::optional<GatewareProfile> parse_gateware_profile(std::string_view name) {
 GatewareCaps caps_of(GatewareProfile p) {
   GatewareCaps c;
   if (p == GatewareProfile::Up5k) {
-    c.features = 0x3C;  // dither, strict link, RGB565, RGBA2222
+    c.features = 0x2C;  // dither, strict link, RGBA2222
     c.fifo_depth = 64;
     c.max_width = 320;
     c.max_height = 240;

@@ -54,6 +54,28 @@ DeviceStats stats_difference(const DeviceStats& a, const DeviceStats& b) {
   return d;
 }
 
+Result<BoardTiming> timing_preset(std::string_view name) {
+  BoardTiming b;
+  if (name == "ecp5-50mhz") return b;
+  if (name == "up5k") {
+    // iCEBreaker: 30 MHz core, 128 KiB SPRAM (one 32-bit access per clock), SPI 10 MHz, no BUSY pin
+    b.name = "up5k";
+    b.clock_mhz = 30.0;
+    b.spi_clock_mhz = 10.0;
+    b.memory_bytes_per_cycle = 4.0;
+    return b;
+  }
+  if (name == "ecp5") {
+    // ULX3S: 50 MHz core, 16-bit SDR SDRAM (BL2 words every other clock at best), SPI 15 MHz
+    b.name = "ecp5";
+    b.clock_mhz = 50.0;
+    b.spi_clock_mhz = 15.0;
+    b.memory_bytes_per_cycle = 2.0;
+    return b;
+  }
+  return make_error("unknown timing profile '" + std::string(name) + "' (ecp5-50mhz, up5k, ecp5)");
+}
+
 Result<void> apply_timing_setting(BoardTiming& b, std::string_view setting) {
   struct Key {
     std::string_view name;
@@ -75,6 +97,12 @@ Result<void> apply_timing_setting(BoardTiming& b, std::string_view setting) {
   const auto eq = setting.find('=');
   if (eq == std::string_view::npos) return make_error("timing setting '" + std::string(setting) + "' is not KEY=VALUE");
   const std::string_view name = setting.substr(0, eq);
+  if (name == "profile") {
+    auto p = timing_preset(setting.substr(eq + 1));
+    if (!p) return p.error();
+    b = *p;
+    return {};
+  }
   const std::string text(setting.substr(eq + 1));
   char* end = nullptr;
   const double v = std::strtod(text.c_str(), &end);

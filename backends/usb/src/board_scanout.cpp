@@ -18,11 +18,17 @@ constexpr unsigned kScanoutAttempts = 3;
 Result<void> BoardBackend::emit_scanout() {
   if (auto r = poll_status(kStatusBusy | kStatusLinkPending | kStatusSwapPending | kStatusLevelMask, 0, "the display swap"); !r)
     return r.error();
-  const std::uint8_t idx[] = {index_of(Reg::FRAME_CRC), index_of(Reg::FRAME_CRC)};
+  // FB_FORMAT and FB_DISPLAY as the device validated them (a format or size the design lacks was
+  // replaced), not as they were written.
+  const std::uint8_t idx[] = {index_of(Reg::FRAME_CRC), index_of(Reg::FRAME_CRC), index_of(Reg::FB_FORMAT),
+                              index_of(Reg::FB_FORMAT), index_of(Reg::FB_DISPLAY), index_of(Reg::FB_DISPLAY)};
   auto v = read_frames(idx);
   if (!v) return v.error();
-  if ((*v)[0] != (*v)[1])
-    return make_error("board '" + profile_.name + "': FRAME_CRC reads disagree (MISO bit errors)", backends::kDeviceProtocol);
+  if ((*v)[0] != (*v)[1] || (*v)[2] != (*v)[3] || (*v)[4] != (*v)[5])
+    return make_error("board '" + profile_.name + "': FRAME_CRC, FB_FORMAT or FB_DISPLAY reads disagree (MISO bit errors)",
+                      backends::kDeviceProtocol);
+  fb_format_ = (*v)[2];
+  fb_display_ = (*v)[4];
   auto frame = std::make_shared<backends::ScanoutFrame>();
   frame->crc = static_cast<std::uint32_t>((*v)[0]);
   frame->number = ++frame_number_;

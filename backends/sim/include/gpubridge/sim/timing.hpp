@@ -47,7 +47,12 @@ TimingEstimate estimate_timing(const DeviceStats& work, const BoardTiming& board
 double spi_link_ms(double frames, const BoardTiming& board);
 // a − b, field by field.
 DeviceStats stats_difference(const DeviceStats& a, const DeviceStats& b);
-// "clock_mhz=25 spi_clock_mhz=10 ..." settings applied to a profile (errors name the key).
+// "clock_mhz=25 spi_clock_mhz=10 ..." settings applied to a profile (errors name the key);
+// "profile=NAME" replaces every value with a preset's.
 Result<void> apply_timing_setting(BoardTiming& board, std::string_view setting);
+// Named profiles: "ecp5-50mhz" (the default above, an estimate), and "up5k" / "ecp5": the gateware
+// profiles (gateware/rtl/spigpu_top.v) at their co-simulated clocks, calibrated on the RTL's cycles
+// per frame of every example and scene (`gpubridge bench rtl --fit`, docs/gateware.md).
+Result<BoardTiming> timing_preset(std::string_view name);
 
 }  // namespace gpubridge::sim
