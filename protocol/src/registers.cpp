@@ -119,7 +119,7 @@ constexpr Field kFence[] = {F("ID", 0, 64, K::Unsigned, "reads return the ID of 
 constexpr Field kMemAddr[] = {F("ADDR", 3, 29, K::Unsigned, "byte address / 8 of the next MEM_DATA access")};
 constexpr Field kMemData[] = {F("DATA", 0, 64, K::Unsigned, "8 bytes, big-endian: bits [63:56] at MEM_ADDR")};
 constexpr Field kCaps[] = {
-    F("FEATURES", 56, 8, K::Unsigned, "bit 0 bilinear, 1 blend, 2 dither, 3 strict link, 4 RGB565, 5 RGBA2222, 6 temporal dither"),
+    F("FEATURES", 56, 8, K::Unsigned, "bit 0 bilinear, 1 blend, 2 dither, 3 strict link, 4 RGB565, 5 RGBA2222, 6 temporal dither, 7 texturing"),
     F("FIFO_DEPTH", 46, 10, K::Unsigned, "command FIFO entries"),
     F("MAX_HEIGHT", 35, 11, K::Unsigned, "largest framebuffer height"),
     F("MAX_WIDTH", 24, 11, K::Unsigned, "largest framebuffer width"),
@@ -128,7 +128,7 @@ constexpr Field kCaps[] = {
 constexpr Field kId[] = {
     F("MAGIC", 32, 32, K::Unsigned, "0x53504755 (\"SPGU\")"),
     F("MAJOR", 24, 8, K::Unsigned, "protocol major version (1)"),
-    F("MINOR", 16, 8, K::Unsigned, "protocol minor version (1)"),
+    F("MINOR", 16, 8, K::Unsigned, "protocol minor version (2)"),
     F("VARIANT", 0, 16, K::Unsigned, "implementation: 0 simulator, others per board profile"),
 };
 

@@ -1,6 +1,8 @@
 // Register file behaviour and every error flag of docs/protocol.md sections 5 and 13.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "gpubridge/protocol/registers.hpp"
 #include "sim_test_util.hpp"
 
@@ -17,13 +19,13 @@ TEST(SimRegisters, ResetValuesIdAndCaps) {
   o.max_width = 320;
   o.max_height = 240;
   auto d = make_device(o);
-  EXPECT_EQ(rd(*d, Reg::ID), 0x5350475501010007ull);  // protocol 1.1
+  EXPECT_EQ(rd(*d, Reg::ID), 0x5350475501020007ull);  // protocol 1.2
   const std::uint64_t caps = rd(*d, Reg::CAPS);
   EXPECT_EQ(caps & 0xFFFFFF, 2048u);                // VRAM_KIB
   EXPECT_EQ((caps >> 24) & 0x7FF, 320u);            // MAX_WIDTH
   EXPECT_EQ((caps >> 35) & 0x7FF, 240u);            // MAX_HEIGHT
   EXPECT_EQ((caps >> 46) & 0x3FF, 100u);            // FIFO_DEPTH
-  EXPECT_EQ(caps >> 56, 0x7Fu);                     // FEATURES (bit 6: temporal dither)
+  EXPECT_EQ(caps >> 56, 0xFFu);                     // FEATURES (bit 6: temporal dither, bit 7: texturing)
   for (const auto& r : register_table()) {
     if (r.access != Access::ReadWrite || r.path != Path::Queued) continue;
     EXPECT_EQ(d->read(r.index), r.reset) << r.name;
@@ -121,6 +123,38 @@ TEST(SimRegisters, TemporalDitherNeedsItsFeatureBit) {
   EXPECT_EQ(errors_of(*full), 0);
   w(*full, Reg::TRI_MODE, std::uint64_t{1} << 20);  // bit 20 stays reserved
   EXPECT_EQ(errors_of(*full), ERR_RESERVED_BITS);
+}
+
+TEST(SimRegisters, TexturingNeedsItsFeatureBit) {
+  // CAPS.FEATURES bit 7 (protocol 1.2): without it TRI_MODE.TEXTURED is refused and the triangle is
+  // drawn with its vertex colours, exactly as an untextured draw.
+  DeviceOptions with, without;
+  without.features = kAllFeatures & ~FEATURE_TEXTURE;
+  auto plain = make_device(with);
+  auto d = make_device(without);
+  EXPECT_EQ(rd(*d, Reg::CAPS) >> 63, 0u);
+  EXPECT_EQ(rd(*plain, Reg::CAPS) >> 63, 1u);
+  w(*d, Reg::TRI_MODE, 0x3);  // GOURAUD | TEXTURED
+  EXPECT_EQ(rd(*d, Reg::TRI_MODE), 0x1u);
+  EXPECT_EQ(errors_of(*d), ERR_BAD_VALUE);
+  w(*d, Reg::ERR_CLEAR, 0xFFFF);
+  w(*plain, Reg::TRI_MODE, 0x1);
+  for (auto* dev : {d.get(), plain.get()}) {
+    w(*dev, Reg::FB_FORMAT, fb_format(16, 16, 0));
+    w(*dev, Reg::SCISSOR, scissor(0, 0, 16, 16));
+    w(*dev, Reg::TEX_FMT, 0x33);
+    const std::uint32_t colours[3] = {0xFF0000FFu, 0x00FF00FFu, 0x0000FFFFu};
+    const std::uint64_t xy[3] = {0x00000000u, 0x000000F0u, 0x00F00000u};
+    for (int i = 0; i < 3; ++i) {
+      w(*dev, Reg::COLOR, (std::uint64_t{0x80000000u} << 32) | colours[i]);
+      w(*dev, Reg::TEXCOORD, 0x0100000001000000ull);
+      w(*dev, Reg::VERTEX, xy[i]);
+    }
+  }
+  EXPECT_EQ(errors_of(*d), 0);
+  const auto a = d->memory(), b = plain->memory();
+  EXPECT_TRUE(std::equal(a.begin(), a.begin() + 16 * 16 * 4, b.begin()));
+  EXPECT_NE(a[4 * 17], 0);  // the triangle was drawn
 }
 
 TEST(SimRegisters, ResetNeedsMagicAndKeepsMemory) {

@@ -192,6 +192,7 @@ struct Device::State {
         }
         break;
       case Reg::TRI_MODE:
+        need(FEATURE_TEXTURE, 1ull << 1);
         need(FEATURE_BLEND, 3ull << 7);
         need(FEATURE_DITHER, 1ull << 9);
         need(FEATURE_TEMPORAL_DITHER, (1ull << 15) | (15ull << 16));  // TEMPORAL, DITHER_PHASE

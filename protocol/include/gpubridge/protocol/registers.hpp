@@ -160,7 +160,7 @@ constexpr bool miso_status_valid(std::uint8_t b) { return (b & MISO_MARKER_MASK)
 // Fixed identification values.
 inline constexpr std::uint32_t kIdMagic = 0x53504755;  // "SPGU" in ID[63:32]
 inline constexpr std::uint8_t kVersionMajor = 1;
-inline constexpr std::uint8_t kVersionMinor = 1;  // 1.1: TRI_MODE.TEMPORAL / DITHER_PHASE
+inline constexpr std::uint8_t kVersionMinor = 2;  // 1.1: TRI_MODE.TEMPORAL / DITHER_PHASE; 1.2: CAPS.FEATURES bit 7 (texturing)
 inline constexpr std::uint64_t kResetMagic = 0x5245534554ull;  // "RESET": RESET's required data
 inline constexpr unsigned kMaxFramebufferDim = 1024;
 inline constexpr unsigned kMinTextureLog2 = 3;

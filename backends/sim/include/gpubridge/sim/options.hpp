@@ -43,8 +43,9 @@ enum Feature : std::uint8_t {
   FEATURE_RGB565 = 1u << 4,
   FEATURE_RGBA2222 = 1u << 5,
   FEATURE_TEMPORAL_DITHER = 1u << 6,  // TRI_MODE.TEMPORAL and DITHER_PHASE (protocol 1.1)
+  FEATURE_TEXTURE = 1u << 7,          // TRI_MODE.TEXTURED: the texture unit (protocol 1.2)
 };
-inline constexpr std::uint8_t kAllFeatures = 0x7F;
+inline constexpr std::uint8_t kAllFeatures = 0xFF;
 
 inline constexpr std::uint64_t kMaxVramBytes = 1ull << 32;  // addresses are 32-bit
 inline constexpr unsigned kMaxThreads = 64;
