@@ -25,8 +25,8 @@ std::uint32_t env_u32(const char* name, std::uint32_t fallback) {
 
 class RandomStream {
  public:
-  RandomStream(std::uint32_t seed, std::uint64_t vram, std::uint8_t features, bool texture)
-      : rng_(seed), vram_(vram), features_(features), texture_(texture) {}
+  RandomStream(std::uint32_t seed, std::uint64_t vram, std::uint8_t features)
+      : rng_(seed), vram_(vram), features_(features) {}
 
   unsigned pick(unsigned n) { return std::uniform_int_distribution<unsigned>(0, n - 1)(rng_); }
   bool chance(double p) { return std::uniform_real_distribution<double>(0, 1)(rng_) < p; }
@@ -72,8 +72,8 @@ class RandomStream {
     if (features_ & sim::FEATURE_DITHER) mode |= std::uint64_t{pick(2)} << 9;
     if (chance(0.25)) mode |= std::uint64_t{pick(16)} << 10;  // write masks
     mode |= std::uint64_t{pick(2)} << 14;  // TEX_DECAL
-    if (texture_ && chance(0.5)) {
-      mode |= 2;  // TEXTURED
+    if (chance(0.5)) {
+      mode |= 2;  // TEXTURED (refused, as by the soc, where the profile has no texture unit)
       const unsigned wl = 3 + pick(8), hl = 3 + pick(8);
       unsigned tfmt = pick(3);
       if (tfmt == 1 && !(features_ & sim::FEATURE_RGB565)) tfmt = 0;
@@ -135,7 +135,6 @@ class RandomStream {
   std::mt19937 rng_;
   std::uint64_t vram_;
   std::uint8_t features_;
-  bool texture_;
   unsigned width_ = 16, height_ = 16;
 };
 
@@ -147,7 +146,7 @@ TEST(CoreRandom, DrawsAndClearsMatchSimulator) {
   o.vram_bytes = 64 * 1024;
   o.features = kCoreFeatures;
   Cosim cs(o, seed);
-  RandomStream r(seed, o.vram_bytes, o.features, kCoreTexture);
+  RandomStream r(seed, o.vram_bytes, o.features);
   // memory starts random (texels, stale buffers)
   {
     std::mt19937 fill(seed ^ 0x5EEDu);

@@ -80,7 +80,6 @@ TEST_P(CoreSceneFile, MatchesSimulator) {
   const auto o = scene_device();
   auto parsed = scene::read_scene_file(path);
   ASSERT_TRUE(parsed) << parsed.error().message;
-  if (!kCoreTexture && !parsed->textures.empty()) GTEST_SKIP() << "the profile does not texture";
   if (!scene::plan_memory(*parsed, o.vram_bytes)) GTEST_SKIP() << "the scene does not fit the profile's video memory";
   auto built = scene::build_commands(*parsed, {.vram_bytes = o.vram_bytes});
   ASSERT_TRUE(built) << built.error().message;

@@ -1,8 +1,7 @@
 #pragma once
 // The Verilated core under test, as configured by CMake (one test executable per profile):
 //   GPUBRIDGE_RTL_MODEL        class of the Verilated model (Vcore_ecp5, Vcore_up5k)
-//   GPUBRIDGE_RTL_FEATURES     CAPS.FEATURES the simulator is given (the core's FEATURES as far
-//                              as the simulator knows them)
+//   GPUBRIDGE_RTL_FEATURES     CAPS.FEATURES the simulator is given (the core's FEATURES)
 //   GPUBRIDGE_RTL_VRAM_KIB     the profile's VRAM (the core computes addresses for this size)
 //   GPUBRIDGE_RTL_TEXTURE      1 when the core samples textures
 #include <cstdint>

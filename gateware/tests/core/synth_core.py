@@ -13,14 +13,14 @@ RTL = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "rtl"
 PROFILES = {
     "up5k": {
         "synth": "synth_ice40 -dsp",
-        "top": {"PROFILE": "0", "FEATURES": "8'h2C", "MAX_WIDTH": "320", "MAX_HEIGHT": "240", "VRAM_KIB": "128"},
+        "top": {"PROFILE": "0", "FEATURES": "8'h3C", "MAX_WIDTH": "320", "MAX_HEIGHT": "240", "VRAM_KIB": "128"},
         "stages": [
             ("setup", "core_setup", {"SERIAL": "1", "TEX": "0", "IDX_W": "17", "SKIP": "0"}, ["core_divider.v"]),
             ("divider (in setup)", "core_divider", {"NW": "64", "SKIP": "0"}, []),
             ("rasteriser", "core_raster", {"IDX_W": "17"}, []),
             ("attribute steppers", "core_interp_tm", {"RW": "35"}, []),
             ("depth stage", "core_depth", {"PW": "77", "ZLSB": "17", "IDX_W": "17", "AW": "0", "ADDR_W": "17"}, ["core_rdq.v"]),
-            ("colour stage", "core_color", {"AW": "0", "IDX_W": "17", "ADDR_W": "17", "FEATURES": "8'h2C"}, ["core_rdq.v"]),
+            ("colour stage", "core_color", {"AW": "0", "IDX_W": "17", "ADDR_W": "17", "FEATURES": "8'h3C"}, ["core_rdq.v"]),
             ("memory port", "core_memport", {"TAGS_AW": "1"}, []),
             ("alias check", "core_alias", {"ADDR_W": "17"}, []),
         ],
