@@ -25,7 +25,9 @@ module core_setup #(
     parameter integer SERIAL = 0,
     parameter integer TEX = 1,       // S, T, Q planes exist (33-bit deltas)
     parameter integer IDX_W = 20,
-    parameter integer SKIP = 1       // divider skips leading zero quotient bits (faster, larger)
+    parameter integer SKIP = 1,      // divider skips leading zero quotient bits (faster, larger)
+    parameter integer XREJECT = 1,   // drop triangles wholly left or right of the clip rectangle
+    parameter integer NDIV = 1       // dividers: 1, or 3 (one per numerator of a plane)
 ) (
     input  wire         clk,
     input  wire         rst,
@@ -90,8 +92,6 @@ module core_setup #(
   function [1:0] argmax(input signed [16:0] d10, input signed [16:0] d21, input signed [16:0] d02);
     argmax = (d10 <= 0 && d02 >= 0) ? 2'd0 : (d10 > 0 && d21 <= 0) ? 2'd1 : 2'd2;
   endfunction
-  // (no column bounds: a triangle beside the clip rectangle costs its empty rows, about two cycles
-  // each, which is cheaper in logic than a second bounding box)
   wire [1:0] top = argmin(dy2, dy0, dy1);
   wire signed [15:0] mny = pick3(top, y0, y1, y2);
   wire signed [15:0] mxy = pick3(argmax(dy2, dy0, dy1), y0, y1, y2);
@@ -103,7 +103,21 @@ module core_setup #(
   wire signed [12:0] cy0 = $signed({2'b0, clip_y0}), cy1 = $signed({2'b0, clip_y1});
   wire signed [12:0] by0 = (fy0 > cy0) ? fy0 : cy0;
   wire signed [12:0] by1 = (fy1 < cy1) ? fy1 : cy1;
-  wire box_empty = (by0 >= by1);
+  // Columns: with XREJECT a triangle wholly beside the clip rectangle is dropped here; without
+  // (the small profile) it costs its empty rows, about two cycles each, and its setup.
+  wire x_out;
+  generate
+    if (XREJECT != 0) begin : columns
+      wire signed [15:0] mnx = pick3(argmin(dx2, dx0, dx1), x0, x1, x2);
+      wire signed [15:0] mxx = pick3(argmax(dx2, dx0, dx1), x0, x1, x2);
+      wire signed [12:0] fx0 = 13'(($signed({mnx[15], mnx}) + 17'sd7) >>> 4);
+      wire signed [12:0] fx1 = 13'((($signed({mxx[15], mxx}) + 17'sd8) >>> 4));
+      assign x_out = (fx0 >= cx1) || (fx1 <= cx0);
+    end else begin : no_columns
+      assign x_out = 1'b0;
+    end
+  endgenerate
+  wire box_empty = (by0 >= by1) || x_out;
   wire signed [12:0] xt = 13'(xtop >>> 4);
   wire [10:0] xs = (xt < cx0) ? clip_x0 : (xt >= cx1) ? clip_x1 - 11'd1 : xt[10:0];
 
@@ -253,26 +267,56 @@ module core_setup #(
   endgenerate
   wire mac_busy = mac_run || mac_go;
 
-  // ---------------------------------------------------------------- divider
-  reg          div_go;
-  wire         div_done;
-  wire [31:0]  div_q;
-  wire [34:0]  div_r, div_rc;
-  /* verilator lint_off PINCONNECTEMPTY */
-  core_divider #(.NW(ACC_W), .DW(35), .QW(32), .SKIP(SKIP)) divider (
-      .clk(clk), .rst(rst), .start(div_go), .num(acc_s), .den(den),
-      .busy(), .done(div_done), .quo(div_q), .rem(div_r), .rem_c(div_rc));
-  /* verilator lint_on PINCONNECTEMPTY */
-  reg  [2:0]  div_attr;     // the attribute whose division runs
-  reg  [1:0]  div_field;    // the plane field it produces
-  reg         div_pending;  // running, or its results not yet written
-  reg         xl_next;      // the step left follows the step right's write
-  reg  [31:0] div_a0;
-  wire        div_free = !div_pending && !div_go;
+  // ---------------------------------------------------------------- dividers
+  // NDIV = 1: one divider takes a plane's three numerators in turn; NDIV = 3: one per numerator
+  // (step right, step down, value at the origin), so a plane's divisions overlap each other and
+  // the next plane's multiplies. A finished division is written to the steppers through the one
+  // plane-write port (the step right followed by the step left) before its divider starts again.
+  localparam integer ND = (NDIV >= 3) ? 3 : 1;
+  localparam integer SW = (ND == 1) ? 1 : 2;  // divider index bits
+  reg  [ND-1:0]    dv_go;
+  wire [ND-1:0]    dv_done;
+  wire [ND*32-1:0] dv_q;
+  wire [ND*35-1:0] dv_r, dv_rc;
+  reg  [ND-1:0]    dv_pend;          // running, or its results not yet written
+  reg  [ND-1:0]    dv_rdy;           // finished, not yet written
+  reg  [ND*2-1:0]  dv_field;         // the plane field it produces
+  reg  [ND*3-1:0]  dv_attr;
+  reg  [ND*32-1:0] dv_a0;
+  genvar gd;
+  generate
+    for (gd = 0; gd < ND; gd = gd + 1) begin : dividers
+      /* verilator lint_off PINCONNECTEMPTY */
+      core_divider #(.NW(ACC_W), .DW(35), .QW(32), .SKIP(SKIP)) divider (
+          .clk(clk), .rst(rst), .start(dv_go[gd]), .num(acc_s), .den(den), .busy(), .done(dv_done[gd]),
+          .quo(dv_q[gd*32 +: 32]), .rem(dv_r[gd*35 +: 35]), .rem_c(dv_rc[gd*35 +: 35]));
+      /* verilator lint_on PINCONNECTEMPTY */
+    end
+  endgenerate
+  // the divider a field's numerator goes to, and whether it can take it now
+  function integer div_of(input [1:0] field);
+    div_of = (ND == 1) ? 0 : (field == 2'd1) ? 0 : (field == 2'd3) ? 1 : ND - 1;
+  endfunction
+  wire free_x = !dv_pend[div_of(2'd1)] && !dv_go[div_of(2'd1)];
+  wire free_y = !dv_pend[div_of(2'd3)] && !dv_go[div_of(2'd3)];
+  wire free_0 = !dv_pend[div_of(2'd0)] && !dv_go[div_of(2'd0)];
+  wire all_free = (dv_pend == {ND{1'b0}}) && (dv_go == {ND{1'b0}});
 
-  // plane writes come from the divider's held results
-  assign pw_q = (pw_field == 2'd0) ? div_a0 + div_q : (pw_field == 2'd2) ? ~div_q : div_q;
-  assign pw_r = (pw_field == 2'd2) ? div_rc : div_r;
+  // plane writes come from a divider's held results
+  reg  [SW-1:0] wsel;  // the divider being written
+  reg        xl_next;  // the step left follows the step right's write
+  wire [31:0] w_q  = dv_q[wsel*32 +: 32];
+  wire [31:0] w_a0 = dv_a0[wsel*32 +: 32];
+  assign pw_q = (pw_field == 2'd0) ? w_a0 + w_q : (pw_field == 2'd2) ? ~w_q : w_q;
+  assign pw_r = (pw_field == 2'd2) ? dv_rc[wsel*35 +: 35] : dv_r[wsel*35 +: 35];
+  // the lowest finished divider
+  reg [SW-1:0] rdy_sel;
+  integer gi;
+  always @(*) begin
+    rdy_sel = {SW{1'b0}};
+    for (gi = ND - 1; gi >= 0; gi = gi - 1)
+      if (dv_rdy[gi]) rdy_sel = SW'(gi);
+  end
 
   // ---------------------------------------------------------------- sequencer
   localparam [4:0] S_IDLE = 5'd0, S_AREA = 5'd1, S_FLIP = 5'd2, S_BOX = 5'd3, S_ORIGIN = 5'd4,
@@ -285,10 +329,21 @@ module core_setup #(
 
   assign busy = (st != S_IDLE);
 
+  // the numerator in acc goes to its divider (which latches it in the next cycle)
+  task start_div(input [1:0] field);
+    begin
+      dv_go[div_of(field)]                 <= 1'b1;
+      dv_pend[div_of(field)]               <= 1'b1;
+      dv_field[div_of(field)*2 +: 2]       <= field;
+      dv_attr[div_of(field)*3 +: 3]        <= ak;
+      dv_a0[div_of(field)*32 +: 32]        <= 32'(a0);
+    end
+  endtask
+
   always @(posedge clk) begin
     done   <= 1'b0;
     pw_en  <= 1'b0;
-    div_go <= 1'b0;
+    dv_go  <= {ND{1'b0}};
     mac_go <= 1'b0;
     add_go <= 1'b0;
     e_we   <= 3'b000;
@@ -297,19 +352,24 @@ module core_setup #(
       st          <= S_IDLE;
       flip        <= 1'b0;
       draw        <= 1'b0;
-      div_pending <= 1'b0;
+      dv_pend     <= {ND{1'b0}};
+      dv_rdy      <= {ND{1'b0}};
+      xl_next     <= 1'b0;
     end else begin
       // division results become plane writes: the step right is followed by the step left
-      if (div_done) begin
+      dv_rdy <= dv_rdy | dv_done;
+      if (xl_next) begin
         pw_en    <= 1'b1;
-        pw_attr  <= div_attr;
-        pw_field <= div_field;
-        xl_next  <= (div_field == 2'd1);
-        if (div_field != 2'd1) div_pending <= 1'b0;
-      end else if (xl_next) begin
-        pw_en       <= 1'b1;
-        pw_field    <= 2'd2;
-        div_pending <= 1'b0;
+        pw_field <= 2'd2;
+        dv_pend[wsel] <= 1'b0;
+      end else if (dv_rdy != {ND{1'b0}}) begin
+        pw_en    <= 1'b1;
+        wsel     <= rdy_sel;
+        pw_attr  <= dv_attr[rdy_sel*3 +: 3];
+        pw_field <= dv_field[rdy_sel*2 +: 2];
+        xl_next  <= (dv_field[rdy_sel*2 +: 2] == 2'd1);
+        dv_rdy[rdy_sel] <= 1'b0;
+        if (dv_field[rdy_sel*2 +: 2] != 2'd1) dv_pend[rdy_sel] <= 1'b0;
       end
       case (st)
         S_IDLE: if (start) begin
@@ -411,9 +471,8 @@ module core_setup #(
           mac_go <= 1'b1;
           st <= S_GX_W;
         end
-        S_GX_W: if (!mac_busy && div_free) begin
-          div_go <= 1'b1; div_pending <= 1'b1; div_field <= 2'd1; div_attr <= ak;
-          div_a0 <= 32'(a0);
+        S_GX_W: if (!mac_busy && free_x) begin
+          start_div(2'd1);
           osel1 <= O_DX1; osel2 <= O_DX2; mneg <= flip;  // 32 Gy
           st <= S_GY;
         end
@@ -421,8 +480,8 @@ module core_setup #(
           mac_go <= 1'b1;
           st <= S_M0;
         end
-        S_M0: if (!mac_busy && div_free) begin
-          div_go <= 1'b1; div_pending <= 1'b1; div_field <= 2'd3;
+        S_M0: if (!mac_busy && free_y) begin
+          start_div(2'd3);
           sh5 <= 1'b0; osel1 <= O_E1; osel2 <= O_E2; mneg <= 1'b0;
           cstep <= 2'd0;
           st <= S_M0_C;
@@ -442,11 +501,11 @@ module core_setup #(
             if (cstep == 2'd3) st <= S_M0_D;
           end
         end
-        S_M0_D: if (!add_go && div_free) begin
-          div_go <= 1'b1; div_pending <= 1'b1; div_field <= 2'd0;
+        S_M0_D: if (!add_go && free_0) begin
+          start_div(2'd0);
           st <= S_ANEXT;
         end
-        S_DRAIN: if (div_free) st <= S_END;
+        S_DRAIN: if (all_free) st <= S_END;
         default: begin  // S_END
           done <= 1'b1;
           st   <= S_IDLE;

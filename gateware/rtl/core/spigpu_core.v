@@ -111,7 +111,8 @@ module spigpu_core #(
   wire [34:0] pw_r;
   reg         su_go;
   wire        su_rect = (cmd_op != OP_TRI);  // small profile: clears are drawn as rectangles
-  core_setup #(.SERIAL(SMALL), .TEX(TEX), .IDX_W(IDX_W), .SKIP(1 - SMALL)) setup (
+  core_setup #(.SERIAL(SMALL), .TEX(TEX), .IDX_W(IDX_W), .SKIP(1 - SMALL), .XREJECT(1 - SMALL),
+               .NDIV((SMALL != 0) ? 1 : 3)) setup (
       .clk(clk), .rst(rst), .start(su_go), .rect(su_rect), .busy(su_busy), .done(su_done), .draw(su_draw),
       .v0(cmd_v0), .v1(cmd_v1), .v2(cmd_v2),
       .clip_x0(sc_x0), .clip_y0(sc_y0), .clip_x1(clip_x1), .clip_y1(clip_y1), .width(cmd_fb_width),
