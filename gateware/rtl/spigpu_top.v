@@ -1,6 +1,7 @@
 // spigpu v1 device (docs/protocol.md sections 2-13), one clock domain. The profile parameter picks
 // what the device has; CAPS reports exactly that (docs/gateware.md "Profiles"):
-//   PROFILE 0 "up5k": iCE40 UP5K, 128 KiB SPRAM as VRAM, 320 x 240 at most, FIFO 64, RGBA2222 only;
+//   PROFILE 0 "up5k": iCE40 UP5K, 128 KiB SPRAM as VRAM, 320 x 240 at most, FIFO 64, no texturing,
+//                     bilinear or blending;
 //   PROFILE 1 "ecp5": ECP5-85F, 32 MiB SDR SDRAM as VRAM, 1024 x 768 at most, FIFO 1023, every feature.
 // Display timing is in core clocks (LINE_CLOCKS x V_TOTAL lines, V_ACTIVE visible); the board top
 // levels set it for 640 x 480 at 60 Hz, the co-simulation uses a short frame.
@@ -56,12 +57,11 @@ module spigpu_top #(
   output wire [31:0] perf_setup,
   output wire [31:0] perf_raster
 );
-  // CAPS.FEATURES: bit 0 bilinear, 1 blend, 2 dither, 3 strict link, 4 RGB565, 5 RGBA2222.
-  // The core's FEATURES bit 7 builds its texture unit; protocol v1.0 has no CAPS bit for a device
-  // without one, so every profile has it (a profile without texturing needs that bit first).
-  // up5k: dither, strict link, RGBA2222 (no bilinear, blend or RGB565: gw-core's small profile)
-  localparam [7:0]  FEATURES   = PROFILE == 0 ? 8'h2C : 8'h3F;
-  localparam [7:0]  CORE_FEATURES = FEATURES | 8'h80;
+  // CAPS.FEATURES: bit 0 bilinear, 1 blend, 2 dither, 3 strict link, 4 RGB565, 5 RGBA2222,
+  // 7 texturing (protocol 1.1). up5k: dither, strict link, RGB565, RGBA2222 (no bilinear, blend or
+  // texture unit: they do not fit the 5,280 LUTs beside the rest).
+  localparam [7:0]  FEATURES   = PROFILE == 0 ? 8'h3C : 8'hBF;
+  localparam [7:0]  CORE_FEATURES = FEATURES;
   localparam        MAX_WIDTH  = PROFILE == 0 ? 320 : 1024;
   localparam        MAX_HEIGHT = PROFILE == 0 ? 240 : 768;
   localparam        FIFO_DEPTH = PROFILE == 0 ? 64 : 1023;

@@ -15,7 +15,7 @@ std::optional<GatewareProfile> parse_gateware_profile(std::string_view name) {
 GatewareCaps caps_of(GatewareProfile p) {
   GatewareCaps c;
   if (p == GatewareProfile::Up5k) {
-    c.features = 0x2C;  // dither, strict link, RGBA2222
+    c.features = 0x3C;  // dither, strict link, RGB565, RGBA2222 (no texturing, bilinear or blending)
     c.fifo_depth = 64;
     c.max_width = 320;
     c.max_height = 240;
@@ -23,7 +23,7 @@ GatewareCaps caps_of(GatewareProfile p) {
     c.variant = 0x0001;
     c.core_hz = 30e6;
   } else {
-    c.features = 0x3F;
+    c.features = 0xBF;  // every feature of protocol 1.1 but temporal dither
     c.fifo_depth = 1023;
     c.max_width = 1024;
     c.max_height = 768;

@@ -113,6 +113,7 @@ module command_exec #(
         if (d != enum_fix[63:0]) bad = 1'b1;
       end
       `SPIGPU_REG_TRI_MODE: begin
+        if (d[1] && !FEATURES[7]) begin d[1] = 1'b0; bad = 1'b1; end
         if (d[8:7] != 2'd0 && !FEATURES[1]) begin d[8:7] = 2'd0; bad = 1'b1; end
         if (d[9] && !FEATURES[2]) begin d[9] = 1'b0; bad = 1'b1; end
       end

@@ -85,13 +85,15 @@ module spigpu_soc #(
   output wire [31:0]  perf_core_stalls,   // clocks a core memory request waited
   output wire [31:0]  perf_refreshes      // SDRAM auto refreshes
 );
+`include "spigpu_regs.vh"
   localparam [29:0] VRAM_WORDS = VRAM_KIB * 256;
   localparam [28:0] VRAM_UNITS = VRAM_KIB * 128;
   localparam [9:0]  FIFO_D10 = FIFO_DEPTH;
   localparam [10:0] MAXW11 = MAX_WIDTH, MAXH11 = MAX_HEIGHT;
   localparam [23:0] VRAM24 = VRAM_KIB;
   localparam [63:0] CAPS = {FEATURES, FIFO_D10, MAXH11, MAXW11, VRAM24};
-  localparam [63:0] ID = {32'h53504755, 8'd1, 8'd0, VARIANT};
+  localparam [63:0] ID_RESET = reg_reset(`SPIGPU_REG_ID);   // magic and protocol version from the table
+  localparam [63:0] ID = {ID_RESET[63:16], VARIANT};
   localparam        VAW = PROFILE == 0 ? 15 : 23;      // back-end word address bits
 
   // --- SPI slave ---
