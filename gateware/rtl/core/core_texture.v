@@ -10,6 +10,7 @@
 // {q, t, s, rgba, yl, xl, z, idx}; out: the colour stage's {yl, xl, idx, rgba}.
 module core_texture #(
     parameter integer AW = 2,  // log2 of pixels whose texels are in flight
+    parameter integer CACHE = 0,  // texel cache (block RAM)
     parameter integer IDX_W = 20,
     parameter integer ADDR_W = 32
 ) (
@@ -23,6 +24,8 @@ module core_texture #(
     input  wire         bilinear,
     input  wire [1:0]   tfmt,        // 0 RGBA8888, 1 RGB565, 2 RGBA2222
     input  wire         decal,
+    input  wire         inval,       // forget the cached texels (a draw that does not continue the last)
+    input  wire         cache_en,    // use the cache (off in serial mode)
     input  wire         in_valid,
     output wire         in_ready,
     input  wire [IDX_W+155:0] in_pix,
@@ -150,25 +153,135 @@ module core_texture #(
   reg         v5, bil5;
   reg [29:0]  w00, w10, w01, w11;
   reg [7:0]   lanes5, fu5, fv5;
+  reg [9:0]   ia5, ib5, ja5, jb5;
   reg [PAY-1:0] pay5;
-  reg [1:0]   fi;   // next texel of this pixel to request
+
+  // the texel read queue's size, and the response's target (defined with the queue below)
+  localparam integer QA = (AW < 1) ? 1 : AW;  // at least two pixels in flight
+  localparam integer N = 1 << QA;
+  localparam integer IW = PAY + 8 + 8 + 8 + 1 + 40;
+  wire [1:0] fslot;
+  wire [9:0] f_ia, f_ib, f_ja, f_jb;
+
+  // ---------------------------------------------------------------- texel cache (CACHE = 1)
+  // Four banks by texel parity ({j & 1, i & 1}: the four texels of a bilinear sample are in four
+  // banks, or are the same texel), each holding raw words for eight texel rows of any width
+  // (index: j bits [2:1] and i bits [9:1]; tag: j >> 3), so the rows a span samples are still
+  // there when the walk comes back on the next row. A pixel's four texels are looked up as it
+  // enters stage 5 and its misses are filled by their responses. An entry is valid when its epoch
+  // is the current one: `inval` (a draw that does not continue the last) starts a new epoch, and
+  // every 256 epochs the banks are swept so an old epoch cannot come back. `cache_en` off (serial
+  // mode) bypasses the cache.
+  wire [3:0]   hit5;      // slot k (00, 10, 01, 11 as bits 3 .. 0) hits
+  wire [127:0] hdata5;    // the words of the slots that hit
+  wire         sweeping;  // the cache is being swept: the pipeline waits
+  function [9:0] slot_i(input k0, input [9:0] ia_, input [9:0] ib_);  // k0: slot bit 0
+    slot_i = k0 ? ib_ : ia_;
+  endfunction
+  function [9:0] slot_j(input k1, input [9:0] ja_, input [9:0] jb_);  // k1: slot bit 1
+    slot_j = k1 ? jb_ : ja_;
+  endfunction
+  generate
+    if (CACHE != 0) begin : cache
+      (* ram_style = "block", no_rw_check *) reg [46:0] bank0[0:2047];
+      (* ram_style = "block", no_rw_check *) reg [46:0] bank1[0:2047];
+      (* ram_style = "block", no_rw_check *) reg [46:0] bank2[0:2047];
+      (* ram_style = "block", no_rw_check *) reg [46:0] bank3[0:2047];
+      reg [46:0]  rd0, rd1, rd2, rd3;   // {epoch, tag, word}
+      reg [6:0]   tg0, tg1, tg2, tg3;   // the tags asked for
+      reg [7:0]   epoch;
+      reg [11:0]  sweep;                // bit 11: sweeping; [10:0] the entry
+      assign sweeping = sweep[11];
+      // lookup: bank {jp, ip} reads the pixel's texel with those parities
+      wire [9:0] li0 = (ia[0] == 1'b0) ? ia : ib, lj0 = (ja[0] == 1'b0) ? ja : jb;  // bank 0: jp 0, ip 0
+      wire [9:0] li1 = (ia[0] == 1'b1) ? ia : ib;                                  // bank 1: jp 0, ip 1
+      wire [9:0] lj2 = (ja[0] == 1'b1) ? ja : jb;                                  // bank 2: jp 1, ip 0
+      // entry of texel (i, j) in its bank: {j[2:1], i[9:1]}
+      wire [10:0] x0 = {lj0[2:1], li0[9:1]}, x1 = {lj0[2:1], li1[9:1]};
+      wire [10:0] x2 = {lj2[2:1], li0[9:1]}, x3 = {lj2[2:1], li1[9:1]};
+      // fill: the response's slot of the filling entry
+      wire [9:0] fi_i = slot_i(fslot[0], f_ia, f_ib), fi_j = slot_j(fslot[1], f_ja, f_jb);
+      wire [1:0] fbank = {fi_j[0], fi_i[0]};
+      wire [10:0] fidx = sweeping ? sweep[10:0] : {fi_j[2:1], fi_i[9:1]};
+      wire [46:0] fword = sweeping ? {epoch - 8'd1, 39'd0} : {epoch, fi_j[9:3], rsp_data};
+      wire        fill = (rsp_valid && cache_en) || sweeping;
+      wire unused_parity = &{1'b0, li0[0], lj0[0], li1[0], lj2[0], fi_i[0], fi_j[0]};
+      always @(posedge clk) begin
+        if (fill && (sweeping || fbank == 2'd0)) bank0[fidx] <= fword;
+        if (fill && (sweeping || fbank == 2'd1)) bank1[fidx] <= fword;
+        if (fill && (sweeping || fbank == 2'd2)) bank2[fidx] <= fword;
+        if (fill && (sweeping || fbank == 2'd3)) bank3[fidx] <= fword;
+        if (en) begin
+          rd0 <= bank0[x0];
+          rd1 <= bank1[x1];
+          rd2 <= bank2[x2];
+          rd3 <= bank3[x3];
+          tg0 <= lj0[9:3];
+          tg1 <= lj0[9:3];
+          tg2 <= lj2[9:3];
+          tg3 <= lj2[9:3];
+        end
+      end
+      always @(posedge clk) begin
+        if (rst) begin
+          epoch <= 8'd1;
+          sweep <= {1'b1, 11'd0};  // power on: mark every entry old
+        end else if (sweeping) begin
+          sweep <= (sweep[10:0] == 11'h7FF) ? 12'd0 : sweep + 12'd1;
+        end else if (inval) begin
+          epoch <= epoch + 8'd1;
+          if (epoch == 8'hFF) sweep <= {1'b1, 11'd0};  // epoch 0 next: forget every older one
+        end
+      end
+      wire [3:0] bhit = {rd3[46:39] == epoch && rd3[38:32] == tg3, rd2[46:39] == epoch && rd2[38:32] == tg2,
+                         rd1[46:39] == epoch && rd1[38:32] == tg1, rd0[46:39] == epoch && rd0[38:32] == tg0} &
+                        {4{cache_en}};
+      // slot k's bank: {j parity, i parity} of its texel
+      wire [1:0] sb00 = {ja5[0], ia5[0]}, sb10 = {ja5[0], ib5[0]}, sb01 = {jb5[0], ia5[0]}, sb11 = {jb5[0], ib5[0]};
+      function [31:0] bw(input [1:0] b, input [31:0] d0, input [31:0] d1, input [31:0] d2, input [31:0] d3);
+        bw = (b == 2'd0) ? d0 : (b == 2'd1) ? d1 : (b == 2'd2) ? d2 : d3;
+      endfunction
+      assign hit5 = {bhit[sb00], bhit[sb10], bhit[sb01], bhit[sb11]};
+      assign hdata5 = {bw(sb00, rd0[31:0], rd1[31:0], rd2[31:0], rd3[31:0]),
+                       bw(sb10, rd0[31:0], rd1[31:0], rd2[31:0], rd3[31:0]),
+                       bw(sb01, rd0[31:0], rd1[31:0], rd2[31:0], rd3[31:0]),
+                       bw(sb11, rd0[31:0], rd1[31:0], rd2[31:0], rd3[31:0])};
+    end else begin : no_cache
+      assign hit5 = 4'd0;
+      assign hdata5 = 128'd0;
+      assign sweeping = 1'b0;
+      wire unused_cache = &{1'b0, inval, cache_en, f_ia, f_ib, f_ja, f_jb};
+    end
+  endgenerate
+
+  // ---------------------------------------------------------------- misses to memory
+  // slots 00 10 01 11 as bits 3 2 1 0; nearest needs slot 00 only
+  reg  [3:0]  asked;      // slots of this pixel already requested
+  reg         pushed;     // this pixel's queue entry exists
   wire        q_full;
-  wire        last = !bil5 || fi == 2'd3;
-  wire        issue = v5 && (fi != 2'd0 || !q_full);
-  assign rd_valid = issue;
-  assign rd_addr  = (fi == 2'd0) ? w00 : (fi == 2'd1) ? w10 : (fi == 2'd2) ? w01 : w11;
-  wire        done5 = issue && rd_ready && last;
-  assign en = !v5 || done5;
+  wire [3:0]  need = (bil5 ? 4'b1111 : 4'b1000) & ~hit5;
+  wire [3:0]  rem = need & ~asked;
+  wire [1:0]  slot = rem[3] ? 2'd0 : rem[2] ? 2'd1 : rem[1] ? 2'd2 : 2'd3;
+  wire        can = v5 && (pushed || !q_full) && !sweeping;
+  wire        push = v5 && !pushed && !q_full && !sweeping;
+  assign rd_valid = can && (rem != 4'd0);
+  assign rd_addr  = (slot == 2'd0) ? w00 : (slot == 2'd1) ? w10 : (slot == 2'd2) ? w01 : w11;
+  wire [3:0]  slot_bit = 4'b1000 >> slot;
+  wire [3:0]  rem_after = rem & ~((rd_valid && rd_ready) ? slot_bit : 4'd0);
+  wire        done5 = can && (rem_after == 4'd0);
+  assign en = (!v5 || done5) && !sweeping;
   assign in_ready = en;
 
   always @(posedge clk) begin
     if (rst) begin
-      v5 <= 1'b0;
-      fi <= 2'd0;
+      v5     <= 1'b0;
+      asked  <= 4'd0;
+      pushed <= 1'b0;
     end else begin
-      if (issue && rd_ready) fi <= last ? 2'd0 : fi + 2'd1;
       if (en) begin
         v5     <= v4;
+        asked  <= 4'd0;
+        pushed <= 1'b0;
         bil5   <= bilinear;
         w00    <= a00[31:2];
         w10    <= a10[31:2];
@@ -177,46 +290,62 @@ module core_texture #(
         lanes5 <= {a00[1:0], a10[1:0], a01[1:0], a11[1:0]};
         fu5    <= fu;
         fv5    <= fv;
+        ia5    <= ia;
+        ib5    <= ib;
+        ja5    <= ja;
+        jb5    <= jb;
         pay5   <= pay4;
+      end else begin
+        if (push) pushed <= 1'b1;
+        if (rd_valid && rd_ready) asked <= asked | slot_bit;
       end
     end
   end
 
   // ---------------------------------------------------------------- texel read queue
-  localparam integer QA = (AW < 1) ? 1 : AW;  // at least two pixels in flight
-  localparam integer N = 1 << QA;
-  localparam integer IW = PAY + 8 + 8 + 8 + 1;
+  // An entry per pixel: the words of the slots that hit, and the slots still to come from memory
+  // (responses arrive in request order: the oldest entry with slots outstanding takes each).
   reg [IW-1:0]  items[0:N-1];
   reg [127:0]   words[0:N-1];
-  reg [QA:0]    wp, dp, rp;
-  reg [1:0]     sub;
+  reg [3:0]     miss[0:N-1];
+  reg [QA:0]    wp, rp;
   assign q_full = (wp - rp) == N[QA:0];
   wire [IW-1:0] hitem = items[rp[QA-1:0]];
   wire [127:0]  hword = words[rp[QA-1:0]];
-  wire          hvalid = (dp != rp);
-  wire          dbil = items[dp[QA-1:0]][IW-1];
+  wire          hvalid = (wp != rp) && (miss[rp[QA-1:0]] == 4'd0);
   wire          pop;
+  // the entry the next response belongs to: the oldest with slots outstanding
+  reg  [QA-1:0] fe;
+  integer qk;
+  always @(*) begin
+    fe = rp[QA-1:0];
+    for (qk = N - 1; qk >= 0; qk = qk - 1)
+      if ((QA+1)'(qk) < (wp - rp) && miss[QA'(rp[QA-1:0] + QA'(qk))] != 4'd0) fe = QA'(rp[QA-1:0] + QA'(qk));
+  end
+  wire [3:0] fmiss = miss[fe];
+  assign fslot = fmiss[3] ? 2'd0 : fmiss[2] ? 2'd1 : fmiss[1] ? 2'd2 : 2'd3;
+  assign f_ia = items[fe][IW-1:IW-10];
+  assign f_ib = items[fe][IW-11:IW-20];
+  assign f_ja = items[fe][IW-21:IW-30];
+  assign f_jb = items[fe][IW-31:IW-40];
   always @(posedge clk) begin
     if (rst) begin
-      wp <= 0; dp <= 0; rp <= 0; sub <= 2'd0;
+      wp <= 0; rp <= 0;
     end else begin
-      if (issue && rd_ready && fi == 2'd0) begin
-        items[wp[QA-1:0]] <= {bil5, lanes5, fu5, fv5, pay5};
+      if (push) begin
+        items[wp[QA-1:0]] <= {ia5, ib5, ja5, jb5, bil5, lanes5, fu5, fv5, pay5};
+        words[wp[QA-1:0]] <= hdata5;
+        miss[wp[QA-1:0]]  <= need;
         wp <= wp + 1'b1;
       end
       if (rsp_valid) begin
-        case (sub)
-          2'd0: words[dp[QA-1:0]][127:96] <= rsp_data;
-          2'd1: words[dp[QA-1:0]][95:64] <= rsp_data;
-          2'd2: words[dp[QA-1:0]][63:32] <= rsp_data;
-          default: words[dp[QA-1:0]][31:0] <= rsp_data;
+        case (fslot)
+          2'd0: words[fe][127:96] <= rsp_data;
+          2'd1: words[fe][95:64] <= rsp_data;
+          2'd2: words[fe][63:32] <= rsp_data;
+          default: words[fe][31:0] <= rsp_data;
         endcase
-        if (!dbil || sub == 2'd3) begin
-          sub <= 2'd0;
-          dp  <= dp + 1'b1;
-        end else begin
-          sub <= sub + 2'd1;
-        end
+        miss[fe] <= fmiss & ~(4'b1000 >> fslot);
       end
       if (pop) rp <= rp + 1'b1;
     end
@@ -236,8 +365,8 @@ module core_texture #(
       endcase
     end
   endfunction
-  wire        hbil = hitem[IW-1];
-  wire [7:0]  hl00 = hitem[IW-2:IW-9];
+  wire        hbil = hitem[PAY+24];
+  wire [7:0]  hl00 = hitem[PAY+23:PAY+16];
   wire [7:0]  hfu = hitem[PAY+15:PAY+8], hfv = hitem[PAY+7:PAY];
   wire [PAY-1:0] hpay = hitem[PAY-1:0];
   wire [31:0] c00 = texel(hword[127:96], hl00[7:6], tfmt);

@@ -245,6 +245,13 @@ module spigpu_core #(
       .passed(d_passed));
 
   // ---------------------------------------------------------------- texture unit
+  // The texel cache is kept across consecutive non-serial textured draws with the same texture and
+  // buffers while the core stays busy; otherwise memory may have changed under it (a clear, another
+  // draw, MEM_DATA writes while the core was idle) and it is forgotten when the draw starts.
+  reg          tc_keep, tc_inval;
+  reg  [103:0] tc_sig;
+  wire [103:0] tc_sig_n = {cmd_tex_base, cmd_tex_fmt, cmd_fb_draw, cmd_fb_z, cmd_fb_format};
+  wire         tc_ok_n = tex_on && !serial_n;
   wire          c_in_valid, c_in_ready;
   wire [CW-1:0] c_in;
   wire          tr_valid, tr_ready, tr_rsp;
@@ -256,10 +263,11 @@ module spigpu_core #(
     if (TEX != 0) begin : texturing
       wire          t_in_ready, t_out_valid;
       wire [CW-1:0] t_out;
-      core_texture #(.AW(Q_AW), .IDX_W(IDX_W), .ADDR_W(ADDR_W)) texture (
+      core_texture #(.AW(Q_AW), .CACHE(1 - SMALL), .IDX_W(IDX_W), .ADDR_W(ADDR_W)) texture (
           .clk(clk), .rst(rst), .tex16(r_tex_base), .wl(r_tex_fmt[3:0]), .hl(r_tex_fmt[7:4]),
           .wrap_s(r_tex_fmt[9:8]), .wrap_t(r_tex_fmt[11:10]),
           .bilinear(r_tex_fmt[12] && FEATURES[F_BILINEAR]), .tfmt(r_tex_fmt[17:16]), .decal(r_decal),
+          .inval(tc_inval), .cache_en(!r_serial),
           .in_valid(d_out_valid && r_tex), .in_ready(t_in_ready), .in_pix(d_out),
           .out_valid(t_out_valid), .out_ready(c_in_ready), .out_pix(t_out),
           .rd_valid(tr_valid), .rd_ready(tr_ready), .rd_addr(tr_addr), .rsp_valid(tr_rsp),
@@ -349,10 +357,12 @@ module spigpu_core #(
   wire [31:0] cpat = (cmd_fb_format == 2'd1) ? {2{c565}} : (cmd_fb_format == 2'd2) ? {4{c2222}} : cc;
 
   always @(posedge clk) begin
-    accept <= 1'b0;
-    su_go  <= 1'b0;
-    ras_go <= 1'b0;
-    k_go   <= 1'b0;
+    accept   <= 1'b0;
+    su_go    <= 1'b0;
+    ras_go   <= 1'b0;
+    k_go     <= 1'b0;
+    tc_inval <= 1'b0;
+    if (rst || core_idle) tc_keep <= 1'b0;
     if (rst) begin
       cst <= C_IDLE;
       colour_on_r <= 1'b1;
@@ -382,6 +392,7 @@ module spigpu_core #(
             end else if (drained && !su_busy) begin
               accept    <= 1'b1;
               k_go      <= 1'b1;
+              tc_keep   <= 1'b0;
               k_base    <= (cmd_op == OP_CLEAR) ? cmd_fb_draw : cmd_fb_z;
               k_bpp     <= (cmd_op == OP_CLEAR_Z || cmd_fb_format == 2'd0) ? 2'd2 :
                            (cmd_fb_format == 2'd1) ? 2'd1 : 2'd0;
@@ -409,6 +420,9 @@ module spigpu_core #(
           r_zflat     <= cmd_clear_depth;
           r_rect      <= (cmd_op != OP_TRI);
           r_zsel      <= (cmd_op != OP_TRI);
+          tc_keep <= (cmd_op == OP_TRI) && tc_ok_n;
+          tc_sig  <= tc_sig_n;
+          tc_inval <= !(tc_keep && (cmd_op == OP_TRI) && tc_ok_n && tc_sig == tc_sig_n);
           if (cmd_op == OP_TRI) begin
             r_gouraud   <= m_gouraud;
             r_tex       <= tex_on;
@@ -488,5 +502,5 @@ module spigpu_core #(
   // what a profile does not use (the generate blocks that read it are absent) or nothing reads
   wire unused_ok = &{1'b0, ras_e0, pw_q[31:24], r_tex, r_decal, r_tex_base, r_tex_fmt, r_need, k_base,
                      k_bpp, k_pattern, k_w, k_x0, k_y0, k_x1, k_y1, a_stq, d_passed, d_out, tr_ready,
-                     tr_rsp, t_count, cmd_tri_mode[31:20], k_ready, m_pending};
+                     tr_rsp, t_count, cmd_tri_mode[31:20], k_ready, m_pending, tc_inval};
 endmodule

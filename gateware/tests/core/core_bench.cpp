@@ -55,13 +55,14 @@ void frame_setup(Cosim& cs, unsigned w, unsigned h, unsigned fmt) {
 }
 
 // Pixels per cycle drawing a w x h rectangle as two triangles (setup included), mode m.
-void fill(const char* name, unsigned fmt, std::uint64_t mode, unsigned w = 256, unsigned h = 128) {
+void fill(const char* name, unsigned fmt, std::uint64_t mode, unsigned w = 256, unsigned h = 128, bool bilinear = false) {
   if (fmt == 1 && !(kCoreFeatures & sim::FEATURE_RGB565)) return;
   if (fmt == 2 && !(kCoreFeatures & sim::FEATURE_RGBA2222)) return;
   if ((mode & 2) && !kCoreTexture) return;
   if (((mode >> 7) & 3) && !(kCoreFeatures & sim::FEATURE_BLEND)) return;
   Cosim cs(device(std::min<std::uint64_t>(kCoreVramBytes, 1u << 20)), 1, kIdeal);
   frame_setup(cs, w, h, fmt);
+  if (bilinear) cs.write(Reg::TEX_FMT, 0x1066);
   cs.write(Reg::TRI_MODE, mode);
   cs.core().run_until_idle();
   const auto p0 = cs.core().perf();
@@ -161,6 +162,7 @@ int main(int argc, char** argv) {
   fill("RGBA2222 Gouraud, dithered", 2, 0x1 | (1u << 9));
   fill("RGBA8888 alpha blend", 0, 0x1 | (1u << 7));
   fill("RGBA8888 textured nearest (64x64 RGBA8888)", 0, 0x2);
+  fill("RGBA8888 textured bilinear (64x64 RGBA8888)", 0, 0x2, 256, 128, true);
   setup_cost("flat", 0);
   setup_cost("flat, Z", 0x4 | (1u << 3) | 0x40);
   setup_cost("Gouraud", 0x1);
