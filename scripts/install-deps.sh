@@ -19,6 +19,7 @@ packages=(
   libsystemd-dev                              
   umockdev libumockdev-dev                    
   xvfb xauth x11-utils                        
+  verilator yosys                             # gateware: rtl backend, ctest -L rtl (lint, co-simulation, yosys read)
 )
 
 export DEBIAN_FRONTEND=noninteractive

@@ -70,6 +70,7 @@ class SimHarness {
  private:
   void send(const protocol::Frame& f);
   void sync() const;  // gateware builds: frames sent, devices idle, video memory compared
+  void flush() const;  // gateware builds: the frames not yet sent go to the board
 
   Setup setup_;
   sim::Device* device_ = nullptr;

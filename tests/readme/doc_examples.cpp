@@ -121,6 +121,10 @@ std::vector<Example> make() {
           .prints(R"(register-echo +ok)")
           .prints(R"(scenes +ok)")
           .prints("PASS"),
+      run("build/tools/gpubridge bringup --board icebreaker --rtl --mem-bytes 2048 --iterations 1")
+          .prints(R"(register-echo +ok)")
+          .prints(R"(spi-clock +ok)")
+          .prints("PASS"),
       daemon("build/daemon/gpubridged --backend auto &").warns("auto: no board attached.*using the simulator"),
       run("touch plugged"),
       daemon("build/daemon/gpubridged --backend 'emulated:ft232h-generic?presence=plugged' &"),
@@ -162,6 +166,9 @@ std::vector<Example> make() {
            "runs it on one example with few frames"),
       run("build/tools/gpubridge bench usb")
           .prints(R"(write-heavy frame: 30000 register writes, payload/SPI clock bits = [\d.]+%)"),
+      skip("build/tools/gpubridge bench rtl --quick",
+           "co-simulates two examples on both gateware profiles for minutes on a machine shared with the rest of "
+           "the suite; CTest rtl.cli.bench_quick runs it"),
       skip("build/bench/protocol/protocol_parser_bench",
            "Google Benchmark runs for minutes (and is built only with libbenchmark)"),
   }});
@@ -191,6 +198,7 @@ std::vector<Example> make() {
 
   all.push_back({"README.md", "Testing", 0, "README_Testing", {
       skip("ctest --test-dir build -L daemon", "runs part of this suite (CTest inside CTest)"),
+      skip("ctest --test-dir build -L rtl", "runs part of this suite (CTest inside CTest)"),
       skip("scripts/fuzz-smoke.sh 600", "10 minutes per fuzz target, by hand; scripts/test.sh runs the 5-second smoke"),
       skip("scripts/soak-daemon.sh --minutes 10",
            "a 10-minute soak, by hand (docs/daemon.md \"Hostile soak\"); each of its scenarios runs in CTest "
@@ -203,6 +211,19 @@ std::vector<Example> make() {
            "rewrites docs/accuracy-report.*; CTest bench_accuracy_quick_smoke runs it with --quick"),
       skip("build/examples/gpubridge-demo figures --dir docs/screenshots",
            "rewrites the committed figures; docs/examples.md's block runs it into another directory"),
+  }});
+
+  all.push_back({"docs/gateware.md", "Running the co-simulation", 0, "docs_gateware_Running", {
+      run("build/tools/gpubridge bringup --board icebreaker --rtl --mem-bytes 2048 --iterations 1")
+          .prints(R"(register-echo +ok)")
+          .prints("PASS"),
+      skip("build/daemon/gpubridged --backend rtl:icebreaker --mirror &",
+           "CTest daemon_mirror_tests (*Gateware*) runs it through the FT2232H driver and checks every frame"),
+      skip("build/tools/gpubridge bench rtl --quick", "minutes of co-simulation; CTest rtl.cli.bench_quick runs it"),
+      skip("build/tools/gpubridge bench rtl --fit", "the full calibration run, an hour of co-simulation, by hand"),
+      skip("gateware/synth.py", "yosys synthesis of both profiles takes many minutes, by hand"),
+      skip("gateware/tests/core/synth_core.py", "yosys synthesis per stage takes many minutes, by hand"),
+      skip("build/gateware/tests/core/rtl_core_ecp5_bench", "a measurement, by hand; the core's tests run in ctest -L rtl"),
   }});
 
   all.push_back({"docs/dmc1.md", "Quick start", 0, "docs_dmc1_QuickStart", {

@@ -42,6 +42,27 @@ TEST(SimTiming, FormulasOnHandComputedCounters) {
   EXPECT_FALSE(apply_timing_setting(slow, "nosuch=1").ok());
 }
 
+// The gateware profiles' presets (fitted on the RTL, docs/gateware.md): profile=NAME replaces every
+// value, later settings still apply, and an unknown name says which ones exist.
+TEST(SimTiming, GatewarePresetsReplaceTheProfile) {
+  BoardTiming b;
+  ASSERT_TRUE(apply_timing_setting(b, "profile=up5k").ok());
+  EXPECT_EQ(b.name, "up5k");
+  EXPECT_DOUBLE_EQ(b.clock_mhz, 30.0);
+  EXPECT_DOUBLE_EQ(b.spi_clock_mhz, 10.0);
+  EXPECT_GT(b.cycles_per_triangle, BoardTiming{}.cycles_per_triangle);  // bit-serial setup
+  ASSERT_TRUE(apply_timing_setting(b, "clock_mhz=25").ok());
+  EXPECT_DOUBLE_EQ(b.clock_mhz, 25.0);
+  ASSERT_TRUE(apply_timing_setting(b, "profile=ecp5").ok());
+  EXPECT_EQ(b.name, "ecp5");
+  EXPECT_DOUBLE_EQ(b.memory_bytes_per_cycle, 2.0);  // 16-bit SDR SDRAM
+  ASSERT_TRUE(apply_timing_setting(b, "profile=ecp5-50mhz").ok());
+  EXPECT_DOUBLE_EQ(b.cycles_per_triangle, BoardTiming{}.cycles_per_triangle);
+  const auto bad = apply_timing_setting(b, "profile=ice40");
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.error().message.find("up5k"), std::string::npos) << bad.error().message;
+}
+
 TEST(SimObserver, ReportsEveryCoveredPixelWithExactValues) {
   Canvas c(40, 30);
   std::vector<CoveredPixel> seen;

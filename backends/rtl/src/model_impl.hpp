@@ -22,7 +22,17 @@ class ModelImpl : public GatewareModel {
     m_->spi_mosi = 0;
     m_->eval();
   }
-  ~ModelImpl() override { m_->final(); }
+  ~ModelImpl() override {
+    // Verilator 5.006 unregisters a model's scopes through the calling thread's context, not the
+    // model's own (verilator#8265): point it at ours while the model goes, and at the default
+    // context once ours is gone, so that no later destructor locks a freed context (which hung
+    // rtl_accuracy_tests in SimHarness::~SimHarness).
+    Verilated::threadContextp(ctx_.get());
+    m_->final();
+    m_.reset();
+    ctx_.reset();
+    Verilated::threadContextp(Verilated::defaultContextp());
+  }
 
   void set_inputs(const ModelInputs& in) override {
     m_->rst = in.rst;

@@ -63,6 +63,15 @@ Result<BoardTiming> timing_preset(std::string_view name) {
     b.clock_mhz = 30.0;
     b.spi_clock_mhz = 10.0;
     b.memory_bytes_per_cycle = 4.0;
+    // least-squares fit on the RTL (gpubridge bench rtl --fit, docs/gateware.md "Timing model"):
+    // the bit-serial setup and the time-shared steppers make triangles and pixels dear
+    b.cycles_per_command = 94.89;
+    b.cycles_per_triangle = 521.4;
+    b.cycles_per_scanned_pixel = 3.894;
+    b.cycles_per_pixel = 0.0;
+    b.cycles_per_textured_pixel = 0.0;  // no texture unit
+    b.cycles_per_blended_pixel = 0.0;   // no blending
+    b.clear_bytes_per_cycle = 1.0 / 0.389;
     return b;
   }
   if (name == "ecp5") {
@@ -71,6 +80,14 @@ Result<BoardTiming> timing_preset(std::string_view name) {
     b.clock_mhz = 50.0;
     b.spi_clock_mhz = 15.0;
     b.memory_bytes_per_cycle = 2.0;
+    // least-squares fit on the RTL (gpubridge bench rtl --fit, docs/gateware.md "Timing model")
+    b.cycles_per_command = 7.488;
+    b.cycles_per_triangle = 224.2;
+    b.cycles_per_scanned_pixel = 0.7575;
+    b.cycles_per_pixel = 0.0;
+    b.cycles_per_textured_pixel = 4.29;
+    b.cycles_per_blended_pixel = 3.154;
+    b.clear_bytes_per_cycle = 1.0 / 0.7211;
     return b;
   }
   return make_error("unknown timing profile '" + std::string(name) + "' (ecp5-50mhz, up5k, ecp5)");

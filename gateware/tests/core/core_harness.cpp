@@ -35,7 +35,15 @@ CoreHarness::CoreHarness(std::uint64_t vram_bytes, std::uint32_t seed, MemoryTim
   top_->rst = 0;
 }
 
-CoreHarness::~CoreHarness() { top_->final(); }
+CoreHarness::~CoreHarness() {
+  // the model's scopes are unregistered through the thread's context (Verilator 5.006,
+  // verilator#8265; see backends/rtl/src/model_impl.hpp): ours while it goes, never a freed one
+  Verilated::threadContextp(ctx_.get());
+  top_->final();
+  top_.reset();
+  ctx_.reset();
+  Verilated::threadContextp(Verilated::defaultContextp());
+}
 
 void CoreHarness::tick() {
   std::uniform_real_distribution<double> u(0.0, 1.0);
