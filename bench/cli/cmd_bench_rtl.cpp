@@ -230,11 +230,26 @@ int run_bench_rtl(const GlobalOptions& g, const RtlBenchArgs& a) {
                              "cycles_per_textured_pixel", "cycles_per_blended_pixel", "cycles_per_clear_byte"};
       nlohmann::json fit;
       for (std::size_t j = 0; j < p.size(); ++j) fit[names[j]] = p[j];
+      // the fit as a profile (memory bound included), and its error on the same frames
+      sim::BoardTiming fitted = *preset;
+      fitted.cycles_per_command = p[0];
+      fitted.cycles_per_triangle = p[1];
+      fitted.cycles_per_scanned_pixel = p[2];
+      fitted.cycles_per_pixel = p[3];
+      fitted.cycles_per_textured_pixel = p[4];
+      fitted.cycles_per_blended_pixel = p[5];
+      fitted.clear_bytes_per_cycle = p[6] > 0 ? 1.0 / p[6] : 1e9;
+      double worst_fit = 0;
+      for (const auto& s : samples) {
+        const double f = sim::estimate_timing(s.work, fitted, s.bpp).board_cycles;
+        worst_fit = std::max(worst_fit, std::fabs((f - s.rtl_cycles) / s.rtl_cycles * 100));
+      }
+      fit["worst_error_pct"] = worst_fit;
       report[gw]["fit"] = fit;
       if (!g.json) {
         std::printf("  least-squares fit:");
         for (std::size_t j = 0; j < p.size(); ++j) std::printf(" %s=%.4g", names[j], p[j]);
-        std::printf("\n");
+        std::printf("\n  worst error with the fit %.1f%%\n", worst_fit);
       }
     }
   }

@@ -31,7 +31,16 @@ class LayoutSink final : public draw::CommandSink {
     return b_.readback(address, length);
   }
   Result<void> flush() override { return b_.flush(); }
-  std::uint64_t vram_bytes() const override { return std::max(layout_, b_.info().vram_bytes); }
+  // An 8 MiB device without framebuffer limits, so that the examples keep their own layout and sizes
+  // (the drawing context would otherwise fit them to the board): the small device then refuses what
+  // it lacks, as the simulator configured like it does.
+  backends::DeviceInfo device() const override {
+    backends::DeviceInfo d = b_.info();
+    d.vram_bytes = std::max(layout_, d.vram_bytes);
+    d.max_width = protocol::kMaxFramebufferDim;
+    d.max_height = protocol::kMaxFramebufferDim;
+    return d;
+  }
 
  private:
   backends::Backend& b_;
