@@ -34,7 +34,17 @@ class CosimSink final : public draw::CommandSink {
     return std::vector<std::uint8_t>(m.begin() + address, m.begin() + address + length);
   }
   Result<void> flush() override { return {}; }
-  std::uint64_t vram_bytes() const override { return cs_.device().options().vram_bytes; }
+  // the simulator beside the core: its VRAM, framebuffer limits and CAPS
+  backends::DeviceInfo device() const override {
+    const auto& o = cs_.device().options();
+    backends::DeviceInfo d;
+    d.backend = "sim";
+    d.vram_bytes = o.vram_bytes;
+    d.max_width = o.max_width;
+    d.max_height = o.max_height;
+    d.caps = cs_.device().read(protocol::index_of(protocol::Reg::CAPS));
+    return d;
+  }
 
  private:
   Cosim& cs_;
