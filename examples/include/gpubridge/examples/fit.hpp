@@ -26,9 +26,9 @@
 
 namespace gpubridge::examples {
 
-// Features an example may use: the CAPS.FEATURES bits, and texturing (the texture unit itself),
-// which every protocol 1.0 device has (kept apart so a device without it, or --without texture,
-// can be handled like any other missing feature).
+// Features an example may use: the CAPS.FEATURES bits, texturing (the texture unit) among them as
+// bit 7 since protocol 1.2 (a device without it, or --without texture, is handled like any other
+// missing feature).
 inline constexpr std::uint16_t kBilinear = sim::FEATURE_BILINEAR;
 inline constexpr std::uint16_t kBlend = sim::FEATURE_BLEND;
 inline constexpr std::uint16_t kDither = sim::FEATURE_DITHER;
@@ -36,7 +36,8 @@ inline constexpr std::uint16_t kStrictLink = sim::FEATURE_STRICT_LINK;
 inline constexpr std::uint16_t kRgb565 = sim::FEATURE_RGB565;
 inline constexpr std::uint16_t kRgba2222 = sim::FEATURE_RGBA2222;
 inline constexpr std::uint16_t kTemporalDither = sim::FEATURE_TEMPORAL_DITHER;
-inline constexpr std::uint16_t kTexturing = 1u << 8;
+// texturing is CAPS.FEATURES bit 7 since protocol 1.2; every 1.0 and 1.1 device (ID.MINOR < 2) textures
+inline constexpr std::uint16_t kTexturing = sim::FEATURE_TEXTURE;
 // "bilinear", "blend", "dither", "rgb565", "rgba2222", "temporal", "texture".
 std::string_view feature_name(std::uint16_t bit);
 std::optional<std::uint16_t> parse_feature(std::string_view name);
