@@ -23,6 +23,7 @@
 #include "gpubridge/sim/timing.hpp"
 #include "gpubridge/usb/board_profile.hpp"
 #include "gpubridge/usb/emu/emulated_stack.hpp"
+#include "gpubridge/usb/emu/rtl_pins.hpp"
 
 namespace gpubridge::cli {
 namespace {
@@ -56,10 +57,10 @@ Result<std::vector<Sample>> measure(const std::string& scene, const std::string&
   if (!profile) return profile.error();
   profile->scanout = usb::ScanoutMode::CrcOnly;
   usb::emu::EmulationOptions eo;
-  eo.gateware = true;
+  eo.pins = usb::emu::rtl_pins();
   auto board = usb::emu::open_emulated_board(*profile, eo);
   if (!board) return board.error();
-  rtl::RtlDevice& g = *board->stack->gateware();
+  rtl::RtlDevice& g = usb::emu::rtl_pins_of(*board->stack)->device();
   const auto caps = g.caps();
   sim::DeviceOptions o;
   o.vram_bytes = std::uint64_t{caps.vram_kib} * 1024;

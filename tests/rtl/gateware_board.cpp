@@ -87,12 +87,12 @@ Result<std::unique_ptr<GatewareBoard>> GatewareBoard::open(const usb::BoardProfi
   // The stack must exist before the backend attaches (attach already talks to the device), so the
   // shadow is connected through a stack opened first and a backend attached to it afterwards.
   usb::emu::EmulationOptions eo;
-  eo.gateware = true;
+  eo.pins = usb::emu::rtl_pins();
   auto stack = usb::emu::EmulatedStack::create(profile, eo);
   if (!stack) return stack.error();
   std::shared_ptr<usb::emu::EmulatedStack> shared = std::move(*stack);
   GatewareBoard* raw = g.get();
-  shared->set_gateware_shadow(g->sim_pins_.get(), [raw](std::uint8_t index, std::uint64_t gw, std::uint64_t other) {
+  usb::emu::rtl_pins_of(*shared)->set_shadow(g->sim_pins_.get(), [raw](std::uint8_t index, std::uint64_t gw, std::uint64_t other) {
     // registers whose value does not depend on when the read happens
     const bool timed = index == index_of(Reg::STATUS) || index == index_of(Reg::FRAME_CRC) ||
                        index == index_of(Reg::MEM_ADDR) || index == index_of(Reg::MEM_DATA);
@@ -103,7 +103,7 @@ Result<std::unique_ptr<GatewareBoard>> GatewareBoard::open(const usb::BoardProfi
     if (gw != other && raw->read_mismatches_.size() < 8)
       raw->read_mismatches_.push_back(fmt::format("read of 0x{:02X}: gateware 0x{:016X}, simulator 0x{:016X}", index, gw, other));
   });
-  shared->gateware()->set_frame_callback([raw](const rtl::ScanFrame& f) { raw->gw_frames_.push_back(f); });
+  usb::emu::rtl_pins_of(*shared)->device().set_frame_callback([raw](const rtl::ScanFrame& f) { raw->gw_frames_.push_back(f); });
   auto bridge = usb::emu::open_bridge(profile, shared->usb(), shared->hid());
   if (!bridge) return bridge.error();
   auto backend = usb::BoardBackend::attach(profile, shared, std::move(*bridge), opts);

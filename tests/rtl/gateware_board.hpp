@@ -12,6 +12,7 @@
 #include "gpubridge/sim/device.hpp"
 #include "gpubridge/usb/board_profile.hpp"
 #include "gpubridge/usb/emu/emulated_stack.hpp"
+#include "gpubridge/usb/emu/rtl_pins.hpp"
 #include "gpubridge/usb/emu/spi_slave.hpp"
 
 namespace gpubridge::test {
@@ -29,7 +30,8 @@ class GatewareBoard {
   backends::Backend& backend() { return *board_.backend; }
   usb::BoardBackend& board() { return *board_.backend; }
   usb::emu::EmulatedStack& stack() { return *board_.stack; }
-  rtl::RtlDevice& gateware() { return *stack().gateware(); }
+  usb::emu::RtlPins& pins() { return *usb::emu::rtl_pins_of(stack()); }
+  rtl::RtlDevice& gateware() { return pins().device(); }
   sim::Device& sim() { return *sim_; }
 
   // Empty when equal: video memory byte for byte, every frame the gateware scanned out against the

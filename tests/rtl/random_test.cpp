@@ -170,7 +170,7 @@ class Generator {
 
   void bit_error() {
     // a MOSI bit error somewhere in the next groups: strict link mode catches and resends it
-    auto& pins = g_.stack().pins();
+    auto& pins = g_.pins();
     pins.faults().flip_mosi_bit = pins.frames_completed() * 72 + 72 * (1 + pick(40)) + pick(72);
   }
 
