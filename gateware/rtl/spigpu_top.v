@@ -58,9 +58,10 @@ module spigpu_top #(
   output wire [31:0] perf_raster
 );
   // CAPS.FEATURES: bit 0 bilinear, 1 blend, 2 dither, 3 strict link, 4 RGB565, 5 RGBA2222,
-  // 7 texturing (protocol 1.1). up5k: dither, strict link, RGB565, RGBA2222 (no bilinear, blend or
-  // texture unit: they do not fit the 5,280 LUTs beside the rest).
-  localparam [7:0]  FEATURES   = PROFILE == 0 ? 8'h3C : 8'hBF;
+  // 6 temporal dither (protocol 1.1), 7 texturing (protocol 1.2). up5k: dither, strict link, RGB565,
+  // RGBA2222 (no bilinear, blend, temporal dither or texture unit: they do not fit the 5,280 LUTs
+  // beside the rest). ecp5: everything.
+  localparam [7:0]  FEATURES   = PROFILE == 0 ? 8'h3C : 8'hFF;
   localparam [7:0]  CORE_FEATURES = FEATURES;
   localparam        MAX_WIDTH  = PROFILE == 0 ? 320 : 1024;
   localparam        MAX_HEIGHT = PROFILE == 0 ? 240 : 768;

@@ -90,6 +90,7 @@ class Generator {
                          (std::uint64_t{pick(4)} << 7) | (std::uint64_t{pick(2)} << 9) |
                          (chance(0.2) ? std::uint64_t{pick(16)} << 10 : 0) | (std::uint64_t{pick(2)} << 14);
     if (chance(0.4)) mode |= 2;  // TEXTURED
+    if (chance(0.4)) mode |= (std::uint64_t{1} << 15) | (std::uint64_t{pick(16)} << 16);  // TEMPORAL, DITHER_PHASE
     send({write_frame(Reg::FB_FORMAT, (std::uint64_t{fmt_} << 32) | (std::uint64_t{height_} << 16) | width_),
           write_frame(Reg::FB_DRAW, draw_), write_frame(Reg::FB_Z, z_), write_frame(Reg::SCISSOR, scissor),
           write_frame(Reg::TRI_MODE, mode)});

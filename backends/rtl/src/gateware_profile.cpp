@@ -23,7 +23,7 @@ GatewareCaps caps_of(GatewareProfile p) {
     c.variant = 0x0001;
     c.core_hz = 30e6;
   } else {
-    c.features = 0xBF;  // every feature of protocol 1.1 (bit 6 is undefined)
+    c.features = 0xFF;  // every feature of protocol 1.2
     c.fifo_depth = 1023;
     c.max_width = 1024;
     c.max_height = 768;

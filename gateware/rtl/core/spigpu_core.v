@@ -11,7 +11,7 @@
 module spigpu_core #(
     parameter integer PROFILE    = 1,       // 0 up5k (small: serial setup, steps in block RAM, one
                                             // read in flight per stage), 1 ecp5 (parallel, deeper)
-    parameter [7:0]   FEATURES   = 8'hBF,   // CAPS.FEATURES; bit 7: texturing
+    parameter [7:0]   FEATURES   = 8'hFF,   // CAPS.FEATURES; bit 6: temporal dither, bit 7: texturing
     parameter integer MAX_WIDTH  = 1024,    // CAPS.MAX_WIDTH / MAX_HEIGHT
     parameter integer MAX_HEIGHT = 1024,
     parameter integer VRAM_KIB   = 32768,   // CAPS.VRAM_KIB

@@ -116,6 +116,8 @@ module command_exec #(
         if (d[1] && !FEATURES[7]) begin d[1] = 1'b0; bad = 1'b1; end
         if (d[8:7] != 2'd0 && !FEATURES[1]) begin d[8:7] = 2'd0; bad = 1'b1; end
         if (d[9] && !FEATURES[2]) begin d[9] = 1'b0; bad = 1'b1; end
+        // TEMPORAL [15] and DITHER_PHASE [19:16] (protocol 1.1)
+        if (d[19:15] != 5'd0 && !FEATURES[6]) begin d[19:15] = 5'd0; bad = 1'b1; end
       end
       default: ;
     endcase

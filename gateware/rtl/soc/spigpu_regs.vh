@@ -102,7 +102,7 @@ function automatic [63:0] reg_reserved(input [6:0] idx);
   case (idx)
     `SPIGPU_REG_VERTEX: reg_reserved = 64'hFF00000000000000;
     `SPIGPU_REG_PRIM: reg_reserved = 64'hFFFFFFFFFFFFFFFC;
-    `SPIGPU_REG_TRI_MODE: reg_reserved = 64'hFFFFFFFFFFFF8000;
+    `SPIGPU_REG_TRI_MODE: reg_reserved = 64'hFFFFFFFFFFF00000;
     `SPIGPU_REG_TEX_BASE: reg_reserved = 64'hFFFFFFFF0000000F;
     `SPIGPU_REG_TEX_FMT: reg_reserved = 64'hFFFFFFFFFFFCE000;
     `SPIGPU_REG_SCISSOR: reg_reserved = 64'hF800F800F800F800;
@@ -135,7 +135,7 @@ function automatic [63:0] reg_reset(input [6:0] idx);
     `SPIGPU_REG_CLEAR_COLOR: reg_reset = 64'hFF;
     `SPIGPU_REG_CLEAR_DEPTH: reg_reset = 64'hFFFFFF;
     `SPIGPU_REG_FB_FORMAT: reg_reset = 64'h1E00280;
-    `SPIGPU_REG_ID: reg_reset = 64'h5350475501010000;
+    `SPIGPU_REG_ID: reg_reset = 64'h5350475501020000;
     default: reg_reset = 64'h0;
   endcase
 endfunction

@@ -70,6 +70,8 @@ class RandomStream {
     mode |= std::uint64_t{pick(2)} << 6;  // Z_WRITE
     if (features_ & sim::FEATURE_BLEND) mode |= std::uint64_t{chance(0.5) ? 0 : pick(4)} << 7;
     if (features_ & sim::FEATURE_DITHER) mode |= std::uint64_t{pick(2)} << 9;
+    if ((features_ & sim::FEATURE_TEMPORAL_DITHER) && chance(0.5))
+      mode |= (std::uint64_t{1} << 15) | (std::uint64_t{pick(16)} << 16);  // TEMPORAL, DITHER_PHASE
     if (chance(0.25)) mode |= std::uint64_t{pick(16)} << 10;  // write masks
     mode |= std::uint64_t{pick(2)} << 14;  // TEX_DECAL
     if (chance(0.5)) {

@@ -27,7 +27,7 @@ PROFILES = {
     },
     "ecp5": {
         "synth": "synth_ecp5",
-        "top": {"PROFILE": "1", "FEATURES": "8'hBF", "MAX_WIDTH": "1024", "MAX_HEIGHT": "768", "VRAM_KIB": "32768", "PERF": "0"},
+        "top": {"PROFILE": "1", "FEATURES": "8'hFF", "MAX_WIDTH": "1024", "MAX_HEIGHT": "768", "VRAM_KIB": "32768", "PERF": "0"},
         "stages": [
             ("setup (dividers included)", "core_setup", {"SERIAL": "0", "TEX": "1", "IDX_W": "20", "SKIP": "1", "XREJECT": "1", "NDIV": "3"}, ["core_divider.v"]),
             ("  of which one divider", "core_divider", {"NW": "72", "SKIP": "1"}, []),
@@ -35,7 +35,7 @@ PROFILES = {
             ("one attribute stepper (of 8)", "core_stepper", {"QW": "32"}, []),
             ("depth stage", "core_depth", {"PW": "176", "ZLSB": "20", "IDX_W": "20", "AW": "2", "ADDR_W": "25"}, ["core_rdq.v"]),
             ("texture unit", "core_texture", {"AW": "2", "IDX_W": "20", "ADDR_W": "25"}, ["core_recip_rom.v"]),
-            ("colour stage", "core_color", {"AW": "2", "IDX_W": "20", "ADDR_W": "25", "FEATURES": "8'hBF"}, ["core_rdq.v"]),
+            ("colour stage", "core_color", {"AW": "2", "IDX_W": "20", "ADDR_W": "25", "FEATURES": "8'hFF"}, ["core_rdq.v"]),
             ("clear engine", "core_clear", {"ADDR_W": "25"}, []),
             ("memory port", "core_memport", {"TAGS_AW": "3"}, []),
             ("alias check", "core_alias", {"ADDR_W": "25"}, []),
