@@ -104,7 +104,7 @@ Result<std::unique_ptr<GatewareBoard>> GatewareBoard::open(const usb::BoardProfi
       raw->read_mismatches_.push_back(fmt::format("read of 0x{:02X}: gateware 0x{:016X}, simulator 0x{:016X}", index, gw, other));
   });
   usb::emu::rtl_pins_of(*shared)->device().set_frame_callback([raw](const rtl::ScanFrame& f) { raw->gw_frames_.push_back(f); });
-  auto bridge = usb::emu::open_bridge(profile, shared->usb(), shared->hid());
+  auto bridge = usb::open_bridge(profile, shared->transport());
   if (!bridge) return bridge.error();
   auto backend = usb::BoardBackend::attach(profile, shared, std::move(*bridge), opts);
   if (!backend) return backend.error();
