@@ -1,11 +1,13 @@
 #!/usr/bin/env python3
 """Resource use of the whole spigpu device (spigpu_top: soc + render core) per profile, yosys 0.23.
 
-    gateware/synth.py [--profile up5k|ecp5] [--json out.json]
+    gateware/synth.py [--profile up5k|ecp5] [--modules] [--json out.json]
 up5k: synth_ice40 -dsp (the UP5K has 5,280 LUT4, 30 SB_RAM40_4K, 4 SB_SPRAM256KA, 8 SB_MAC16);
 ecp5: synth_ecp5 (LUT4 / TRELLIS_FF / CCU2C / MULT18X18D / DP16KD). Logic synthesis only: placement
 and routing are the board flow's (nextpnr), which may merge or split cells. The render core per
-stage: gateware/tests/core/synth_core.py.
+stage: gateware/tests/core/synth_core.py. --modules keeps the hierarchy (-noflatten) and prints every
+module's cells: what each stage costs (the total is then higher than flattened, where yosys optimises
+across module boundaries).
 """
 import argparse, json, os, re, subprocess, sys
 
@@ -21,33 +23,64 @@ CELLS = {
 }
 
 
-def synth(profile):
+def count(section):
+    return {k: sum(int(m) for c in names for m in re.findall(rf"\b{c}\s+(\d+)", section)) for k, names in CELLS.items()}
+
+
+def synth(profile, modules=False):
     value, cmd = PROFILES[profile]
     files = [os.path.join("rtl", "spigpu_top.v")]
     for d in ("soc", "core"):
         files += sorted(os.path.join("rtl", d, f) for f in os.listdir(os.path.join(GW, "rtl", d)) if f.endswith(".v"))
     # the ecp5 profile has no SPRAM: its primitive (known to synth_ice40) is a black box there
     lib = "read_verilog -lib sim/SB_SPRAM256KA.v; " if profile == "ecp5" else ""
+    flat = " -noflatten" if modules else ""
     script = (f"{lib}read_verilog -sv -Irtl/soc -Irtl/core {' '.join(files)}; chparam -set PROFILE {value} spigpu_top; "
-              f"{cmd} -top spigpu_top; stat")
+              f"{cmd}{flat} -top spigpu_top; stat")
     out = subprocess.run(["yosys", "-q", "-p", script, "-l", "/dev/stdout"], cwd=GW, capture_output=True, text=True)
     if out.returncode != 0:
         sys.exit(f"yosys failed on profile {profile}:\n{out.stderr[-2000:]}")
-    sec = out.stdout[out.stdout.rfind("=== spigpu_top ==="):]
-    return {k: sum(int(m) for c in names for m in re.findall(rf"\b{c}\s+(\d+)", sec)) for k, names in CELLS.items()}
+    if not modules:
+        return count(out.stdout[out.stdout.rfind("=== spigpu_top ==="):])
+    return per_module(out.stdout)
+
+
+def per_module(log):
+    """{module: cells} from a -noflatten stat: each module's last listing in the log (synth_ice40 and
+    synth_ecp5 print one of their own), parameter hashes dropped, parameterisations added up."""
+    last = {}
+    for m in re.finditer(r"^=== (\S+) ===\n(.*?)(?=^=== |\Z)", log, re.S | re.M):
+        if m.group(1) != "design":
+            last[m.group(1)] = count(m.group(2))
+    res = {}
+    for full, c in last.items():
+        name = re.sub(r"^\$paramod(\$[0-9a-f]+)?\\", "", full).split("\\")[0]
+        res[name] = {k: c[k] + res[name][k] for k in c} if name in res else c
+    return res
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--profile", choices=sorted(PROFILES), action="append")
+    ap.add_argument("--modules", action="store_true", help="per module, hierarchy kept (-noflatten)")
     ap.add_argument("--json", help="write the figures as JSON")
     a = ap.parse_args()
     report = {}
-    print(f"{'profile':8s} {'LUT4':>6s} {'FF':>6s} {'carry':>6s} {'DSP':>4s} {'BRAM':>5s} {'SPRAM':>5s}")
+    head = f"{'LUT4':>6s} {'FF':>6s} {'carry':>6s} {'DSP':>4s} {'BRAM':>5s} {'SPRAM':>5s}"
+    row = lambda r: f"{r['lut']:6d} {r['ff']:6d} {r['carry']:6d} {r['dsp']:4d} {r['bram']:5d} {r['spram']:5d}"
+    if not a.modules:
+        print(f"{'profile':8s} {head}")
     for name in a.profile or sorted(PROFILES, reverse=True):
-        r = synth(name)
+        r = synth(name, a.modules)
         report[name] = r
-        print(f"{name:8s} {r['lut']:6d} {r['ff']:6d} {r['carry']:6d} {r['dsp']:4d} {r['bram']:5d} {r['spram']:5d}", flush=True)
+        if a.modules:
+            print(f"{name + ' module':24s} {head}")
+            for mod, c in sorted(r.items(), key=lambda kv: -kv[1]["lut"]):
+                print(f"{mod:24s} {row(c)}")
+            total = {k: sum(c[k] for c in r.values()) for k in CELLS}
+            print(f"{'total (not flattened)':24s} {row(total)}", flush=True)
+        else:
+            print(f"{name:8s} {row(r)}", flush=True)
     if a.json:
         with open(a.json, "w") as f:
             json.dump(report, f, indent=2)
