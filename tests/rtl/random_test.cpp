@@ -6,7 +6,9 @@
 // readback on the way.
 //
 // The seed is printed. GPUBRIDGE_RTL_SEED=<n> reruns a seed, GPUBRIDGE_RTL_STEPS=<n> makes runs
-// longer (default 40 steps per bridge).
+// longer (default 40 steps per bridge). GPUBRIDGE_RTL_NO_FAULTS (no injected bit errors),
+// GPUBRIDGE_RTL_NO_ALIAS (no colour / depth buffer overlap) and GPUBRIDGE_RTL_TRACE=FILE (every
+// frame the simulator receives) narrow a failing seed down.
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -185,7 +187,14 @@ class Generator {
     state();
   }
 
+  // RESET empties the FIFO (docs/protocol.md section 13): queued writes not yet executed are
+  // discarded, so what a RESET right after a draw keeps depends on how fast the device executes
+  // (the untimed simulator has executed everything, the gateware may still be on the first
+  // triangle). Both are right; the stream drains first so that the outcome is the protocol's, not
+  // the timing's. (RESET discarding writes deterministically, held strict-mode writes, is
+  // SocBench.ResetDiscardsHeldWrites.)
   void reset() {
+    flush();
     if (auto r = g_.backend().reset(); !r && error_.empty()) error_ = "reset: " + r.error().message;
     state();
   }
@@ -203,6 +212,11 @@ struct RandomCase {
   std::string board;
   std::string gateware;  // set for generic bridge profiles
   std::uint32_t spi_hz = 0;
+  // Regressions: a fixed seed and length (0: GPUBRIDGE_RTL_SEED / _STEPS or random) and the case
+  // name the stream was generated under (the generator's seed is the run seed ^ hash(stream)).
+  std::uint64_t seed = 0;
+  unsigned steps = 0;
+  std::string stream;
 };
 void PrintTo(const RandomCase& c, std::ostream* os) { *os << c.name; }
 
@@ -210,14 +224,15 @@ class RandomStreams : public ::testing::TestWithParam<RandomCase> {};
 
 TEST_P(RandomStreams, GatewareAndSimulatorAgree) {
   if (!rtl::RtlDevice::available()) GTEST_SKIP() << rtl::RtlDevice::unavailable_reason();
-  const std::uint64_t seed = run_seed();
-  std::printf("GPUBRIDGE_RTL_SEED=%llu (rerun with this environment variable)\n", static_cast<unsigned long long>(seed));
+  const std::uint64_t seed = GetParam().seed ? GetParam().seed : run_seed();
+  if (GetParam().seed) std::printf("fixed seed %llu, %u steps\n", static_cast<unsigned long long>(seed), GetParam().steps);
+  else std::printf("GPUBRIDGE_RTL_SEED=%llu (rerun with this environment variable)\n", static_cast<unsigned long long>(seed));
   auto profile = board_profile(GetParam().board);
   if (!GetParam().gateware.empty()) profile = with_gateware(profile, GetParam().gateware, GetParam().spi_hz);
   auto g = GatewareBoard::open(profile);
   ASSERT_TRUE(g) << g.error().message;
-  Generator gen(seed ^ std::hash<std::string>{}(GetParam().name), **g);
-  const std::string err = gen.run(static_cast<unsigned>(env_u64("GPUBRIDGE_RTL_STEPS", 40)));
+  Generator gen(seed ^ std::hash<std::string>{}(GetParam().stream.empty() ? GetParam().name : GetParam().stream), **g);
+  const std::string err = gen.run(GetParam().steps ? GetParam().steps : static_cast<unsigned>(env_u64("GPUBRIDGE_RTL_STEPS", 40)));
   EXPECT_EQ(err, "") << "seed " << seed;
   EXPECT_EQ((*g)->compare(), "") << "seed " << seed;
   const auto c = (*g)->gateware().counters();
@@ -232,9 +247,22 @@ TEST_P(RandomStreams, GatewareAndSimulatorAgree) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Bridges, RandomStreams,
-                         ::testing::Values(RandomCase{"ft232h_ulx3s_ecp5", "ulx3s", "", 0},
-                                           RandomCase{"ft2232h_icebreaker_up5k", "icebreaker", "", 0},
-                                           RandomCase{"mcp2210_up5k", "mcp2210-generic", "up5k", 4'000'000}),
+                         ::testing::Values(RandomCase{"ft232h_ulx3s_ecp5", "ulx3s", "", 0, 0, 0, ""},
+                                           RandomCase{"ft2232h_icebreaker_up5k", "icebreaker", "", 0, 0, 0, ""},
+                                           RandomCase{"mcp2210_up5k", "mcp2210-generic", "up5k", 4'000'000, 0, 0, ""}),
+                         [](const auto& p) { return p.param.name; });
+
+// Seeds that once failed, as fixed short streams.
+// 2621897521, 5 steps through the MCP2210 (up5k): a draw (a strip of six vertices), then RESET at
+// once; RESET emptied the gateware's FIFO while triangles were still queued, the simulator had
+// executed them all (the stream now drains before RESET). 12 steps through the FT232H (ecp5): an injected MOSI bit error turned
+// the first FRAME_CRC read after a swap into a read of 0x1A and the board backend failed the swap
+// instead of reading again (BoardBackend::emit_scanout now rereads a disagreeing pair).
+INSTANTIATE_TEST_SUITE_P(Regressions, RandomStreams,
+                         ::testing::Values(RandomCase{"reset_after_draw_mcp2210", "mcp2210-generic", "up5k", 4'000'000,
+                                                      2621897521, 5, "mcp2210_up5k"},
+                                           RandomCase{"bit_error_in_frame_crc_read_ft232h", "ulx3s", "", 0, 2621897521, 12,
+                                                      "ft232h_ulx3s_ecp5"}),
                          [](const auto& p) { return p.param.name; });
 
 }  // namespace

@@ -282,6 +282,28 @@ TEST_P(SocBench, ResetRestoresRegistersAndKeepsMemory) {
   expect_vram_equal();
 }
 
+// RESET empties the FIFO: writes held by strict link mode (not yet released by a LINK_CHECK) are
+// discarded on both devices whatever their speed, so this is where RESET meets queued writes
+// deterministically (tests/rtl/random_test.cpp drains before its RESETs).
+TEST_P(SocBench, ResetDiscardsHeldWrites) {
+  if (!(rtl_->caps().features & 0x08)) GTEST_SKIP() << "profile without strict link";
+  burst({Frame{false, index_of(Reg::LINK_CTRL), 1}});
+  host_->restart_crc();
+  burst({Frame{false, index_of(Reg::MEM_ADDR), 0x80}, Frame{false, index_of(Reg::MEM_DATA), 0x0123456789ABCDEFull},
+         Frame{false, index_of(Reg::CLEAR_COLOR), 0x11223344}, Frame{false, index_of(Reg::FENCE), 9}});
+  rtl_->idle_ns(5000);
+  expect_read_equal(index_of(Reg::STATUS), kStatusCompared | (1ull << 20) | 0xFFFF);  // LINK_PENDING, 4 held
+  write(Reg::RESET, protocol::kResetMagic);
+  rtl_->idle_ns(3000);
+  wait_idle();
+  for (std::uint8_t i : {0x0A, 0x13, 0x15, 0x18, 0x70}) expect_read_equal(i);
+  expect_read_equal(index_of(Reg::STATUS), kStatusCompared);
+  EXPECT_EQ(host_->read(Reg::FENCE), 0u);  // the FENCE never executed
+  expect_vram_equal();
+  const auto m = rtl_->vram();
+  EXPECT_EQ(m[0x80] | m[0x81] | m[0x82] | m[0x83], 0);  // nor did the MEM_DATA write
+}
+
 INSTANTIATE_TEST_SUITE_P(Profiles, SocBench, ::testing::Values(rtl::GatewareProfile::Up5k, rtl::GatewareProfile::Ecp5),
                          [](const auto& p) { return std::string(rtl::to_string(p.param)); });
 

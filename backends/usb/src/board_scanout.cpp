@@ -20,17 +20,25 @@ Result<void> BoardBackend::emit_scanout() {
     return r.error();
   // FB_FORMAT and FB_DISPLAY as the device validated them (a format or size the design lacks was
   // replaced), not as they were written.
+  // Each read twice; a pair that disagrees is read again (a bit error on MOSI turns a read into a
+  // read of another register, one on MISO garbles the value; neither is covered by a link group).
   const std::uint8_t idx[] = {index_of(Reg::FRAME_CRC), index_of(Reg::FRAME_CRC), index_of(Reg::FB_FORMAT),
                               index_of(Reg::FB_FORMAT), index_of(Reg::FB_DISPLAY), index_of(Reg::FB_DISPLAY)};
-  auto v = read_frames(idx);
-  if (!v) return v.error();
-  if ((*v)[0] != (*v)[1] || (*v)[2] != (*v)[3] || (*v)[4] != (*v)[5])
-    return make_error("board '" + profile_.name + "': FRAME_CRC, FB_FORMAT or FB_DISPLAY reads disagree (MISO bit errors)",
-                      backends::kDeviceProtocol);
-  fb_format_ = (*v)[2];
-  fb_display_ = (*v)[4];
+  std::vector<std::uint64_t> v;
+  for (unsigned attempt = 0;; ++attempt) {
+    auto r = read_frames(idx);
+    if (!r) return r.error();
+    v = std::move(*r);
+    if (v[0] == v[1] && v[2] == v[3] && v[4] == v[5]) break;
+    if (attempt + 1 >= kScanoutAttempts)
+      return make_error("board '" + profile_.name + "': FRAME_CRC, FB_FORMAT or FB_DISPLAY reads disagree after " +
+                            std::to_string(kScanoutAttempts) + " attempts (SPI bit errors); lower bridge.spi_clock_hz",
+                        backends::kDeviceProtocol);
+  }
+  fb_format_ = v[2];
+  fb_display_ = v[4];
   auto frame = std::make_shared<backends::ScanoutFrame>();
-  frame->crc = static_cast<std::uint32_t>((*v)[0]);
+  frame->crc = static_cast<std::uint32_t>(v[0]);
   frame->number = ++frame_number_;
   frame->width = fb_format_ & 0x7FF;
   frame->height = (fb_format_ >> 16) & 0x7FF;
