@@ -65,7 +65,10 @@ module core_setup #(
     output wire [34:0]  pw_r
 );
   localparam integer AW = (TEX != 0) ? 33 : 25;     // attribute delta bits
-  localparam integer ACC_W = (TEX != 0) ? 72 : 64;  // accumulator / numerator bits
+  // accumulator / numerator bits. Without S, T, Q the widest value is M0 = 2(d1 e1 + d2 e2) +
+  // 2 d1 + 2 d2 + |D| with |d| < 2^24 (Z), |e| < 2^33 (see mop), |D| < 2^33: |M0| < 2^60, so 61
+  // bits; the steps are below 2^47. With them |d| < 2^33 and N needs 70 bits (section 9).
+  localparam integer ACC_W = (TEX != 0) ? 72 : 61;
 
   // ---------------------------------------------------------------- vertices (kick order)
   wire signed [15:0] x0 = v0[15:0], y0 = v0[31:16];
@@ -92,13 +95,16 @@ module core_setup #(
   function [1:0] argmax(input signed [16:0] d10, input signed [16:0] d21, input signed [16:0] d02);
     argmax = (d10 <= 0 && d02 >= 0) ? 2'd0 : (d10 > 0 && d21 <= 0) ? 2'd1 : 2'd2;
   endfunction
-  wire [1:0] top = argmin(dy2, dy0, dy1);
-  wire signed [15:0] mny = pick3(top, y0, y1, y2);
-  wire signed [15:0] mxy = pick3(argmax(dy2, dy0, dy1), y0, y1, y2);
-  wire signed [15:0] xtop = pick3(top, x0, x1, x2);
+  // One vertex multiplexer (xa, ya) serves the box (S_BOX: the top vertex, S_BOX2: the bottom
+  // one) and the edge values (the edge's start vertex), selected by `pv`.
+  reg  [1:0] pv;
+  wire signed [15:0] xa = pick3(pv, x0, x1, x2);
+  wire signed [15:0] ya = pick3(pv, y0, y1, y2);
+  reg        box2;   // S_BOX2: ya is the bottom vertex's
   // samples 16p + 8 inside [min, max]: p from (min + 7) >> 4 to (max + 8) >> 4, exclusive
-  wire signed [12:0] fy0 = 13'(($signed({mny[15], mny}) + 17'sd7) >>> 4);
-  wire signed [12:0] fy1 = 13'((($signed({mxy[15], mxy}) + 17'sd8) >>> 4));
+  wire signed [12:0] fy = 13'(($signed({ya[15], ya}) + (box2 ? 17'sd8 : 17'sd7)) >>> 4);
+  reg  signed [12:0] fy0, xt;  // the top vertex's first row and column (S_BOX)
+  wire signed [12:0] fy1 = fy;
   wire signed [12:0] cx0 = $signed({2'b0, clip_x0}), cx1 = $signed({2'b0, clip_x1});
   wire signed [12:0] cy0 = $signed({2'b0, clip_y0}), cy1 = $signed({2'b0, clip_y1});
   wire signed [12:0] by0 = (fy0 > cy0) ? fy0 : cy0;
@@ -118,7 +124,6 @@ module core_setup #(
     end
   endgenerate
   wire box_empty = (by0 >= by1) || x_out;
-  wire signed [12:0] xt = 13'(xtop >>> 4);
   wire [10:0] xs = (xt < cx0) ? clip_x0 : (xt >= cx1) ? clip_x1 - 11'd1 : xt[10:0];
 
   // ---------------------------------------------------------------- attribute deltas
@@ -167,9 +172,7 @@ module core_setup #(
   reg  [1:0] asel;
   wire signed [17:0] sx = $signed({3'b0, x_start, 4'b1000});  // 16x + 8
   wire signed [17:0] sy = $signed({3'b0, box_y0, 4'b1000});
-  reg  [1:0] ek;    // edge being evaluated: its start vertex
-  wire signed [15:0] xa = (ek == 2'd0) ? x1 : (ek == 2'd1) ? x2 : x0;
-  wire signed [15:0] ya = (ek == 2'd0) ? y1 : (ek == 2'd1) ? y2 : y0;
+  reg  [1:0] ek;    // edge being evaluated (its start vertex, pv, is ek + 1 modulo 3)
   wire signed [17:0] ey_a = sy - 18'(ya), ex_a = sx - 18'(xa);  // sample point minus Pa
   reg signed [32:0] ma1, ma2;
   reg [5:0] mbits;
@@ -322,7 +325,7 @@ module core_setup #(
   localparam [4:0] S_IDLE = 5'd0, S_AREA = 5'd1, S_FLIP = 5'd2, S_BOX = 5'd3, S_ORIGIN = 5'd4,
                    S_EDGE = 5'd5, S_BIAS = 5'd6, S_ANEXT = 5'd7, S_GX = 5'd8, S_GY = 5'd9,
                    S_M0 = 5'd10, S_M0_C = 5'd11, S_M0_D = 5'd12, S_DRAIN = 5'd13, S_END = 5'd14,
-                   S_WAIT = 5'd15, S_GX_W = 5'd16;
+                   S_WAIT = 5'd15, S_GX_W = 5'd16, S_BOX2 = 5'd17;
   reg [4:0]  st, ret;   // S_WAIT: until the multiply is done, then ret
   reg [1:0]  cstep;     // M0 corrections
   reg [7:0]  todo;
@@ -377,6 +380,7 @@ module core_setup #(
           box_x1 <= clip_x1;
           flip  <= 1'b0;
           sh5   <= 1'b0;
+          box2  <= 1'b0;
           cstep <= 2'd0;
           if (rect) begin
             box_y0  <= clip_y0;
@@ -401,13 +405,27 @@ module core_setup #(
           if (acc == 0) begin
             draw <= 1'b0;
             st   <= S_END;
+          end else if (acc_s[ACC_W-1]) begin
+            // D < 0: exchanged; |D| by the area multiply again, negated (no negator for 2D)
+            flip   <= 1'b1;
+            mneg   <= 1'b1;
+            mac_go <= 1'b1;
+            st <= S_WAIT; ret <= S_FLIP;
           end else begin
-            flip <= acc_s[ACC_W-1];
-            den  <= acc_s[ACC_W-1] ? 35'(-(acc_s <<< 1)) : 35'(acc_s <<< 1);
-            st   <= S_BOX;
+            den <= 35'(acc_s <<< 1);
+            pv  <= argmin(dy2, dy0, dy1);  // the top vertex
+            st  <= S_BOX;
           end
         end
         S_BOX: begin
+          fy0  <= fy;
+          xt   <= 13'(xa >>> 4);
+          pv   <= argmax(dy2, dy0, dy1);   // the bottom vertex
+          box2 <= 1'b1;
+          st   <= S_BOX2;
+        end
+        S_BOX2: begin
+          box2 <= 1'b0;
           if (box_empty) begin
             draw <= 1'b0;
             st   <= S_END;
@@ -423,6 +441,7 @@ module core_setup #(
           asel <= A_ORIGIN; osel1 <= O_W; osel2 <= O_XS; msub <= 1'b0; mneg <= 1'b0;
           mac_go <= 1'b1;
           ek <= 2'd0;
+          pv <= 2'd1;
           st <= S_WAIT; ret <= S_EDGE;
         end
         S_EDGE: begin
@@ -447,6 +466,7 @@ module core_setup #(
             cstep[0] <= 1'b0;
             e_we <= (ek == 2'd0) ? 3'b001 : (ek == 2'd1) ? 3'b010 : 3'b100;
             ek   <= ek + 2'd1;
+            pv   <= (ek == 2'd0) ? 2'd2 : 2'd0;
             if (ek == 2'd2) begin
               todo <= need;
               st   <= S_ANEXT;

@@ -2,8 +2,8 @@
 // STATUS.VBLANK / SWAP_PENDING and the frame counter.
 //
 // An executed FB_DISPLAY write asks for a swap with its address and the FB_FORMAT of that moment;
-// the buffer length W x H x bpp is computed (a shift-add multiply, 12 clocks) and the swap becomes
-// pending. At the next vertical sync (start of vertical blanking) the pending swap is latched and the
+// the buffer length W x H x bpp is computed (12 clocks; the product on a multiplier, a DSP) and the
+// swap becomes pending. At the next vertical sync (start of vertical blanking) the pending swap is latched and the
 // frame is read, in address order, into the CRC-32 and out of the frame port (the video output of a
 // board, and what the co-simulation captures). When its last byte has been read the frame is
 // "scanned out": FRAME_COUNT advances, FRAME_CRC = {frame number, CRC} and SWAP_PENDING clears, so a
@@ -78,7 +78,6 @@ module scanout #(
   reg        computing, pending, reading;
   reg [3:0]  mul_step;
   reg [21:0] mul_acc;          // width x height
-  reg [10:0] mul_h;
   reg [29:0] rd_addr;          // next word to read (the frame's first word until reading starts)
   reg [30:0] end_word;         // first word after the frame
   reg [23:0] bytes_left;       // bytes still to fold
@@ -198,14 +197,11 @@ module scanout #(
         frame_format <= swap_format;
         frame_width <= swap_width;
         frame_height <= swap_height;
-        mul_h <= swap_height;
-        mul_acc <= 22'd0;
         mul_step <= 4'd0;
       end else if (computing) begin
-        // mul_acc = width x height, one bit of the height per clock (MSB first)
+        // mul_acc = width x height, on a multiplier; the swap keeps its 12 clocks
         if (mul_step != 4'd11) begin
-          mul_acc <= {mul_acc[20:0], 1'b0} + (mul_h[10] ? {11'd0, frame_width} : 22'd0);
-          mul_h <= {mul_h[9:0], 1'b0};
+          mul_acc <= frame_width * frame_height;
           mul_step <= mul_step + 4'd1;
         end else begin
           computing <= 1'b0;
