@@ -38,10 +38,10 @@ module mem_arbiter #(
   output wire        c_rsp_valid,
   output wire [31:0] rsp_rdata,       // data of whichever response is valid
   output reg         c_range_err,
-  // swap protection window [prot_lo, prot_hi) in words
+  // swap protection window [prot_lo, prot_hi) in VRAM words (scanout: both at most 2^AW)
   input  wire        prot_active,
-  input  wire [29:0] prot_lo,
-  input  wire [29:0] prot_hi,
+  input  wire [AW:0] prot_lo,
+  input  wire [AW:0] prot_hi,
   // back end (SPRAM or SDRAM controller): in-order read responses
   output wire          b_req_valid,
   input  wire          b_req_ready,
@@ -66,7 +66,10 @@ module mem_arbiter #(
   // starts MEM_* after the core finished and no core command during them).
   wire        m_writes = m_req_valid && m_req_we;
   wire [29:0] w_addr   = m_writes ? m_req_addr : c_req_addr;
-  wire        w_prot   = prot_active && w_addr >= prot_lo && w_addr < prot_hi;
+  // only writes inside VRAM meet the compare (the core's beyond it are dropped, MEM_DATA's are
+  // never issued), so AW + 1 bits are enough
+  wire [AW:0] w_vram   = {1'b0, w_addr[AW-1:0]};
+  wire        w_prot   = prot_active && w_vram >= prot_lo && w_vram < prot_hi;
   wire m_block = m_writes && w_prot;
   wire c_block = !m_writes && c_req_we && w_prot;
   wire c_oor   = c_req_addr >= VRAM_WORDS;
@@ -125,5 +128,5 @@ module mem_arbiter #(
     end
   end
 
-  wire unused_ok = &{1'b0, addr[29:AW]};
+  wire unused_ok = &{1'b0, addr[29:AW], w_addr[29:AW]};
 endmodule

@@ -85,15 +85,22 @@ module register_file #(
   wire        wr_bad   = wr && (wclass == 2'd0 || wclass == 2'd1);
   wire        wr_queue = wr && wclass == 2'd2;
   wire        wr_imm   = wr && wclass == 2'd3;
-  wire [63:0] rsv_mask = reg_reserved(frame_idx);
-  wire        imm_rsv  = wr_imm && (frame_data & rsv_mask) != 64'h0;
-  wire [63:0] imm_data = frame_data & ~rsv_mask;
-
   wire is_err_clear = frame_idx == `SPIGPU_REG_ERR_CLEAR;
   wire is_link_ctrl = frame_idx == `SPIGPU_REG_LINK_CTRL;
   wire is_check     = frame_idx == `SPIGPU_REG_LINK_CHECK;
   wire is_host_tag  = frame_idx == `SPIGPU_REG_HOST_TAG;
   wire is_reset     = frame_idx == `SPIGPU_REG_RESET;
+  // reserved bits: only immediate writes are checked here (queued ones when they execute), so
+  // the table's masks of the immediate registers are enough
+  localparam [63:0] RSV_ERR_CLEAR = reg_reserved(`SPIGPU_REG_ERR_CLEAR);
+  localparam [63:0] RSV_LINK_CTRL = reg_reserved(`SPIGPU_REG_LINK_CTRL);
+  localparam [63:0] RSV_CHECK     = reg_reserved(`SPIGPU_REG_LINK_CHECK);
+  localparam [63:0] RSV_HOST_TAG  = reg_reserved(`SPIGPU_REG_HOST_TAG);
+  localparam [63:0] RSV_RESET     = reg_reserved(`SPIGPU_REG_RESET);
+  wire [63:0] rsv_mask = is_err_clear ? RSV_ERR_CLEAR : is_link_ctrl ? RSV_LINK_CTRL : is_check ? RSV_CHECK
+                       : is_host_tag ? RSV_HOST_TAG : is_reset ? RSV_RESET : 64'h0;
+  wire        imm_rsv  = wr_imm && (frame_data & rsv_mask) != 64'h0;
+  wire [63:0] imm_data = frame_data & ~rsv_mask;
 
   wire strict_refused = is_link_ctrl && imm_data[0] && !FEATURES[3];
   wire reset_ok       = wr_imm && is_reset && frame_data == RESET_MAGIC;

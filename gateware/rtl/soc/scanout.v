@@ -41,10 +41,11 @@ module scanout #(
   output wire [29:0] req_addr,
   input  wire        rsp_valid,
   input  wire [31:0] rsp_rdata,
-  // write protection of the frame not yet read
+  // write protection of the frame not yet read: words [prot_lo, prot_hi) of VRAM (both at most
+  // 2^VAW: only writes inside VRAM are compared)
   output wire        prot_active,
-  output wire [29:0] prot_lo,
-  output wire [29:0] prot_hi,
+  output wire [VAW:0] prot_lo,
+  output wire [VAW:0] prot_hi,
   // registers
   output reg  [15:0] frame_count,
   output wire [47:0] frame_crc,
@@ -78,8 +79,12 @@ module scanout #(
   reg        computing, pending, reading;
   reg [3:0]  mul_step;
   reg [21:0] mul_acc;          // width x height
-  reg [29:0] rd_addr;          // next word to read (the frame's first word until reading starts)
-  reg [30:0] end_word;         // first word after the frame
+  // Addresses in VRAM words: the reader stops at the end of VRAM (what lies beyond reads as 0), so
+  // the next word to read needs VAW + 1 bits, plus `above` for a frame starting beyond VRAM.
+  reg [VAW:0] rd_addr;         // next word to read (the frame's first word until reading starts)
+  reg         above;           // the frame starts beyond VRAM
+  reg [VAW:0] end_vram;        // min(first word after the frame, 2^VAW)
+  localparam [VAW:0] VRAM_END = {1'b1, {VAW{1'b0}}};
   reg [23:0] bytes_left;       // bytes still to fold
   reg [31:0] crc, crc_value;
   reg [15:0] crc_frame;
@@ -103,17 +108,21 @@ module scanout #(
   reg  [2:0]  buf_count;
   reg  [1:0]  byte_in_word;    // CRC_BYTES = 1: next byte of the head word
 
-  wire in_frame  = {1'b0, rd_addr} < end_word;
-  wire in_vram   = rd_addr[29:VAW] == {(30 - VAW){1'b0}};
-  assign req_valid   = reading && in_frame && in_vram && outstanding + buf_count < BUFW;
-  assign req_addr    = rd_addr;
+  // words of the frame still to read from VRAM (the rest, beyond VRAM, reads as 0)
+  wire in_frame  = !above && rd_addr < end_vram;
+  assign req_valid   = reading && in_frame && outstanding + buf_count < BUFW;
+  assign req_addr    = 30'(rd_addr[VAW-1:0]);
   assign prot_active = computing || pending || (reading && in_frame);
-  assign prot_lo     = rd_addr;
+  assign prot_lo     = above ? VRAM_END : rd_addr;
   // while the end is being computed, everything from the frame's start up is protected
-  assign prot_hi     = computing || end_word[30] ? 30'h3FFFFFFF : end_word[29:0];
+  assign prot_hi     = computing ? VRAM_END : end_vram;
+  // the frame's end in words, from its start inside VRAM (beyond it: above)
+  localparam integer EW = (VAW + 2 > 23) ? VAW + 2 : 23;
+  wire [EW-1:0] end_in = EW'(rd_addr) + EW'(words);
+  wire          end_beyond = above || end_in > EW'(VRAM_END);
 
   // the head word: from memory while there are answers; zeros once the reader left VRAM
-  wire        mem_done  = !(in_frame && in_vram) && outstanding == 3'd0 && buf_count == 3'd0;
+  wire        mem_done  = !in_frame && outstanding == 3'd0 && buf_count == 3'd0;
   wire        have_word = buf_count != 3'd0 || mem_done;
   wire [31:0] head_word = buf_count != 3'd0 ? buf_word[buf_rd] : 32'd0;
 
@@ -183,7 +192,7 @@ module scanout #(
     end else begin
       if (rsp_valid && drop != 3'd0) drop <= drop - 3'd1;
       outstanding <= outstanding + {2'd0, issued} - {2'd0, take};
-      if (issued) rd_addr <= rd_addr + 30'd1;
+      if (issued) rd_addr <= rd_addr + 1'b1;
       if (take) begin
         buf_word[buf_wr] <= rsp_rdata;
         buf_wr <= buf_wr + 1'b1;
@@ -193,7 +202,8 @@ module scanout #(
 
       if (swap_req) begin
         computing <= 1'b1;
-        rd_addr <= {swap_addr, 2'b00};
+        rd_addr <= {1'b0, swap_addr[VAW-3:0], 2'b00};
+        above <= swap_addr[27:VAW-2] != {(30 - VAW){1'b0}};
         frame_format <= swap_format;
         frame_width <= swap_width;
         frame_height <= swap_height;
@@ -206,9 +216,9 @@ module scanout #(
         end else begin
           computing <= 1'b0;
           pending <= 1'b1;
-          end_word <= {1'b0, rd_addr} + {9'd0, words};
+          end_vram <= end_beyond ? VRAM_END : end_in[VAW:0];
           bytes_left <= bytes;
-          if ({1'b0, rd_addr} + {9'd0, words} > (31'd1 << VAW)) err_range <= 1'b1;
+          if (end_beyond) err_range <= 1'b1;
         end
       end
 

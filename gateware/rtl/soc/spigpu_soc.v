@@ -190,7 +190,7 @@ module spigpu_soc #(
   wire [29:0] s_req_addr;
   wire [31:0] rsp_rdata;
   wire        prot_active;
-  wire [29:0] prot_lo, prot_hi;
+  wire [VAW:0] prot_lo, prot_hi;
   mem_access #(.VRAM_UNITS(VRAM_UNITS)) u_mem (
     .clk(clk), .rst(rst), .soft_reset(soft_reset), .set_addr(mem_set_addr), .write(mem_write),
     .op_data(mem_op_data), .op_ack(mem_op_ack), .ex_idle(mem_ex_idle), .read_strobe(mem_read_strobe), .addr(mem_addr),
