@@ -4,9 +4,12 @@
 // Restoring long division, one quotient bit per cycle, on the magnitude of num: a negative num
 // is divided as ~num = -num - 1 and the result mapped back (floor(num/den) = ~floor(~num/den),
 // rem = den - 1 - rem'). The numerator register shifts left and takes the quotient bits in at
-// the bottom. With SKIP, while the partial remainder is below den / 16 the next four quotient
-// bits are known to be 0 and four numerator bits are taken at once (small numerators then cost
-// a quarter cycle per leading bit); without it a division takes NW cycles.
+// the bottom, already complemented for a negative num. The remainder is mapped back by the
+// reader: `neg` says that rem and rem_c are exchanged (rem = rem_c' and rem_c = rem' below),
+// so one multiplexer there picks either without a second one here. With SKIP, while the partial
+// remainder is below den / 16 the next four quotient bits are known to be 0 and four numerator
+// bits are taken at once (small numerators then cost a quarter cycle per leading bit); without
+// it a division takes NW cycles.
 module core_divider #(
     parameter integer NW = 72,  // numerator width (signed)
     parameter integer DW = 35,  // divisor / remainder width (unsigned)
@@ -21,8 +24,9 @@ module core_divider #(
     output wire                 busy,
     output reg                  done,   // one-cycle pulse: quo / rem valid (held until next start)
     output wire [QW-1:0]        quo,
-    output wire [DW-1:0]        rem,
-    output wire [DW-1:0]        rem_c   // den - 1 - rem (the step left's remainder, see core_setup)
+    output wire [DW-1:0]        rem,    // with neg = 0: num - quo * den; with neg = 1: den - 1 - that
+    output wire [DW-1:0]        rem_c,  // den - 1 - rem (the step left's remainder, see core_setup)
+    output reg                  neg     // num < 0: rem and rem_c exchanged
 );
   localparam integer MW = NW - 1;  // magnitude bits
   localparam integer CW = $clog2(MW + 1);
@@ -31,7 +35,6 @@ module core_divider #(
   reg [MW-1:0] nq;      // numerator bits not yet consumed (top), quotient bits so far (bottom)
   reg [DW-1:0] pr;      // partial remainder, < den
   reg [DW-1:0] dv;
-  reg          neg;
   reg [CW-1:0] left;    // numerator bits left
   reg          run;
 
@@ -58,17 +61,13 @@ module core_divider #(
       if (left == 0) begin
         run  <= 1'b0;
         done <= 1'b1;
-        if (neg) begin
-          nq[QW-1:0] <= ~nq[QW-1:0];
-          pr         <= rem_c;
-        end
       end else if (skip) begin
         pr   <= {pr[DW-5:0], nq[MW-1:MW-4]};
-        nq   <= nq << 4;
+        nq   <= {nq[MW-5:0], {4{neg}}};
         left <= left - 4;
       end else begin
         pr   <= fits ? diff[DW-1:0] : trial[DW-1:0];
-        nq   <= {nq[MW-2:0], fits};
+        nq   <= {nq[MW-2:0], fits ^ neg};
         left <= left - 1'b1;
       end
     end

@@ -281,6 +281,7 @@ module core_setup #(
   wire [ND-1:0]    dv_done;
   wire [ND*32-1:0] dv_q;
   wire [ND*35-1:0] dv_r, dv_rc;
+  wire [ND-1:0]    dv_neg;           // its remainders exchanged (core_divider)
   reg  [ND-1:0]    dv_pend;          // running, or its results not yet written
   reg  [ND-1:0]    dv_rdy;           // finished, not yet written
   reg  [ND*2-1:0]  dv_field;         // the plane field it produces
@@ -292,7 +293,8 @@ module core_setup #(
       /* verilator lint_off PINCONNECTEMPTY */
       core_divider #(.NW(ACC_W), .DW(35), .QW(32), .SKIP(SKIP)) divider (
           .clk(clk), .rst(rst), .start(dv_go[gd]), .num(acc_s), .den(den), .busy(), .done(dv_done[gd]),
-          .quo(dv_q[gd*32 +: 32]), .rem(dv_r[gd*35 +: 35]), .rem_c(dv_rc[gd*35 +: 35]));
+          .quo(dv_q[gd*32 +: 32]), .rem(dv_r[gd*35 +: 35]), .rem_c(dv_rc[gd*35 +: 35]),
+          .neg(dv_neg[gd]));
       /* verilator lint_on PINCONNECTEMPTY */
     end
   endgenerate
@@ -311,7 +313,7 @@ module core_setup #(
   wire [31:0] w_q  = dv_q[wsel*32 +: 32];
   wire [31:0] w_a0 = dv_a0[wsel*32 +: 32];
   assign pw_q = (pw_field == 2'd0) ? w_a0 + w_q : (pw_field == 2'd2) ? ~w_q : w_q;
-  assign pw_r = (pw_field == 2'd2) ? dv_rc[wsel*35 +: 35] : dv_r[wsel*35 +: 35];
+  assign pw_r = ((pw_field == 2'd2) ^ dv_neg[wsel]) ? dv_rc[wsel*35 +: 35] : dv_r[wsel*35 +: 35];
   // the lowest finished divider
   reg [SW-1:0] rdy_sel;
   integer gi;
