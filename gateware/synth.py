@@ -1,18 +1,23 @@
 #!/usr/bin/env python3
 """Resource use of the whole spigpu device (spigpu_top: soc + render core) per profile, yosys 0.23.
 
-    gateware/synth.py [--profile up5k|ecp5] [--modules] [--json out.json]
+    gateware/synth.py [--profile up5k|ecp5] [--modules] [--abc9] [--check] [--json out.json]
 up5k: synth_ice40 -dsp (the UP5K has 5,280 LUT4, 30 SB_RAM40_4K, 4 SB_SPRAM256KA, 8 SB_MAC16);
 ecp5: synth_ecp5 (LUT4 / TRELLIS_FF / CCU2C / MULT18X18D / DP16KD). Logic synthesis only: placement
 and routing are the board flow's (nextpnr), which may merge or split cells. The render core per
 stage: gateware/tests/core/synth_core.py. --modules keeps the hierarchy (-noflatten) and prints every
 module's cells: what each stage costs (the total is then higher than flattened, where yosys optimises
-across module boundaries).
+across module boundaries). --abc9 maps the up5k profile with synth_ice40's timing-driven abc9 for the
+UltraPlus (-abc9 -device u; fewer LUT4 here, the board flow has to confirm it routes). --check exits 1
+when a profile's cells exceed its part (PARTS), naming each resource over.
 """
 import argparse, json, os, re, subprocess, sys
 
 GW = os.path.dirname(os.path.abspath(__file__))
 PROFILES = {"up5k": ("0", "synth_ice40 -dsp"), "ecp5": ("1", "synth_ecp5")}
+# the parts each profile must fit: iCE40 UP5K; ECP5 LFE5U-85F (the ULX3S's)
+PARTS = {"up5k": {"lut": 5280, "bram": 30, "spram": 4, "dsp": 8},
+         "ecp5": {"lut": 83640, "bram": 208, "dsp": 156}}
 CELLS = {
     "lut": ["SB_LUT4", "LUT4"],
     "ff": [r"SB_DFF\w*", "TRELLIS_FF"],
@@ -27,8 +32,10 @@ def count(section):
     return {k: sum(int(m) for c in names for m in re.findall(rf"\b{c}\s+(\d+)", section)) for k, names in CELLS.items()}
 
 
-def synth(profile, modules=False):
+def synth(profile, modules=False, abc9=False):
     value, cmd = PROFILES[profile]
+    if abc9 and profile == "up5k":
+        cmd += " -abc9 -device u"
     files = [os.path.join("rtl", "spigpu_top.v")]
     for d in ("soc", "core"):
         files += sorted(os.path.join("rtl", d, f) for f in os.listdir(os.path.join(GW, "rtl", d)) if f.endswith(".v"))
@@ -63,6 +70,8 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--profile", choices=sorted(PROFILES), action="append")
     ap.add_argument("--modules", action="store_true", help="per module, hierarchy kept (-noflatten)")
+    ap.add_argument("--abc9", action="store_true", help="up5k: synth_ice40 -abc9 -device u")
+    ap.add_argument("--check", action="store_true", help="exit 1 if a profile exceeds its part (flattened figures)")
     ap.add_argument("--json", help="write the figures as JSON")
     a = ap.parse_args()
     report = {}
@@ -70,8 +79,9 @@ def main():
     row = lambda r: f"{r['lut']:6d} {r['ff']:6d} {r['carry']:6d} {r['dsp']:4d} {r['bram']:5d} {r['spram']:5d}"
     if not a.modules:
         print(f"{'profile':8s} {head}")
+    over = []
     for name in a.profile or sorted(PROFILES, reverse=True):
-        r = synth(name, a.modules)
+        r = synth(name, a.modules, a.abc9)
         report[name] = r
         if a.modules:
             print(f"{name + ' module':24s} {head}")
@@ -81,9 +91,16 @@ def main():
             print(f"{'total (not flattened)':24s} {row(total)}", flush=True)
         else:
             print(f"{name:8s} {row(r)}", flush=True)
+            over += [f"{name}: {k} {r[k]} > {limit}" for k, limit in PARTS[name].items() if r[k] > limit]
     if a.json:
         with open(a.json, "w") as f:
             json.dump(report, f, indent=2)
+    if a.check:
+        if a.modules:
+            sys.exit("--check needs the flattened figures: drop --modules")
+        if over:
+            sys.exit("does not fit the part: " + "; ".join(over))
+        print("fits: " + ", ".join(f"{n} {', '.join(f'{k} {report[n][k]}/{v}' for k, v in PARTS[n].items())}" for n in report))
 
 
 if __name__ == "__main__":

@@ -3,11 +3,11 @@
 //
 // An executed FB_DISPLAY write asks for a swap with its address and the FB_FORMAT of that moment;
 // the buffer length W x H x bpp is computed (12 clocks; the product on a multiplier, a DSP) and the
-// swap becomes pending. At the next vertical sync (start of vertical blanking) the pending swap is latched and the
-// frame is read, in address order, into the CRC-32 and out of the frame port (the video output of a
-// board, and what the co-simulation captures). When its last byte has been read the frame is
-// "scanned out": FRAME_COUNT advances, FRAME_CRC = {frame number, CRC} and SWAP_PENDING clears, so a
-// host that sees SWAP_PENDING = 0 reads the CRC of that frame. Bytes beyond VRAM read as 0 and
+// swap becomes pending. At the next vertical sync (start of vertical blanking) the pending swap is
+// latched and the frame is read, in address order, into the CRC-32 and out of the frame port (the
+// video output of a board, and what the co-simulation captures). When its last byte has been read
+// the frame is "scanned out": FRAME_COUNT advances, FRAME_CRC = {frame number, CRC} and SWAP_PENDING
+// clears, so a host that sees SWAP_PENDING = 0 reads the CRC of that frame. Bytes beyond VRAM read as 0 and
 // raise ERR_MEM_RANGE when the swap is requested (the simulator raises it when FB_DISPLAY executes).
 // Until the reader has passed them, the not-yet-read words of the pending frame are write-protected
 // (mem_arbiter), so the frame is the buffer as it was when FB_DISPLAY executed.
