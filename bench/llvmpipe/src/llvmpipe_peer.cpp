@@ -9,30 +9,66 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
 #include <cstdlib>
 #include <cstring>
 #include <string_view>
 
 namespace gpubridge::bench {
 
+namespace {
+
+// The vertex buffer layouts (only what each program reads; see llvmpipe_peer.hpp).
+enum class Layout { Gouraud, Textured, Position };
+constexpr int kLayouts = 3;
+constexpr int kOutputs = 4;
+
+struct GouraudVertex {
+  float x, y, z;
+  std::uint8_t rgba[4];  // normalised: exactly the r/255 of GlVertex
+};
+struct TexturedVertex {
+  float x, y, z, w, u, v;
+};
+struct PositionVertex {
+  float x, y, z;
+};
+
+Layout layout_of(GlDrawState::Output o) {
+  switch (o) {
+    case GlDrawState::Output::Color: return Layout::Gouraud;
+    case GlDrawState::Output::TextureDecal:
+    case GlDrawState::Output::TexelCoordinates: return Layout::Textured;
+    case GlDrawState::Output::FlatColor: return Layout::Position;
+  }
+  return Layout::Gouraud;
+}
+
+}  // namespace
+
 struct LlvmpipePeer::Gl {
   EGLDisplay display = EGL_NO_DISPLAY;
   EGLContext context = EGL_NO_CONTEXT;
   unsigned width = 0, height = 0;
   GLuint fbo_rgba8 = 0, fbo_float = 0, color_rb = 0, float_rb = 0, depth_rb = 0;
-  GLuint program = 0, vao = 0, vbo = 0, texture = 0;
-  GLint u_scale = -1, u_mode = -1, u_tex_size = -1;
-  GLsizei vertex_count = 0;
+  GLuint texture = 0;
+  GLuint program[kOutputs] = {};  // by GlDrawState::Output
+  GLint u_flat_color = -1, u_tex_size = -1;
+  GLuint vao[kLayouts] = {}, vbo[kLayouts] = {};
+  GLsizei vertex_count[kLayouts] = {};
   float tex_w = 1, tex_h = 1;
 
   ~Gl() {
     if (display == EGL_NO_DISPLAY) return;
     if (context != EGL_NO_CONTEXT) {
-      glDeleteBuffers(1, &vbo);
-      glDeleteVertexArrays(1, &vao);
+      glDeleteBuffers(kLayouts, vbo);
+      glDeleteVertexArrays(kLayouts, vao);
       glDeleteTextures(1, &texture);
-      glDeleteProgram(program);
+      for (GLuint p : program) glDeleteProgram(p);
       glDeleteFramebuffers(1, &fbo_rgba8);
       glDeleteFramebuffers(1, &fbo_float);
       GLuint rbs[3] = {color_rb, float_rb, depth_rb};
@@ -46,33 +82,57 @@ struct LlvmpipePeer::Gl {
 
 namespace {
 
-constexpr const char* kVertexShader = R"(#version 330 core
-layout(location = 0) in vec4 pos;    // x, y in pixels (y down), z in [0, 1], w
+// Positions arrive in pixels (y down, no flip: FBO row r is window y in [r, r + 1)), z in [0, 1].
+// Gouraud and flat draws leave w at 1: noperspective colour and depth do not depend on it, and the
+// Gouraud scenes' w is 1 anyway.
+constexpr const char* kGouraudVertex = R"(#version 330 core
+layout(location = 0) in vec3 pos;
 layout(location = 1) in vec4 color;
-layout(location = 2) in vec2 uv;
 uniform vec2 scale;                  // 2 / width, 2 / height
 noperspective out vec4 v_color;      // the device's Gouraud is linear in screen space
+void main() {
+  gl_Position = vec4(pos.xy * scale - 1.0, 2.0 * pos.z - 1.0, 1.0);
+  v_color = color;
+}
+)";
+constexpr const char* kGouraudFragment = R"(#version 330 core
+noperspective in vec4 v_color;
+out vec4 frag;
+void main() { frag = v_color; }
+)";
+
+constexpr const char* kTexturedVertex = R"(#version 330 core
+layout(location = 0) in vec4 pos;    // x, y in pixels, z in [0, 1], w
+layout(location = 1) in vec2 uv;
+uniform vec2 scale;
 out vec2 v_uv;                       // perspective-correct
 void main() {
-  vec2 ndc = pos.xy * scale - 1.0;   // no y flip: FBO row r is window y in [r, r + 1)
-  gl_Position = vec4(ndc * pos.w, (2.0 * pos.z - 1.0) * pos.w, pos.w);
-  v_color = color;
+  gl_Position = vec4((pos.xy * scale - 1.0) * pos.w, (2.0 * pos.z - 1.0) * pos.w, pos.w);
   v_uv = uv;
 }
 )";
-
-constexpr const char* kFragmentShader = R"(#version 330 core
-noperspective in vec4 v_color;
+constexpr const char* kDecalFragment = R"(#version 330 core
 in vec2 v_uv;
-uniform int mode;                    // 0 colour, 1 texture decal, 2 texel coordinates
 uniform sampler2D tex;
+out vec4 frag;
+void main() { frag = texture(tex, v_uv); }
+)";
+constexpr const char* kTexelFragment = R"(#version 330 core
+in vec2 v_uv;
 uniform vec2 tex_size;
 out vec4 frag;
-void main() {
-  if (mode == 0) frag = v_color;
-  else if (mode == 1) frag = texture(tex, v_uv);
-  else frag = vec4(v_uv * tex_size, 0.0, 1.0);
-}
+void main() { frag = vec4(v_uv * tex_size, 0.0, 1.0); }
+)";
+
+constexpr const char* kFlatVertex = R"(#version 330 core
+layout(location = 0) in vec3 pos;
+uniform vec2 scale;
+void main() { gl_Position = vec4(pos.xy * scale - 1.0, 2.0 * pos.z - 1.0, 1.0); }
+)";
+constexpr const char* kFlatFragment = R"(#version 330 core
+uniform vec4 color;
+out vec4 frag;
+void main() { frag = color; }
 )";
 
 Error gl_error(std::string what) {
@@ -105,6 +165,57 @@ Result<GLuint> compile(GLenum kind, const char* source) {
   }
   return s;
 }
+
+Result<GLuint> link(const char* vertex, const char* fragment) {
+  auto vs = compile(GL_VERTEX_SHADER, vertex);
+  if (!vs) return vs.error();
+  auto fs = compile(GL_FRAGMENT_SHADER, fragment);
+  if (!fs) {
+    glDeleteShader(*vs);
+    return fs.error();
+  }
+  GLuint p = glCreateProgram();
+  glAttachShader(p, *vs);
+  glAttachShader(p, *fs);
+  glLinkProgram(p);
+  glDeleteShader(*vs);
+  glDeleteShader(*fs);
+  GLint linked = 0;
+  glGetProgramiv(p, GL_LINK_STATUS, &linked);
+  if (!linked) {
+    glDeleteProgram(p);
+    return gl_error("program link failed");
+  }
+  return p;
+}
+
+// One vertex array per layout, its attributes 0 (position) and 1 (colour or u/v) as the programs
+// declare them.
+void make_vertex_array(GLuint* vao, GLuint* vbo, Layout layout) {
+  glGenVertexArrays(1, vao);
+  glBindVertexArray(*vao);
+  glGenBuffers(1, vbo);
+  glBindBuffer(GL_ARRAY_BUFFER, *vbo);
+  switch (layout) {
+    case Layout::Gouraud:
+      glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, sizeof(GouraudVertex), reinterpret_cast<void*>(offsetof(GouraudVertex, x)));
+      glVertexAttribPointer(1, 4, GL_UNSIGNED_BYTE, GL_TRUE, sizeof(GouraudVertex),
+                            reinterpret_cast<void*>(offsetof(GouraudVertex, rgba)));
+      glEnableVertexAttribArray(1);
+      break;
+    case Layout::Textured:
+      glVertexAttribPointer(0, 4, GL_FLOAT, GL_FALSE, sizeof(TexturedVertex), reinterpret_cast<void*>(offsetof(TexturedVertex, x)));
+      glVertexAttribPointer(1, 2, GL_FLOAT, GL_FALSE, sizeof(TexturedVertex), reinterpret_cast<void*>(offsetof(TexturedVertex, u)));
+      glEnableVertexAttribArray(1);
+      break;
+    case Layout::Position:
+      glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, sizeof(PositionVertex), reinterpret_cast<void*>(offsetof(PositionVertex, x)));
+      break;
+  }
+  glEnableVertexAttribArray(0);
+}
+
+std::uint8_t unorm8(float f) { return std::uint8_t(std::lround(std::clamp(f, 0.0f, 1.0f) * 255.0f)); }
 
 GLuint make_renderbuffer(GLenum format, unsigned w, unsigned h) {
   GLuint rb = 0;
@@ -162,35 +273,22 @@ Result<std::unique_ptr<LlvmpipePeer>> LlvmpipePeer::create(unsigned width, unsig
   }
   glViewport(0, 0, GLsizei(width), GLsizei(height));
 
-  auto vs = compile(GL_VERTEX_SHADER, kVertexShader);
-  if (!vs) return vs.error();
-  auto fs = compile(GL_FRAGMENT_SHADER, kFragmentShader);
-  if (!fs) return fs.error();
-  gl->program = glCreateProgram();
-  glAttachShader(gl->program, *vs);
-  glAttachShader(gl->program, *fs);
-  glLinkProgram(gl->program);
-  glDeleteShader(*vs);
-  glDeleteShader(*fs);
-  GLint linked = 0;
-  glGetProgramiv(gl->program, GL_LINK_STATUS, &linked);
-  if (!linked) return gl_error("program link failed");
-  glUseProgram(gl->program);
-  gl->u_scale = glGetUniformLocation(gl->program, "scale");
-  gl->u_mode = glGetUniformLocation(gl->program, "mode");
-  gl->u_tex_size = glGetUniformLocation(gl->program, "tex_size");
-  glUniform2f(gl->u_scale, 2.0f / float(width), 2.0f / float(height));
-  glUniform1i(glGetUniformLocation(gl->program, "tex"), 0);
-
-  glGenVertexArrays(1, &gl->vao);
-  glBindVertexArray(gl->vao);
-  glGenBuffers(1, &gl->vbo);
-  glBindBuffer(GL_ARRAY_BUFFER, gl->vbo);
-  const GLsizei stride = sizeof(GlVertex);
-  glVertexAttribPointer(0, 4, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<void*>(offsetof(GlVertex, x)));
-  glVertexAttribPointer(1, 4, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<void*>(offsetof(GlVertex, r)));
-  glVertexAttribPointer(2, 2, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<void*>(offsetof(GlVertex, u)));
-  for (GLuint i = 0; i < 3; ++i) glEnableVertexAttribArray(i);
+  // Every program is compiled and linked here, once; draws only switch between them.
+  const std::pair<const char*, const char*> sources[kOutputs] = {
+      {kGouraudVertex, kGouraudFragment}, {kTexturedVertex, kDecalFragment}, {kTexturedVertex, kTexelFragment},
+      {kFlatVertex, kFlatFragment}};
+  for (int i = 0; i < kOutputs; ++i) {
+    auto p = link(sources[i].first, sources[i].second);
+    if (!p) return p.error();
+    gl->program[i] = *p;
+    glUseProgram(*p);
+    glUniform2f(glGetUniformLocation(*p, "scale"), 2.0f / float(width), 2.0f / float(height));
+  }
+  glUseProgram(gl->program[int(GlDrawState::Output::TextureDecal)]);
+  glUniform1i(glGetUniformLocation(gl->program[int(GlDrawState::Output::TextureDecal)], "tex"), 0);
+  gl->u_tex_size = glGetUniformLocation(gl->program[int(GlDrawState::Output::TexelCoordinates)], "tex_size");
+  gl->u_flat_color = glGetUniformLocation(gl->program[int(GlDrawState::Output::FlatColor)], "color");
+  for (int i = 0; i < kLayouts; ++i) make_vertex_array(&gl->vao[i], &gl->vbo[i], Layout(i));
   glGenTextures(1, &gl->texture);
   if (glGetError() != GL_NO_ERROR) return gl_error("OpenGL setup reported an error");
 
@@ -214,17 +312,50 @@ void LlvmpipePeer::set_texture(std::span<const std::uint8_t> rgba, unsigned widt
   gl_->tex_h = float(height);
 }
 
-void LlvmpipePeer::set_vertices(std::span<const GlVertex> vertices) {
-  glBindBuffer(GL_ARRAY_BUFFER, gl_->vbo);
-  glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(vertices.size_bytes()), vertices.data(), GL_STATIC_DRAW);
-  gl_->vertex_count = GLsizei(vertices.size());
+void LlvmpipePeer::set_vertices(std::span<const GlVertex> vertices, GlDrawState::Output output) {
+  const Layout layout = layout_of(output);
+  const int l = int(layout);
+  glBindBuffer(GL_ARRAY_BUFFER, gl_->vbo[l]);
+  auto upload = [&](const auto& packed) {
+    glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(packed.size() * sizeof(packed[0])), packed.data(), GL_STATIC_DRAW);
+  };
+  switch (layout) {
+    case Layout::Gouraud: {
+      std::vector<GouraudVertex> packed(vertices.size());
+      for (std::size_t i = 0; i < vertices.size(); ++i) {
+        const GlVertex& v = vertices[i];
+        packed[i] = {v.x, v.y, v.z, {unorm8(v.r), unorm8(v.g), unorm8(v.b), unorm8(v.a)}};
+      }
+      upload(packed);
+      break;
+    }
+    case Layout::Textured: {
+      std::vector<TexturedVertex> packed(vertices.size());
+      for (std::size_t i = 0; i < vertices.size(); ++i) {
+        const GlVertex& v = vertices[i];
+        packed[i] = {v.x, v.y, v.z, v.w, v.u, v.v};
+      }
+      upload(packed);
+      break;
+    }
+    case Layout::Position: {
+      std::vector<PositionVertex> packed(vertices.size());
+      for (std::size_t i = 0; i < vertices.size(); ++i) packed[i] = {vertices[i].x, vertices[i].y, vertices[i].z};
+      upload(packed);
+      break;
+    }
+  }
+  gl_->vertex_count[l] = GLsizei(vertices.size());
 }
 
 void LlvmpipePeer::render(const GlDrawState& st) {
   const bool texel_out = st.output == GlDrawState::Output::TexelCoordinates;
+  const int l = int(layout_of(st.output));
   glBindFramebuffer(GL_FRAMEBUFFER, texel_out ? gl_->fbo_float : gl_->fbo_rgba8);
-  glUniform1i(gl_->u_mode, texel_out ? 2 : st.output == GlDrawState::Output::TextureDecal ? 1 : 0);
-  glUniform2f(gl_->u_tex_size, gl_->tex_w, gl_->tex_h);
+  glUseProgram(gl_->program[int(st.output)]);
+  glBindVertexArray(gl_->vao[l]);
+  if (texel_out) glUniform2f(gl_->u_tex_size, gl_->tex_w, gl_->tex_h);
+  if (st.output == GlDrawState::Output::FlatColor) glUniform4fv(gl_->u_flat_color, 1, st.flat_rgba);
   if (st.depth == GlDrawState::Depth::Off) {
     glDisable(GL_DEPTH_TEST);
   } else {
@@ -246,7 +377,7 @@ void LlvmpipePeer::render(const GlDrawState& st) {
     glClearDepth(1.0);
     glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
   }
-  glDrawArrays(GL_TRIANGLES, 0, gl_->vertex_count);
+  glDrawArrays(GL_TRIANGLES, 0, gl_->vertex_count[l]);
   glFinish();
 }
 

@@ -7,6 +7,14 @@
 // and its top-left rule then matches the device's y-down rule. Colour is interpolated
 // `noperspective` (the device's Gouraud is screen-linear), u/v perspective-correct, depth linear.
 //
+// Measured as its best users would run it (issue 17): one GL program per output, each with only the
+// varyings and state it needs, all linked once in create(); each program has its own vertex buffer
+// holding only the attributes it reads, uploaded by set_vertices() outside any timed region.
+//   Color            Gouraud: position (x, y, z) + RGBA8 colour, one noperspective vec4 varying
+//   TextureDecal     position (x, y, z, w) + u/v, one perspective vec2 varying, a sampler
+//   TexelCoordinates the same inputs, writes u * W, v * H to a float target (error pass only)
+//   FlatColor        position (x, y, z) only, the colour a uniform (the error pass's hit counts)
+//
 // LP_NUM_THREADS is read when llvmpipe creates its screen, so each thread count runs in its own
 // child process (run_isolated) and only results cross the process boundary.
 #include <cstdint>
@@ -31,8 +39,9 @@ struct GlVertex {
 struct GlDrawState {
   enum class Depth { Off, Less, LessEqual, Always } depth = Depth::Off;  // Always: test on, every fragment writes
   enum class Blend { Off, Alpha, Add } blend = Blend::Off;
-  enum class Output { Color, TextureDecal, TexelCoordinates } output = Output::Color;
+  enum class Output { Color, TextureDecal, TexelCoordinates, FlatColor } output = Output::Color;
   bool clear = true;
+  float flat_rgba[4] = {1, 1, 1, 1};  // Output::FlatColor only
 };
 
 class LlvmpipePeer {
@@ -47,9 +56,11 @@ class LlvmpipePeer {
   const std::string& renderer() const { return renderer_; }
   // Binds an RGBA8 texture (rows top first), repeat addressing.
   void set_texture(std::span<const std::uint8_t> rgba, unsigned width, unsigned height, bool bilinear);
-  // Stores the triangle list (3 vertices per triangle) in a vertex buffer.
-  void set_vertices(std::span<const GlVertex> vertices);
-  // One frame: optional clear (colour 0, depth 1), draw everything, glFinish.
+  // Stores the triangle list (3 vertices per triangle) in the vertex buffer of the program that
+  // draws `output`, packed to the attributes that program reads.
+  void set_vertices(std::span<const GlVertex> vertices, GlDrawState::Output output);
+  // One frame with the program of state.output and the vertices last given for it: optional clear
+  // (colour 0, depth 1), one glDrawArrays, glFinish.
   void render(const GlDrawState& state);
   // Read-back of the last frame, rows top first: RGBA8 colour, 24-bit depth, texel coordinates
   // (u * W, v * H per pixel, from the float target of Output::TexelCoordinates).
