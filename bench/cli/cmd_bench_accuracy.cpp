@@ -20,6 +20,7 @@ struct AccuracyArgs {
   bool quick = false;
   unsigned runs = 5;
   unsigned scale = 1;
+  unsigned peer_rounds = 3;
   bool no_llvmpipe = false;
   std::string out_dir;
   std::vector<std::string> scenes;
@@ -99,6 +100,7 @@ int run_accuracy(const GlobalOptions& g, const AccuracyArgs& a) {
   opt.runs = a.runs;
   opt.scale = a.scale;
   opt.llvmpipe = !a.no_llvmpipe;
+  opt.peer_rounds = a.peer_rounds;
   opt.scenes = a.scenes;
   opt.exact_only = a.exact_only;
   if (!a.out_dir.empty()) {
@@ -119,6 +121,7 @@ int run_accuracy(const GlobalOptions& g, const AccuracyArgs& a) {
   if (a.quick) command += " --quick";
   if (a.runs != 5) command += " --runs " + std::to_string(a.runs);
   if (a.scale != 1) command += " --scale " + std::to_string(a.scale);
+  if (a.peer_rounds != 3) command += " --peer-rounds " + std::to_string(a.peer_rounds);
   for (const auto& name : a.scenes) command += " --scene " + name;
   if (a.exact_only) command += " --exact-only";
   if (!a.out_dir.empty()) command += " --out-dir " + a.out_dir;
@@ -158,6 +161,11 @@ GPUBRIDGE_COMMAND("bench", 80, [](CLI::App& app, GlobalOptions& g, auto& runners
       ->check(CLI::Range(1u, 1000u))
       ->capture_default_str();
   sub->add_flag("--no-llvmpipe", args->no_llvmpipe, "skip the llvmpipe peer rows");
+  sub->add_option("--peer-rounds", args->peer_rounds,
+                  "rounds in which the llvmpipe peer and the minimal GL program (bench/llvmpipe/minimal_gl.c) "
+                  "alternate, per thread count; each keeps its best frame (--quick: 1)")
+      ->check(CLI::Range(1u, 20u))
+      ->capture_default_str();
   sub->add_option("--scene", args->scenes,
                   "only this scene (repeatable): tri10-front, tri1k-front, tri50k-front, tri10-random, tri1k-random, "
                   "tri50k-random, road, cubes, fan, alpha-blend");

@@ -10,6 +10,7 @@ namespace gpubridge::bench {
 struct LlvmpipeResult {
   std::string renderer;
   std::vector<double> seconds;                  // best frame time per scene
+  std::vector<unsigned long long> pixel_sum;    // sum of the RGBA bytes of the last timed frame
   std::vector<std::optional<ErrorStats>> error; // per scene (only when measured)
 };
 

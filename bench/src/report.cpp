@@ -29,9 +29,15 @@ std::string report_markdown(const Report& r, const std::string& command) {
     << "- Throughput: best frame of several after a warm-up; a frame is CLEAR + CLEAR_Z + the whole scene as "
        "register frames (COLOR/TEXCOORD/VERTEX) written to the simulator device, until it has drained. llvmpipe: "
        "glClear + one glDrawArrays + glFinish on a 640x480 RGBA8 + DEPTH24 framebuffer object (EGL surfaceless), "
-       "vertices in a static buffer. Threads: simulator workers; for llvmpipe 1 = `LP_NUM_THREADS=0` (one core), "
-       "2 = two rasteriser threads. Mpix/s counts the pixels the exact simulator found covered per frame (the "
-       "same figure for every row of a scene).\n"
+       "with one GL program per draw mode holding only what that mode needs (Gouraud: one noperspective colour "
+       "varying; textured: one perspective u/v varying and a sampler), linked before timing, and a static vertex "
+       "buffer of only the attributes that program reads (Gouraud: x, y, z floats + RGBA8), uploaded before "
+       "timing. Threads: simulator workers; for llvmpipe 1 = `LP_NUM_THREADS=0` (one core), 2 = two rasteriser "
+       "threads. Mpix/s counts the pixels the exact simulator found covered per frame (the same figure for every "
+       "row of a scene).\n"
+    << "- Peer check: " << r.minimal_gl << " (bench/llvmpipe/minimal_gl.c, a standalone program with one "
+       "`frag = colour` GL program) draws the same vertices of the depth-LESS Gouraud scenes at the same thread "
+       "count and resolution in this run; the peer should reach at least 0.9 of its rate.\n"
     << "- Error: the scene's leading triangles (the error subset) drawn with depth ALWAYS + write, no blending, "
        "against the double-precision reference rasteriser (tests/accuracy/reference) of the same register data. "
        "Coverage mismatches: pixels whose hit count or owning (last) triangle differs from the reference "
@@ -41,8 +47,25 @@ std::string report_markdown(const Report& r, const std::string& command) {
        "(tests/accuracy/reference/texel_probe.hpp; resolution 1/512 texel, so 0.5 is the measurement floor), "
        "llvmpipe's from a float render target (its interpolated coordinate before sampling). An exact "
        "implementation rounds once: colour and Z errors <= 0.5 LSB.\n\n";
-  o << "## Speed goals (measured side by side in this run)\n\n";
+  o << "## Speed goals of issue 17 against the llvmpipe peer (measured side by side in this run)\n\n";
   for (const auto& g : r.goals) o << "- " << g << "\n";
+  bool any_minimal = false;
+  for (const auto& row : r.rows) any_minimal = any_minimal || row.vs_minimal_gl.has_value();
+  if (any_minimal) {
+    o << "\n## Peer check: llvmpipe peer against the minimal GL program (same run)\n\n"
+      << "| Scene | Threads | Peer Mtri/s | Minimal GL Mtri/s | Peer / minimal | Same picture |\n|---|---|---|---|---|---|\n";
+    for (std::size_t i = 0; i < r.rows.size(); ++i) {
+      const Row& row = r.rows[i];
+      if (!row.vs_minimal_gl) continue;
+      const std::size_t si = std::size_t(std::find_if(r.scenes.begin(), r.scenes.end(), [&](const Scene& s) {
+                                            return s.name == row.scene;
+                                          }) - r.scenes.begin());
+      const double tris = si < r.scene_triangles.size() ? double(r.scene_triangles[si]) : 0.0;
+      o << fmt::format("| {} | {} | {:.3f} | {:.3f} | {:.2f} | {} |\n", row.scene, row.threads, row.mtri_s,
+                       tris / *row.minimal_gl_seconds / 1e6, *row.vs_minimal_gl,
+                       row.minimal_gl_same_image.value_or(false) ? "yes" : "NO");
+    }
+  }
   o << "\n## Scenes\n\n| Scene | Triangles | Covered px / frame | Description |\n|---|---|---|---|\n";
   for (std::size_t i = 0; i < r.scenes.size(); ++i)
     o << "| " << r.scenes[i].name << " | " << (i < r.scene_triangles.size() ? r.scene_triangles[i] : 0) << " | "
@@ -66,7 +89,7 @@ std::string report_markdown(const Report& r, const std::string& command) {
 nlohmann::json report_json(const Report& r) {
   nlohmann::json j;
   j["machine"] = r.machine;
-  j["llvmpipe"] = {{"available", r.llvmpipe_ok}, {"renderer_or_reason", r.llvmpipe}};
+  j["llvmpipe"] = {{"available", r.llvmpipe_ok}, {"renderer_or_reason", r.llvmpipe}, {"minimal_gl", r.minimal_gl}};
   j["goals"] = r.goals;
   j["scenes"] = nlohmann::json::array();
   for (std::size_t i = 0; i < r.scenes.size(); ++i)
@@ -80,6 +103,11 @@ nlohmann::json report_json(const Report& r) {
                       {"threads", row.threads}, {"seconds", row.seconds}, {"mtri_s", row.mtri_s},
                       {"mpix_s", row.mpix_s}};
     if (row.ratio_vs_llvmpipe) jr["ratio_vs_llvmpipe"] = *row.ratio_vs_llvmpipe;
+    if (row.vs_minimal_gl) {
+      jr["minimal_gl_seconds"] = *row.minimal_gl_seconds;
+      jr["vs_minimal_gl"] = *row.vs_minimal_gl;
+      jr["minimal_gl_same_image"] = row.minimal_gl_same_image.value_or(false);
+    }
     if (row.error) {
       const auto& e = *row.error;
       jr["error"] = {{"pixels", e.pixels}, {"coverage_mismatches", e.coverage_mismatches}, {"z_max_lsb", e.z_max}};

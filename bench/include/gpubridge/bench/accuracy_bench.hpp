@@ -21,6 +21,7 @@ struct AccuracyBenchOptions {
   unsigned scale = 1;         // divides the scene triangle counts (quick: 200)
   unsigned runs = 5;          // timed runs per measurement (best is reported), after 1 warm-up
   bool llvmpipe = true;       // measure the llvmpipe peer (omitted with a reason when unavailable)
+  unsigned peer_rounds = 3;   // the peer and the minimal GL program alternate this often (best of all; quick: 1)
   std::vector<unsigned> threads{1, 2};
   std::vector<std::string> scenes;  // only these scenes (by name); empty = all
   bool exact_only = false;          // only the exact configuration (no other accuracy knobs)
@@ -47,6 +48,11 @@ struct Row {
   double seconds = 0;    // best frame time
   double mtri_s = 0, mpix_s = 0;
   std::optional<double> ratio_vs_llvmpipe;  // sim throughput / llvmpipe throughput, same scene & threads
+  // llvmpipe rows of the scenes bench/llvmpipe/minimal_gl.c draws: its best frame time in the same
+  // run (same vertices, thread count, resolution), the peer's throughput as a fraction of its
+  // throughput, and whether both frames had the same RGBA byte sum (the same picture).
+  std::optional<double> minimal_gl_seconds, vs_minimal_gl;
+  std::optional<bool> minimal_gl_same_image;
   std::optional<ErrorStats> error;
 };
 
@@ -54,6 +60,7 @@ struct Report {
   std::string machine;      // CPU model, core count, load average at start
   std::string llvmpipe;     // renderer string, or why the llvmpipe rows are missing
   bool llvmpipe_ok = false;
+  std::string minimal_gl;   // the minimal GL program run beside the peer, or why it did not run
   std::vector<Scene> scenes;  // descriptions only (triangles cleared after the run)
   std::vector<std::uint64_t> scene_pixels;  // covered pixels per frame (exact simulator)
   std::vector<std::size_t> scene_triangles;  // triangles per frame
