@@ -9,6 +9,7 @@
 #include <thread>
 
 #include "error_measure.hpp"
+#include "fill_ceiling.hpp"
 #include "llvmpipe_runner.hpp"
 #include "minimal_gl_runner.hpp"
 #include "sim_runner.hpp"
@@ -131,6 +132,14 @@ Result<Report> run_accuracy_bench(const AccuracyBenchOptions& opt, const std::fu
     rep.minimal_gl = "not run (--no-llvmpipe)";
   }
 
+  progress("fill ceiling");
+  rep.ceiling = measure_fill_ceiling(opt.threads, runs, opt.quick);
+  auto fill_fraction = [&](unsigned t, double mpix_s) -> std::optional<double> {
+    for (const auto& c : rep.ceiling)
+      if (c.threads == t && c.cache_mpix_s > 0) return mpix_s / c.cache_mpix_s;
+    return std::nullopt;
+  };
+
   auto configs = bench_configs();
   if (opt.exact_only) configs.resize(1);
   rep.scene_pixels.assign(rep.scenes.size(), 0);
@@ -156,6 +165,7 @@ Result<Report> run_accuracy_bench(const AccuracyBenchOptions& opt, const std::fu
         row.seconds = timing->best_seconds;
         row.mtri_s = double(s.triangles.size()) / row.seconds / 1e6;
         row.mpix_s = double(rep.scene_pixels[si]) / row.seconds / 1e6;
+        row.fill_fraction = fill_fraction(t, row.mpix_s);
         if (lp[ti]) row.ratio_vs_llvmpipe = lp[ti]->seconds[si] / row.seconds;
         if (ti == 0) row.error = err;  // error does not depend on the thread count (tested)
         rep.rows.push_back(row);
@@ -173,6 +183,7 @@ Result<Report> run_accuracy_bench(const AccuracyBenchOptions& opt, const std::fu
       row.seconds = lp[ti]->seconds[si];
       row.mtri_s = double(rep.scenes[si].triangles.size()) / row.seconds / 1e6;
       row.mpix_s = double(rep.scene_pixels[si]) / row.seconds / 1e6;
+      row.fill_fraction = fill_fraction(row.threads, row.mpix_s);
       row.error = lp[ti]->error[si];
       if (const auto& m = minimal[ti][si]) {
         row.minimal_gl_seconds = m->best_seconds;

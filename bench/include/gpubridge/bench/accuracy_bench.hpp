@@ -53,7 +53,19 @@ struct Row {
   // throughput, and whether both frames had the same RGBA byte sum (the same picture).
   std::optional<double> minimal_gl_seconds, vs_minimal_gl;
   std::optional<bool> minimal_gl_same_image;
+  std::optional<double> fill_fraction;  // mpix_s / the in-cache fill ceiling at the same thread count
   std::optional<ErrorStats> error;
+};
+
+// This machine's fill ceiling (issue 17): the pixel rate of the least work a depth-tested colour
+// fill does per pixel, a 32-bit Z read-modify-write (LESS, every pixel passes) and a 32-bit colour
+// write, 16 lanes (AVX-512 where the CPU has it), nothing else.
+struct FillCeiling {
+  unsigned threads = 1;
+  std::string vectors;      // the instruction set the kernel ran with: "AVX-512", "AVX2" or "SSE2"
+  double cache_mpix_s = 0;  // a 2,048-pixel tile per thread (16 KiB of Z + colour: L1): the physical limit
+  double frame_mpix_s = 0;  // one 640x480 Z + colour split between the threads (2.4 MiB, the scenes' own)
+  double dram_mpix_s = 0;   // 2 x 128 MiB split between the threads (beyond the last-level cache)
 };
 
 struct Report {
@@ -65,6 +77,7 @@ struct Report {
   std::vector<std::uint64_t> scene_pixels;  // covered pixels per frame (exact simulator)
   std::vector<std::size_t> scene_triangles;  // triangles per frame
   std::vector<Row> rows;
+  std::vector<FillCeiling> ceiling;  // per thread count, measured in the same run
   std::vector<std::string> goals;  // the speed goals with their measured ratios
   std::optional<CordicFront> cordic;  // its own section (cordic_front.hpp)
 };
