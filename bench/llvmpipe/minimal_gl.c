@@ -13,6 +13,7 @@
 #include <EGL/eglext.h>
 #include <GL/gl.h>
 #include <GL/glext.h>
+#include <malloc.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -53,6 +54,13 @@ static double now(void) {
 
 int main(int argc, char** argv) {
   if (argc != 5) return fail("usage: minimal_gl VERTICES WIDTH HEIGHT RUNS");
+  /* llvmpipe allocates and frees its binned scene every frame. With glibc's start-up thresholds the
+   * heap top is trimmed after each frame and faulted in again by the next (a fifth of a frame of
+   * 10-px triangles); a program that has freed a large block runs with the thresholds raised. Fix
+   * them at that raised state, as the peer does (llvmpipe_runner.cpp), so neither depends on its
+   * allocation history. */
+  mallopt(M_MMAP_THRESHOLD, 32 << 20);
+  mallopt(M_TRIM_THRESHOLD, 64 << 20);
   const int w = atoi(argv[2]), h = atoi(argv[3]), runs = atoi(argv[4]);
   if (w < 1 || h < 1 || w > 4096 || h > 4096 || runs < 1) return fail("WIDTH, HEIGHT must be 1..4096, RUNS >= 1");
   FILE* f = fopen(argv[1], "rb");
@@ -107,6 +115,7 @@ int main(int argc, char** argv) {
   glGenBuffers(1, &vbo);
   glBindBuffer(GL_ARRAY_BUFFER, vbo);
   glBufferData(GL_ARRAY_BUFFER, bytes, data, GL_STATIC_DRAW);
+  free(data); /* GL has its copy */
   glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 16, (void*)0);
   glVertexAttribPointer(1, 4, GL_UNSIGNED_BYTE, GL_TRUE, 16, (void*)12);
   glEnableVertexAttribArray(0);
@@ -132,7 +141,6 @@ int main(int argc, char** argv) {
   for (size_t i = 0; i < (size_t)w * (size_t)h * 4; ++i) sum += pixels[i];
   printf("triangles=%ld best_seconds=%.9f pixel_sum=%llu\n", bytes / 48, best, sum);
   free(pixels);
-  free(data);
   eglMakeCurrent(dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
   eglDestroyContext(dpy, ctx);
   eglTerminate(dpy);

@@ -1,6 +1,8 @@
 // llvmpipe side of the bench (see llvmpipe_runner.hpp).
 #include "llvmpipe_runner.hpp"
 
+#include <malloc.h>
+
 #include <chrono>
 
 #include <nlohmann/json.hpp>
@@ -82,6 +84,11 @@ ErrorStats llvmpipe_error(LlvmpipePeer& peer, const Scene& s, const ReferenceFra
 Result<LlvmpipeResult> run_llvmpipe(const std::vector<Scene>& scenes, const std::vector<ReferenceFrame>& refs,
                                     unsigned lp_threads, unsigned runs, bool measure) {
   auto text = run_isolated(lp_threads, [&]() -> Result<std::string> {
+    // The malloc thresholds of bench/llvmpipe/minimal_gl.c (see there): llvmpipe frees and
+    // reallocates its binned scene every frame, and whether glibc trims and re-faults it each time
+    // must not depend on what this process allocated before.
+    mallopt(M_MMAP_THRESHOLD, 32 << 20);
+    mallopt(M_TRIM_THRESHOLD, 64 << 20);
     auto peer_r = LlvmpipePeer::create(640, 480);
     if (!peer_r) return peer_r.error();
     auto& peer = **peer_r;
