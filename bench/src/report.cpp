@@ -61,7 +61,7 @@ std::string report_markdown(const Report& r, const std::string& command) {
                                             return s.name == row.scene;
                                           }) - r.scenes.begin());
       const double tris = si < r.scene_triangles.size() ? double(r.scene_triangles[si]) : 0.0;
-      o << fmt::format("| {} | {} | {:.3f} | {:.3f} | {:.2f} | {} |\n", row.scene, row.threads, row.mtri_s,
+      o << fmt::format("| {} | {} | {:.4g} | {:.4g} | {:.2f} | {} |\n", row.scene, row.threads, row.mtri_s,
                        tris / *row.minimal_gl_seconds / 1e6, *row.vs_minimal_gl,
                        row.minimal_gl_same_image.value_or(false) ? "yes" : "NO");
     }
