@@ -35,7 +35,7 @@ struct TexturedVertex {
   float x, y, z, w, u, v;
 };
 struct PositionVertex {
-  float x, y, z;
+  float x, y, z, w;
 };
 
 Layout layout_of(GlDrawState::Output o) {
@@ -124,10 +124,12 @@ out vec4 frag;
 void main() { frag = vec4(v_uv * tex_size, 0.0, 1.0); }
 )";
 
+// The flat program draws the error pass's hit counts of every scene, so its positions go through
+// the textured program's transform (w included): coverage is then that of the program the scene uses.
 constexpr const char* kFlatVertex = R"(#version 330 core
-layout(location = 0) in vec3 pos;
+layout(location = 0) in vec4 pos;
 uniform vec2 scale;
-void main() { gl_Position = vec4(pos.xy * scale - 1.0, 2.0 * pos.z - 1.0, 1.0); }
+void main() { gl_Position = vec4((pos.xy * scale - 1.0) * pos.w, (2.0 * pos.z - 1.0) * pos.w, pos.w); }
 )";
 constexpr const char* kFlatFragment = R"(#version 330 core
 uniform vec4 color;
@@ -209,7 +211,7 @@ void make_vertex_array(GLuint* vao, GLuint* vbo, Layout layout) {
       glEnableVertexAttribArray(1);
       break;
     case Layout::Position:
-      glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, sizeof(PositionVertex), reinterpret_cast<void*>(offsetof(PositionVertex, x)));
+      glVertexAttribPointer(0, 4, GL_FLOAT, GL_FALSE, sizeof(PositionVertex), reinterpret_cast<void*>(offsetof(PositionVertex, x)));
       break;
   }
   glEnableVertexAttribArray(0);
@@ -340,7 +342,7 @@ void LlvmpipePeer::set_vertices(std::span<const GlVertex> vertices, GlDrawState:
     }
     case Layout::Position: {
       std::vector<PositionVertex> packed(vertices.size());
-      for (std::size_t i = 0; i < vertices.size(); ++i) packed[i] = {vertices[i].x, vertices[i].y, vertices[i].z};
+      for (std::size_t i = 0; i < vertices.size(); ++i) packed[i] = {vertices[i].x, vertices[i].y, vertices[i].z, vertices[i].w};
       upload(packed);
       break;
     }

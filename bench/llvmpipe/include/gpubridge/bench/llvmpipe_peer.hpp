@@ -13,7 +13,7 @@
 //   Color            Gouraud: position (x, y, z) + RGBA8 colour, one noperspective vec4 varying
 //   TextureDecal     position (x, y, z, w) + u/v, one perspective vec2 varying, a sampler
 //   TexelCoordinates the same inputs, writes u * W, v * H to a float target (error pass only)
-//   FlatColor        position (x, y, z) only, the colour a uniform (the error pass's hit counts)
+//   FlatColor        position (x, y, z, w) only, the colour a uniform (the error pass's hit counts)
 //
 // LP_NUM_THREADS is read when llvmpipe creates its screen, so each thread count runs in its own
 // child process (run_isolated) and only results cross the process boundary.
