@@ -20,8 +20,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::uint8_t unorm8(float f) { return std::uint8_t(std::lround(std::clamp(f, 0.0f, 1.0f) * 255.0f)); }
-
 // The file minimal_gl.c reads: per vertex float x, y, z then R, G, B, A bytes (16 bytes, host order).
 std::vector<std::uint8_t> vertex_file(const Scene& s) {
   std::vector<std::uint8_t> out(s.triangles.size() * 3 * 16);

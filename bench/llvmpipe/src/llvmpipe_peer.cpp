@@ -217,8 +217,6 @@ void make_vertex_array(GLuint* vao, GLuint* vbo, Layout layout) {
   glEnableVertexAttribArray(0);
 }
 
-std::uint8_t unorm8(float f) { return std::uint8_t(std::lround(std::clamp(f, 0.0f, 1.0f) * 255.0f)); }
-
 GLuint make_renderbuffer(GLenum format, unsigned w, unsigned h) {
   GLuint rb = 0;
   glGenRenderbuffers(1, &rb);

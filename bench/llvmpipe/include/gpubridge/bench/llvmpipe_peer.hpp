@@ -17,6 +17,8 @@
 //
 // LP_NUM_THREADS is read when llvmpipe creates its screen, so each thread count runs in its own
 // child process (run_isolated) and only results cross the process boundary.
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -35,6 +37,10 @@ struct GlVertex {
   float r = 1, g = 1, b = 1, a = 1;
   float u = 0, v = 0;  // texture widths / heights
 };
+
+// A GlVertex colour channel (a byte / 255) back to its byte: the RGBA8 vertex colour of the Gouraud
+// program and of bench/llvmpipe/minimal_gl.c's vertex file.
+inline std::uint8_t unorm8(float f) { return std::uint8_t(std::lround(std::clamp(f, 0.0f, 1.0f) * 255.0f)); }
 
 struct GlDrawState {
   enum class Depth { Off, Less, LessEqual, Always } depth = Depth::Off;  // Always: test on, every fragment writes
