@@ -221,7 +221,7 @@ std::vector<Example> make() {
            "CTest daemon_mirror_tests (*Gateware*) runs it through the FT2232H driver and checks every frame"),
       skip("build/tools/gpubridge bench rtl --quick", "minutes of co-simulation; CTest rtl.cli.bench_quick runs it"),
       skip("build/tools/gpubridge bench rtl --fit", "the full calibration run, an hour of co-simulation, by hand"),
-      skip("gateware/synth.py", "yosys synthesis of both profiles takes many minutes, by hand"),
+      skip("gateware/synth.py --pack --check", "yosys synthesis of both profiles and nextpnr packing take many minutes (and up5k does not fit yet: exit 1), by hand"),
       skip("gateware/tests/core/synth_core.py", "yosys synthesis per stage takes many minutes, by hand"),
       skip("build/gateware/tests/core/rtl_core_ecp5_bench", "a measurement, by hand; the core's tests run in ctest -L rtl"),
   }});
