@@ -147,5 +147,22 @@ TEST_F(DaemonDmc1Client, NoDaemonSaysWhatToStart) {
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
 }
 
+// A frame rate that is no rate (NaN, Inf, one so small the n-th frame's due time overflows the
+// clock, negative) is refused before connecting, by the demo and by `gpubridge play` alike (the
+// client library's check_pace_options; CLI11's Range let NaN through to a float-to-integer cast).
+TEST_F(DaemonDmc1Client, AFrameRateThatIsNoRateIsRefused) {
+  const fs::path stream = dir_ / "one.dmc1";
+  ASSERT_EQ(demo({"write", "--frames", "1", "--out", stream.string()}).exit_code, 0);
+  for (const std::string fps : {"nan", "inf", "1e-300", "-1", "1e6"}) {
+    const auto r = demo({"stream", "--fps", fps});
+    EXPECT_EQ(r.exit_code, 2) << fps << ": " << r.err;
+    EXPECT_NE(r.err.find("--fps must be 0 (unpaced) or 0.001000 .. 100000 frames per second"), std::string::npos) << fps << ": " << r.err;
+    EXPECT_EQ(r.err.find("cannot connect"), std::string::npos) << fps << ": refused only after trying the daemon";
+    const auto p = run_process({GPUBRIDGE_CLI_PATH, "play", "--fps", fps, stream.string()}, 10s, env_);
+    EXPECT_EQ(p.exit_code, 1) << fps << ": " << p.err;
+    EXPECT_NE(p.err.find("--fps must be 0 (unpaced)"), std::string::npos) << fps << ": " << p.err;
+  }
+}
+
 }  // namespace
 }  // namespace gpubridge::test

@@ -273,7 +273,7 @@ int run_play_dmc1(const GlobalOptions& g, const ClientOptions& o, const PlayOpti
 }
 
 int run_play(const GlobalOptions& g, const ClientOptions& o, const PlayOptions& p) {
-  if (p.fps < 0 || p.fps > 100000 || p.fps != p.fps) return fail("play", "--fps must be 0 (unpaced) .. 100000");
+  if (auto r = client::check_pace_options(pace_options(p), "--fps"); !r) return fail("play", r.error().message);
   if (dmc1::stream_format_for_path(p.trace) || is_dmc1_binary_trace(p.trace)) return run_play_dmc1(g, o, p);
   auto stream = load_trace(p.trace);
   if (!stream) return fail("play", stream.error().message);

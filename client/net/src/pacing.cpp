@@ -6,9 +6,17 @@
 
 namespace gpubridge::client {
 
+Result<void> check_pace_options(const PaceOptions& o, std::string_view option) {
+  // Written so NaN fails too (every comparison with NaN is false).
+  if (o.fps == 0 || (o.fps >= kMinFps && o.fps <= kMaxFps)) return {};
+  return make_error(std::string(option) + " must be 0 (unpaced) or " + std::to_string(kMinFps) + " .. " +
+                    std::to_string(static_cast<unsigned>(kMaxFps)) + " frames per second; got " + std::to_string(o.fps));
+}
+
 FramePacer::FramePacer(Client& client, PaceOptions options, const std::atomic<bool>* interrupt)
     : client_(client), options_(options), interrupt_(interrupt) {
   options_.window = std::max(options_.window, 1u);
+  if (!check_pace_options(options_, "fps")) options_.fps = 0;
 }
 
 Result<void> FramePacer::fence(Timeout timeout) {

@@ -25,9 +25,9 @@ namespace {
 using namespace gpubridge;
 namespace level = examples::dmc1_level;
 
-int fail(const std::string& msg) {
+int fail(const std::string& msg, int code = 1) {
   std::fprintf(stderr, "gpubridge-dmc1-demo: %s\n", msg.c_str());
-  return 1;
+  return code;
 }
 
 // Which frames of the camera path to send or write.
@@ -160,8 +160,7 @@ int main(int argc, char** argv) {
   add_path_options(send, stream_path, "frames to send (one lap by default)");
   send->add_flag("--loop", so.loop, "go round the path until interrupted (Ctrl-C)");
   send->add_option("--fps", so.pace.fps, "frames per second (0 = as fast as the daemon draws them)")
-      ->check(CLI::Range(0.0, 1000.0))
-      ->capture_default_str();
+      ->capture_default_str();  // checked after parsing by the client library (CLI11's Range lets NaN through)
   send->add_option("--window", so.pace.window, "frames in flight before the next waits for the daemon (pipelined fences)")
       ->check(CLI::Range(1u, 1024u))
       ->capture_default_str();
@@ -185,7 +184,10 @@ int main(int argc, char** argv) {
   gold->add_option("--palette", palette, "palette")->capture_default_str();
   gold->add_flag("--write", rewrite, "rewrite the goldens (only when the rendering legitimately changed)");
   CLI11_PARSE(app, argc, argv);
-  if (send->parsed()) return stream(stream_path, so, json);
+  if (send->parsed()) {
+    if (auto r = client::check_pace_options(so.pace, "--fps"); !r) return fail(r.error().message, 2);
+    return stream(stream_path, so, json);
+  }
   if (write->parsed()) return write_stream(out, write_path);
   return goldens(dir, textures, palette, rewrite);
 }

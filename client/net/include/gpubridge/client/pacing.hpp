@@ -19,9 +19,16 @@ struct PaceOptions {
   bool sync = false;    // wait for every frame to execute (a round trip each)
 };
 
+// The rates FramePacer takes: 0, or kMinFps .. kMaxFps (a lower rate would put the n-th frame's
+// due time beyond what a clock can hold; NaN and Inf are no rate).
+inline constexpr double kMinFps = 0.001, kMaxFps = 100000;
+// An error naming `option` (the program's flag, "--fps") when o.fps is not 0 or within the range.
+Result<void> check_pace_options(const PaceOptions& o, std::string_view option);
+
 class FramePacer {
  public:
   // interrupt: the program's Ctrl-C flag (also given to the Client): a sleep ends when it is set.
+  // Options check_pace_options refuses pace as fps 0 (programs check first and say why).
   FramePacer(Client& client, PaceOptions options, const std::atomic<bool>* interrupt = nullptr);
   // A fence as the options say: with sync, one round trip; else sent at once, waiting only while
   // `window` fences are unfinished.
