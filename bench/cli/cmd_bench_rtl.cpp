@@ -18,6 +18,7 @@
 #include "gpubridge/draw/sink.hpp"
 #include "gpubridge/examples/example.hpp"
 #include "gpubridge/rtl/rtl_device.hpp"
+#include "gpubridge/rtl/simulator_options.hpp"
 #include "gpubridge/scene/scene.hpp"
 #include "gpubridge/sim/device.hpp"
 #include "gpubridge/sim/timing.hpp"
@@ -61,13 +62,7 @@ Result<std::vector<Sample>> measure(const std::string& scene, const std::string&
   auto board = usb::emu::open_emulated_board(*profile, eo);
   if (!board) return board.error();
   rtl::RtlDevice& g = usb::emu::rtl_pins_of(*board->stack)->device();
-  const auto caps = g.caps();
-  sim::DeviceOptions o;
-  o.vram_bytes = std::uint64_t{caps.vram_kib} * 1024;
-  o.max_width = caps.max_width;
-  o.max_height = caps.max_height;
-  o.fifo_depth = caps.fifo_depth;
-  o.features = caps.features;
+  const auto o = rtl::simulator_options(g.caps());
   auto sim = sim::Device::create(o);
   if (!sim) return sim.error();
 

@@ -6,22 +6,12 @@
 #include <cstdlib>
 
 #include "gpubridge/protocol/crc32.hpp"
+#include "gpubridge/rtl/simulator_options.hpp"
 
 namespace gpubridge::test {
 
 using protocol::Reg;
 using protocol::index_of;
-
-sim::DeviceOptions sim_options_for(const rtl::GatewareCaps& c) {
-  sim::DeviceOptions o;
-  o.vram_bytes = std::uint64_t{c.vram_kib} * 1024;
-  o.max_width = c.max_width;
-  o.max_height = c.max_height;
-  o.fifo_depth = c.fifo_depth;
-  o.features = c.features;
-  o.variant = c.variant;
-  return o;
-}
 
 usb::BoardProfile board_profile(const std::string& name) {
   auto p = usb::find_board_profile(GPUBRIDGE_CONFIG_DIR, name);
@@ -74,7 +64,7 @@ Result<std::unique_ptr<GatewareBoard>> GatewareBoard::open(const usb::BoardProfi
   std::unique_ptr<GatewareBoard> g(new GatewareBoard);
   const auto gp = rtl::parse_gateware_profile(profile.gateware);
   if (!gp) return make_error("profile " + profile.name + " names no gateware");
-  auto s = sim::Device::create(sim_options_for(rtl::caps_of(*gp)));
+  auto s = sim::Device::create(rtl::simulator_options(rtl::caps_of(*gp)));
   if (!s) return s.error();
   g->sim_ = std::move(*s);
   g->sim_->set_scanout_callback([raw = g.get()](std::shared_ptr<const backends::ScanoutFrame> f) { raw->sim_frames_.push_back(*f); });

@@ -17,8 +17,6 @@
 
 namespace gpubridge::test {
 
-sim::DeviceOptions sim_options_for(const rtl::GatewareCaps& c);
-
 // The board profile a test uses: a profile from configs/boards, or a generic one given a gateware.
 usb::BoardProfile board_profile(const std::string& name);
 usb::BoardProfile with_gateware(usb::BoardProfile p, const std::string& gateware, std::uint32_t spi_clock_hz);

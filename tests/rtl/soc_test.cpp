@@ -8,6 +8,7 @@
 
 #include "gpubridge/protocol/crc32.hpp"
 #include "gpubridge/rtl/rtl_device.hpp"
+#include "gpubridge/rtl/simulator_options.hpp"
 #include "gpubridge/sim/device.hpp"
 #include "pin_host.hpp"
 
@@ -17,17 +18,6 @@ using namespace gpubridge;
 using protocol::Frame;
 using protocol::Reg;
 using protocol::index_of;
-
-sim::DeviceOptions sim_options(const rtl::GatewareCaps& c) {
-  sim::DeviceOptions o;
-  o.vram_bytes = std::uint64_t{c.vram_kib} * 1024;
-  o.max_width = c.max_width;
-  o.max_height = c.max_height;
-  o.fifo_depth = c.fifo_depth;
-  o.features = c.features;
-  o.variant = c.variant;
-  return o;
-}
 
 // STATUS fields a timed device and the untimed simulator share once both are idle: the errors and
 // the frame counter (BUSY, FIFO_LEVEL and VBLANK are timing; the host waited for them).
@@ -40,7 +30,7 @@ class SocBench : public ::testing::TestWithParam<rtl::GatewareProfile> {
     auto d = rtl::RtlDevice::create(GetParam());
     ASSERT_TRUE(d) << d.error().message;
     rtl_ = std::move(*d);
-    auto s = sim::Device::create(sim_options(rtl_->caps()));
+    auto s = sim::Device::create(rtl::simulator_options(rtl_->caps()));
     ASSERT_TRUE(s) << s.error().message;
     sim_ = std::move(*s);
     host_ = std::make_unique<test::PinHost>(*rtl_);
