@@ -20,6 +20,8 @@ packages=(
   umockdev libumockdev-dev                    
   xvfb xauth x11-utils                        
   verilator yosys                             # gateware: rtl backend, ctest -L rtl (lint, co-simulation, yosys read)
+  nextpnr-ice40 fpga-icestorm                 # gateware: iCE40 place and route, icepack (docs/gateware.md)
+  openfpgaloader                              # gpubridge flash (iceprog comes with fpga-icestorm)
 )
 
 export DEBIAN_FRONTEND=noninteractive

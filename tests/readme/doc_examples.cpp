@@ -125,6 +125,8 @@ std::vector<Example> make() {
           .prints(R"(register-echo +ok)")
           .prints(R"(spi-clock +ok)")
           .prints("PASS"),
+      skip("build/tools/gpubridge flash --board icebreaker",
+           "needs an iCEBreaker; usb_flash_cli_tests (FlashCli.*) runs it with stand-in programmers on PATH"),
       daemon("build/daemon/gpubridged --backend auto &").warns("auto: no board attached.*using the simulator"),
       run("touch plugged"),
       daemon("build/daemon/gpubridged --backend 'emulated:ft232h-generic?presence=plugged' &"),
@@ -263,12 +265,27 @@ std::vector<Example> make() {
 
   all.push_back({"docs/dmc1.md", "Board path", 0, "docs_dmc1_BoardPath", {
       run("build/tools/gpubridge boards").prints(R"(icebreaker-dmc1 +dmc1 +uart +0403:6010)"),
+      skip("build/tools/gpubridge flash --board icebreaker-dmc1 soc.bin",
+           "needs an iCEBreaker and the SOC's bitstream; FlashCli.BoardsWithoutARecipeOrWithForeignBitstreamsSayWhatToDo "
+           "runs it with a stand-in programmer"),
       skip("build/tools/gpubridge probe --board icebreaker-dmc1",
            "needs the board; without one it exits 1 naming the USB ids it looked for (CTest dmc1_cli_probe_uart_board)"),
       skip("build/tools/gpubridge render --device dmc1 level.dmc1 --textures tests/dmc1/data/textures.bin.gz     "
            "--palette tests/dmc1/data/palette.bin --out level.png --board icebreaker-dmc1",
            "needs an iCEBreaker on USB; SerialLink.RenderStreamsToTheBoardThroughItsPort runs it with --tty on a "
            "pseudo-terminal whose other end is the SOC's receiver model"),
+  }});
+
+  all.push_back({"docs/boards.md", "Flashing", 0, "docs_boards_Flashing", {
+      skip("build/tools/gpubridge flash --board icebreaker --dry-run",
+           "needs the iCEBreaker bitstream scripts/gateware.sh builds; FlashCli.DryRunPrintsTheCommandAndRunsNothing runs it"),
+      skip("build/tools/gpubridge flash --board icebreaker",
+           "needs an iCEBreaker; FlashCli.FlashesTheBoardsBuiltBitstreamWithOpenFpgaLoader runs it with a stand-in programmer"),
+      skip("build/tools/gpubridge flash --board icebreaker --to sram",
+           "needs an iCEBreaker; FlashCli.SramGoesThroughIceprogAndJsonReportsIt runs it with a stand-in programmer"),
+      run("build/tools/gpubridge bringup --board icebreaker")
+          .instead("build/tools/gpubridge bringup --board icebreaker --emulate", "no board here: the chip model and the simulator")
+          .prints("PASS"),
   }});
 
   all.push_back({"docs/daemon.md", "Running", 0, "docs_daemon_Running", {

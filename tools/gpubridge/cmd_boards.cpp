@@ -1,5 +1,6 @@
 // `gpubridge boards` and `gpubridge cables`: the board profiles and bridge cables, from the data
 // in configs/boards/*.json and configs/cables/*.json.
+#include <algorithm>
 #include <cstdio>
 
 #include <nlohmann/json.hpp>
@@ -15,6 +16,46 @@ std::string hex4(std::uint16_t v) {
   char b[8];
   std::snprintf(b, sizeof b, "%04x", v);
   return b;
+}
+
+// The programmers of a board in order of preference, each with the memories it can write.
+std::vector<std::pair<std::string, std::vector<std::string>>> programmers(const std::string& fpga, const usb::FlashRecipe& recipe) {
+  std::vector<std::pair<std::string, std::vector<std::string>>> out;
+  const auto family = usb::fpga_family(fpga);
+  if (!family) return out;
+  for (const auto tool : {usb::FlashTool::OpenFpgaLoader, usb::FlashTool::Iceprog})
+    for (const auto target : {usb::FlashTarget::Flash, usb::FlashTarget::Sram}) {
+      const auto can = usb::flash_tools(*family, recipe, target);
+      if (std::find(can.begin(), can.end(), tool) == can.end()) continue;
+      if (out.empty() || out.back().first != usb::to_string(tool)) out.emplace_back(usb::to_string(tool), std::vector<std::string>{});
+      out.back().second.emplace_back(usb::to_string(target));
+    }
+  return out;
+}
+
+nlohmann::json flash_json(const std::string& fpga, const usb::FlashRecipe& recipe) {
+  if (!recipe.present) return nullptr;
+  nlohmann::json by_tool = nlohmann::json::object();
+  for (const auto& [tool, targets] : programmers(fpga, recipe)) by_tool[tool] = targets;
+  nlohmann::json out{{"programmers", by_tool}};
+  if (!recipe.bitstream.empty()) out["bitstream"] = recipe.bitstream;
+  else out["source"] = recipe.source;
+  return out;
+}
+
+// One line of the FLASH table: board, bitstream, "openfpgaloader (flash), iceprog (flash, sram)".
+void print_flash_row(const std::string& name, const std::string& fpga, const usb::FlashRecipe& recipe) {
+  if (!recipe.present) {
+    std::printf("%-16s %-16s %s\n", name.c_str(), "-", "no flash recipe: use the board's own programmer");
+    return;
+  }
+  std::string tools;
+  for (const auto& [tool, targets] : programmers(fpga, recipe)) {
+    std::string t;
+    for (const auto& m : targets) t += (t.empty() ? "" : ", ") + m;
+    tools += (tools.empty() ? "" : ", ") + tool + " (" + t + ")";
+  }
+  std::printf("%-16s %-16s %s\n", name.c_str(), recipe.bitstream.empty() ? "(yours)" : recipe.bitstream.c_str(), tools.c_str());
 }
 
 int run_boards(const GlobalOptions& g, const std::string& dir) {
@@ -48,7 +89,8 @@ int run_boards(const GlobalOptions& g, const std::string& dir) {
                      {"device",
                       {{"vram_kib", p.vram_kib}, {"max_width", p.max_width}, {"max_height", p.max_height}, {"fifo_depth", p.fifo_depth},
                        {"clock_mhz", p.clock_mhz}}},
-                     {"strict_link", p.strict_link}});
+                     {"strict_link", p.strict_link},
+                     {"flash", flash_json(p.fpga, p.flash)}});
     for (const auto& p : *uart_boards)
       out.push_back({{"name", p.name},
                      {"device_kind", protocol::device_kind_info(p.device_kind).name},
@@ -60,7 +102,8 @@ int run_boards(const GlobalOptions& g, const std::string& dir) {
                        {"pid", hex4(p.pid)},
                        {"interface", std::string(1, static_cast<char>('A' + p.interface))},
                        {"baud", p.baud},
-                       {"tty", p.tty}}}});
+                       {"tty", p.tty}}},
+                     {"flash", flash_json(p.fpga, p.flash)}});
     std::puts(json_text(out, 2).c_str());
     return 0;
   }
@@ -73,6 +116,10 @@ int run_boards(const GlobalOptions& g, const std::string& dir) {
                 p.name.c_str(), std::string(protocol::device_kind_info(p.device_kind).name).c_str(), "uart", hex4(p.vid).c_str(),
                 hex4(p.pid).c_str(), "-", "-", "-", p.fpga.c_str(), static_cast<char>('A' + p.interface), p.baud,
                 std::string(protocol::device_kind_info(p.device_kind).name).c_str(), p.name.c_str());
+  // Which bitstream goes with which board, and what can program it (gpubridge flash --board NAME).
+  std::printf("\n%-16s %-16s %s\n", "BOARD", "BITSTREAM", "PROGRAMMERS (gpubridge flash; files from scripts/gateware.sh)");
+  for (const auto& p : *boards) print_flash_row(p.name, p.fpga, p.flash);
+  for (const auto& p : *uart_boards) print_flash_row(p.name, p.fpga, p.flash);
   return 0;
 }
 

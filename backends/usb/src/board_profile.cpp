@@ -206,6 +206,34 @@ Result<void> read_identity(Reader& top, Profile& p) {
   return {};
 }
 
+// The optional "flash" section: the bitstream file the gateware build writes and the programmers
+// that can load it; checked against the profile's "fpga" (iceprog programs iCE40 parts only).
+template <class Profile>
+Result<void> read_flash(Reader& top, const std::string& file, Profile& p) {
+  const json* f = top.get("flash");
+  if (!f) return {};
+  if (!f->is_object()) return top.fail("flash", "expected an object (bitstream, openfpgaloader_board, iceprog, source)");
+  const auto family = fpga_family(p.fpga);
+  if (!family) return top.fail("flash", "needs \"fpga\" to name the part (\"iCE40 ...\" or \"ECP5 ...\"), got \"" + p.fpga + "\"");
+  Reader r(*f, file, "flash.");
+  auto& fl = p.flash;
+  fl.present = true;
+  GPUBRIDGE_TRY_SET(fl.bitstream, r.str("bitstream", ""));
+  if (fl.bitstream.find('/') != std::string::npos || fl.bitstream == "." || fl.bitstream == "..")
+    return r.fail("bitstream", "a file name in the bitstream directory, not a path");
+  const std::string ext = *family == FpgaFamily::Ice40 ? ".bin" : ".bit";
+  if (!fl.bitstream.empty() && !fl.bitstream.ends_with(ext))
+    return r.fail("bitstream", "an " + std::string(*family == FpgaFamily::Ice40 ? "iCE40" : "ECP5") + " bitstream ends in " + ext);
+  GPUBRIDGE_TRY_SET(fl.openfpgaloader_board, r.str("openfpgaloader_board", ""));
+  GPUBRIDGE_TRY_SET(fl.iceprog, r.boolean("iceprog", false));
+  if (fl.iceprog && *family != FpgaFamily::Ice40) return r.fail("iceprog", "iceprog programs iCE40 parts only");
+  GPUBRIDGE_TRY_SET(fl.source, r.str("source", ""));
+  if (fl.bitstream.empty() && fl.source.empty())
+    return r.fail("source", "say where the bitstream comes from when this project does not build one (no \"bitstream\")");
+  if (fl.openfpgaloader_board.empty() && !fl.iceprog) return r.fail("openfpgaloader_board", "missing: name a programmer (or \"iceprog\": true)");
+  return r.no_unknown_keys();
+}
+
 // The profile called `name`, else nullptr with every name listed in `names`.
 template <class Profile>
 Profile* find_named(std::vector<Profile>& all, const std::string& name, std::string& names) {
@@ -308,6 +336,7 @@ Result<BoardProfile> parse_board_profile(std::string_view text, const std::strin
     GPUBRIDGE_TRY_SET(p.miso_delay_ns, g.uint("miso_delay_ns", 0, 1000, 20));
     if (auto r = g.no_unknown_keys(); !r) return r.error();
   }
+  if (auto r = read_flash(top, file, p); !r) return r.error();
   if (auto r = top.no_unknown_keys(); !r) return r.error();
   return p;
 }
@@ -366,6 +395,7 @@ Result<UartBoardProfile> parse_uart_board_profile(std::string_view text, const s
   GPUBRIDGE_TRY_SET(p.tty, u.str("tty", ""));
   GPUBRIDGE_TRY_SET(p.baud, u.uint("baud", 300, 4000000, 115200));
   if (auto r = u.no_unknown_keys(); !r) return r.error();
+  if (auto r = read_flash(top, file, p); !r) return r.error();
   if (auto r = top.no_unknown_keys(); !r) return r.error();
   return p;
 }

@@ -12,6 +12,7 @@
 #include "gpubridge/common/result.hpp"
 #include "gpubridge/protocol/device_kind.hpp"
 #include "gpubridge/usb/bridge_chips.hpp"
+#include "gpubridge/usb/flash_recipe.hpp"
 #include "gpubridge/usb/ftdi_mpsse.hpp"
 
 namespace gpubridge::usb {
@@ -44,6 +45,7 @@ struct BoardProfile {
   // the device's clock-to-pad plus wiring plus the bridge's input setup time.
   std::string gateware;
   unsigned miso_delay_ns = 20;
+  FlashRecipe flash;          // how `gpubridge flash` programs the board (flash_recipe.hpp)
 };
 
 struct CableInfo {
@@ -66,6 +68,7 @@ struct UartBoardProfile {
   std::string serial;              // optional: select this adapter when several are attached
   std::string tty;                 // optional: a fixed port instead of finding it from the USB ids
   unsigned baud = 115200;
+  FlashRecipe flash;
 };
 
 // GPUBRIDGE_CONFIG_DIR from the environment, else the source tree's configs/ (compile time).
