@@ -141,7 +141,17 @@ std::string GatewareBoard::compare(bool errors_too) {
   }
   if (board_frames_.size() > sim_frames_.size()) out += "the board reported more frames than the simulator swapped\n";
   if (errors_too) {
+    // Idle, STATUS holds still: read until two reads in a row agree, since an injected bit error
+    // may still be pending and garble one read (into a read of another register, or a write).
     auto st = board_.backend->read_register(index_of(Reg::STATUS));
+    for (int i = 0; i < 4 && st; ++i) {
+      auto again = board_.backend->read_register(index_of(Reg::STATUS));
+      if (!again || *again == *st) {
+        st = again;
+        break;
+      }
+      st = again;
+    }
     if (!st) out += "STATUS read: " + st.error().message + "\n";
     else if ((*st >> 48) != sim_->errors())
       out += fmt::format("STATUS.ERRORS: gateware {}, simulator {}\n", protocol::describe_errors(std::uint16_t(*st >> 48)),

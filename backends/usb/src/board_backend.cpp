@@ -88,18 +88,7 @@ Result<void> BoardBackend::attach_locked() {
   // Register echo through HOST_TAG: proves writes land and lets us detect board resets later.
   tag_ = opts_.host_tag;
   if (!tag_) tag_ = static_cast<std::uint64_t>(std::chrono::steady_clock::now().time_since_epoch().count()) | 1;
-  std::vector<std::uint8_t> mosi;
-  const Frame frames[] = {protocol::write_frame(Reg::HOST_TAG, tag_), protocol::read_frame(Reg::HOST_TAG)};
-  append_frame(mosi, frames[0]);
-  append_frame(mosi, frames[1]);
-  const SpiWindow windows[] = {{std::span(mosi).first(kFrameBytes), false, {}}, {std::span(mosi).subspan(kFrameBytes), true, {}}};
-  auto echo = exchange(windows, frames);
-  if (!echo) return echo.error();
-  const std::uint64_t got = frame_value(*echo, 0);
-  if (got != tag_)
-    return make_error("board '" + profile_.name + "': HOST_TAG echo failed (wrote 0x" + fmt::format("{:016X}", tag_) +
-                          ", read 0x" + fmt::format("{:016X}", got) + "); writes do not reach the device",
-                      backends::kDeviceProtocol);
+  if (auto r = write_host_tag(); !r) return r;
 
   const bool design_strict = (caps_ >> 56) & 0x08;
   strict_ = profile_.strict_link && design_strict;
@@ -173,18 +162,32 @@ Result<void> BoardBackend::flush() {
   return {};
 }
 
+// RESET is immediate and unprotected by the link CRC (its magic value guards against stray
+// resets, not against a garbled one being ignored), so it goes out with a HOST_TAG read behind it:
+// a reset device reads 0; anything else means the RESET frame was garbled and it is sent again.
 Result<void> BoardBackend::reset() {
   std::lock_guard lock(mu_);
   if (gone_) return gone_error();
-  std::vector<std::uint8_t> mosi;
-  const Frame f = protocol::write_frame(Reg::RESET, protocol::kResetMagic);
-  append_frame(mosi, f);
-  const SpiWindow w{mosi, false, {}};
-  if (auto r = exchange(std::span(&w, 1), std::span(&f, 1)); !r) {
-    if (auto fr = on_fault(r.error()); !fr) return fr;
-    return r.error();
+  std::uint64_t tag = 0;
+  for (unsigned attempt = 0; attempt < 3; ++attempt) {
+    if (attempt > 0) ++stats_.reset_retries;
+    std::vector<std::uint8_t> mosi;
+    const Frame frames[] = {protocol::write_frame(Reg::RESET, protocol::kResetMagic), read_request(index_of(Reg::HOST_TAG))};
+    append_frame(mosi, frames[0]);
+    append_frame(mosi, frames[1]);
+    const SpiWindow windows[] = {{std::span(mosi).first(kFrameBytes), false, {}},
+                                 {std::span(mosi).subspan(kFrameBytes), true, {}}};
+    auto r = exchange(windows, frames);
+    if (!r) {
+      if (auto fr = on_fault(r.error()); !fr) return fr;
+      return r.error();
+    }
+    tag = frame_value(*r, 0);
+    if (tag == 0) return attach_locked();
   }
-  return attach_locked();
+  return make_error("board '" + profile_.name + "': RESET did not act (HOST_TAG still reads 0x" + fmt::format("{:X}", tag) +
+                        " after 3 attempts); SPI bit errors: lower bridge.spi_clock_hz",
+                    backends::kDeviceProtocol);
 }
 
 }  // namespace gpubridge::usb

@@ -49,11 +49,18 @@ Result<std::vector<std::uint8_t>> BoardBackend::exchange(std::span<const SpiWind
   return r;
 }
 
+// The data bits of a read are ignored by the device (docs/protocol.md 2.2); a HOST_TAG read carries
+// the tag, so a MOSI bit error that turns it into a write rewrites the same tag instead of zeroing
+// it, which would look exactly like a board reset.
+Frame BoardBackend::read_request(std::uint8_t index) const {
+  return Frame{true, index, index == index_of(Reg::HOST_TAG) ? tag_ : 0};
+}
+
 Result<std::vector<std::uint64_t>> BoardBackend::read_frames(std::span<const std::uint8_t> indices) {
   std::vector<Frame> frames;
   std::vector<std::uint8_t> mosi;
   for (auto i : indices) {
-    frames.push_back(Frame{true, i, 0});
+    frames.push_back(read_request(i));
     append_frame(mosi, frames.back());
   }
   const SpiWindow w{mosi, true, {}};
@@ -92,6 +99,31 @@ Result<std::uint64_t> BoardBackend::read_link_status_stable() {
                     backends::kDeviceProtocol);
 }
 
+// HOST_TAG written and read back in one transfer, written again (a bounded number of times) while
+// the echo differs: the write is immediate and unprotected, so a MOSI bit error may garble it.
+Result<void> BoardBackend::write_host_tag() {
+  std::uint64_t got = 0;
+  for (unsigned attempt = 0; attempt < 3; ++attempt) {
+    std::vector<std::uint8_t> mosi;
+    const Frame frames[] = {protocol::write_frame(Reg::HOST_TAG, tag_), read_request(index_of(Reg::HOST_TAG))};
+    append_frame(mosi, frames[0]);
+    append_frame(mosi, frames[1]);
+    const SpiWindow windows[] = {{std::span(mosi).first(kFrameBytes), false, {}},
+                                 {std::span(mosi).subspan(kFrameBytes), true, {}}};
+    auto echo = exchange(windows, frames);
+    if (!echo) return echo.error();
+    got = frame_value(*echo, 0);
+    if (got == tag_) return {};
+  }
+  return make_error("board '" + profile_.name + "': HOST_TAG echo failed (wrote 0x" + fmt::format("{:016X}", tag_) +
+                        ", read 0x" + fmt::format("{:016X}", got) + "); writes do not reach the device",
+                    backends::kDeviceProtocol);
+}
+
+// HOST_TAG differs from ours. Every reset sets it to 0 (docs/protocol.md section 4), so only 0 means
+// the board was reset; any other value was written by a frame a bit error turned into a HOST_TAG
+// write (e.g. LINK_CHECK 0x14 -> 0x16): the device kept its state, the tag is written again, and
+// in strict mode the group that lost the frame fails its check and is resent.
 Result<void> BoardBackend::check_host_tag() {
   const std::uint8_t idx[] = {index_of(Reg::HOST_TAG)};
   std::uint64_t last = 0;
@@ -101,11 +133,15 @@ Result<void> BoardBackend::check_host_tag() {
     if ((*v)[0] == tag_) return {};
     last = (*v)[0];
   }
+  if (last != 0) {
+    ++stats_.tag_rewrites;
+    gpubridge::logger("usb")->debug("board {}: HOST_TAG reads 0x{:X}, not a reset (0): writing the tag again", profile_.name, last);
+    return write_host_tag();
+  }
   ++board_resets_;
   mem_addr_.reset();
-  const std::string msg = "board '" + profile_.name + "' was reset (HOST_TAG reads 0x" + fmt::format("{:X}", last) +
-                          "): power cycle or FPGA reconfiguration, device state lost; the board was re-attached and "
-                          "state must be replayed";
+  const std::string msg = "board '" + profile_.name + "' was reset (HOST_TAG reads 0): power cycle or FPGA reconfiguration, "
+                          "device state lost; the board was re-attached and state must be replayed";
   if (auto r = attach_locked(); !r) return make_error(msg + "; re-attach failed: " + r.error().message, r.error().code);
   return make_error(msg, backends::kDeviceProtocol);
 }
@@ -124,15 +160,18 @@ Result<void> BoardBackend::on_fault(const Error& e) {
   return check_host_tag();
 }
 
+// STATUS is read twice per poll (one transfer) and the wait ends only when both reads show it
+// ended: a MOSI bit error turns a STATUS read into a read of another register or a write, whose
+// MISO data (often 0) would otherwise pass for an idle device; one error cannot garble both.
 Result<std::uint64_t> BoardBackend::poll_status(std::uint64_t mask, std::uint64_t want, const char* waiting_for) {
-  const std::uint8_t idx[] = {index_of(Reg::STATUS)};
+  const std::uint8_t idx[] = {index_of(Reg::STATUS), index_of(Reg::STATUS)};
   std::uint64_t last = 0;
   for (unsigned i = 0; i < opts_.max_status_polls; ++i) {
     ++stats_.status_polls;
     auto v = read_frames(idx);
     if (!v) return v.error();
-    last = (*v)[0];
-    if ((last & mask) == want) return last;
+    last = (*v)[1];
+    if (((*v)[0] & mask) == want && (last & mask) == want) return last;
   }
   return make_error("board '" + profile_.name + "': timed out waiting for " + waiting_for + " after " +
                         std::to_string(opts_.max_status_polls) + " STATUS polls (last 0x" + fmt::format("{:016X}", last) +
@@ -140,13 +179,15 @@ Result<std::uint64_t> BoardBackend::poll_status(std::uint64_t mask, std::uint64_
                     backends::kDeviceTimeout);
 }
 
+// FIFO_LEVEL from two STATUS reads in one transfer, the higher one counting (a garbled read must
+// not grant credits the FIFO does not have).
 Result<unsigned> BoardBackend::fifo_credits() {
-  const std::uint8_t idx[] = {index_of(Reg::STATUS)};
+  const std::uint8_t idx[] = {index_of(Reg::STATUS), index_of(Reg::STATUS)};
   for (unsigned i = 0; i < opts_.max_status_polls; ++i) {
     ++stats_.status_polls;
     auto v = read_frames(idx);
     if (!v) return v.error();
-    const unsigned level = static_cast<unsigned>((*v)[0] & kStatusLevelMask);
+    const unsigned level = static_cast<unsigned>(std::max((*v)[0] & kStatusLevelMask, (*v)[1] & kStatusLevelMask));
     if (level + kGroupFrames <= fifo_depth_) return fifo_depth_ - level;
   }
   return make_error("board '" + profile_.name + "': command FIFO never drained below " +
@@ -221,8 +262,8 @@ BoardBackend::Batch BoardBackend::build_batch(std::span<const Frame> rest, std::
   }
   b.body_bytes = b.mosi.size();
   const Frame tail_strict[] = {protocol::read_frame(Reg::LINK_STATUS), protocol::read_frame(Reg::LINK_STATUS),
-                               protocol::read_frame(Reg::HOST_TAG)};
-  const Frame tail_plain[] = {protocol::read_frame(Reg::STATUS), protocol::read_frame(Reg::HOST_TAG)};
+                               read_request(index_of(Reg::HOST_TAG))};
+  const Frame tail_plain[] = {protocol::read_frame(Reg::STATUS), read_request(index_of(Reg::HOST_TAG))};
   for (const auto& f : strict_ ? std::span<const Frame>(tail_strict) : std::span<const Frame>(tail_plain)) {
     b.wire.push_back(f);
     append_frame(b.mosi, f);

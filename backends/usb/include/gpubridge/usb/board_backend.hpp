@@ -24,6 +24,8 @@ struct BoardOptions {
 struct LinkStats {
   std::uint64_t frames_sent = 0, payload_frames = 0, groups_sent = 0, groups_resent = 0, batches = 0;
   std::uint64_t status_polls = 0, recoveries = 0;
+  std::uint64_t tag_rewrites = 0;  // HOST_TAG found overwritten by a garbled frame (not a reset) and written again
+  std::uint64_t reset_retries = 0;  // RESET frames sent again because HOST_TAG showed the first did not act
 };
 
 class BoardBackend final : public backends::Backend {
@@ -70,6 +72,8 @@ class BoardBackend final : public backends::Backend {
   Result<void> on_fault(const Error& e);
   Result<void> restart_link();
   Result<std::uint64_t> read_link_status_stable();
+  protocol::Frame read_request(std::uint8_t index) const;
+  Result<void> write_host_tag();
   Result<void> check_host_tag();
   Result<std::uint64_t> poll_status(std::uint64_t mask, std::uint64_t want, const char* waiting_for);
   Result<unsigned> fifo_credits();
