@@ -59,13 +59,16 @@ void BoardBackend::track(const Frame& f) {
 }
 
 Result<void> BoardBackend::attach_locked() {
-  const std::uint8_t id_caps[] = {index_of(Reg::ID), index_of(Reg::ID), index_of(Reg::CAPS)};
+  // ID and CAPS each read twice; pairs that disagree are read again (a bit error on MOSI turns a
+  // read into a read of another register, one on MISO garbles the value).
+  const std::uint8_t id_caps[] = {index_of(Reg::ID), index_of(Reg::ID), index_of(Reg::CAPS), index_of(Reg::CAPS)};
   auto v = read_frames(id_caps);
+  for (unsigned attempt = 1; attempt < 3 && v && ((*v)[0] != (*v)[1] || (*v)[2] != (*v)[3]); ++attempt) v = read_frames(id_caps);
   if (!v) return v.error();
   const std::uint64_t id = (*v)[0];
-  if (id != (*v)[1])
-    return make_error("board '" + profile_.name + "': two ID reads differ (0x" + fmt::format("{:016X}", id) + " vs 0x" +
-                          fmt::format("{:016X}", (*v)[1]) + "): unreliable SPI link; lower bridge.spi_clock_hz",
+  if (id != (*v)[1] || (*v)[2] != (*v)[3])
+    return make_error("board '" + profile_.name + "': two ID or CAPS reads differ three times (ID 0x" + fmt::format("{:016X}", id) +
+                          " vs 0x" + fmt::format("{:016X}", (*v)[1]) + "): unreliable SPI link; lower bridge.spi_clock_hz",
                       backends::kDeviceProtocol);
   if ((id >> 32) != protocol::kIdMagic)
     return make_error("board '" + profile_.name + "': ID register reads 0x" + fmt::format("{:016X}", id) +

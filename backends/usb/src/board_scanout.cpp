@@ -22,15 +22,16 @@ Result<void> BoardBackend::emit_scanout() {
   // replaced), not as they were written.
   // Each read twice; a pair that disagrees is read again (a bit error on MOSI turns a read into a
   // read of another register, one on MISO garbles the value; neither is covered by a link group),
-  // unless HOST_TAG says the board was reset between the reads (its reset values are no frame).
-  const std::uint8_t idx[] = {index_of(Reg::FRAME_CRC), index_of(Reg::FRAME_CRC), index_of(Reg::FB_FORMAT),
-                              index_of(Reg::FB_FORMAT), index_of(Reg::FB_DISPLAY), index_of(Reg::FB_DISPLAY)};
+  // HOST_TAG rides in the same transfer: a board reset since the swap leaves pairs that agree on
+  // reset values, which are no frame.
+  const std::uint8_t idx[] = {index_of(Reg::FRAME_CRC),  index_of(Reg::FRAME_CRC),  index_of(Reg::FB_FORMAT), index_of(Reg::FB_FORMAT),
+                              index_of(Reg::FB_DISPLAY), index_of(Reg::FB_DISPLAY), index_of(Reg::HOST_TAG)};
   std::vector<std::uint64_t> v;
   for (unsigned attempt = 0;; ++attempt) {
     auto r = read_frames(idx);
     if (!r) return r.error();
     v = std::move(*r);
-    if (v[0] == v[1] && v[2] == v[3] && v[4] == v[5]) break;
+    if (v[0] == v[1] && v[2] == v[3] && v[4] == v[5] && v[6] == tag_) break;
     if (auto t = check_host_tag(); !t) return t.error();
     if (attempt + 1 >= kScanoutAttempts)
       return make_error("board '" + profile_.name + "': FRAME_CRC, FB_FORMAT or FB_DISPLAY reads disagree after " +
