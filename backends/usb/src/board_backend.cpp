@@ -174,18 +174,12 @@ Result<void> BoardBackend::reset() {
   std::uint64_t tag = 0;
   for (unsigned attempt = 0; attempt < 3; ++attempt) {
     if (attempt > 0) ++stats_.reset_retries;
-    std::vector<std::uint8_t> mosi;
-    const Frame frames[] = {protocol::write_frame(Reg::RESET, protocol::kResetMagic), read_request(index_of(Reg::HOST_TAG))};
-    append_frame(mosi, frames[0]);
-    append_frame(mosi, frames[1]);
-    const SpiWindow windows[] = {{std::span(mosi).first(kFrameBytes), false, {}},
-                                 {std::span(mosi).subspan(kFrameBytes), true, {}}};
-    auto r = exchange(windows, frames);
+    auto r = write_then_read_tag(protocol::write_frame(Reg::RESET, protocol::kResetMagic));
     if (!r) {
       if (auto fr = on_fault(r.error()); !fr) return fr;
       return r.error();
     }
-    tag = frame_value(*r, 0);
+    tag = *r;
     if (tag == 0) return attach_locked();
   }
   return make_error("board '" + profile_.name + "': RESET did not act (HOST_TAG still reads 0x" + fmt::format("{:X}", tag) +

@@ -99,20 +99,27 @@ Result<std::uint64_t> BoardBackend::read_link_status_stable() {
                     backends::kDeviceProtocol);
 }
 
-// HOST_TAG written and read back in one transfer, written again (a bounded number of times) while
-// the echo differs: the write is immediate and unprotected, so a MOSI bit error may garble it.
+// One transfer: the immediate write `w`, then a HOST_TAG read; returns what the read returned (the
+// host's way to see that an immediate write acted).
+Result<std::uint64_t> BoardBackend::write_then_read_tag(const Frame& w) {
+  std::vector<std::uint8_t> mosi;
+  const Frame frames[] = {w, read_request(index_of(Reg::HOST_TAG))};
+  append_frame(mosi, frames[0]);
+  append_frame(mosi, frames[1]);
+  const SpiWindow windows[] = {{std::span(mosi).first(kFrameBytes), false, {}}, {std::span(mosi).subspan(kFrameBytes), true, {}}};
+  auto r = exchange(windows, frames);
+  if (!r) return r.error();
+  return frame_value(*r, 0);
+}
+
+// HOST_TAG written and read back, written again (a bounded number of times) while the echo
+// differs: the write is immediate and unprotected, so a MOSI bit error may garble it.
 Result<void> BoardBackend::write_host_tag() {
   std::uint64_t got = 0;
   for (unsigned attempt = 0; attempt < 3; ++attempt) {
-    std::vector<std::uint8_t> mosi;
-    const Frame frames[] = {protocol::write_frame(Reg::HOST_TAG, tag_), read_request(index_of(Reg::HOST_TAG))};
-    append_frame(mosi, frames[0]);
-    append_frame(mosi, frames[1]);
-    const SpiWindow windows[] = {{std::span(mosi).first(kFrameBytes), false, {}},
-                                 {std::span(mosi).subspan(kFrameBytes), true, {}}};
-    auto echo = exchange(windows, frames);
+    auto echo = write_then_read_tag(protocol::write_frame(Reg::HOST_TAG, tag_));
     if (!echo) return echo.error();
-    got = frame_value(*echo, 0);
+    got = *echo;
     if (got == tag_) return {};
   }
   return make_error("board '" + profile_.name + "': HOST_TAG echo failed (wrote 0x" + fmt::format("{:016X}", tag_) +

@@ -73,6 +73,7 @@ class BoardBackend final : public backends::Backend {
   Result<void> restart_link();
   Result<std::uint64_t> read_link_status_stable();
   protocol::Frame read_request(std::uint8_t index) const;
+  Result<std::uint64_t> write_then_read_tag(const protocol::Frame& w);
   Result<void> write_host_tag();
   Result<void> check_host_tag();
   Result<std::uint64_t> poll_status(std::uint64_t mask, std::uint64_t want, const char* waiting_for);
