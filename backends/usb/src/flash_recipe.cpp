@@ -3,7 +3,8 @@
 #include <algorithm>
 #include <array>
 #include <cctype>
-#include <cstdio>
+
+#include <fmt/format.h>
 
 #include "gpubridge/backends/backend.hpp"
 
@@ -12,17 +13,8 @@ namespace {
 
 Error bad(std::string message) { return make_error(std::move(message), backends::kBadRequest); }
 
-std::string hex32(std::uint32_t v) {
-  char b[16];
-  std::snprintf(b, sizeof b, "0x%08x", v);
-  return b;
-}
-
-std::string hex4(std::uint16_t v) {
-  char b[8];
-  std::snprintf(b, sizeof b, "0x%04x", v);
-  return b;
-}
+std::string hex32(std::uint32_t v) { return fmt::format("{:#010x}", v); }
+std::string hex4(std::uint16_t v) { return fmt::format("{:#06x}", v); }
 
 // ECP5 parts by JTAG IDCODE (Lattice's BSDL files; ecppack --idcode takes the same numbers).
 struct Ecp5Part {
