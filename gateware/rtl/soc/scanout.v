@@ -94,7 +94,7 @@ module scanout #(
   // bytes of the frame, W x H x bpp (into bytes_left one clock before the end is computed), and
   // its words ceil(bytes / 4): one adder for every format
   wire [23:0] bytes = frame_format == 2'd0 ? {mul_acc, 2'b00} : frame_format == 2'd1 ? {1'b0, mul_acc, 1'b0} : {2'b00, mul_acc};
-  wire [21:0] words = 22'((bytes_left + 24'd3) >> 2);  // bytes < 2^24 - 3
+  wire [21:0] words = 22'((bytes_left + 24'd3) >> 2);  // no carry out: bytes <= 4 (2^22 - 1)
 
   // --- frame reading ---
   localparam       BAW = BUF_WORDS == 4 ? 2 : 1;
