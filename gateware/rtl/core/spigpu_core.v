@@ -135,8 +135,7 @@ module spigpu_core #(
   reg [3:0]  r_phase;
   reg [10:0] r_width;
   reg [7:0]  r_need;
-  reg        r_rect, r_zsel;
-  reg [23:0] r_zflat;
+  reg        r_rect, r_zsel;   // r_zsel: Z is CLEAR_DEPTH, held in r_flat (a clear drawn as a rectangle)
   // clear state
   reg [27:0] k_base;
   reg [1:0]  k_bpp;
@@ -224,9 +223,9 @@ module spigpu_core #(
   wire [PW-1:0] pix;
   generate
     if (TEX != 0) begin : pix_tex
-      assign pix = {a_stq, src_rgba, y2, x2, r_zsel ? r_zflat : a_z, idx2};
+      assign pix = {a_stq, src_rgba, y2, x2, r_zsel ? r_flat[23:0] : a_z, idx2};
     end else begin : pix_plain
-      assign pix = {src_rgba, y2, x2, r_zsel ? r_zflat : a_z, idx2};
+      assign pix = {src_rgba, y2, x2, r_zsel ? r_flat[23:0] : a_z, idx2};
     end
   endgenerate
 
@@ -417,7 +416,6 @@ module spigpu_core #(
           r_tex_base  <= cmd_tex_base;
           r_tex_fmt   <= cmd_tex_fmt;
           r_width     <= cmd_fb_width;
-          r_zflat     <= cmd_clear_depth;
           r_rect      <= (cmd_op != OP_TRI);
           r_zsel      <= (cmd_op != OP_TRI);
           tc_keep <= (cmd_op == OP_TRI) && tc_ok_n;
@@ -451,7 +449,8 @@ module spigpu_core #(
             r_dither    <= 1'b0;
             r_temporal  <= 1'b0;
             r_keep      <= 4'd0;
-            r_flat      <= cmd_clear_color;
+            // CLEAR_Z writes no colour, so r_flat carries its depth (one register, not two)
+            r_flat      <= (cmd_op == OP_CLEAR_Z) ? {8'd0, cmd_clear_depth} : cmd_clear_color;
             r_serial    <= 1'b0;
             r_need      <= 8'd0;
             r_need_dst  <= 1'b0;
