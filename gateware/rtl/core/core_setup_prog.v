@@ -98,7 +98,7 @@ module core_setup_prog (
       7'd88: word <= 32'h000000C0;
       7'd89: word <= 32'h000000C0;
       7'd90: word <= 32'h00033C00;
-      7'd91: word <= 32'h06500413;
+      7'd91: word <= 32'h1E500413;
       7'd92: word <= 32'h00002855;
       7'd93: word <= 32'h00003056;
       7'd94: word <= 32'h000000EC;

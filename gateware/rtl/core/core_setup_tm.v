@@ -60,9 +60,9 @@ module core_setup_tm #(
     output wire [23:0]  pw_q,
     output wire [34:0]  pw_r
 );
-  // Without S, T, Q: |M0| < 2^60 (see core_setup), so 61 bits; RAM words are 36 bits (the
-  // biased edge values), a operands at most 25 (Z deltas).
-  localparam integer ACC_W = 61;
+  // Without S, T, Q: |M0| < 2^60 (see core_setup), and a0 2D < 2^58 is added to it (below),
+  // so 62 bits; RAM words are 36 bits (the biased edge values), a operands at most 25 (Z).
+  localparam integer ACC_W = 62;
   localparam integer MW = 36;
   localparam integer AW = 25;
 
@@ -72,7 +72,7 @@ module core_setup_tm #(
   // D1 = A1 - A0, D2 = A2 - A0. Reads of 26-28 are the top vertex's Y and X, the bottom one's Y.
   localparam [4:0] R_DX0 = 5'd6, R_DX1 = 5'd7, R_DX2 = 5'd8, R_DY0 = 5'd9, R_DY1 = 5'd10,
                    R_DY2 = 5'd11, R_ABSD = 5'd12, R_EY = 5'd14, R_E0 = 5'd18,
-                   R_E1 = 5'd19, R_E2 = 5'd20, R_D1 = 5'd21, R_A0 = 5'd23, R_YTOP = 5'd26,
+                   R_E1 = 5'd19, R_E2 = 5'd20, R_D1 = 5'd21, R_YTOP = 5'd26,
                    R_XTOP = 5'd27, R_YBOT = 5'd28;
   function [4:0] r_x(input [1:0] i);
     r_x = {2'b0, i, 1'b0};
@@ -151,15 +151,17 @@ module core_setup_tm #(
   reg        v2_, w2, dv2;        // stage 2: acts this cycle, with rd
   reg  [4:0] op2, wa2;
 
-  // multiply: fetch (fr, fph, fk) runs a cycle ahead of execution (xr, xph, xk)
-  reg        fr, fph, xr, xph, xfirst;
+  // multiply: fetch (fr, fph, fk) runs a cycle ahead of execution (xr, xph, xk); phase 2 is
+  // the third product of the value at the origin, A0 * |D| (A0 is the word after D2)
+  reg        fr, xr, xfirst, three;
+  reg  [1:0] fph, xph;
   reg  [4:0] fk, xk, mbits;
   reg  [4:0] m1a, m2a, a1a;
   reg        mneg, msub;
   wire       quiet = !fr && !xr && !v1_ && !v2_;
 
-  wire [4:0] raddr = fr ? (fph ? m2a : m1a) : ra;
-  wire [4:0] aaddr = a1a + {4'd0, fph};  // a2 is the word after a1
+  wire [4:0] raddr = !fr ? ra : (fph == 2'd0) ? m1a : fph[0] ? m2a : R_ABSD;
+  wire [4:0] aaddr = a1a + {3'd0, fph};  // a2 (a3) is the word after a1 (a2)
   reg  [ACC_W-1:0] acc;
   wire signed [ACC_W-1:0] acc_s = $signed(acc);
   assign e_data = acc_s[35:0];
@@ -179,23 +181,25 @@ module core_setup_tm #(
   // ---------------------------------------------------------------- accumulator
   wire       b = rda[xk - 5'd1];
   wire       msb = (xk == mbits);
-  wire       c_neg = mneg ^ msb ^ (xph & msub);
-  wire [4:0] ctl = xr ? {xfirst, !xph, b, c_neg, c_neg} : (v2_ ? op2 : 5'd0);
+  wire       c_neg = mneg ^ msb ^ (xph[0] & msub);
+  wire [4:0] ctl = xr ? {xfirst, xph == 2'd0, b, c_neg, c_neg} : (v2_ ? op2 : 5'd0);
   wire [ACC_W-1:0] a_in = ctl[4] ? {ACC_W{1'b0}} : ctl[3] ? acc << 1 : acc;
   wire [ACC_W-1:0] b_in = (ctl[2] ? ACC_W'($signed(rd)) : {ACC_W{1'b0}}) ^ {ACC_W{ctl[1]}};
   always @(posedge clk) acc <= a_in + b_in + {{(ACC_W-1){1'b0}}, ctl[0]};
 
   // ---------------------------------------------------------------- box (from RAM reads)
-  function [1:0] argmin(input signed [16:0] d10, input signed [16:0] d21, input signed [16:0] d02);
-    argmin = (d10 >= 0 && d02 <= 0) ? 2'd0 : (d10 < 0 && d21 >= 0) ? 2'd1 : 2'd2;
-  endfunction
-  function [1:0] argmax(input signed [16:0] d10, input signed [16:0] d21, input signed [16:0] d02);
-    argmax = (d10 <= 0 && d02 >= 0) ? 2'd0 : (d10 > 0 && d21 <= 0) ? 2'd1 : 2'd2;
-  endfunction
-  function tl(input signed [16:0] dx, input signed [16:0] dy, input f);
-    tl = f ? ((dy == 0 && dx < 0) || dy > 0) : ((dy == 0 && dx > 0) || dy < 0);
-  endfunction
-  wire tl0 = tl(dx0, dy0, flip), tl1 = tl(dx1, dy1, flip), tl2 = tl(dx2, dy2, flip);
+  // From signs and the dy == 0 flags only (no comparators): no edge is (0, 0) once D != 0, so
+  // where dy = 0 the sign of dx says dx > 0 or dx < 0.
+  reg  [2:0] dyz;  // dy_k == 0
+  wire [2:0] sy_ = {dy2[16], dy1[16], dy0[16]}, sx_ = {dx2[16], dx1[16], dx0[16]};
+  // index of the smallest / largest of (p0, p1, p2) from the signs and zeros of d10, d21, d02
+  // (dy2, dy0, dy1)
+  wire [1:0] top = (!sy_[2] && (sy_[1] || dyz[1])) ? 2'd0 : (sy_[2] && !sy_[0]) ? 2'd1 : 2'd2;
+  wire [1:0] bot = ((sy_[2] || dyz[2]) && !sy_[1]) ? 2'd0 :
+                   (!sy_[2] && !dyz[2] && (sy_[0] || dyz[0])) ? 2'd1 : 2'd2;
+  // top-left rule on the edge as drawn (reversed when exchanged): bias 0, otherwise -1
+  wire [2:0] tlv = flip ? (dyz & sx_) | (~dyz & ~sy_) : (dyz & ~sx_) | (~dyz & sy_);
+  wire tl0 = tlv[0], tl1 = tlv[1], tl2 = tlv[2];
   reg        box2;  // rd is the bottom vertex's Y
   wire signed [15:0] rc = $signed(rd[15:0]);
   // samples 16p + 8 inside [min, max]: p from (min + 7) >> 4 to (max + 8) >> 4, exclusive
@@ -206,15 +210,13 @@ module core_setup_tm #(
   wire signed [12:0] by0 = (fy0 > cy0) ? fy0 : cy0;
   wire signed [12:0] by1 = (fy < cy1) ? fy : cy1;
   wire [10:0] xs = (xt < cx0) ? clip_x0 : (xt >= cx1) ? clip_x1 - 11'd1 : xt[10:0];
-  wire [4:0] r_sel = (i_addr == R_YTOP) ? r_y(argmin(dy2, dy0, dy1)) :
-                     (i_addr == R_XTOP) ? r_x(argmin(dy2, dy0, dy1)) :
-                     (i_addr == R_YBOT) ? r_y(argmax(dy2, dy0, dy1)) : i_addr;
+  wire [4:0] r_sel = (i_addr == R_YTOP) ? r_y(top) : (i_addr == R_XTOP) ? r_x(top) :
+                     (i_addr == R_YBOT) ? r_y(bot) : i_addr;
 
   // ---------------------------------------------------------------- divider and plane writes
   reg         dv_pend, dv_rdy, xl_next;
   reg  [1:0]  dv_field;
   reg  [2:0]  dv_attr;
-  reg  [23:0] a0r, dv_a0;
   wire        dv_done, dv_neg;
   wire [31:0] dv_q;
   wire [34:0] dv_r, dv_rc;
@@ -224,7 +226,7 @@ module core_setup_tm #(
       .quo(dv_q), .rem(dv_r), .rem_c(dv_rc), .neg(dv_neg));
   /* verilator lint_on PINCONNECTEMPTY */
   wire unused_q = &{1'b0, dv_q[31:24]};
-  assign pw_q = (pw_field == 2'd0) ? dv_a0 + dv_q[23:0] : (pw_field == 2'd2) ? ~dv_q[23:0] : dv_q[23:0];
+  assign pw_q = (pw_field == 2'd2) ? ~dv_q[23:0] : dv_q[23:0];
   assign pw_r = ((pw_field == 2'd2) ^ dv_neg) ? dv_rc : dv_r;
 
   // ---------------------------------------------------------------- sequencer
@@ -262,11 +264,12 @@ module core_setup_tm #(
     // pipeline
     v1_ <= 1'b0; w1 <= 1'b0; dv1 <= 1'b0;
     v2_ <= v1_; w2 <= w1; dv2 <= dv1; op2 <= op1; wa2 <= wa1;
-    xr <= fr; xph <= fph; xk <= fk; xfirst <= fr && !fph && fk == mbits;
+    xr <= fr; xph <= fph; xk <= fk; xfirst <= fr && fph == 2'd0 && fk == mbits;
     if (fr) begin
-      fph <= !fph;
-      if (fph) begin
-        fk <= fk - 5'd1;
+      fph <= fph + 2'd1;
+      if (fph == {three, !three}) begin
+        fph <= 2'd0;
+        fk  <= fk - 5'd1;
         if (fk == 5'd1) fr <= 1'b0;
       end
     end
@@ -274,16 +277,15 @@ module core_setup_tm #(
     if (w2) begin
       case (wa2)
         R_DX0: dx0 <= acc[16:0];
-        R_DY0: dy0 <= acc[16:0];
+        R_DY0: begin dy0 <= acc[16:0]; dyz[0] <= (acc[16:0] == 17'd0); end
         R_DX1: dx1 <= acc[16:0];
-        R_DY1: dy1 <= acc[16:0];
+        R_DY1: begin dy1 <= acc[16:0]; dyz[1] <= (acc[16:0] == 17'd0); end
         R_DX2: dx2 <= acc[16:0];
-        R_DY2: dy2 <= acc[16:0];
+        R_DY2: begin dy2 <= acc[16:0]; dyz[2] <= (acc[16:0] == 17'd0); end
         R_ABSD: den <= {acc[33:0], 1'b0};
         default: ;
       endcase
     end
-    if (adv && i_wf && i_addr == R_A0) a0r <= fld[23:0];
     if (rst) begin
       flip    <= 1'b0;
       draw    <= 1'b0;
@@ -334,9 +336,10 @@ module core_setup_tm #(
           m2a   <= i_tgt[4:0];
           msub  <= (i_pair != 2'd3);
           mneg  <= (i_neg == 2'd1) ? flip : (i_neg == 2'd2) ? !flip : 1'b0;
+          three <= (i_neg == 2'd3);
           mbits <= (i_pair == P_DX) ? 5'd17 : (i_pair == P_E) ? 5'd18 : (ak == 3'd4) ? 5'd25 : 5'd9;
           fr    <= 1'b1;
-          fph   <= 1'b0;
+          fph   <= 2'd0;
           fk    <= (i_pair == P_DX) ? 5'd17 : (i_pair == P_E) ? 5'd18 : (ak == 3'd4) ? 5'd25 : 5'd9;
         end
         case (i_act)
@@ -368,7 +371,6 @@ module core_setup_tm #(
             dv_pend  <= 1'b1;
             dv_attr  <= ak;
             dv_field <= i_cond;
-            dv_a0    <= a0r;
           end
           A_DONE: done <= 1'b1;
           A_NODRAW: begin

@@ -21,7 +21,7 @@ WAITS = {None: 0, "quiet": 1, "mul": 2, "div": 3}
 ACTS = {None: 0, "jmp": 1, "brzero": 2, "brnneg": 3, "flip": 4, "fy0": 5, "xt": 6, "box": 7,
         "org": 8, "brrect": 9, "todo": 10, "nexta": 11, "div": 12, "done": 13, "nodraw": 14}
 PAIRS = {None: 0, "dx": 1, "e": 2, "d": 3}   # a operands (DX1, DX2), (EY, EX), (D1, D2)
-NEGS = {0: 0, "flip": 1, "nflip": 2}
+NEGS = {0: 0, "flip": 1, "nflip": 2, "a0": 3}   # a0: a third product, A0 * |D|
 # field multiplexer: {kind, vertex}; kind 0 X, 1 Y, 2 the attribute, 3 the sample point
 F_X = [0, 1, 2]
 F_Y = [4, 5, 6]
@@ -99,7 +99,9 @@ for m1, m2, neg, field in ((DY[1], DY[2], "nflip", 1), (DX[1], DX[2], "flip", 3)
     for _ in range(4):
         ins(op="dbl")
     ins(act="div", cond=field, wait="div")
-ins(addr=E[1], tgt=E[2], pair="d", wait="quiet")  # 2(d1 e1 + d2 e2) + corrections + |D|
+# 2(d1 e1 + d2 e2 + a0 |D|) + corrections + |D|: the value at the origin plus a0 2D, whose
+# quotient is a0 plus the plane's (no adder for a0 after the division)
+ins(addr=E[1], tgt=E[2], pair="d", neg="a0", wait="quiet")
 ins(addr=D1, op="add", cond=2, wait="mul")
 ins(addr=D2, op="add", cond=3)
 ins(addr=ABSD, op="dbladd")
