@@ -129,7 +129,7 @@ module spigpu_core #(
           .den(su_den), .pw_en(pw_en), .pw_attr(pw_attr), .pw_field(pw_field), .pw_q(q24), .pw_r(pw_r));
       assign pw_q = {8'd0, q24};
     end else begin : setup_par
-      core_setup #(.SERIAL(0), .TEX(TEX), .IDX_W(IDX_W), .SKIP(1), .XREJECT(1), .NDIV(3)) setup (
+      core_setup #(.TEX(TEX), .IDX_W(IDX_W), .SKIP(1), .XREJECT(1), .NDIV(3)) setup (
           .clk(clk), .rst(rst), .start(su_go), .rect(su_rect), .busy(su_busy), .done(su_done), .draw(su_draw),
           .v0(cmd_v0), .v1(cmd_v1), .v2(cmd_v2),
           .clip_x0(sc_x0), .clip_y0(sc_y0), .clip_x1(clip_x1), .clip_y1(clip_y1), .width(cmd_fb_width),
