@@ -1,6 +1,6 @@
 // Triangle setup of the small profile (iCE40): the same integers as core_setup (docs/protocol.md
 // sections 8 and 9, exchange by negation, see core_setup), computed by a sequencer around one
-// 61-bit accumulator whose operands come from block RAM, running a program that is block RAM
+// 62-bit accumulator whose operands come from block RAM, running a program that is block RAM
 // too (core_setup_prog, written by gen_setup_prog.py, which lists the steps).
 //
 // Why: on the UP5K the logic of a setup with its operands on wires was multiplexers (a 36-bit
@@ -18,7 +18,9 @@
 // cycles before one that reads it (the sequencer waits for an empty pipeline where needed).
 // Multiplies a1*m1 +/- a2*m2 are Horner's rule, most significant bit first, two cycles per
 // bit: m1 and m2 alternate on the operand RAM's read port while a copy of the RAM (the a
-// operands' low 25 bits) gives the bit of a1 or a2. The one divider takes a plane's three
+// operands' low 25 bits) gives the bit of a1 or a2; the value at the origin adds a third
+// product, A0 * |D| (three cycles per bit), so that its quotient is a0 plus the plane's and no
+// adder or register holds a0 after the division. The one divider takes a plane's three
 // numerators in turn; a multiply overlaps the previous division. The origin index
 // y0 * width + x_start is a DSP multiply.
 //
@@ -89,7 +91,7 @@ module core_setup_tm #(
   // ---------------------------------------------------------------- field multiplexer
   // fsel = {kind, vertex}: kind 0 X, 1 Y, 2 the attribute ak, 3 the sample point (vertex 0:
   // 16 y0 + 8, 1: 16 x_start + 8)
-  wire [31:0] I;        // the instruction
+  wire [31:0] I;        // the instruction (registered block RAM read of pc_next)
   wire [3:0] fsel = I[21:18];
   reg  [2:0] ak;
   wire [87:0] fv = (fsel[1:0] == 2'd0) ? v0[87:0] : (fsel[1:0] == 2'd1) ? v1[87:0] : v2[87:0];
