@@ -20,7 +20,7 @@ module core_divider #(
     input  wire                 rst,
     input  wire                 start,  // pulse while idle: latch num
     input  wire signed [NW-1:0] num,
-    input  wire [DW-1:0]        den,    // held by the caller until done (not copied here)
+    input  wire [DW-1:0]        den,    // held by the caller until rem_c is read (not copied)
     output wire                 busy,
     output reg                  done,   // one-cycle pulse: quo / rem valid (held until next start)
     output wire [QW-1:0]        quo,
