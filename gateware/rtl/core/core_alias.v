@@ -3,8 +3,15 @@
 // observable and the core must finish each pixel before starting the next and emit rows left to
 // right. Whole buffers are compared (W * H pixels), as the simulator does, in 16-byte blocks
 // (buffers start on 16-byte boundaries; rounding their ends up can only add false alarms),
-// clipped at 2^ADDR_W (accesses beyond it are dropped or read 0 in any order). Registered in
-// three steps; the inputs are held during triangle setup, which takes longer.
+// clipped at 2^ADDR_W (accesses beyond it are dropped or read 0 in any order). The inputs are held
+// during triangle setup, which takes longer than the two register steps here.
+//
+// Buffers [a, a + la) and [b, b + lb), each clipped at TOP = 2^ADDR_W / 16, overlap when both start
+// below TOP and a - b < lb and b - a < la: one subtractor per pair of buffers and two comparisons
+// of its difference with the lengths, instead of the clipped ends (two adders and two clamps per
+// buffer) and comparisons of ends with starts. A length of ceil(bytes / 16) blocks is compared as
+// 16 (a - b) < bytes, the same for an integer a - b, so no rounding adders: for the colour and
+// depth buffers (a - b) << k < W * H with k = 2 (4 bytes a pixel), 3 (2) or 4 (1).
 module core_alias #(
     parameter integer ADDR_W = 32
 ) (
@@ -24,40 +31,43 @@ module core_alias #(
     input  wire        textured,   // texture sampled
     output reg         serial
 );
-  localparam integer BW = ADDR_W - 2;  // block address bits plus headroom for the end
-  localparam [BW-1:0] TOP = {2'b01, {(BW - 2){1'b0}}};  // 2^ADDR_W / 16
+  localparam integer SW = ADDR_W - 4;  // block address bits below TOP
+  localparam integer LW = 19;          // a texture's length in blocks: up to 2^18
+  localparam integer MW = (SW + 4 > 22) ? SW + 4 : 22;  // (a - b) << k against W * H
+  localparam integer TW = (SW > LW) ? SW : LW;          // a - b against a texture's length
   reg  [21:0] wh;
-  reg  [BW-1:0] c0, c1, z0, z1, t0, t1;
-  // buffer lengths in 16-byte blocks, rounded up
-  wire [23:0] cbytes = (fmt == 2'd0) ? {wh, 2'd0} : (fmt == 2'd1) ? {1'd0, wh, 1'd0} : {2'd0, wh};
-  wire [17:0] cblocks = 18'((cbytes + 24'd15) >> 4);
-  wire [17:0] zblocks = 18'(({wh, 2'd0} + 24'd15) >> 4);
+  reg         c_in, z_in, t_in;                        // the buffer starts below TOP
+  reg  [SW:0] d_cz, d_zc, d_tc, d_ct, d_tz, d_zt;      // differences of starts, SW + 1 bits signed
+  wire [2:0]  kc = (fmt == 2'd0) ? 3'd2 : (fmt == 2'd1) ? 3'd3 : 3'd4;  // colour: 16 / bytes a pixel
   wire [1:0]  tbl = (tex_fmt == 2'd0) ? 2'd2 : (tex_fmt == 2'd1) ? 2'd1 : 2'd0;
-  wire [4:0]  tl = 5'(tex_wl) + 5'(tex_hl) + 5'(tbl) - 5'd4;  // >= 2
-  function [BW-1:0] lo(input [27:0] b16);  // start, clipped at 2^ADDR_W
-    lo = ((b16 >> (ADDR_W - 4)) != 28'd0) ? TOP : BW'(b16[ADDR_W-5:0]);
+  wire [4:0]  tl = 5'(tex_wl) + 5'(tex_hl) + 5'(tbl) - 5'd4;  // 2..18
+  reg  [LW-1:0] tblocks;
+  function below(input [27:0] b16);
+    below = (b16 >> SW) == 28'd0;
   endfunction
-  localparam integer EW = ((BW > 18) ? BW : 18) + 1;
-  function [BW-1:0] hi(input [BW-1:0] start, input [17:0] len);  // end, clipped
-    reg [EW-1:0] e;
-    begin
-      e = {{(EW - BW){1'b0}}, start} + {{(EW - 18){1'b0}}, len};
-      hi = (e > {{(EW - BW){1'b0}}, TOP}) ? TOP : e[BW-1:0];
-    end
+  // a - b < ceil(W * H * 2^k / 16), d = a - b (both below TOP: d fits SW + 1 bits signed)
+  function before_wh(input [SW:0] d, input [2:0] k);
+    before_wh = d[SW] || ((MW'(d[SW-1:0]) << k) < MW'(wh));
   endfunction
-  function ov(input [BW-1:0] a0, input [BW-1:0] a1, input [BW-1:0] b0, input [BW-1:0] b1);
-    ov = (a0 < b1) && (b0 < a1);
+  // a - b < a texture's length in blocks
+  function before_tex(input [SW:0] d);
+    before_tex = d[SW] || (TW'(d[SW-1:0]) < TW'(tblocks));
   endfunction
+  wire [SW-1:0] c = fb_draw16[SW-1:0], z = fb_z16[SW-1:0], t = tex16[SW-1:0];
   always @(posedge clk) begin
     wh <= 22'(width * height);
-    c0 <= lo(fb_draw16);
-    c1 <= hi(lo(fb_draw16), cblocks);
-    z0 <= lo(fb_z16);
-    z1 <= hi(lo(fb_z16), zblocks);
-    t0 <= lo(tex16);
-    t1 <= hi(lo(tex16), 18'd1 << tl);
-    serial <= (depth_on && colour_on && ov(c0, c1, z0, z1)) ||
-              (textured && ov(t0, t1, c0, c1)) ||
-              (textured && z_write && ov(t0, t1, z0, z1));
+    tblocks <= LW'(1) << tl;
+    c_in <= below(fb_draw16);
+    z_in <= below(fb_z16);
+    t_in <= below(tex16);
+    d_cz <= {1'b0, c} - {1'b0, z};
+    d_zc <= {1'b0, z} - {1'b0, c};
+    d_tc <= {1'b0, t} - {1'b0, c};
+    d_ct <= {1'b0, c} - {1'b0, t};
+    d_tz <= {1'b0, t} - {1'b0, z};
+    d_zt <= {1'b0, z} - {1'b0, t};
+    serial <= (depth_on && colour_on && c_in && z_in && before_wh(d_cz, 3'd2) && before_wh(d_zc, kc)) ||
+              (textured && t_in && c_in && before_wh(d_tc, kc) && before_tex(d_ct)) ||
+              (textured && z_write && t_in && z_in && before_wh(d_tz, 3'd2) && before_tex(d_zt));
   end
 endmodule

@@ -18,9 +18,9 @@ module core_divider #(
 ) (
     input  wire                 clk,
     input  wire                 rst,
-    input  wire                 start,  // pulse while idle: latch num / den
+    input  wire                 start,  // pulse while idle: latch num
     input  wire signed [NW-1:0] num,
-    input  wire [DW-1:0]        den,
+    input  wire [DW-1:0]        den,    // held by the caller until rem_c is read (not copied)
     output wire                 busy,
     output reg                  done,   // one-cycle pulse: quo / rem valid (held until next start)
     output wire [QW-1:0]        quo,
@@ -34,7 +34,7 @@ module core_divider #(
 
   reg [MW-1:0] nq;      // numerator bits not yet consumed (top), quotient bits so far (bottom)
   reg [DW-1:0] pr;      // partial remainder, < den
-  reg [DW-1:0] dv;
+  wire [DW-1:0] dv = den;
   reg [CW-1:0] left;    // numerator bits left
   reg          run;
 
@@ -54,7 +54,6 @@ module core_divider #(
       neg  <= num[NW-1];
       nq   <= num[NW-1] ? ~num[MW-1:0] : num[MW-1:0];
       pr   <= {DW{1'b0}};
-      dv   <= den;
       left <= MW_BITS;
       run  <= 1'b1;
     end else if (run) begin

@@ -1,5 +1,6 @@
-// Triangle setup (docs/protocol.md sections 8 and 9): a sequencer around one accumulator with
-// one adder, a dual multiply-accumulate and the exact divider.
+// Triangle setup of the large profile (docs/protocol.md sections 8 and 9): a sequencer around one
+// accumulator with one adder, a dual multiply-accumulate and the exact dividers. The small
+// profile's setup is core_setup_tm (the same integers, operands in block RAM).
 //
 // Everything is computed in kick order. Section 8.1 exchanges P1 and P2 when D < 0; the three
 // edges of the exchanged triangle are the kick-order edges reversed, so the exchange is done by
@@ -17,12 +18,10 @@
 //   4. per interpolated attribute: the three numerators divided by 2D into (quotient,
 //      remainder) plane fields; the step left is written as (~qx, 2D - 1 - rx), which the steppers
 //      add with a carry in. A clear (rect) sets up only the clip rectangle and its first index.
-// Multiplies are a1*m1 +/- a2*m2: in parallel (SERIAL = 0), or by Horner's rule, most
-// significant bit first, two cycles per bit of the a operands (SERIAL = 1, for the iCE40). A
-// multiply overlaps the previous division. The vertex inputs are read while the command waits on
+// Multiplies are a1*m1 +/- a2*m2, both products at once. A multiply overlaps the previous
+// division. The vertex inputs are read while the command waits on
 // the port (held stable by the soc).
 module core_setup #(
-    parameter integer SERIAL = 0,
     parameter integer TEX = 1,       // S, T, Q planes exist (33-bit deltas)
     parameter integer IDX_W = 20,
     parameter integer SKIP = 1,      // divider skips leading zero quotient bits (faster, larger)
@@ -143,7 +142,6 @@ module core_setup #(
   wire [2:0] akv = (TEX != 0 || ak < 3'd5) ? ak : 3'd4;
   wire signed [AW-1:0] a0 = attr(v0[183:32], akv);
   wire signed [AW-1:0] d1 = attr(v1[183:32], akv) - a0, d2 = attr(v2[183:32], akv) - a0;  // |d| < 2^(AW-1)
-  wire [5:0] abits = (ak < 3'd4) ? 6'd9 : (ak == 3'd4) ? 6'd25 : 6'd33;
 
   // ---------------------------------------------------------------- operands
   // m operand (one bus): selected by `osel`, alternating between osel1 and osel2 in a multiply
@@ -175,23 +173,22 @@ module core_setup #(
   reg  [1:0] ek;    // edge being evaluated (its start vertex, pv, is ek + 1 modulo 3)
   wire signed [17:0] ey_a = sy - 18'(ya), ex_a = sx - 18'(xa);  // sample point minus Pa
   reg signed [32:0] ma1, ma2;
-  reg [5:0] mbits;
   always @(*) begin
     case (asel)
-      A_AREA:   begin ma1 = 33'(dx1); ma2 = 33'(dx2); mbits = 6'd17; end      // dx20*dy01 - dx01*dy20
-      A_ORIGIN: begin ma1 = {22'd0, box_y0}; ma2 = 33'd1; mbits = 6'd12; end  // y0*width + x_start
-      A_EDGE:   begin ma1 = 33'(ey_a); ma2 = 33'(ex_a); mbits = 6'd18; end
-      default:  begin ma1 = 33'(d1); ma2 = 33'(d2); mbits = abits; end
+      A_AREA:   begin ma1 = 33'(dx1); ma2 = 33'(dx2); end      // dx20*dy01 - dx01*dy20
+      A_ORIGIN: begin ma1 = {22'd0, box_y0}; ma2 = 33'd1; end  // y0*width + x_start
+      A_EDGE:   begin ma1 = 33'(ey_a); ma2 = 33'(ex_a); end
+      default:  begin ma1 = 33'(d1); ma2 = 33'(d2); end
     endcase
   end
 
   // ---------------------------------------------------------------- accumulator
-  // acc <- (dbl ? 2 acc : acc) +/- (use ? mop : 0); clear: acc <- 0
+  // acc <- (dbl ? 2 acc : acc) +/- mop
   reg [ACC_W-1:0] acc;
   wire signed [ACC_W-1:0] acc_s = $signed(acc);
   assign e_data = acc_s[35:0];
-  reg        c_dbl, c_use, c_neg, c_en;  // this cycle's accumulator operation
-  wire [ACC_W-1:0] bop = c_use ? ACC_W'(mop) : {ACC_W{1'b0}};
+  reg        c_dbl, c_neg, c_en;  // this cycle's accumulator operation
+  wire [ACC_W-1:0] bop = ACC_W'(mop);
   wire [ACC_W-1:0] acc_sum = (c_dbl ? acc << 1 : acc) + (bop ^ {ACC_W{c_neg}}) + {{(ACC_W-1){1'b0}}, c_neg};
 
   // multiply: osel1/osel2 sources, negate (mneg), subtract the second (msub)
@@ -203,71 +200,35 @@ module core_setup #(
   reg        add_go, add_dbl, add_neg;
   reg  [3:0] add_osel;
 
-  generate
-    if (SERIAL != 0) begin : serial_mac
-      reg  [5:0] k;  // the bit of the a operands this step takes, plus one
-      wire b1 = ma1[k - 6'd1], b2 = ma2[k - 6'd1];
-      wire msb = (k == mbits);
-      always @(*) begin
-        osel  = mac_run ? (ph ? osel2 : osel1) : add_osel;
-        c_en  = mac_run || add_go;
-        c_dbl = mac_run ? !ph : add_dbl;
-        c_use = mac_run ? (ph ? b2 : b1) : 1'b1;
-        c_neg = mac_run ? (mneg ^ msb ^ (ph & msub)) : add_neg;
+  // both products at once; the m operands are taken in two cycles (one bus)
+  reg signed [35:0] m1;
+  wire signed [ACC_W-1:0] p1 = ACC_W'(ma1) * ACC_W'(m1);   // |a| < 2^(AW-1), |m| < 2^35
+  wire signed [ACC_W-1:0] p2 = ACC_W'(ma2) * ACC_W'(mop);
+  wire signed [ACC_W-1:0] s12 = p1 + (msub ? -p2 : p2);
+  always @(*) begin
+    osel  = mac_run ? (ph ? osel2 : osel1) : add_osel;
+    c_en  = add_go && !mac_run;
+    c_dbl = add_dbl;
+    c_neg = add_neg;
+  end
+  always @(posedge clk) begin
+    if (rst) begin
+      mac_run <= 1'b0;
+    end else if (mac_go) begin
+      mac_run <= 1'b1;
+      ph      <= 1'b0;
+    end else if (mac_run) begin
+      if (!ph) begin
+        m1 <= mop;
+        ph <= 1'b1;
+      end else begin
+        acc     <= mneg ? -s12 : s12;
+        mac_run <= 1'b0;
       end
-      always @(posedge clk) begin
-        if (rst) begin
-          mac_run <= 1'b0;
-        end else if (mac_go) begin
-          mac_run <= 1'b1;
-          k       <= mbits;
-          ph      <= 1'b0;
-          acc     <= {ACC_W{1'b0}};
-        end else begin
-          if (c_en) acc <= acc_sum;
-          if (mac_run) begin
-            ph <= !ph;
-            if (ph) begin
-              k <= k - 6'd1;
-              if (k == 6'd1) mac_run <= 1'b0;
-            end
-          end
-        end
-      end
-    end else begin : parallel_mac
-      // both products at once; the m operands are taken in two cycles (one bus)
-      reg signed [35:0] m1;
-      wire signed [ACC_W-1:0] p1 = ACC_W'(ma1) * ACC_W'(m1);   // |a| < 2^(AW-1), |m| < 2^35
-      wire signed [ACC_W-1:0] p2 = ACC_W'(ma2) * ACC_W'(mop);
-      wire signed [ACC_W-1:0] s12 = p1 + (msub ? -p2 : p2);
-      wire unused_mbits = &{1'b0, mbits};  // widths matter only bit by bit
-      always @(*) begin
-        osel  = mac_run ? (ph ? osel2 : osel1) : add_osel;
-        c_en  = add_go && !mac_run;
-        c_dbl = add_dbl;
-        c_use = 1'b1;
-        c_neg = add_neg;
-      end
-      always @(posedge clk) begin
-        if (rst) begin
-          mac_run <= 1'b0;
-        end else if (mac_go) begin
-          mac_run <= 1'b1;
-          ph      <= 1'b0;
-        end else if (mac_run) begin
-          if (!ph) begin
-            m1 <= mop;
-            ph <= 1'b1;
-          end else begin
-            acc     <= mneg ? -s12 : s12;
-            mac_run <= 1'b0;
-          end
-        end else if (c_en) begin
-          acc <= acc_sum;
-        end
-      end
+    end else if (c_en) begin
+      acc <= acc_sum;
     end
-  endgenerate
+  end
   wire mac_busy = mac_run || mac_go;
 
   // ---------------------------------------------------------------- dividers

@@ -111,17 +111,36 @@ module spigpu_core #(
   wire [34:0] pw_r;
   reg         su_go;
   wire        su_rect = (cmd_op != OP_TRI);  // small profile: clears are drawn as rectangles
-  core_setup #(.SERIAL(SMALL), .TEX(TEX), .IDX_W(IDX_W), .SKIP(1 - SMALL), .XREJECT(1 - SMALL),
-               .NDIV((SMALL != 0) ? 1 : 3)) setup (
-      .clk(clk), .rst(rst), .start(su_go), .rect(su_rect), .busy(su_busy), .done(su_done), .draw(su_draw),
-      .v0(cmd_v0), .v1(cmd_v1), .v2(cmd_v2),
-      .clip_x0(sc_x0), .clip_y0(sc_y0), .clip_x1(clip_x1), .clip_y1(clip_y1), .width(cmd_fb_width),
-      .need(need),
-      .dx0(su_dx0), .dx1(su_dx1), .dx2(su_dx2), .dy0(su_dy0), .dy1(su_dy1), .dy2(su_dy2),
-      .flip(su_flip), .e_we(su_e_we), .e_data(su_e_data), .e1(ras_e1), .e2(ras_e2),
-      .box_x0(su_bx0), .box_y0(su_by0), .box_x1(su_bx1), .box_y1(su_by1), .x_start(su_xs),
-      .origin_idx(su_idx),
-      .den(su_den), .pw_en(pw_en), .pw_attr(pw_attr), .pw_field(pw_field), .pw_q(pw_q), .pw_r(pw_r));
+  generate
+    if (SMALL != 0) begin : setup_tm
+      // a sequencer whose operands are block RAM words (no operand buses); the rasteriser's
+      // edge values are not read back
+      wire [23:0] q24;
+      wire unused_e = &{1'b0, ras_e1, ras_e2, need[7:5]};
+      core_setup_tm #(.IDX_W(IDX_W)) setup (
+          .clk(clk), .rst(rst), .start(su_go), .rect(su_rect), .busy(su_busy), .done(su_done),
+          .draw(su_draw), .v0(cmd_v0), .v1(cmd_v1), .v2(cmd_v2),
+          .clip_x0(sc_x0), .clip_y0(sc_y0), .clip_x1(clip_x1), .clip_y1(clip_y1), .width(cmd_fb_width),
+          .need(need[4:0]),
+          .dx0(su_dx0), .dx1(su_dx1), .dx2(su_dx2), .dy0(su_dy0), .dy1(su_dy1), .dy2(su_dy2),
+          .flip(su_flip), .e_we(su_e_we), .e_data(su_e_data),
+          .box_x0(su_bx0), .box_y0(su_by0), .box_x1(su_bx1), .box_y1(su_by1), .x_start(su_xs),
+          .origin_idx(su_idx),
+          .den(su_den), .pw_en(pw_en), .pw_attr(pw_attr), .pw_field(pw_field), .pw_q(q24), .pw_r(pw_r));
+      assign pw_q = {8'd0, q24};
+    end else begin : setup_par
+      core_setup #(.TEX(TEX), .IDX_W(IDX_W), .SKIP(1), .XREJECT(1), .NDIV(3)) setup (
+          .clk(clk), .rst(rst), .start(su_go), .rect(su_rect), .busy(su_busy), .done(su_done), .draw(su_draw),
+          .v0(cmd_v0), .v1(cmd_v1), .v2(cmd_v2),
+          .clip_x0(sc_x0), .clip_y0(sc_y0), .clip_x1(clip_x1), .clip_y1(clip_y1), .width(cmd_fb_width),
+          .need(need),
+          .dx0(su_dx0), .dx1(su_dx1), .dx2(su_dx2), .dy0(su_dy0), .dy1(su_dy1), .dy2(su_dy2),
+          .flip(su_flip), .e_we(su_e_we), .e_data(su_e_data), .e1(ras_e1), .e2(ras_e2),
+          .box_x0(su_bx0), .box_y0(su_by0), .box_x1(su_bx1), .box_y1(su_by1), .x_start(su_xs),
+          .origin_idx(su_idx),
+          .den(su_den), .pw_en(pw_en), .pw_attr(pw_attr), .pw_field(pw_field), .pw_q(pw_q), .pw_r(pw_r));
+    end
+  endgenerate
 
   // ---------------------------------------------------------------- render state of the draw
   reg        r_gouraud, r_tex, r_ztest, r_zwrite, r_dither, r_decal, r_serial, r_need_dst;
@@ -135,8 +154,7 @@ module spigpu_core #(
   reg [3:0]  r_phase;
   reg [10:0] r_width;
   reg [7:0]  r_need;
-  reg        r_rect, r_zsel;
-  reg [23:0] r_zflat;
+  reg        r_rect, r_zsel;   // r_zsel: Z is CLEAR_DEPTH, held in r_flat (a clear drawn as a rectangle)
   // clear state
   reg [27:0] k_base;
   reg [1:0]  k_bpp;
@@ -224,9 +242,9 @@ module spigpu_core #(
   wire [PW-1:0] pix;
   generate
     if (TEX != 0) begin : pix_tex
-      assign pix = {a_stq, src_rgba, y2, x2, r_zsel ? r_zflat : a_z, idx2};
+      assign pix = {a_stq, src_rgba, y2, x2, r_zsel ? r_flat[23:0] : a_z, idx2};
     end else begin : pix_plain
-      assign pix = {src_rgba, y2, x2, r_zsel ? r_zflat : a_z, idx2};
+      assign pix = {src_rgba, y2, x2, r_zsel ? r_flat[23:0] : a_z, idx2};
     end
   endgenerate
 
@@ -417,7 +435,6 @@ module spigpu_core #(
           r_tex_base  <= cmd_tex_base;
           r_tex_fmt   <= cmd_tex_fmt;
           r_width     <= cmd_fb_width;
-          r_zflat     <= cmd_clear_depth;
           r_rect      <= (cmd_op != OP_TRI);
           r_zsel      <= (cmd_op != OP_TRI);
           tc_keep <= (cmd_op == OP_TRI) && tc_ok_n;
@@ -451,7 +468,8 @@ module spigpu_core #(
             r_dither    <= 1'b0;
             r_temporal  <= 1'b0;
             r_keep      <= 4'd0;
-            r_flat      <= cmd_clear_color;
+            // CLEAR_Z writes no colour, so r_flat carries its depth (one register, not two)
+            r_flat      <= (cmd_op == OP_CLEAR_Z) ? {8'd0, cmd_clear_depth} : cmd_clear_color;
             r_serial    <= 1'b0;
             r_need      <= 8'd0;
             r_need_dst  <= 1'b0;

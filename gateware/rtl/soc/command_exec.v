@@ -15,7 +15,8 @@
 module command_exec #(
   parameter [7:0] FEATURES = 8'h3F,
   parameter       MAX_WIDTH = 1024,
-  parameter       MAX_HEIGHT = 1024
+  parameter       MAX_HEIGHT = 1024,
+  parameter       VRAM_KIB = 32768
 ) (
   input  wire         clk,
   input  wire         rst,           // power-on or RESET
@@ -132,16 +133,34 @@ module command_exec #(
   localparam [63:0] RESET_TEXCOORD    = reg_reset(`SPIGPU_REG_TEXCOORD);
 
   // --- state ---
+  // Only what the core can tell apart is stored: FB_FORMAT's sizes in the bits their largest
+  // values need (MAX_WIDTH / MAX_HEIGHT after validation, or the reset value, 640 x 480, which is
+  // not validated), and FB_DRAW / FB_Z as their block address below the core's 2^ADDR_W
+  // (ADDR_W = log2 VRAM_KIB + 10) plus one bit for "at or beyond it", which the core's address
+  // arithmetic (core_addr.vh) reads from the upper bits: they are all that bit.
+  localparam [10:0]  RESET_W = RESET_FB_FORMAT[10:0];
+  localparam [10:0]  RESET_H = RESET_FB_FORMAT[26:16];
+  localparam integer WB  = $clog2(((MAX_WIDTH > RESET_W) ? MAX_WIDTH : RESET_W) + 1);
+  localparam integer HB  = $clog2(((MAX_HEIGHT > RESET_H) ? MAX_HEIGHT : RESET_H) + 1);
+  localparam integer B16 = $clog2(VRAM_KIB) + 6;
+  function automatic [B16:0] base_sat(input [27:0] b16);
+    base_sat = {(b16 >> B16) != 28'd0, b16[B16-1:0]};
+  endfunction
+  function automatic [27:0] base_out(input [B16:0] b);
+    base_out = {{(28 - B16){b[B16]}}, b[B16-1:0]};
+  endfunction
   reg [63:0]  color, texcoord;
   reg [1:0]   prim_type;
   reg [1:0]   vcount;
   reg [183:0] stored0, stored1;
   reg [31:0]  tri_mode;
-  reg [27:0]  tex_base, fb_draw, fb_z;
+  reg [27:0]  tex_base;
+  reg [B16:0] fb_draw, fb_z;
   reg [17:0]  tex_fmt;
   reg [43:0]  scissor;
   reg [1:0]   fb_format;
-  reg [10:0]  fb_width, fb_height;
+  reg [WB-1:0] fb_width;
+  reg [HB-1:0] fb_height;
   reg [31:0]  clear_color;
   reg [23:0]  clear_depth;
   reg         kick_shadowed;   // the kicking VERTEX has written its shadow entry
@@ -179,11 +198,11 @@ module command_exec #(
   assign cmd_tex_base = tex_base;
   assign cmd_tex_fmt = tex_fmt;
   assign cmd_scissor = scissor;
-  assign cmd_fb_draw = fb_draw;
-  assign cmd_fb_z = fb_z;
+  assign cmd_fb_draw = base_out(fb_draw);
+  assign cmd_fb_z = base_out(fb_z);
   assign cmd_fb_format = fb_format;
-  assign cmd_fb_width = fb_width;
-  assign cmd_fb_height = fb_height;
+  assign cmd_fb_width = 11'(fb_width);
+  assign cmd_fb_height = 11'(fb_height);
   assign cmd_clear_color = clear_color;
   assign cmd_clear_depth = clear_depth;
   assign cmd_v0 = stored0;
@@ -218,11 +237,11 @@ module command_exec #(
       tex_base <= 28'd0;
       tex_fmt <= RESET_TEX_FMT[17:0];
       scissor <= {RESET_SCISSOR[58:48], RESET_SCISSOR[42:32], RESET_SCISSOR[26:16], RESET_SCISSOR[10:0]};
-      fb_draw <= 28'd0;
-      fb_z <= 28'd0;
+      fb_draw <= {(B16 + 1){1'b0}};
+      fb_z <= {(B16 + 1){1'b0}};
       fb_format <= RESET_FB_FORMAT[33:32];
-      fb_width <= RESET_FB_FORMAT[10:0];
-      fb_height <= RESET_FB_FORMAT[26:16];
+      fb_width <= WB'(RESET_W);
+      fb_height <= HB'(RESET_H);
       clear_color <= RESET_CLEAR_COLOR[31:0];
       clear_depth <= RESET_CLEAR_DEPTH[23:0];
       kick_shadowed <= 1'b0;
@@ -259,12 +278,12 @@ module command_exec #(
           `SPIGPU_REG_TEX_BASE: tex_base <= d[31:4];
           `SPIGPU_REG_TEX_FMT: tex_fmt <= d[17:0];
           `SPIGPU_REG_SCISSOR: scissor <= {d[58:48], d[42:32], d[26:16], d[10:0]};
-          `SPIGPU_REG_FB_DRAW: fb_draw <= d[31:4];
-          `SPIGPU_REG_FB_Z: fb_z <= d[31:4];
+          `SPIGPU_REG_FB_DRAW: fb_draw <= base_sat(d[31:4]);
+          `SPIGPU_REG_FB_Z: fb_z <= base_sat(d[31:4]);
           `SPIGPU_REG_FB_FORMAT: begin
             fb_format <= d[33:32];
-            fb_width <= d[10:0];
-            fb_height <= d[26:16];
+            fb_width <= WB'(d[10:0]);
+            fb_height <= HB'(d[26:16]);
           end
           `SPIGPU_REG_CLEAR_COLOR: clear_color <= d[31:0];
           `SPIGPU_REG_CLEAR_DEPTH: clear_depth <= d[23:0];

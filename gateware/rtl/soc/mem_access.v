@@ -39,7 +39,6 @@ module mem_access #(
 );
   localparam IDLE = 3'd0, WR0 = 3'd1, WR1 = 3'd2, RD0 = 3'd3, RD1 = 3'd4, WAIT = 3'd5;
   reg  [2:0]  phase;
-  reg  [28:0] op_addr;      // 8-byte unit being accessed
   reg         pend_read;
   reg         owner_ex;     // the access in progress belongs to an executor operation
   reg         beyond;       // the buffer holds bytes from beyond VRAM
@@ -49,7 +48,10 @@ module mem_access #(
 
   assign req_valid = phase == WR0 || phase == WR1 || phase == RD0 || phase == RD1;
   assign req_we    = phase == WR0 || phase == WR1;
-  assign req_addr  = {op_addr, phase == WR1 || phase == RD1};
+  // The unit being accessed is the pointer itself: a write is to `addr` (advanced when it is done),
+  // a reload to the new `addr`, and every change of the pointer while an access is in progress
+  // starts a new one (or ends it, beyond VRAM), so no copy of it is kept.
+  assign req_addr  = {addr, phase == WR1 || phase == RD1};
   assign req_wdata = phase == WR0 ? op_data[63:32] : op_data[31:0];
   assign ex_idle   = !(phase != IDLE && owner_ex);
 
@@ -109,7 +111,6 @@ module mem_access #(
       end
       if (do_write) begin
         if (in_vram) begin
-          op_addr <= addr;
           phase <= WR0;
           owner_ex <= 1'b1;
         end else begin
@@ -123,7 +124,6 @@ module mem_access #(
         discard <= outstanding_next;
         owner_ex <= !do_read;   // a read's reload supersedes an executor reload
         if (load_addr < VRAM_UNITS) begin
-          op_addr <= load_addr;
           phase <= RD0;
           beyond <= 1'b0;
         end else begin

@@ -87,16 +87,14 @@ module scanout #(
   localparam [VAW:0] VRAM_END = {1'b1, {VAW{1'b0}}};
   reg [23:0] bytes_left;       // bytes still to fold
   reg [31:0] crc, crc_value;
-  reg [15:0] crc_frame;
   assign swap_ready   = !computing && !pending && !reading;
   assign swap_pending = computing || pending || reading;
-  assign frame_crc    = {crc_frame, crc_value};
+  assign frame_crc    = {frame_count, crc_value};  // the frame number is FRAME_COUNT itself
 
-  // words of the frame: ceil(W x H x bpp / 4)
-  wire [21:0] words = frame_format == 2'd0 ? mul_acc
-                    : frame_format == 2'd1 ? {1'b0, mul_acc[21:1]} + {21'd0, mul_acc[0]}
-                    : {2'b00, mul_acc[21:2]} + {21'd0, mul_acc[1:0] != 2'd0};
+  // bytes of the frame, W x H x bpp (into bytes_left one clock before the end is computed), and
+  // its words ceil(bytes / 4): one adder for every format
   wire [23:0] bytes = frame_format == 2'd0 ? {mul_acc, 2'b00} : frame_format == 2'd1 ? {1'b0, mul_acc, 1'b0} : {2'b00, mul_acc};
+  wire [21:0] words = 22'((bytes_left + 24'd3) >> 2);  // no carry out: bytes <= 4 (2^22 - 1)
 
   // --- frame reading ---
   localparam       BAW = BUF_WORDS == 4 ? 2 : 1;
@@ -181,7 +179,6 @@ module scanout #(
       reading <= 1'b0;
       frame_count <= 16'd0;
       crc_value <= 32'd0;
-      crc_frame <= 16'd0;
       buf_rd <= {BAW{1'b0}};
       buf_wr <= {BAW{1'b0}};
       buf_count <= 3'd0;
@@ -210,14 +207,15 @@ module scanout #(
         mul_step <= 4'd0;
       end else if (computing) begin
         // mul_acc = width x height, on a multiplier; the swap keeps its 12 clocks
+        // (no frame is being read while a swap is computed, so bytes_left is free)
         if (mul_step != 4'd11) begin
           mul_acc <= frame_width * frame_height;
           mul_step <= mul_step + 4'd1;
+          if (mul_step == 4'd10) bytes_left <= bytes;
         end else begin
           computing <= 1'b0;
           pending <= 1'b1;
           end_vram <= end_beyond ? VRAM_END : end_in[VAW:0];
-          bytes_left <= bytes;
           if (end_beyond) err_range <= 1'b1;
         end
       end
@@ -234,7 +232,6 @@ module scanout #(
         if (last) begin
           reading <= 1'b0;
           frame_count <= frame_count + 16'd1;
-          crc_frame <= frame_count + 16'd1;
           crc_value <= ~crc_next;
         end
       end

@@ -170,7 +170,7 @@ module spigpu_soc #(
   wire [63:0] mem_op_data;
   wire        swap_req, swap_ready, waiting_vsync;
   wire [27:0] swap_addr;
-  command_exec #(.FEATURES(FEATURES), .MAX_WIDTH(MAX_WIDTH), .MAX_HEIGHT(MAX_HEIGHT)) u_exec (
+  command_exec #(.FEATURES(FEATURES), .MAX_WIDTH(MAX_WIDTH), .MAX_HEIGHT(MAX_HEIGHT), .VRAM_KIB(VRAM_KIB)) u_exec (
     .clk(clk), .rst(rst_any), .in_valid(fifo_out_valid), .in_entry(fifo_out), .in_pop(fifo_pop),
     .sh_wr_req(sh_wr_req), .sh_wr_idx(sh_wr_idx), .sh_wr_data(sh_wr_data), .sh_wr_ack(sh_wr_ack),
     .err_set(ex_err), .core_drain(core_drain), .cmd_valid(cmd_valid), .cmd_ready(cmd_ready), .cmd_op(cmd_op),

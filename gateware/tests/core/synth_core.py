@@ -15,8 +15,8 @@ PROFILES = {
         "synth": "synth_ice40 -dsp",
         "top": {"PROFILE": "0", "FEATURES": "8'h3C", "MAX_WIDTH": "320", "MAX_HEIGHT": "240", "VRAM_KIB": "128", "PERF": "0"},
         "stages": [
-            ("setup (divider included)", "core_setup", {"SERIAL": "1", "TEX": "0", "IDX_W": "17", "SKIP": "0", "XREJECT": "0", "NDIV": "1"}, ["core_divider.v"]),
-            ("  of which the divider", "core_divider", {"NW": "64", "SKIP": "0"}, []),
+            ("setup (divider included)", "core_setup_tm", {"IDX_W": "17"}, ["core_setup_prog.v", "core_divider.v"]),
+            ("  of which the divider", "core_divider", {"NW": "62", "SKIP": "0"}, []),
             ("rasteriser", "core_raster", {"IDX_W": "17"}, []),
             ("attribute steppers", "core_interp_tm", {"RW": "35"}, []),
             ("depth stage", "core_depth", {"PW": "77", "ZLSB": "17", "IDX_W": "17", "AW": "0", "ADDR_W": "17"}, ["core_rdq.v"]),
@@ -29,7 +29,7 @@ PROFILES = {
         "synth": "synth_ecp5",
         "top": {"PROFILE": "1", "FEATURES": "8'hFF", "MAX_WIDTH": "1024", "MAX_HEIGHT": "768", "VRAM_KIB": "32768", "PERF": "0"},
         "stages": [
-            ("setup (dividers included)", "core_setup", {"SERIAL": "0", "TEX": "1", "IDX_W": "20", "SKIP": "1", "XREJECT": "1", "NDIV": "3"}, ["core_divider.v"]),
+            ("setup (dividers included)", "core_setup", {"TEX": "1", "IDX_W": "20", "SKIP": "1", "XREJECT": "1", "NDIV": "3"}, ["core_divider.v"]),
             ("  of which one divider", "core_divider", {"NW": "72", "SKIP": "1"}, []),
             ("rasteriser", "core_raster", {"IDX_W": "20"}, []),
             ("one attribute stepper (of 8)", "core_stepper", {"QW": "32"}, []),
