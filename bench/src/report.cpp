@@ -3,6 +3,7 @@
 #include <cmath>
 #include <map>
 #include <sstream>
+#include <string_view>
 
 #include <fmt/format.h>
 
@@ -138,14 +139,34 @@ nlohmann::json report_json(const Report& r) {
   return j;
 }
 
-// Three scatter panels (coverage, depth, texel error against speed), one point per simulator
-// configuration at one thread plus llvmpipe; the Pareto front of each panel is joined by a line.
+namespace {
+
+// A point's name on the front: "exact", "preview", the knobs that differ from the hardware
+// ("recip_bits=8 nr_steps=0"), or "llvmpipe".
+std::string short_label(const Row& row) {
+  if (row.renderer != "sim") return row.renderer;
+  if (row.config == "exact" || row.config.rfind("preview", 0) == 0) return row.config;
+  const std::string hw[] = {"recip_bits=10", "nr_steps=1", "subpixel_bits=4", "z_bits=24"};
+  std::istringstream in(row.config);
+  std::string word, out;
+  while (in >> word)
+    if (std::find(std::begin(hw), std::end(hw), word) == std::end(hw)) out += (out.empty() ? "" : " ") + word;
+  return out.empty() ? row.config : out;
+}
+
+}  // namespace
+
+// Four scatter panels (coverage, colour, depth and texel error against speed) with one point per
+// simulator configuration at one thread plus llvmpipe, each named on the plot and coloured by its
+// family (exact, hardware-precision knobs, preview, llvmpipe; the legend is inside the canvas); the
+// Pareto front over all of them is joined by a line in each panel.
 std::string report_svg(const Report& r) {
+  enum class Family { Exact, Knobs, Preview, Peer };
   struct Point {
     std::string label;
+    Family family = Family::Knobs;
     double speed = 0;  // geometric mean of Mpix/s over the scenes
-    double coverage = 0, z = 0, texel = 0;
-    bool llvmpipe = false;
+    double coverage = 0, color = 0, z = 0, texel = 0;
   };
   std::map<std::string, std::vector<const Row*>> by_config;
   std::vector<std::string> order;
@@ -157,9 +178,13 @@ std::string report_svg(const Report& r) {
   }
   std::vector<Point> pts;
   for (const auto& key : order) {
+    const Row& first = *by_config[key].front();
     Point p;
-    p.label = key;
-    p.llvmpipe = key.rfind("llvmpipe", 0) == 0;
+    p.label = short_label(first);
+    p.family = first.renderer != "sim"              ? Family::Peer
+               : first.config == "exact"            ? Family::Exact
+               : first.config.rfind("preview", 0) == 0 ? Family::Preview
+                                                    : Family::Knobs;
     double log_sum = 0;
     int n = 0;
     std::uint64_t mism = 0, pixels = 0;
@@ -170,6 +195,7 @@ std::string report_svg(const Report& r) {
         mism += row->error->coverage_mismatches;
         pixels += row->error->pixels;
         p.z = std::max(p.z, row->error->z_max);
+        if (row->error->has_color) p.color = std::max(p.color, row->error->color_max);
         if (row->error->has_texel) p.texel = std::max(p.texel, row->error->texel_max);
       }
     }
@@ -177,38 +203,48 @@ std::string report_svg(const Report& r) {
     p.coverage = pixels ? 100.0 * double(mism) / double(pixels) : 0;
     pts.push_back(p);
   }
-  const int pw = 380, ph = 300, margin = 60, gap = 40;
-  const int width = 3 * pw + 2 * gap + 2 * margin, height = ph + 2 * margin + 20;
+  auto colour_of = [](Family f) {
+    switch (f) {
+      case Family::Exact: return "#000";
+      case Family::Preview: return "#d60";
+      case Family::Peer: return "#c33";
+      case Family::Knobs: break;
+    }
+    return "#36c";
+  };
+  const int pw = 520, ph = 300, margin = 70, gap = 90, legend_h = 70;
+  const int width = 2 * pw + gap + 2 * margin, height = 2 * ph + gap + 2 * margin + legend_h;
   std::ostringstream o;
   o << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << width << "\" height=\"" << height
     << "\" font-family=\"sans-serif\" font-size=\"11\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n"
-    << "<text x=\"" << margin << "\" y=\"20\" font-size=\"14\">Speed (geometric mean Mpix/s over the scenes, 1 thread) "
-       "against error, per configuration; lower right is better</text>\n";
+    << "<text x=\"" << margin << "\" y=\"24\" font-size=\"14\">Speed (geometric mean Mpix/s over the scenes, 1 thread) "
+       "against error, per configuration; lower right is better; green line: the front (no point is both faster and "
+       "less wrong)</text>\n";
   double smin = 1e30, smax = 0;
   for (const auto& p : pts) smin = std::min(smin, p.speed), smax = std::max(smax, p.speed);
   if (pts.empty() || smax <= 0) return o.str() + "</svg>\n";
-  const double lx0 = std::log10(smin) - 0.1, lx1 = std::log10(smax) + 0.1;
+  const double lx0 = std::log10(smin) - 0.15, lx1 = std::log10(smax) + 0.15;
   struct Panel {
     const char* title;
     double Point::*value;
   };
-  const Panel panels[3] = {{"coverage mismatches (% of pixels)", &Point::coverage},
+  const Panel panels[4] = {{"coverage mismatches (% of pixels)", &Point::coverage},
+                           {"max colour error (8-bit LSB, untextured scenes)", &Point::color},
                            {"max Z error (24-bit LSB)", &Point::z},
                            {"max texel error (1/256 texel)", &Point::texel}};
-  for (int k = 0; k < 3; ++k) {
-    const int ox = margin + k * (pw + gap), oy = margin;
+  for (int k = 0; k < 4; ++k) {
+    const int ox = margin + (k % 2) * (pw + gap), oy = margin + (k / 2) * (ph + gap);
     // Error axis: log10(1 + error) so that 0 is drawable.
     double ymax = 0;
     for (const auto& p : pts) ymax = std::max(ymax, std::log10(1 + p.*(panels[k].value)));
-    ymax = std::max(ymax * 1.1, 0.5);
-    auto X = [&](double s) { return ox + (std::log10(s) - lx0) / (lx1 - lx0) * pw; };
+    ymax = std::max(ymax * 1.15, 0.5);
+    auto X = [&](double sp) { return ox + (std::log10(sp) - lx0) / (lx1 - lx0) * pw; };
     auto Y = [&](double e) { return oy + ph - std::log10(1 + e) / ymax * ph; };
     o << "<rect x=\"" << ox << "\" y=\"" << oy << "\" width=\"" << pw << "\" height=\"" << ph
       << "\" fill=\"none\" stroke=\"#444\"/>\n"
       << "<text x=\"" << ox << "\" y=\"" << oy - 8 << "\" font-size=\"12\">" << panels[k].title << "</text>\n"
-      << "<text x=\"" << ox + pw / 2 << "\" y=\"" << oy + ph + 30
-      << "\" text-anchor=\"middle\">Mpix/s (log)</text>\n";
-    for (double tick : {1.0, 10.0, 100.0, 1000.0, 10000.0}) {
+      << "<text x=\"" << ox + pw / 2 << "\" y=\"" << oy + ph + 30 << "\" text-anchor=\"middle\">Mpix/s (log)</text>\n";
+    for (double tick : {1.0, 2.0, 5.0, 10.0, 20.0, 50.0, 100.0, 200.0, 500.0, 1000.0}) {
       if (std::log10(tick) < lx0 || std::log10(tick) > lx1) continue;
       o << fmt::format("<line x1=\"{0:.1f}\" y1=\"{1}\" x2=\"{0:.1f}\" y2=\"{2}\" stroke=\"#ddd\"/>", X(tick), oy, oy + ph)
         << fmt::format("<text x=\"{:.1f}\" y=\"{}\" text-anchor=\"middle\">{}</text>\n", X(tick), oy + ph + 14, tick);
@@ -218,7 +254,7 @@ std::string report_svg(const Report& r) {
       o << fmt::format("<line x1=\"{}\" y1=\"{:.1f}\" x2=\"{}\" y2=\"{:.1f}\" stroke=\"#ddd\"/>", ox, Y(tick), ox + pw, Y(tick))
         << fmt::format("<text x=\"{}\" y=\"{:.1f}\" text-anchor=\"end\">{}</text>\n", ox - 4, Y(tick) + 4, tick);
     }
-    // Pareto front: no other point is both faster and at most as wrong.
+    // The front over every configuration: no other point is both faster and at most as wrong.
     std::vector<const Point*> front;
     for (const auto& p : pts) {
       bool dominated = false;
@@ -234,24 +270,36 @@ std::string report_svg(const Report& r) {
       for (const Point* p : front) o << fmt::format("{:.1f},{:.1f} ", X(p->speed), Y(p->*(panels[k].value)));
       o << "\"/>\n";
     }
-    int idx = 0;
+    // Points named where they are; points that land close together stack their names upwards.
+    std::vector<std::pair<double, double>> placed;
     for (const auto& p : pts) {
       const double x = X(p.speed), y = Y(p.*(panels[k].value));
+      int stack = 0;
+      for (const auto& [px, py] : placed)
+        if (std::fabs(px - x) < 70 && std::fabs(py - y) < 6) ++stack;
+      placed.emplace_back(x, y);
+      const bool left = x > ox + pw - 120;  // names near the right edge go left of their point
       o << fmt::format("<circle cx=\"{:.1f}\" cy=\"{:.1f}\" r=\"4\" fill=\"{}\"><title>{}</title></circle>", x, y,
-                       p.llvmpipe ? "#c33" : "#36c", p.label)
-        << fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\" font-size=\"9\" fill=\"#333\">{}</text>\n", x + 5,
-                       y - 4 - 9 * (idx % 3), idx + 1);
-      ++idx;
+                       colour_of(p.family), p.label)
+        << fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\" font-size=\"9\" fill=\"{}\"{}>{}</text>\n", left ? x - 6 : x + 6,
+                       y - 5 - 10 * stack, colour_of(p.family), left ? " text-anchor=\"end\"" : "", p.label);
     }
   }
-  // Legend: numbers to configurations.
-  int idx = 0;
-  std::ostringstream legend;
-  for (const auto& p : pts) {
-    legend << (idx ? "   " : "") << idx + 1 << " = " << p.label;
-    ++idx;
+  // Legend, inside the canvas: the families' colours.
+  const int ly = height - legend_h + 10;
+  o << "<rect x=\"" << margin << "\" y=\"" << ly << "\" width=\"" << width - 2 * margin << "\" height=\"" << legend_h - 24
+    << "\" fill=\"#f8f8f8\" stroke=\"#999\"/>\n";
+  const std::pair<Family, const char*> families[] = {
+      {Family::Exact, "exact (the hardware, bit for bit)"},
+      {Family::Knobs, "hardware-precision knobs (reciprocal table, subpixel, Z bits)"},
+      {Family::Preview, "preview (float rasteriser)"},
+      {Family::Peer, "llvmpipe peer"}};
+  int lx = margin + 12;
+  for (const auto& [f, text] : families) {
+    o << fmt::format("<circle cx=\"{}\" cy=\"{}\" r=\"5\" fill=\"{}\"/><text x=\"{}\" y=\"{}\">{}</text>\n", lx, ly + 23,
+                     colour_of(f), lx + 10, ly + 27, text);
+    lx += 30 + 6 * static_cast<int>(std::string_view(text).size());  // about 6 px per character at 11 px
   }
-  o << "<text x=\"" << margin << "\" y=\"" << height - 14 << "\" font-size=\"9\">" << legend.str() << "</text>\n";
   o << "</svg>\n";
   return o.str();
 }

@@ -25,6 +25,7 @@ struct AccuracyBenchOptions {
   std::vector<unsigned> threads{1, 2};
   std::vector<std::string> scenes;  // only these scenes (by name); empty = all
   bool exact_only = false;          // only the exact configuration (no other accuracy knobs)
+  bool preview_only = false;        // only the exact and the preview configuration
   bool cordic = true;               // the CORDIC front of the torus example (cordic_front.hpp)
 };
 
