@@ -80,6 +80,7 @@ struct Report {
   std::vector<Row> rows;
   std::vector<FillCeiling> ceiling;  // per thread count, measured in the same run
   std::vector<std::string> goals;  // the speed goals with their measured ratios
+  std::vector<std::string> preview_goals;  // preview vs exact per scene and thread count (issue 24)
   std::optional<CordicFront> cordic;  // its own section (cordic_front.hpp)
 };
 
