@@ -58,6 +58,7 @@ TEST(DaemonSource, TheOverlaySaysWhichAccuracyRenderedTheFrame) {
   EXPECT_EQ(device_accuracy(R"({"backend":"sim","accuracy":"preview"})"), "preview");
   EXPECT_EQ(device_accuracy(R"({"backend":"sim"})"), "");  // an older daemon
   ViewState v;
+  v.status.state = SourceStatus::State::Streaming;
   v.status.backend = "sim";
   v.status.accuracy = "preview";
   v.frame = ShownFrame{.number = 7, .width = 64, .height = 48};
