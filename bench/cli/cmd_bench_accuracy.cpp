@@ -25,6 +25,7 @@ struct AccuracyArgs {
   std::string out_dir;
   std::vector<std::string> scenes;
   bool exact_only = false;
+  bool preview_only = false;
   bool cordic_only = false;
 };
 
@@ -103,6 +104,7 @@ int run_accuracy(const GlobalOptions& g, const AccuracyArgs& a) {
   opt.peer_rounds = a.peer_rounds;
   opt.scenes = a.scenes;
   opt.exact_only = a.exact_only;
+  opt.preview_only = a.preview_only;
   if (!a.out_dir.empty()) {
     std::error_code ec;
     std::filesystem::create_directories(a.out_dir, ec);
@@ -124,6 +126,7 @@ int run_accuracy(const GlobalOptions& g, const AccuracyArgs& a) {
   if (a.peer_rounds != 3) command += " --peer-rounds " + std::to_string(a.peer_rounds);
   for (const auto& name : a.scenes) command += " --scene " + name;
   if (a.exact_only) command += " --exact-only";
+  if (a.preview_only) command += " --preview-only";
   if (!a.out_dir.empty()) command += " --out-dir " + a.out_dir;
   const std::string md = bench::report_markdown(*report, command);
   const auto json = bench::report_json(*report);
@@ -170,6 +173,9 @@ GPUBRIDGE_COMMAND("bench", 80, [](CLI::App& app, GlobalOptions& g, auto& runners
                   "only this scene (repeatable): tri10-front, tri1k-front, tri50k-front, tri10-random, tri1k-random, "
                   "tri50k-random, road, cubes, fan, alpha-blend");
   sub->add_flag("--exact-only", args->exact_only, "only the exact configuration (skip the other accuracy knobs)");
+  sub->add_flag("--preview-only", args->preview_only,
+                "only the exact and the preview configuration (the preview-vs-exact goal lines)")
+      ->excludes("--exact-only");
   sub->add_flag("--cordic-only", args->cordic_only,
                 "only the CORDIC front (the torus example's shift-and-add vertex stage, 4..16 iterations, against "
                 "floating point); with --out-dir, replaces that section of the existing accuracy-report.md/.json "

@@ -140,7 +140,7 @@ BackendPtr first_present_board(const DaemonConfig& cfg) {
 }
 
 // sim
-Result<BackendPtr> open_sim(std::string_view, const DaemonConfig&) { return make_simulator(); }
+Result<BackendPtr> open_sim(std::string_view, const DaemonConfig& cfg) { return make_simulator(cfg); }
 Result<std::string> describe_sim(std::string_view, const DaemonConfig&) { return std::string("the simulator"); }
 
 // discard
@@ -172,7 +172,7 @@ Result<std::vector<usb::BoardProfile>> profiles_auto(std::string_view, const Dae
 Result<BackendPtr> open_auto(std::string_view, const DaemonConfig& cfg) {
   if (auto board = first_present_board(cfg)) return board;
   logger("daemon")->info("auto: no board attached (details at --log-level debug); using the simulator");
-  return make_simulator();
+  return make_simulator(cfg);
 }
 Result<BackendPtr> reopen_auto(std::string_view, const DaemonConfig& cfg) {  // never settles for the simulator
   if (auto board = first_present_board(cfg)) return board;
@@ -380,8 +380,12 @@ std::string backend_syntax() {
   return out;
 }
 
-Result<BackendPtr> make_simulator() {
-  auto sim = sim::SimBackend::create();
+Result<BackendPtr> make_simulator(const DaemonConfig& cfg) {
+  sim::DeviceOptions o;
+  auto knobs = sim::parse_knobs(cfg.accuracy);
+  if (!knobs) return make_error("accuracy (--accuracy): " + knobs.error().message);
+  o.accuracy = *knobs;
+  auto sim = sim::SimBackend::create(o);
   if (!sim) return sim.error();
   return BackendPtr(std::move(*sim));
 }
@@ -409,7 +413,7 @@ std::function<Result<BackendPtr>()> fallback_factory(const DaemonConfig& cfg) {
   // A DMC-1 board falls back to nothing: the spigpu simulator would change the device kind under
   // its clients (DEVICE_GONE, then the board again when its port comes back).
   if (uart_board(cfg.backend, cfg)) return {};
-  return make_simulator;
+  return [cfg] { return make_simulator(cfg); };
 }
 
 std::function<Result<BackendPtr>()> make_reattach_factory(const DaemonConfig& cfg) {

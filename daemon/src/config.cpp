@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 
@@ -12,6 +13,7 @@
 #include "gpubridge/common/log.hpp"
 #include "gpubridge/common/try.hpp"
 #include "gpubridge/protocol/messages.hpp"
+#include "gpubridge/sim/options.hpp"
 
 namespace gpubridge::daemon {
 namespace {
@@ -103,7 +105,7 @@ Result<DaemonConfig> parse_config(const json& doc, const std::string& source) {
   if (!doc.is_object()) return rd.fail("(top level)", "expected a JSON object");
   GPUBRIDGE_TRY(rd.known_keys(doc, "", {"listen", "token", "token_file", "backend", "fallback_to_sim", "reattach_interval_ms", "boards_dir",
                                         "frames_dir", "record_dir", "log_level", "limits", "mirror", "tls_dir", "dmc1_textures",
-                                        "dmc1_palette", "comment"}));
+                                        "dmc1_palette", "accuracy", "comment"}));
   DaemonConfig cfg;
   if (doc.contains("listen")) {
     const auto& l = doc.at("listen");
@@ -130,6 +132,18 @@ Result<DaemonConfig> parse_config(const json& doc, const std::string& source) {
   GPUBRIDGE_TRY(rd.read_string(doc, "", "tls_dir", cfg.tls_dir));
   GPUBRIDGE_TRY(rd.read_string(doc, "", "dmc1_textures", cfg.dmc1_textures));
   GPUBRIDGE_TRY(rd.read_string(doc, "", "dmc1_palette", cfg.dmc1_palette));
+  if (doc.contains("accuracy")) {  // "preview", or a list of settings: ["preview", "z_bits=16"]
+    const auto& a = doc.at("accuracy");
+    if (a.is_string()) {
+      cfg.accuracy = {a.get<std::string>()};
+    } else if (a.is_array() && std::all_of(a.begin(), a.end(), [](const json& v) { return v.is_string(); })) {
+      cfg.accuracy = a.get<std::vector<std::string>>();
+    } else {
+      return rd.fail("accuracy", "expected \"exact\", \"preview\" or an array of such settings and KNOB=VALUE strings, got " +
+                                     Reader::shown(a));
+    }
+    if (auto k = sim::parse_knobs(cfg.accuracy); !k) return rd.fail("accuracy", k.error().message);
+  }
   if (!is_log_level(cfg.log_level)) return rd.fail("log_level", log_level_problem(cfg.log_level));
   if (doc.contains("limits")) {
     const auto& l = doc.at("limits");
@@ -160,6 +174,7 @@ nlohmann::json config_to_json(const DaemonConfig& cfg) {
   if (!cfg.tls_dir.empty()) doc["tls_dir"] = cfg.tls_dir;
   if (!cfg.dmc1_textures.empty()) doc["dmc1_textures"] = cfg.dmc1_textures;
   if (!cfg.dmc1_palette.empty()) doc["dmc1_palette"] = cfg.dmc1_palette;
+  if (!cfg.accuracy.empty()) doc["accuracy"] = cfg.accuracy;
   json limits = json::object();
   for_each_limit(cfg.limits, [&](const char* key, const char*, std::uint64_t, std::uint64_t, auto value) { limits[key] = value; });
   doc["limits"] = limits;
@@ -225,6 +240,11 @@ Result<void> finalize_config(DaemonConfig& cfg) {
   });
   if (!bad) return bad;
   if (!is_log_level(cfg.log_level)) return make_error("log_level (--log-level): " + log_level_problem(cfg.log_level));
+  auto knobs = sim::parse_knobs(cfg.accuracy);
+  if (!knobs) return make_error("accuracy (--accuracy): " + knobs.error().message);
+  sim::DeviceOptions with_knobs;
+  with_knobs.accuracy = *knobs;
+  if (auto v = with_knobs.validate(); !v) return make_error("accuracy (--accuracy): " + v.error().message);
   if (cfg.reattach_interval_ms > kMaxReattachIntervalMs)
     return make_error("reattach_interval_ms: expected 0.." + std::to_string(kMaxReattachIntervalMs) + " (0 = never), got " +
                       std::to_string(cfg.reattach_interval_ms));

@@ -119,7 +119,8 @@ std::string Hub::device_json(const std::string& compression, const std::string& 
                    {"bridge", info_.bridge},       {"max_width", info_.max_width},
                    {"max_height", info_.max_height}, {"vram_bytes", info_.vram_bytes},
                    {"id", info_.id},               {"caps", info_.caps},
-                   {"mirror", options_.mirror},    {"daemon_version", kVersion},
+                   {"mirror", options_.mirror},    {"accuracy", info_.accuracy},
+                   {"daemon_version", kVersion},
                    {"compression", compression},   {"transport", transport}};
   if (!info_.frames_note.empty()) j["frames_note"] = info_.frames_note;
   return json_text(j);
@@ -176,6 +177,7 @@ nlohmann::json Hub::status_json() const {
           {"backend", info_.backend},
           {"board", info_.board},
           {"bridge", info_.bridge},
+          {"accuracy", info_.accuracy},
           {"lease", lease},
           {"lease_waiters", lease_.waiters()},
           {"client_count", clients.size()},

@@ -239,6 +239,12 @@ int main(int argc, char** argv) {
                  "which its DMC-1 streams and goldens use)");
   app.add_option("--dmc1-palette", dmc1_palette, "DMC-1 backends: the palette (768 bytes; default: tests/dmc1/data's)");
   app.add_flag("--no-fallback", no_fallback, "do not switch to the simulator when a board disappears");
+  std::vector<std::string> accuracy;
+  app.add_option("--accuracy", accuracy,
+                 "the simulator's accuracy: exact (default), preview (the float rasteriser: faster, not the hardware's "
+                 "bits; docs/simulator.md) and/or knobs KNOB=VALUE; for backend sim, auto without a board and a board's "
+                 "fallback (a --mirror model is always exact)")
+      ->expected(1, 16);
   app.add_flag("--mirror", mirror,
                "board backends: also run the simulator on the same commands and compare every frame "
                "(subscribers may ask for the board, the simulator or a diff image)");
@@ -298,6 +304,7 @@ int main(int argc, char** argv) {
   if (!record_dir.empty()) cfg.record_dir = record_dir;
   if (!log_level.empty()) cfg.log_level = log_level;
   if (!tls_dir.empty()) cfg.tls_dir = tls_dir;
+  if (!accuracy.empty()) cfg.accuracy = accuracy;
   if (!dmc1_textures.empty()) cfg.dmc1_textures = dmc1_textures;
   if (!dmc1_palette.empty()) cfg.dmc1_palette = dmc1_palette;
   if (max_clients) cfg.limits.max_clients = *max_clients;

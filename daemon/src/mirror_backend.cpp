@@ -145,7 +145,7 @@ Result<std::unique_ptr<backends::Backend>> make_mirror(std::unique_ptr<backends:
   if (info.backend != "board")
     return make_error("--mirror needs a board backend (a board profile name, emulated:BOARD or rtl:BOARD), not \"" + info.backend +
                       "\": mirror mode compares a board with the simulator");
-  sim::DeviceOptions o;
+  sim::DeviceOptions o;  // accuracy: exact, always (the reference, whatever --accuracy says)
   // The model gets the board's memory and limits, so a command that does not fit the board does
   // not fit the model either (CAPS fields from the register table).
   o.vram_bytes = std::clamp<std::uint64_t>(info.vram_bytes / 1024 * 1024, 64 * 1024, sim::kMaxVramBytes);

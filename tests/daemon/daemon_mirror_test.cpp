@@ -83,6 +83,45 @@ TEST(MirrorConfig, KeyIsABooleanAndOffByDefault) {
   EXPECT_NE(bad.error().message.find("c.json: mirror: expected true or false"), std::string::npos) << bad.error().message;
 }
 
+// `accuracy` (--accuracy): "preview" or a list of settings, checked when the file is read; the
+// effective configuration keeps it.
+TEST(AccuracyConfig, PreviewOrSettingsCheckedWhenRead) {
+  auto one = daemon::parse_config(nlohmann::json::parse(R"({"accuracy": "preview"})"), "c.json");
+  ASSERT_TRUE(one) << one.error().message;
+  EXPECT_EQ(one->accuracy, std::vector<std::string>{"preview"});
+  EXPECT_EQ(daemon::config_to_json(*one)["accuracy"], nlohmann::json::parse(R"(["preview"])"));
+  auto list = daemon::parse_config(nlohmann::json::parse(R"({"accuracy": ["preview", "z_bits=16"]})"), "c.json");
+  ASSERT_TRUE(list) << list.error().message;
+  auto retired = daemon::parse_config(nlohmann::json::parse(R"({"accuracy": "fast=1"})"), "c.json");
+  ASSERT_FALSE(retired);
+  EXPECT_NE(retired.error().message.find("c.json: accuracy: accuracy knob 'fast' was retired"), std::string::npos)
+      << retired.error().message;
+  auto wrong = daemon::parse_config(nlohmann::json::parse(R"({"accuracy": 3})"), "c.json");
+  ASSERT_FALSE(wrong);
+  EXPECT_NE(wrong.error().message.find("c.json: accuracy: expected"), std::string::npos) << wrong.error().message;
+  daemon::DaemonConfig no_table;
+  no_table.accuracy = {"preview", "recip_bits=8"};
+  auto refused = daemon::finalize_config(no_table);
+  ASSERT_FALSE(refused);
+  EXPECT_NE(refused.error().message.find("no reciprocal table"), std::string::npos) << refused.error().message;
+}
+
+// A daemon on the simulator with --accuracy preview says so in its WELCOME and STATUS (the viewer's
+// overlay shows it).
+TEST(DaemonAccuracy, WelcomeAndStatusSayPreview) {
+  const auto dir = make_temp_dir("accuracy");
+  const std::string address = "unix:" + (dir / "d.sock").string();
+  Daemon daemon;
+  ASSERT_TRUE(daemon.start({"--listen", address, "--backend", "sim", "--accuracy", "preview", "--log-level", "warn"}))
+      << daemon.error();
+  auto sub = subscriber(address, FrameSource::Board);
+  ASSERT_TRUE(sub);
+  EXPECT_EQ(nlohmann::json::parse(sub->session().device_json).value("accuracy", ""), "preview");
+  const auto status = run_process({GPUBRIDGE_CLI_PATH, "status", "--connect", address, "--json"});
+  ASSERT_EQ(status.exit_code, 0) << status.err;
+  EXPECT_EQ(nlohmann::json::parse(status.out).value("accuracy", ""), "preview") << status.out;
+}
+
 backends::ScanoutFrame make_frame(unsigned w, unsigned h, protocol::PixelFormat f, std::vector<std::uint8_t> px) {
   backends::ScanoutFrame out;
   out.number = 7;
@@ -169,8 +208,10 @@ TEST(DaemonMirror, BoardAndSimulatorFramesBothEqualTheInProcessRender) {
   const auto dir = make_temp_dir("mirror");
   const std::string address = "unix:" + (dir / "d.sock").string();
   Daemon daemon;
+  // --accuracy preview is for the daemon's own simulators: the mirror's model stays exact (the
+  // simulator frames below must equal the exact in-process render).
   ASSERT_TRUE(daemon.start({"--listen", address, "--backend", "emulated:icebreaker", "--mirror", "--no-fallback",
-                            "--log-level", "warn"}))
+                            "--accuracy", "preview", "--log-level", "warn"}))
       << daemon.error();
 
   auto board = subscriber(address, FrameSource::Board);

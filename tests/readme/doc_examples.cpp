@@ -87,6 +87,11 @@ std::vector<Example> make() {
       run("build/tools/gpubridge compare frame.png frame-4t.png --tolerance 0 --diff diff.png")
           .prints(R"(match: 0 of 19200 pixels differ)")
           .leaves("diff.png"),
+      // The preview rasteriser (issue 24): the run says which accuracy rendered the frame.
+      run("build/tools/gpubridge render examples/scenes/gouraud-triangle.json --out preview.png --accuracy preview")
+          .prints(R"(accuracy: preview \(the preview rasteriser)")
+          .leaves("preview.png"),
+      run("build/tools/gpubridge compare frame.png preview.png --tolerance 1").prints(R"(match: \d+ of 19200 pixels differ)"),
       run("build/tools/gpubridge trace convert examples/scenes/gouraud-triangle.json session.gbt")
           .prints(R"(wrote session\.gbt \(binary, \d+ commands)")
           .leaves("session.gbt"),

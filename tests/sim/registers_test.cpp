@@ -254,10 +254,29 @@ TEST(SimRegisters, OptionsAreValidated) {
 TEST(SimKnobs, ParseAndErrors) {
   AccuracyKnobs k;
   EXPECT_TRUE(apply_knob(k, "recip_bits=8").ok());
-  EXPECT_TRUE(apply_knob(k, "fast=1").ok());
   EXPECT_EQ(k.recip_bits, 8u);
-  EXPECT_TRUE(k.fast);
   EXPECT_FALSE(k.exact());
+  EXPECT_EQ(accuracy_mode(k), "knobs");
+  EXPECT_TRUE(apply_knob(k, "exact").ok());  // back to the hardware values
+  EXPECT_TRUE(k.exact());
+  EXPECT_EQ(accuracy_mode(k), "exact");
+  EXPECT_TRUE(apply_knob(k, "preview").ok());
+  EXPECT_TRUE(apply_knob(k, "z_bits=16").ok());
+  EXPECT_TRUE(k.preview);
+  EXPECT_FALSE(k.exact());
+  EXPECT_EQ(to_string(k), "preview z_bits=16");
+  EXPECT_EQ(accuracy_mode(k), "preview");
+  DeviceOptions o;
+  o.accuracy = k;
+  EXPECT_TRUE(o.validate().ok());
+  o.accuracy.recip_bits = 8;  // preview has no reciprocal table
+  auto no_table = o.validate();
+  ASSERT_FALSE(no_table.ok());
+  EXPECT_NE(no_table.error().message.find("no reciprocal table"), std::string::npos);
+  // The retired knob `fast` (slower than exact mode) points to preview.
+  auto retired = apply_knob(k, "fast=1");
+  ASSERT_FALSE(retired.ok());
+  EXPECT_NE(retired.error().message.find("--accuracy preview"), std::string::npos);
   auto bad = apply_knob(k, "recip_bits=40");
   ASSERT_FALSE(bad.ok());
   EXPECT_NE(bad.error().message.find("1..16"), std::string::npos);

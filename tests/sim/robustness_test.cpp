@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <random>
+#include <utility>
 
 #include "sim_test_util.hpp"
 
@@ -17,8 +18,11 @@ TEST(SimRobustness, RandomFramesNeverBreakTheDevice) {
   o.vram_bytes = 256 << 10;  // small: framebuffers and textures often reach beyond VRAM
   o.max_width = 96;
   o.max_height = 64;
-  for (unsigned threads : {1u, 3u}) {
+  // Both rasterisers: the exact one and the preview one (float planes: every conversion of a lane
+  // to an integer must meet a clamped value, whatever the registers hold).
+  for (const auto& [threads, preview] : {std::pair{1u, false}, std::pair{3u, false}, std::pair{1u, true}, std::pair{3u, true}}) {
     o.threads = threads;
+    o.accuracy.preview = preview;
     auto d = make_device(o);
     const std::uint8_t interesting[] = {0x00, 0x01, 0x02, 0x03, 0x04, 0x05, 0x06, 0x07, 0x08, 0x09, 0x0A, 0x0B,
                                         0x0C, 0x0D, 0x0E, 0x0F, 0x10, 0x11, 0x12, 0x13, 0x14, 0x15, 0x16, 0x18,

@@ -52,6 +52,25 @@ TEST(DaemonSource, TheOverlayNamesADeviceKindOtherThanSpigpu) {
   EXPECT_EQ(overlay_lines(v)[0], "unix:/tmp/g.sock  DMC-1 board/icebreaker-dmc1");
 }
 
+// WELCOME's "accuracy" (docs/protocol.md 17.7) reaches the overlay's frame line; the simulator
+// picture of a mirror-mode daemon is always the exact model's.
+TEST(DaemonSource, TheOverlaySaysWhichAccuracyRenderedTheFrame) {
+  EXPECT_EQ(device_accuracy(R"({"backend":"sim","accuracy":"preview"})"), "preview");
+  EXPECT_EQ(device_accuracy(R"({"backend":"sim"})"), "");  // an older daemon
+  ViewState v;
+  v.status.state = SourceStatus::State::Streaming;
+  v.status.backend = "sim";
+  v.status.accuracy = "preview";
+  v.frame = ShownFrame{.number = 7, .width = 64, .height = 48};
+  EXPECT_EQ(overlay_lines(v)[1], "frame 7  64x48 RGBA8888  accuracy preview");
+  v.status.accuracy.clear();
+  EXPECT_EQ(overlay_lines(v)[1], "frame 7  64x48 RGBA8888");
+  v.status.mirror = true;
+  v.status.accuracy = "exact";
+  v.frame->source = protocol::FrameSource::Sim;
+  EXPECT_EQ(accuracy_text(v), "accuracy exact");
+}
+
 SourceStatus wait_for_end(FrameSource& s) {
   for (int i = 0; i < 100; ++i) {
     const auto v = s.status_version();

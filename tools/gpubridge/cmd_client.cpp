@@ -111,6 +111,7 @@ int run_status(const GlobalOptions& g, const ClientOptions& o) {
               j.value("board", "").empty() ? "" : (" board " + j.value("board", "")).c_str(),
               j.value("bridge", "").empty() ? "" : (" via " + j.value("bridge", "")).c_str());
   if (j.contains("frames_note")) std::printf("frames:    %s\n", j.value("frames_note", "").c_str());
+  if (j.contains("accuracy")) std::printf("accuracy:  %s\n", j.value("accuracy", "").c_str());
   if (j["lease"].is_object())
     std::printf("lease:     session %u (%s), %zu waiting\n", j["lease"].value("session", 0u),
                 j["lease"].value("name", "").c_str(), j.value("lease_waiters", std::size_t{0}));

@@ -188,6 +188,7 @@ int run_render(const GlobalOptions& g, const RenderArgs& a) {
                      {"pixels_written", st.pixels_depth_passed},
                      {"device_errors", protocol::describe_errors(errors)},
                      {"accuracy", sim::to_string(opt.accuracy)},
+                     {"accuracy_mode", sim::accuracy_mode(opt.accuracy)},
                      {"threads", opt.threads},
                      {"elapsed_ms", elapsed_ms}};
     if (a.timing) j["timing"] = timing;
@@ -199,7 +200,13 @@ int run_render(const GlobalOptions& g, const RenderArgs& a) {
     if (!a.out.empty())
       std::printf("wrote %s: %ux%u, %s\n", a.out.c_str(), img.width, img.height,
                   source == "scanout" ? "the last scanned-out frame" : "FB_DRAW (nothing was swapped)");
-    if (!opt.accuracy.exact()) std::printf("accuracy knobs: %s (not the exact hardware)\n", sim::to_string(opt.accuracy).c_str());
+    if (opt.accuracy.preview)
+      std::printf("accuracy: %s (the preview rasteriser: float planes, not the hardware's bits)\n",
+                  sim::to_string(opt.accuracy).c_str());
+    else if (!opt.accuracy.exact())
+      std::printf("accuracy: knobs %s (not the exact hardware)\n", sim::to_string(opt.accuracy).c_str());
+    else
+      std::printf("accuracy: exact (the hardware, bit for bit)\n");
     for (const auto& t : timing)
       std::printf("timing frame %s: %.0f board cycles (pipeline %.0f, memory %.0f) = %.3f ms at %.1f MHz; SPI %.3f ms at "
                   "%.1f MHz; frame %.3f ms (%.1f fps)\n",
@@ -229,7 +236,8 @@ GPUBRIDGE_COMMAND("render", 10, [](CLI::App& app, GlobalOptions& g, auto& runner
   sub->add_option("--raw", a->raw, "DMC-1: every frame as little-endian RGB565 words in the GPU's output order");
   sub->add_option("--out,-o", a->out, "PNG of the last scanned-out frame (FB_DRAW if nothing was swapped)");
   sub->add_option("--accuracy", a->accuracy,
-                  "simulator knobs KNOB=VALUE: recip_bits=1..16 nr_steps=0..4 subpixel_bits=0..4 z_bits=1..24 fast=0|1")
+                  "simulator accuracy: exact (default), preview (the float rasteriser: faster, not bit-exact; "
+                  "docs/simulator.md) and/or knobs KNOB=VALUE: recip_bits=1..16 nr_steps=0..4 subpixel_bits=0..4 z_bits=1..24")
       ->expected(1, 16);
   sub->add_option("--threads", a->threads, "rasteriser threads (output is identical for any count)")
       ->check(CLI::Range(1u, 64u))

@@ -50,12 +50,18 @@ bool mirror_enabled(const std::string& device_json) {
   return it != j.end() && it->is_boolean() && it->get<bool>();
 }
 
-std::string frames_note(const std::string& device_json) {
+namespace {
+std::string device_text(const std::string& device_json, const char* key) {
   const auto j = nlohmann::json::parse(device_json, nullptr, false);
   if (j.is_discarded() || !j.is_object()) return {};
-  const auto it = j.find("frames_note");
+  const auto it = j.find(key);
   return it != j.end() && it->is_string() ? it->get<std::string>() : std::string();
 }
+}  // namespace
+
+std::string frames_note(const std::string& device_json) { return device_text(device_json, "frames_note"); }
+
+std::string device_accuracy(const std::string& device_json) { return device_text(device_json, "accuracy"); }
 
 std::optional<std::pair<std::uint64_t, std::uint64_t>> mirror_counts(const std::string& status_json) {
   const auto j = nlohmann::json::parse(status_json, nullptr, false);
@@ -124,6 +130,7 @@ void DaemonFrameSource::run(std::stop_token stop) {
     std::tie(status.backend, status.board) = backend_and_board(session->device_json);
     status.mirror = mirror_enabled(session->device_json);
     status.frames_note = frames_note(session->device_json);
+    status.accuracy = device_accuracy(session->device_json);
     status.device = session->device_kind == protocol::DeviceKind::Spigpu
                         ? std::string()
                         : std::string(protocol::device_kind_info(session->device_kind).label);

@@ -17,6 +17,13 @@ protocol::FrameSource shown_picture(const ViewState& v) { return v.frame ? v.fra
 
 }  // namespace
 
+std::string accuracy_text(const ViewState& v) {
+  // Mirror mode: the simulator picture is the exact model's, whatever the daemon's --accuracy; the
+  // diff compares the board with it.
+  if (v.status.mirror && shown_picture(v) != protocol::FrameSource::Board) return "accuracy exact";
+  return v.status.accuracy.empty() ? std::string() : "accuracy " + v.status.accuracy;
+}
+
 std::string picture_line(const ViewState& v) {
   if (!v.status.mirror) return {};
   std::string line = "showing " + picture_name(shown_picture(v));
@@ -47,8 +54,10 @@ std::vector<std::string> overlay_lines(const ViewState& v) {
   if (auto p = picture_line(v); !p.empty()) lines.push_back(std::move(p));
   if (!v.status.picture_problem.empty()) lines.push_back(v.status.picture_problem);
   if (v.frame) {
-    lines.push_back(fmt::format("frame {}  {}x{} {}{}", v.frame->number, v.frame->width, v.frame->height,
-                                protocol::to_string(v.frame->format), v.frame->crc_ok ? "" : "  CRC MISMATCH"));
+    const std::string accuracy = accuracy_text(v);
+    lines.push_back(fmt::format("frame {}  {}x{} {}{}{}", v.frame->number, v.frame->width, v.frame->height,
+                                protocol::to_string(v.frame->format), accuracy.empty() ? "" : "  " + accuracy,
+                                v.frame->crc_ok ? "" : "  CRC MISMATCH"));
   } else {
     lines.push_back("no frame yet");
   }

@@ -18,11 +18,21 @@ constexpr KnobSpec kKnobs[] = {
     {"z_bits", 1, 24, &AccuracyKnobs::z_bits},
 };
 
-std::string known_knobs() { return "recip_bits, nr_steps, subpixel_bits, z_bits, fast"; }
+std::string known_knobs() { return "recip_bits, nr_steps, subpixel_bits, z_bits; or the words preview, exact"; }
 
 }  // namespace
 
 Result<void> apply_knob(AccuracyKnobs& knobs, std::string_view setting) {
+  if (setting == "preview") {
+    knobs.preview = true;
+    return {};
+  }
+  if (setting == "exact") {
+    knobs = AccuracyKnobs{};
+    return {};
+  }
+  if (setting.starts_with("fast=") || setting == "fast")
+    return make_error("accuracy knob 'fast' was retired (it was slower than the exact path): use --accuracy preview for speed");
   const auto eq = setting.find('=');
   if (eq == std::string_view::npos || eq == 0)
     return make_error("accuracy setting '" + std::string(setting) + "' is not KNOB=VALUE (knobs: " + known_knobs() + ")");
@@ -30,12 +40,6 @@ Result<void> apply_knob(AccuracyKnobs& knobs, std::string_view setting) {
   unsigned value = 0;
   const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
   const bool numeric = ec == std::errc{} && end == text.data() + text.size() && !text.empty();
-  if (name == "fast") {
-    if (!numeric || value > 1)
-      return make_error("accuracy knob fast=" + std::string(text) + ": expected 0 or 1");
-    knobs.fast = value == 1;
-    return {};
-  }
   for (const auto& k : kKnobs) {
     if (k.name != name) continue;
     if (!numeric || value < k.min || value > k.max)
@@ -55,10 +59,17 @@ Result<AccuracyKnobs> parse_knobs(std::span<const std::string> settings) {
 }
 
 std::string to_string(const AccuracyKnobs& k) {
+  if (k.preview) {
+    std::string s = "preview";
+    if (k.subpixel_bits != 4) s += " subpixel_bits=" + std::to_string(k.subpixel_bits);
+    if (k.z_bits != 24) s += " z_bits=" + std::to_string(k.z_bits);
+    return s;
+  }
   return "recip_bits=" + std::to_string(k.recip_bits) + " nr_steps=" + std::to_string(k.nr_steps) +
-         " subpixel_bits=" + std::to_string(k.subpixel_bits) + " z_bits=" + std::to_string(k.z_bits) +
-         " fast=" + (k.fast ? "1" : "0");
+         " subpixel_bits=" + std::to_string(k.subpixel_bits) + " z_bits=" + std::to_string(k.z_bits);
 }
+
+std::string accuracy_mode(const AccuracyKnobs& k) { return k.preview ? "preview" : k.exact() ? "exact" : "knobs"; }
 
 Result<void> DeviceOptions::validate() const {
   auto bad = [](std::string what) { return make_error("simulator option " + what); };
@@ -77,6 +88,8 @@ Result<void> DeviceOptions::validate() const {
   const AccuracyKnobs& k = accuracy;
   if (k.recip_bits < 1 || k.recip_bits > 16 || k.nr_steps > 4 || k.subpixel_bits > 4 || k.z_bits < 1 || k.z_bits > 24)
     return bad("accuracy knobs out of range: " + to_string(k));
+  if (k.preview && (k.recip_bits != 10 || k.nr_steps != 1))
+    return bad("accuracy preview has no reciprocal table: recip_bits and nr_steps do not apply (preview takes subpixel_bits and z_bits)");
   return {};
 }
 

@@ -33,7 +33,8 @@ struct StageFlags {
 // are pixels and `pass` holds the covered ones among them; `whole` as for load_words; q the
 // lanes' planes (R, G, B, A when gouraud, Z when depth, S, T, Q when textured); `bayer` the lanes'
 // dither threshold indices (packed formats). Returns the lanes that passed the depth test.
-template <bool kTextured, PixelFormat kFormat, Chunk kChunk>
+// kTexelLanes (the preview path): q[5] and q[6] hold the texel coordinates themselves.
+template <bool kTextured, PixelFormat kFormat, Chunk kChunk, bool kTexelLanes = false>
 [[gnu::always_inline]] inline u32x8 pixel8(const PixelLanes& px, StageFlags f, const u32x8* q, u32x8 pass,
                                            std::uint8_t* cp, std::uint8_t* zp, unsigned n, bool whole, u32x8 bayer) {
   bool none = false, all = n == 8;
@@ -52,7 +53,8 @@ template <bool kTextured, PixelFormat kFormat, Chunk kChunk>
   if (none) return pass;  // rejected chunks touch no colour
   u32x8 word = u32x8{} + px.flat;
   if (px.gouraud) word = (q[0] & 255u) | ((q[1] & 255u) << 8) | ((q[2] & 255u) << 16) | (q[3] << 24);
-  if constexpr (kTextured) word = texture8(px.texture, q[5], q[6], q[7], pass, n, word);
+  if constexpr (kTextured && kTexelLanes) word = texture8_lanes(px.texture, q[5], q[6], pass, n, word);
+  else if constexpr (kTextured) word = texture8(px.texture, q[5], q[6], q[7], pass, n, word);
   if (kChunk == Chunk::Span && all && !f.reads_color) {  // a fully passing chunk of a plain store: no read
     store_color<kFormat>(cp, pack_color<kFormat>(word, bayer, px.temporal), 8);
     return pass;

@@ -8,6 +8,7 @@
 
 #include "narrow_simd.hpp"
 #include "pixel.hpp"
+#include "preview_simd.hpp"
 #include "span_simd.hpp"
 #include "texture.hpp"
 
@@ -86,10 +87,6 @@ class Kernel {
         const std::int64_t ex = t.edge[i].ex;
         edge_div_[i] = Divider(ex < 0 ? -ex : (ex == 0 ? 1 : ex));
       }
-    }
-    if (kTextured && ctx.fast) {
-      fast_scale_u_ = std::ldexp(1.0, 20 + static_cast<int>(st.tex.wl));
-      fast_scale_v_ = std::ldexp(1.0, 20 + static_cast<int>(st.tex.hl));
     }
     if (kTextured && t.plane[kQ].constant && t.plane[kQ].q != 0) {
       q_const_ = true;  // affine: the reciprocal is the same at every pixel
@@ -202,8 +199,8 @@ class Kernel {
   // The span vector routine (and the small-triangle one, draw_narrow) applies to stores in any
   // pixel format (blend, dither and write mask included) with both buffers inside VRAM and
   // disjoint (it tests eight depths before it writes eight colours), a
-  // texture inside VRAM and disjoint from both (it samples eight texels before it writes), the
-  // exact texel arithmetic (not the `fast` knob), and 2·den < 2^31 so remainders fit signed
+  // texture inside VRAM and disjoint from both (it samples eight texels before it writes), and
+  // 2·den < 2^31 so remainders fit signed
   // 32-bit lanes. Quotients are kept modulo 2^32, which is all any consumer reads (the low 32
   // bits of S, T, Q; 8 of a colour; 24 of Z).
   bool simd_ready() {
@@ -216,7 +213,7 @@ class Kernel {
   void prepare_simd() {
     if (!st_.color_in_vram || skip_color_) return;
     if (kDepth && (!st_.z_in_vram || !st_.buffers_disjoint)) return;
-    if (kTextured && (ctx_.fast || !tex_.direct() || !texture_disjoint(st_, kDepth))) return;
+    if (kTextured && (!tex_.direct() || !texture_disjoint(st_, kDepth))) return;
     if (t_.den >= (std::int64_t{1} << 30)) return;
     simd_tpl_.den = static_cast<std::uint32_t>(t_.den);
     for (unsigned p = 0; p < SimdSpan::kPlanes; ++p) {
@@ -305,20 +302,7 @@ class Kernel {
       ++textured_;  // counted here, added to the context once per run (no per-pixel store through ctx_)
       TexelCoords tc;
       const std::uint32_t q = static_cast<std::uint32_t>(s.q[kQ]);
-      if (q != 0 && ctx_.fast) {
-        // Accuracy knob `fast`: a floating-point divide instead of the reciprocal table and
-        // Newton-Raphson: tu = s/q · 2^8 (texture widths) · W · 4096, clamped so the conversion
-        // is defined for any input.
-        const double inv = 1.0 / static_cast<double>(q);
-        auto conv = [](double value) {  // floor, without a libm call (baseline x86-64 has no roundsd)
-          if (!(value > -0x1p50)) return -(std::int64_t{1} << 50);
-          if (value > 0x1p50) return std::int64_t{1} << 50;
-          const auto t = static_cast<std::int64_t>(value);
-          return t - (static_cast<double>(t) > value ? 1 : 0);
-        };
-        tc.tu = conv(static_cast<double>(static_cast<std::int32_t>(s.q[kS])) * inv * fast_scale_u_);
-        tc.tv = conv(static_cast<double>(static_cast<std::int32_t>(s.q[kT])) * inv * fast_scale_v_);
-      } else if (q != 0) {
+      if (q != 0) {
         const Reciprocal rc = q_const_ ? const_rc_ : ctx_.recip(q);
         tc = texel_coords(static_cast<std::int32_t>(s.q[kS]), static_cast<std::int32_t>(s.q[kT]), rc, st_.tex.wl,
                           st_.tex.hl);
@@ -370,7 +354,6 @@ class Kernel {
   Reciprocal const_rc_;
   Divider edge_div_[3] = {Divider(1), Divider(1), Divider(1)};
   bool simd_ = false, simd_checked_ = false;
-  double fast_scale_u_ = 0, fast_scale_v_ = 0;  // 2^(20 + log2 size): knob `fast`, textured kernels
   SimdSpan simd_tpl_{};
   std::uint64_t textured_ = 0;  // texture-unit pixels of this run
 };
@@ -394,7 +377,7 @@ bool draw_narrow(const Triangle& t, const DrawState& st, RasterContext& ctx, int
   const int w = t.x1 - t.x0;
   if (w > 8 || t.x0 + 8 > static_cast<int>(st.fb_width) || !st.color_in_vram) return false;
   if (depth && (!st.z_in_vram || !st.buffers_disjoint)) return false;
-  if (st.textured && (ctx.fast || !st.tex.in_vram || !texture_disjoint(st, depth))) return false;
+  if (st.textured && (!st.tex.in_vram || !texture_disjoint(st, depth))) return false;
   if (t.den >= (std::int64_t{1} << 28)) return false;
   NarrowTriangle n;
   set_pixel_lanes(n.pixel, st, ctx, Rgba8{t.flat[0], t.flat[1], t.flat[2], t.flat[3]}, gouraud, depth);
@@ -457,7 +440,63 @@ bool draw_narrow(const Triangle& t, const DrawState& st, RasterContext& ctx, int
   return true;
 }
 
+// The preview routine (preview_simd.hpp) for rows [ya, yz) of a triangle set up by
+// setup_triangle_preview; preview_applies(st) holds.
+void draw_preview(const Triangle& t, const DrawState& st, RasterContext& ctx, int ya, int yz, bool gouraud, bool depth) {
+  PreviewRows p;
+  p.width = t.x1 - t.x0;
+  for (int i = 0; i < 3; ++i) {
+    p.e[i] = t.edge[i].e;
+    p.ex[i] = t.edge[i].ex;
+    p.ey[i] = t.edge[i].ey;
+    if (p.width > 8) p.inv_ex[i] = t.edge[i].ex != 0 ? 1.0 / static_cast<double>(t.edge[i].ex) : 0.0;
+  }
+  p.base = t.fplane.base;
+  p.dx = t.fplane.dx;
+  p.dy = t.fplane.dy;
+  p.ky0 = ya - t.y0;
+  p.rows = yz - ya;
+  const std::size_t pix = static_cast<std::size_t>(ya) * st.fb_width + static_cast<std::size_t>(t.x0);
+  p.color = ctx.mem.data() + st.fb_draw + pix * st.bpp;
+  p.depth = depth ? ctx.mem.data() + st.fb_z + pix * 4 : nullptr;
+  p.pitch = std::size_t{st.fb_width} * 4;
+  p.color_pitch = std::size_t{st.fb_width} * st.bpp;
+  p.room = st.fb_width - static_cast<unsigned>(t.x0);
+  p.dither = st.dither.on && st.fb_format != protocol::PixelFormat::RGBA8888;
+  if (p.dither)
+    for (int j = 0; j < 4; ++j)
+      for (int i = 0; i < 4; ++i)
+        for (int k = 0; k < 8; ++k) p.bayer[j][i][k] = dither_threshold(st.dither, t.x0 + i + k, t.y0 + j);
+  const Rgba8 flat = st.gouraud ? Rgba8{t.v[0].c[0], t.v[0].c[1], t.v[0].c[2], t.v[0].c[3]}
+                                : Rgba8{t.flat[0], t.flat[1], t.flat[2], t.flat[3]};
+  set_pixel_lanes(p.pixel, st, ctx, flat, gouraud, depth);
+  std::optional<TextureUnit> unit;  // built only for textured draws
+  if (st.textured) {
+    unit.emplace(st.tex, ctx.mem);
+    p.pixel.texture = {&*unit, &ctx.recip, false, Reciprocal{}, st.tex.wl, st.tex.hl, st.decal};
+    p.scale_u = std::ldexp(1.0f, 20 + static_cast<int>(st.tex.wl));
+    p.scale_v = std::ldexp(1.0f, 20 + static_cast<int>(st.tex.hl));
+  }
+  const PreviewCounts c = shade_preview_simd(p);
+  ctx.counters.scanned += c.scanned;
+  ctx.counters.covered += c.covered;
+  ctx.counters.passed += c.passed;
+  if (st.blend != protocol::BlendMode::Off) ctx.counters.blended += c.passed;
+  if (st.textured) {
+    ctx.counters.textured += c.passed;
+    ctx.counters.texel_bytes += c.passed * (st.tex.bilinear ? 4u : 1u) * protocol::bytes_per_pixel(st.tex.format);
+  }
+}
+
 }  // namespace
+
+bool preview_applies(const DrawState& st) {
+  const std::uint8_t stored = st.fb_format == protocol::PixelFormat::RGB565 ? 0x7 : 0xF;
+  if (!st.color_in_vram || (st.keep_mask & stored) == stored) return false;
+  const bool depth = st.z_test || st.z_write;
+  if (depth && (!st.z_in_vram || !st.buffers_disjoint)) return false;
+  return !st.textured || (st.tex.in_vram && texture_disjoint(st, depth));
+}
 
 void rasterize_rows(const Triangle& t, const DrawState& st, RasterContext& ctx, int row_begin, int row_end) {
   const int ya = std::max(row_begin, t.y0), yz = std::min(row_end, t.y1);
@@ -466,6 +505,7 @@ void rasterize_rows(const Triangle& t, const DrawState& st, RasterContext& ctx, 
   for (unsigned ch = 0; ch < 4; ++ch) colors_differ |= !t.plane[kR + ch].constant;
   const bool gouraud = st.gouraud && colors_differ;   // Gouraud only when colours differ
   const bool depth = st.z_test || st.z_write;
+  if (t.preview) return draw_preview(t, st, ctx, ya, yz, gouraud, depth);
   if (ctx.vector && draw_narrow(t, st, ctx, ya, yz, gouraud, depth)) return;
   const unsigned key = (gouraud ? 1u : 0u) | (st.textured ? 2u : 0u) | (depth ? 4u : 0u) | (st.simple_color ? 8u : 0u);
   kKernels[key](t, st, ctx, ya, yz);

@@ -30,13 +30,17 @@ struct RasterContext {
   VideoMemory& mem;
   const ReciprocalUnit& recip;
   unsigned z_bits = 24;
-  bool fast = false;         // floating-point texel divide (accuracy knob `fast`)
   std::uint16_t errors = 0;  // ERR_MEM_RANGE from out-of-memory accesses
   RasterCounters counters;
   bool vector = true;  // vector routines allowed (DeviceOptions::vector_routines)
 };
 
-// Draws the rows [row_begin, row_end) of t (clipped to its bounding box) with state st.
+// The preview routine (`--accuracy preview`, preview_simd.hpp) can draw with this state: both
+// buffers inside VRAM and disjoint, a texture inside VRAM disjoint from both, a colour stage that
+// is not fully masked. Other draws take the exact path (setup_triangle) even in preview mode.
+bool preview_applies(const DrawState& st);
+
+// Draws the rows [row_begin, row_end) of t (a preview triangle through the preview routine) (clipped to its bounding box) with state st.
 void rasterize_rows(const Triangle& t, const DrawState& st, RasterContext& ctx, int row_begin, int row_end);
 
 // The slow, obviously exact path for --dump-attributes: reports every covered pixel's attribute

@@ -56,7 +56,11 @@ void Renderer::draw(const Vertex& a, const Vertex& b, const Vertex& c, const std
   // the prefetched rows of this one arrive while it is drawn (order of pixel writes unchanged).
   const int slot = pending_ == 0 ? 1 : 0;
   Triangle& t = batching ? batch_.emplace_back() : slots_[slot];
-  if (!setup_triangle(a, b, c, st, knobs_.subpixel_bits, observing, t)) {
+  // Preview mode sets up float planes for the preview routine where it applies (the exact path
+  // draws the rest).
+  const bool ok = knobs_.preview && preview_applies(st) ? setup_triangle_preview(a, b, c, st, knobs_.subpixel_bits, observing, t)
+                                                        : setup_triangle(a, b, c, st, knobs_.subpixel_bits, observing, t);
+  if (!ok) {
     if (batching) batch_.pop_back();
     return;
   }
@@ -79,7 +83,7 @@ void Renderer::draw(const Vertex& a, const Vertex& b, const Vertex& c, const std
 void Renderer::draw_pending() {
   if (pending_ < 0) return;
   const Triangle& t = slots_[pending_];
-  RasterContext ctx{mem_, recip_, knobs_.z_bits, knobs_.fast, 0, {}, vector_};
+  RasterContext ctx{mem_, recip_, knobs_.z_bits, 0, {}, vector_};
   rasterize_rows(t, *pending_state_, ctx, t.y0, t.y1);
   errors_ |= ctx.errors;
   counters_.add(ctx.counters);
@@ -125,7 +129,7 @@ void Renderer::submit() {
   batch_state_.reset();
   drawing_ctx_.clear();
   for (unsigned w = 0; w < pool_.workers(); ++w)
-    drawing_ctx_.push_back(RasterContext{mem_, recip_, knobs_.z_bits, knobs_.fast, 0, {}, vector_});
+    drawing_ctx_.push_back(RasterContext{mem_, recip_, knobs_.z_bits, 0, {}, vector_});
   drawing_active_ = true;
   pool_.start(draw_job_);
 }

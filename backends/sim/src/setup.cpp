@@ -51,8 +51,13 @@ void setup_plane(Plane& p, std::int64_t a0, std::int64_t a1, std::int64_t a2, co
 
 }  // namespace
 
-bool setup_triangle(const Vertex& va, const Vertex& vb, const Vertex& vc, const DrawState& state,
-                    unsigned subpixel_bits, bool all_attributes, Triangle& t) {
+namespace {
+
+// Section 8: D, the exchange, the clipped box and the biased edge functions (shared by the exact
+// and the preview setup). Returns the raw edge functions e20, e01 (the barycentric weights of
+// vertices 1 and 2 at the box origin's sample point) and D.
+bool setup_coverage(const Vertex& va, const Vertex& vb, const Vertex& vc, const DrawState& state,
+                    unsigned subpixel_bits, Triangle& t, Edge& e20, Edge& e01, std::int64_t& area) {
   // subpixel_bits < 4 truncates the vertex coordinates first.
   const std::int32_t keep = subpixel_bits < 4 ? ~((std::int32_t{1} << (4 - subpixel_bits)) - 1) : ~std::int32_t{0};
   const std::int64_t ax = va.x & keep, ay = va.y & keep;
@@ -80,15 +85,37 @@ bool setup_triangle(const Vertex& va, const Vertex& vb, const Vertex& vc, const 
   if (t.x0 >= t.x1 || t.y0 >= t.y1) return false;
 
   t.den = 2 * D;
+  area = D;
   const std::int64_t sx = 16 * std::int64_t{t.x0} + 8, sy = 16 * std::int64_t{t.y0} + 8;
   // Raw edge functions (the barycentric weights of the planes) and, in t.edge, the biased ones.
-  const Edge e20 = make_edge(t.v[2], t.v[0], sx, sy);
-  const Edge e01 = make_edge(t.v[0], t.v[1], sx, sy);
+  e20 = make_edge(t.v[2], t.v[0], sx, sy);
+  e01 = make_edge(t.v[0], t.v[1], sx, sy);
   t.edge[0] = make_edge(t.v[1], t.v[2], sx, sy);
   t.edge[0].e += edge_bias(t.v[1], t.v[2]);
   t.edge[1] = {e20.e + edge_bias(t.v[2], t.v[0]), e20.ex, e20.ey};
   t.edge[2] = {e01.e + edge_bias(t.v[0], t.v[1]), e01.ex, e01.ey};
+  return true;
+}
 
+// One attribute as a plane a(kx, ky) = base + kx·dx + ky·dy over the box (kx, ky relative to its
+// origin) in double, from the same barycentric weights as the exact plane. `offset` is added to
+// base (0.5 for values rounded by truncation).
+void setup_float_plane(FloatPlanes& f, unsigned i, double a0, double a1, double a2, const Edge& b1, const Edge& b2,
+                       double inv_d, double offset) {
+  const double d1 = a1 - a0, d2 = a2 - a0;
+  f.base[i] = a0 + (d1 * static_cast<double>(b1.e) + d2 * static_cast<double>(b2.e)) * inv_d + offset;
+  f.dx[i] = (d1 * static_cast<double>(b1.ex) + d2 * static_cast<double>(b2.ex)) * inv_d;
+  f.dy[i] = (d1 * static_cast<double>(b1.ey) + d2 * static_cast<double>(b2.ey)) * inv_d;
+}
+
+}  // namespace
+
+bool setup_triangle(const Vertex& va, const Vertex& vb, const Vertex& vc, const DrawState& state,
+                    unsigned subpixel_bits, bool all_attributes, Triangle& t) {
+  Edge e20, e01;
+  std::int64_t D = 0;
+  if (!setup_coverage(va, vb, vc, state, subpixel_bits, t, e20, e01, D)) return false;
+  t.preview = false;
   const Vertex* v = t.v;
   const Divider div(t.den);
   const bool color = all_attributes || state.gouraud;
@@ -108,6 +135,38 @@ bool setup_triangle(const Vertex& va, const Vertex& vb, const Vertex& vc, const 
   } else {
     t.plane[kS] = t.plane[kT] = t.plane[kQ] = Plane{};
   }
+  return true;
+}
+
+bool setup_triangle_preview(const Vertex& va, const Vertex& vb, const Vertex& vc, const DrawState& state,
+                            unsigned subpixel_bits, bool observing, Triangle& t) {
+  if (observing) {  // the observer reports the exact interpolants: set those up too
+    if (!setup_triangle(va, vb, vc, state, subpixel_bits, true, t)) return false;
+  } else {
+    Edge e20, e01;
+    std::int64_t D = 0;
+    if (!setup_coverage(va, vb, vc, state, subpixel_bits, t, e20, e01, D)) return false;
+    // The preview routine reads only whether the colours differ and the flat colour (t.flat).
+    for (unsigned ch = 0; ch < 4; ++ch) {
+      t.plane[kR + ch].constant = va.c[ch] == vb.c[ch] && va.c[ch] == vc.c[ch];
+      t.plane[kR + ch].q = va.c[ch];
+    }
+  }
+  // Recompute the raw weights (setup_triangle does not return them): cheap integer products.
+  const std::int64_t sx = 16 * std::int64_t{t.x0} + 8, sy = 16 * std::int64_t{t.y0} + 8;
+  const Edge e20 = make_edge(t.v[2], t.v[0], sx, sy), e01 = make_edge(t.v[0], t.v[1], sx, sy);
+  const Vertex* v = t.v;
+  const double inv_d = 2.0 / static_cast<double>(t.den);  // 1 / D: the setup's one float divide
+  FloatPlanes& f = t.fplane;
+  if (state.gouraud)
+    for (unsigned ch = 0; ch < 4; ++ch) setup_float_plane(f, kR + ch, v[0].c[ch], v[1].c[ch], v[2].c[ch], e20, e01, inv_d, 0.5);
+  if (state.z_test || state.z_write) setup_float_plane(f, kZ, v[0].z, v[1].z, v[2].z, e20, e01, inv_d, 0.5);
+  if (state.textured) {
+    setup_float_plane(f, kS, v[0].s, v[1].s, v[2].s, e20, e01, inv_d, 0.0);
+    setup_float_plane(f, kT, v[0].t, v[1].t, v[2].t, e20, e01, inv_d, 0.0);
+    setup_float_plane(f, kQ, v[0].q, v[1].q, v[2].q, e20, e01, inv_d, 0.0);
+  }
+  t.preview = true;
   return true;
 }
 

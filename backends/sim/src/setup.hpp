@@ -47,6 +47,13 @@ struct Edge {
   std::int64_t ey = 0;  // change per pixel in y (= 16·(Xb − Xa))
 };
 
+// The preview path's planes (`--accuracy preview`): a(kx, ky) = base + kx·dx + ky·dy over the box
+// (kx, ky from its origin pixel); colour and Z carry +0.5 so truncation rounds them. Double here:
+// the preview routine anchors each row's span in double and steps along it in float lanes.
+struct FloatPlanes {
+  double base[kAttrCount], dx[kAttrCount], dy[kAttrCount];
+};
+
 struct Triangle {
   Vertex v[3];          // after the exchange of section 8.1 (D > 0)
   std::int64_t den = 0; // 2D
@@ -55,6 +62,8 @@ struct Triangle {
   Plane plane[kAttrCount];
   std::uint8_t flat[4] = {0, 0, 0, 0};  // flat colour (first vertex as listed)
   std::uint64_t index = 0;              // kicked-triangle number
+  bool preview = false;                 // set up by setup_triangle_preview: drawn from fplane
+  FloatPlanes fplane;                   // preview only (the planes the state needs)
 };
 
 // Returns false when the triangle draws nothing (D = 0 or an empty clipped box). Planes are set up
@@ -62,5 +71,11 @@ struct Triangle {
 // depth test or depth write is on). subpixel_bits < 4 truncates vertex coordinates first.
 bool setup_triangle(const Vertex& a, const Vertex& b, const Vertex& c, const DrawState& state,
                     unsigned subpixel_bits, bool all_attributes, Triangle& out);
+
+// The preview setup (`--accuracy preview`, preview.hpp): the same coverage (D, box, biased integer
+// edge functions) and float planes instead of exact ones, from one float reciprocal of D and no
+// exact division. With `observing` the exact planes are set up too (the observer reports them).
+bool setup_triangle_preview(const Vertex& a, const Vertex& b, const Vertex& c, const DrawState& state,
+                            unsigned subpixel_bits, bool observing, Triangle& out);
 
 }  // namespace gpubridge::sim

@@ -7,33 +7,15 @@
 
 namespace gpubridge::sim {
 
-// The texture stage for eight pixels (section 10): lanes that passed the depth test get their
-// texel coordinates and addressed neighbours one by one (64-bit products, a table lookup), then
-// the bilinear filter and the combine with the vertex colour `color` run in lanes. Returns the
-// combined colour words.
-[[gnu::always_inline]] inline simd::u32x8 texture8(const TextureLanes& s, simd::u32x8 sq, simd::u32x8 tq,
-                                                   simd::u32x8 qq, simd::u32x8 pass, unsigned n, simd::u32x8 color) {
+// The filter and combine of eight lanes whose texel coordinates are known (tc[k] for k < n):
+// lanes that passed the depth test get their addressed neighbours one by one, then the bilinear
+// filter and the combine with the vertex colour `color` run in lanes. Returns the combined words.
+[[gnu::always_inline]] inline simd::u32x8 texture8_sample(const TextureLanes& s, const TexelCoords* tc, simd::u32x8 pass,
+                                                          unsigned n, simd::u32x8 color) {
   using simd::u32x8;
-  std::uint32_t sv[8], tv[8], qv[8], pv[8];
-  simd::store8(sv, sq);
-  simd::store8(tv, tq);
-  simd::store8(qv, qq);
+  std::uint32_t pv[8];
   simd::store8(pv, pass);
   alignas(32) std::uint32_t c00[8] = {}, c10[8] = {}, c01[8] = {}, c11[8] = {}, fu[8] = {}, fv[8] = {};
-  // Texel coordinates of every lane first, in a branch-free loop of independent chains (the
-  // reciprocal's multiplies overlap across lanes); q = 0 gives (0, 0) as in the scalar routine.
-  TexelCoords tc[8];
-  if (s.q_const) {  // the same non-zero Q everywhere: one reciprocal for the triangle
-    for (unsigned k = 0; k < n; ++k)
-      tc[k] = texel_coords(static_cast<std::int32_t>(sv[k]), static_cast<std::int32_t>(tv[k]), s.const_rc, s.wl, s.hl);
-  } else {
-    for (unsigned k = 0; k < n; ++k) {
-      const std::uint32_t q = qv[k];
-      const TexelCoords c = texel_coords(static_cast<std::int32_t>(sv[k]), static_cast<std::int32_t>(tv[k]),
-                                         (*s.recip)(q != 0 ? q : 1), s.wl, s.hl);
-      tc[k] = q != 0 ? c : TexelCoords{};
-    }
-  }
   for (unsigned k = 0; k < n; ++k)
     if (pv[k]) s.tex->quad(tc[k], c00[k], c10[k], c01[k], c11[k], fu[k], fv[k]);  // rejected lanes: never sampled
   u32x8 texel = simd::load8(c00);
@@ -56,6 +38,40 @@ namespace gpubridge::sim {
     out |= simd::div255(x) << c;
   }
   return out;
+}
+
+// The texture stage for eight pixels (section 10): texel coordinates of every lane from the exact
+// (s, t, q) planes through the reciprocal unit, then texture8_sample.
+[[gnu::always_inline]] inline simd::u32x8 texture8(const TextureLanes& s, simd::u32x8 sq, simd::u32x8 tq,
+                                                   simd::u32x8 qq, simd::u32x8 pass, unsigned n, simd::u32x8 color) {
+  std::uint32_t sv[8], tv[8], qv[8];
+  simd::store8(sv, sq);
+  simd::store8(tv, tq);
+  simd::store8(qv, qq);
+  // Texel coordinates of every lane first, in a branch-free loop of independent chains (the
+  // reciprocal's multiplies overlap across lanes); q = 0 gives (0, 0) as in the scalar routine.
+  TexelCoords tc[8];
+  if (s.q_const) {  // the same non-zero Q everywhere: one reciprocal for the triangle
+    for (unsigned k = 0; k < n; ++k)
+      tc[k] = texel_coords(static_cast<std::int32_t>(sv[k]), static_cast<std::int32_t>(tv[k]), s.const_rc, s.wl, s.hl);
+  } else {
+    for (unsigned k = 0; k < n; ++k) {
+      const std::uint32_t q = qv[k];
+      const TexelCoords c = texel_coords(static_cast<std::int32_t>(sv[k]), static_cast<std::int32_t>(tv[k]),
+                                         (*s.recip)(q != 0 ? q : 1), s.wl, s.hl);
+      tc[k] = q != 0 ? c : TexelCoords{};
+    }
+  }
+  return texture8_sample(s, tc, pass, n, color);
+}
+
+// The preview path's texture stage: the lanes already hold the texel coordinates (1/4096 texel,
+// signed 32-bit; preview_simd.cpp computes them in float).
+[[gnu::always_inline]] inline simd::u32x8 texture8_lanes(const TextureLanes& s, simd::u32x8 tu, simd::u32x8 tv,
+                                                         simd::u32x8 pass, unsigned n, simd::u32x8 color) {
+  TexelCoords tc[8];
+  for (unsigned k = 0; k < 8; ++k) tc[k] = {static_cast<std::int32_t>(tu[k]), static_cast<std::int32_t>(tv[k])};
+  return texture8_sample(s, tc, pass, n, color);
 }
 
 

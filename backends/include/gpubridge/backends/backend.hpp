@@ -48,6 +48,10 @@ struct DeviceInfo {
   // Where the scanned-out frames come from when not from the device itself ("" = the device's own):
   // a board that sends no frames back shows the simulator's, and says so here.
   std::string frames_note;
+  // Which arithmetic renders the frames (docs/protocol.md, WELCOME): "exact" (the hardware's bits:
+  // a board, the DMC-1, the simulator's default), "preview" (the simulator's float rasteriser,
+  // `--accuracy preview`) or "knobs" (the simulator with hardware-precision knobs changed).
+  std::string accuracy = "exact";
 };
 
 // Error codes of backend results (Error::code).

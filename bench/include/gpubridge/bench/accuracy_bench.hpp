@@ -25,6 +25,7 @@ struct AccuracyBenchOptions {
   std::vector<unsigned> threads{1, 2};
   std::vector<std::string> scenes;  // only these scenes (by name); empty = all
   bool exact_only = false;          // only the exact configuration (no other accuracy knobs)
+  bool preview_only = false;        // only the exact and the preview configuration
   bool cordic = true;               // the CORDIC front of the torus example (cordic_front.hpp)
 };
 
@@ -79,6 +80,7 @@ struct Report {
   std::vector<Row> rows;
   std::vector<FillCeiling> ceiling;  // per thread count, measured in the same run
   std::vector<std::string> goals;  // the speed goals with their measured ratios
+  std::vector<std::string> preview_goals;  // preview vs exact per scene and thread count (issue 24)
   std::optional<CordicFront> cordic;  // its own section (cordic_front.hpp)
 };
 

@@ -20,8 +20,9 @@ Result<std::unique_ptr<backends::Backend>> make_backend(const std::string& name,
 // syntax, the board profile it names (found and valid), every profile for "auto". A one-line
 // description, or the error make_backend would give for the same reason (`gpubridged --check-config`).
 Result<std::string> check_backend(const DaemonConfig& cfg);
-// The simulator with default options (fallback when a board disappears).
-Result<std::unique_ptr<backends::Backend>> make_simulator();
+// The simulator with cfg's accuracy settings (backend sim, auto without a board, the fallback when
+// a board disappears).
+Result<std::unique_ptr<backends::Backend>> make_simulator(const DaemonConfig& cfg);
 // The backend names in --help form: "sim | auto | emulated:BOARD[?presence=PATH] | ...".
 std::string backend_syntax();
 // True for backends that name a board ("auto", a profile, "emulated:PROFILE"): those can

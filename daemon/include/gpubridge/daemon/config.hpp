@@ -45,6 +45,10 @@ struct DaemonConfig {
   std::string dmc1_textures;
   std::string dmc1_palette;
   std::string tls_dir;              // TLS key + self-signed certificate (created on first start); empty = default_tls_dir()
+  // The simulator's accuracy settings (`--accuracy preview`, knobs KNOB=VALUE; sim::apply_knob), for
+  // every simulator this daemon serves: backend sim, auto without a board, a board's fallback. A
+  // mirror's model is always exact (it is the reference the board is compared with).
+  std::vector<std::string> accuracy;
   Limits limits;
 };
 

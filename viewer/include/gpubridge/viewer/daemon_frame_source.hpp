@@ -40,6 +40,8 @@ bool mirror_enabled(const std::string& device_json);
 // WELCOME's "frames_note" (docs/protocol.md 17.7): whose frames these are when not the device's own
 // (a DMC-1 board shows its simulator's); empty when absent.
 std::string frames_note(const std::string& device_json);
+// WELCOME's "accuracy" (docs/protocol.md 17.7): "exact", "preview" or "knobs"; empty when absent.
+std::string device_accuracy(const std::string& device_json);
 // Frames compared and mismatches from a STATUS_REPLY's "mirror" object; nullopt when absent.
 std::optional<std::pair<std::uint64_t, std::uint64_t>> mirror_counts(const std::string& status_json);
 

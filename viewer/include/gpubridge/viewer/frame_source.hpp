@@ -31,6 +31,7 @@ struct SourceStatus {
   std::string board;    // board name when the backend has one
   std::string device;   // the device kind's label when it is not spigpu ("DMC-1"), else empty
   std::string frames_note;  // whose frames they are when not the device's own (a DMC-1 board: its simulator's)
+  std::string accuracy;     // how the device renders (WELCOME "accuracy": exact, preview, knobs); empty if unknown
   std::string message;  // for Waiting/Failed: the last error, one line
   // Mirror mode (gpubridged --mirror): which picture is subscribed and how many swaps so far had a
   // board frame whose CRC differs from the simulator's (from the daemon's status).

@@ -40,5 +40,8 @@ std::vector<std::string> help_lines();
 std::string window_title(const ViewState& v);
 // Mirror mode: "showing diff board vs simulator  mismatches 2 of 40 frames"; empty otherwise.
 std::string picture_line(const ViewState& v);
+// "accuracy preview": how the shown picture was rendered (the simulator picture of a mirror-mode
+// daemon is always the exact model's); empty when the daemon does not say.
+std::string accuracy_text(const ViewState& v);
 
 }  // namespace gpubridge::viewer

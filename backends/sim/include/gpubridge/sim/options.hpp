@@ -17,22 +17,31 @@ struct AccuracyKnobs {
   unsigned nr_steps = 1;       // Newton-Raphson steps k, 0..4
   unsigned subpixel_bits = 4;  // honoured vertex subpixel bits, 0..4 (fewer: X/Y truncated toward -inf)
   unsigned z_bits = 24;        // honoured depth bits, 1..24 (fewer: Z truncated before test and store)
-  bool fast = false;           // texel coordinates from a floating-point divide (not bit-exact when textured)
+  // The preview rasteriser (`--accuracy preview`, docs/simulator.md "Preview"): float planes and
+  // perspective, several times less exact than the hardware, for previews, remote viewing and CI
+  // smoke runs. Coverage stays exact; subpixel_bits and z_bits still apply; the reciprocal knobs
+  // do not (there is no table).
+  bool preview = false;
 
   // True when every knob has its hardware value (the simulator is then the golden model).
   bool exact() const {
-    return recip_bits == 10 && nr_steps == 1 && subpixel_bits == 4 && z_bits == 24 && !fast;
+    return recip_bits == 10 && nr_steps == 1 && subpixel_bits == 4 && z_bits == 24 && !preview;
   }
   friend bool operator==(const AccuracyKnobs&, const AccuracyKnobs&) = default;
 };
 
-// Applies one "KNOB=VALUE" setting ("recip_bits=8", "fast=1"). Errors name the knob, the value
-// and the accepted range.
+// Applies one setting: "KNOB=VALUE" ("recip_bits=8", "z_bits=16") or a mode word, "preview" (the
+// preview rasteriser) or "exact" (every knob at its hardware value). Errors name the knob, the
+// value and the accepted range. The retired knob `fast` is refused with a pointer to preview.
 Result<void> apply_knob(AccuracyKnobs& knobs, std::string_view setting);
 // Parses a list of settings starting from the defaults.
 Result<AccuracyKnobs> parse_knobs(std::span<const std::string> settings);
-// "recip_bits=10 nr_steps=1 subpixel_bits=4 z_bits=24 fast=0"
+// "recip_bits=10 nr_steps=1 subpixel_bits=4 z_bits=24"; in preview mode "preview" followed by the
+// knobs that differ from the hardware ("preview z_bits=16").
 std::string to_string(const AccuracyKnobs& knobs);
+// The accuracy a frame is rendered with, as the CLI, the daemon and the viewer name it: "exact",
+// "preview" or "knobs" (hardware-precision knobs that differ from the hardware).
+std::string accuracy_mode(const AccuracyKnobs& knobs);
 
 // CAPS.FEATURES bits (docs/protocol.md, CAPS).
 enum Feature : std::uint8_t {

@@ -1,0 +1,133 @@
+// The preview rasteriser (`--accuracy preview`, backends/sim/src/preview_simd.cpp): the same bytes
+// for any thread count and run; the exact path's coverage (top-left rule included, up to the
+// largest coordinates the protocol carries); colour within 1 LSB and Z within a few LSB of the
+// exact values. The suite runs under ASan/UBSan in the sanitizer build, so the extreme cases also
+// check that no float lane reaches an integer conversion out of range.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <random>
+
+#include "random_draws.hpp"
+
+namespace gpubridge::sim::test {
+namespace {
+
+DeviceOptions preview_options(unsigned threads) {
+  DeviceOptions o;
+  o.threads = threads;
+  o.accuracy.preview = true;
+  return o;
+}
+
+TEST(SimPreview, SameBytesForAnyThreadCountAndRun) {
+  std::mt19937 rng(20261126);
+  unsigned differs_from_exact = 0;
+  for (int i = 0; i < 120; ++i) {
+    const Case c = random_case(rng);
+    const Rendered one = render(c, preview_options(1));
+    const Rendered two = render(c, preview_options(2));
+    const Rendered three = render(c, preview_options(3));
+    const Rendered again = render(c, preview_options(1));
+    ASSERT_EQ(one.memory, two.memory) << "case " << i << " TRI_MODE 0x" << std::hex << c.tri_mode;
+    ASSERT_EQ(one.memory, three.memory) << "case " << i;
+    ASSERT_EQ(one.memory, again.memory) << "case " << i;
+    EXPECT_EQ(one.stats.pixels_depth_passed, two.stats.pixels_depth_passed) << i;
+    const Rendered exact = render(c, DeviceOptions{});
+    // Coverage is the exact path's in every state (before the depth test: Z differs slightly).
+    EXPECT_EQ(one.stats.pixels_covered, exact.stats.pixels_covered) << "case " << i;
+    differs_from_exact += one.memory != exact.memory;
+  }
+  // The cases ran the preview routine (Gouraud, Z and texels differ from the exact ones).
+  EXPECT_GT(differs_from_exact, 30u);
+}
+
+// Flat colour, no texture, no depth: nothing is interpolated, so every byte is the exact path's;
+// any difference would be coverage (the edge functions, the top-left rule, the span solve).
+TEST(SimPreview, FlatDrawsAreTheExactBytes) {
+  std::mt19937 rng(7);
+  for (int i = 0; i < 200; ++i) {
+    Case c = random_case(rng);
+    c.tri_mode &= ~(std::uint64_t{1} | 2u | 4u | (1u << 6));  // no Gouraud, texture, Z test or Z write
+    const Rendered p = render(c, preview_options(1 + i % 2)), e = render(c, DeviceOptions{});
+    ASSERT_EQ(p.memory, e.memory) << "case " << i << " TRI_MODE 0x" << std::hex << c.tri_mode << " FB_FORMAT 0x"
+                                  << c.fb_fmt;
+    EXPECT_EQ(p.stats.pixels_covered, e.stats.pixels_covered) << i;
+  }
+}
+
+// Gouraud colour and Z against the exact values, pixel by pixel (RGBA8888, depth ALWAYS + write,
+// so every covered pixel is written by the last triangle covering it in both renders).
+TEST(SimPreview, ColourWithinOneLsbAndZWithinEightLsbOfExact) {
+  std::mt19937 rng(11);
+  int max_c = 0, max_z = 0;
+  for (int i = 0; i < 60; ++i) {
+    Case c = random_case(rng);
+    c.tri_mode = 1u | 4u | (std::uint64_t{7} << 3) | (1u << 6);  // Gouraud, Z test ALWAYS, Z write
+    c.fb_fmt = fb_format(kW, kH, 0);
+    c.fb_draw = 0;
+    c.fb_z = Canvas::kZBase;
+    const Rendered p = render(c, preview_options(1)), e = render(c, DeviceOptions{});
+    for (std::size_t px = 0; px < std::size_t{kW} * kH; ++px) {
+      const std::uint8_t* pc = &p.memory[px * 4];
+      const std::uint8_t* ec = &e.memory[px * 4];
+      for (int ch = 0; ch < 4; ++ch) max_c = std::max(max_c, std::abs(int(pc[ch]) - int(ec[ch])));
+      auto z = [&](const Rendered& r) {
+        const std::uint8_t* q = &r.memory[Canvas::kZBase + px * 4];
+        return (int(q[1]) << 16) | (int(q[2]) << 8) | q[3];
+      };
+      max_z = std::max(max_z, std::abs(z(p) - z(e)));
+    }
+  }
+  // Colours are below 256: float keeps 16 fraction bits, so only values within 2^-16 of a rounding
+  // boundary can round the other way. Z is below 2^24, where float has no fraction bit: the base
+  // value, the two products and the two sums each round by up to half a unit of up to 2^25.
+  EXPECT_LE(max_c, 1);
+  EXPECT_LE(max_z, 8);
+  EXPECT_GT(max_z, 0);  // Z is not exact (the test would not notice if preview were off)
+}
+
+// Vertices anywhere in the s12.4 range (edge values up to 2^36), S/T anywhere in s8.24, Q anywhere
+// including 0: no undefined behaviour (UBSan), coverage still the exact test, and the same bytes
+// with one and two threads.
+TEST(SimPreview, ExtremeCoordinatesAndTexelsStayDefined) {
+  std::mt19937 rng(99);
+  std::uniform_int_distribution<int> any(-32768, 32767);
+  for (int round = 0; round < 8; ++round) {
+    const bool textured = round % 2 == 1;
+    auto draw = [&](const DeviceOptions& o, std::uint32_t seed) {
+      std::mt19937 r(seed);
+      Canvas cv(kW, kH, 0, o);
+      Device& d = *cv.dev;
+      w(d, Reg::TEX_BASE, kTexBase);
+      w(d, Reg::TEX_FMT, 7u | (7u << 4) | (1u << 12));  // 128x128 RGBA8888, bilinear, REPEAT
+      w(d, Reg::TRI_MODE, textured ? 2u | (1u << 14) : 0u);  // decal texture, or flat
+      w(d, Reg::PRIM, 0);
+      for (int t = 0; t < 60; ++t) {
+        for (int k = 0; k < 3; ++k) {
+          const std::uint32_t q = r() % 4 == 0 ? 0u : static_cast<std::uint32_t>(r());
+          w(d, Reg::COLOR, color(static_cast<std::uint32_t>(r()), q));
+          w(d, Reg::TEXCOORD, (std::uint64_t{static_cast<std::uint32_t>(r())} << 32) | static_cast<std::uint32_t>(r()));
+          // Half the vertices near the target, half anywhere: long edges crossing it at any angle.
+          const int x = r() % 2 ? any(r) : static_cast<int>(r() % (16 * kW)), y = r() % 2 ? any(r) : static_cast<int>(r() % (16 * kH));
+          w(d, Reg::VERTEX, vtx(x, y, static_cast<std::uint32_t>(r())));
+        }
+      }
+      d.drain();
+      const auto m = d.memory();
+      return std::pair{std::vector<std::uint8_t>(m.begin(), m.begin() + kW * kH * 4), d.stats().pixels_covered};
+    };
+    const std::uint32_t seed = static_cast<std::uint32_t>(rng());
+    const auto one = draw(preview_options(1), seed), two = draw(preview_options(2), seed);
+    const auto exact = draw(DeviceOptions{}, seed);
+    EXPECT_EQ(one.first, two.first) << "round " << round;
+    EXPECT_EQ(one.second, exact.second) << "round " << round;  // coverage
+    EXPECT_GT(exact.second, 0u) << "round " << round;
+    if (!textured) {
+      EXPECT_EQ(one.first, exact.first) << "round " << round;  // flat: the exact bytes
+    }
+  }
+}
+
+}  // namespace
+}  // namespace gpubridge::sim::test
