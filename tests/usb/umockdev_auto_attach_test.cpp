@@ -53,7 +53,7 @@ class InProcessAutoDaemon {
     if (!backend) return (why = backend.error().message, false);
     started_on = (*backend)->info().backend;
     test::InProcessDaemon::Options opts;
-    opts.fallback = daemon::make_simulator;
+    opts.fallback = [cfg] { return daemon::make_simulator(cfg); };
     opts.before_listening = [this, &cfg, notifications, &why](daemon::Hub& hub) {
       hub.enable_hotplug(daemon::make_reattach_factory(cfg), std::chrono::milliseconds(cfg.reattach_interval_ms));
       if (!notifications) return;
