@@ -114,12 +114,31 @@ TEST_F(FlashCli, AMissingProgrammerSaysWhichPackage) {
   EXPECT_EQ(args_of("iceprog"), "-d\ni:0x0403:0x6010\n-I\nA\n" + bitstream() + "\n");
 }
 
-TEST_F(FlashCli, NoBitstreamBuiltYetNamesTheBuildScript) {
+TEST_F(FlashCli, NoBitstreamYetSaysWhereItLookedAndWhatToPass) {
   std::filesystem::remove(bitstream());
   const auto r = flash({"flash", "--board", "icebreaker"});
   EXPECT_EQ(r.exit_code, 1);
-  EXPECT_NE(r.err.find("scripts/gateware.sh --board icebreaker"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("no bitstream for icebreaker at " + bitstream()), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("gpubridge flash --board icebreaker FILE"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("GPUBRIDGE_BITSTREAM_DIR"), std::string::npos) << r.err;
   EXPECT_FALSE(ran("openFPGALoader"));
+}
+
+// --board takes a profile file as probe and bringup do: a copy of the shipped one, renamed.
+TEST_F(FlashCli, ABoardProfileFileWorksLikeItsName) {
+  const auto file = tmp_.path() / "my-icebreaker.json";
+  std::filesystem::copy_file(std::filesystem::path(GPUBRIDGE_TEST_CONFIG_DIR) / "boards" / "icebreaker.json", file);
+  auto r = flash({"flash", "--board", file.string(), bitstream(), "--dry-run"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out, "openFPGALoader -b ice40_generic " + bitstream() + "\n");
+  const auto uart = tmp_.path() / "my-dmc1.json";
+  std::filesystem::copy_file(std::filesystem::path(GPUBRIDGE_TEST_CONFIG_DIR) / "boards" / "icebreaker-dmc1.json", uart);
+  r = flash({"flash", "--board", uart.string(), bitstream(), "--to", "sram", "--dry-run"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out, "iceprog -d i:0x0403:0x6010 -I A -S " + bitstream() + "\n");
+  r = flash({"flash", "--board", (tmp_.path() / "none.json").string()});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("none.json: cannot read"), std::string::npos) << r.err;
 }
 
 TEST_F(FlashCli, AFileThatIsNoBitstreamNeverReachesTheBoard) {

@@ -117,7 +117,7 @@ int run_boards(const GlobalOptions& g, const std::string& dir) {
                 hex4(p.pid).c_str(), "-", "-", "-", p.fpga.c_str(), static_cast<char>('A' + p.interface), p.baud,
                 std::string(protocol::device_kind_info(p.device_kind).name).c_str(), p.name.c_str());
   // Which bitstream goes with which board, and what can program it (gpubridge flash --board NAME).
-  std::printf("\n%-16s %-16s %s\n", "BOARD", "BITSTREAM", "PROGRAMMERS (gpubridge flash; files from scripts/gateware.sh)");
+  std::printf("\n%-16s %-16s %s\n", "BOARD", "BITSTREAM", "PROGRAMMERS (gpubridge flash --board NAME [FILE])");
   for (const auto& p : *boards) print_flash_row(p.name, p.fpga, p.flash);
   for (const auto& p : *uart_boards) print_flash_row(p.name, p.fpga, p.flash);
   return 0;

@@ -60,18 +60,28 @@ struct BoardForFlash {
   std::string serial;
 };
 
+BoardForFlash for_flash(const usb::BoardProfile& p) { return {p.name, p.fpga, p.file, p.flash, p.vid, p.pid, p.serial}; }
+BoardForFlash for_flash(const usb::UartBoardProfile& p) { return {p.name, p.fpga, p.file, p.flash, p.vid, p.pid, p.serial}; }
+
+// A board by name, or a profile file (.json) of either kind, as probe and bringup take it.
 Result<BoardForFlash> find_board(const std::filesystem::path& config, const std::string& name) {
+  if (name.size() > 5 && name.ends_with(".json")) {
+    auto spi = usb::load_board_profile(name);
+    if (spi) return for_flash(*spi);
+    if (auto uart = usb::find_uart_board_profile(config, name)) return for_flash(*uart);
+    return spi.error();
+  }
   auto spi = usb::load_board_profiles(config);
   if (!spi) return spi.error();
   auto uart = usb::load_uart_board_profiles(config);
   if (!uart) return uart.error();
   std::string names;
   for (const auto& p : *spi) {
-    if (p.name == name) return BoardForFlash{p.name, p.fpga, p.file, p.flash, p.vid, p.pid, p.serial};
+    if (p.name == name) return for_flash(p);
     names += (names.empty() ? "" : ", ") + p.name;
   }
   for (const auto& p : *uart) {
-    if (p.name == name) return BoardForFlash{p.name, p.fpga, p.file, p.flash, p.vid, p.pid, p.serial};
+    if (p.name == name) return for_flash(p);
     names += ", " + p.name;
   }
   return make_error("no board profile named \"" + name + "\" in " + (config / "boards").string() + " (known: " + names +
@@ -153,8 +163,9 @@ int run_flash(const GlobalOptions& g, const FlashArgs& a) {
     rq.bitstream = bitstream_dir() / board->recipe.bitstream;
     std::error_code ec;
     if (!std::filesystem::exists(rq.bitstream, ec))
-      return fail("no bitstream for " + a.board + " at " + rq.bitstream.string() + ": build it with `scripts/gateware.sh --board " + a.board +
-                  "` (docs/gateware.md), or pass the file: gpubridge flash --board " + a.board + " FILE");
+      return fail("no bitstream for " + a.board + " at " + rq.bitstream.string() + ": pass the file (gpubridge flash --board " + a.board +
+                  " FILE) or set GPUBRIDGE_BITSTREAM_DIR to the directory holding " + board->recipe.bitstream +
+                  " (this version does not build board bitstreams yet: docs/boards.md, Flashing)");
   } else {
     return fail("board \"" + a.board + "\" runs a bitstream this project does not build: " + board->recipe.source +
                 "; then gpubridge flash --board " + a.board + " FILE");
@@ -217,10 +228,10 @@ GPUBRIDGE_COMMAND("flash", 65, [](CLI::App& app, GlobalOptions& g, auto& runners
       "flash",
       "program a board with its bitstream through openFPGALoader or iceprog, as its profile's \"flash\" section says "
       "(`gpubridge boards` lists which bitstream goes with which board)");
-  cmd->add_option("--board", a->board, "board profile name (configs/boards/NAME.json)")->required();
+  cmd->add_option("--board", a->board, "board profile name (configs/boards) or a .json file")->required();
   cmd->add_option("bitstream", a->bitstream,
-                  "bitstream file (default: the board's file in $GPUBRIDGE_BITSTREAM_DIR, else in the build tree's gateware/boards/, "
-                  "which scripts/gateware.sh writes)");
+                  "bitstream file (default: the board's file, `gpubridge boards` names it, in $GPUBRIDGE_BITSTREAM_DIR, else in "
+                  "the build tree's gateware/boards/)");
   cmd->add_option("--to", a->target, "which memory: flash (kept across power cycles) or sram (a quick load, lost at power-off)")
       ->check(CLI::IsMember({"flash", "sram"}));
   cmd->add_option("--tool", a->tool, "programmer: openfpgaloader or iceprog (default: the first the board offers that is installed)")
