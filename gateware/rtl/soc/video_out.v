@@ -1,0 +1,228 @@
+// Video output of a board (docs/gateware.md "Video out"): the displayed buffer, every refresh.
+//
+// The scanout reads a frame once per swap (FRAME_CRC, the co-simulation's frame port); a monitor needs
+// the displayed buffer 60 times a second. This stage keeps its own display timing (VESA 640 x 480 at
+// 60 Hz by default, a pixel every PIX_DIV core clocks), follows the swaps the scanout latches
+// (swap_req gives the address, frame_start commits it with the format and size at the vertical sync)
+// and fills a two-line block-RAM line buffer through its own memory-arbiter client: while one source
+// line is shown, the next is read. Pixels are expanded from RGBA8888 / RGB565 / RGBA2222 to 8 bits as
+// docs/protocol.md section 6 says and the top OUT_BITS bits leave (4 for the 12-bit DVI Pmod, 8 for
+// TMDS). A framebuffer is scaled by 2^SCALE_LOG2 and centred; what does not fit the screen is cropped,
+// and so are pixels beyond the 2^LINE_AW words a line buffer half holds. Words beyond VRAM show as 0.
+// The timing counters start with the scanout's (LINE_CLOCKS = H_TOTAL x PIX_DIV), so its vertical sync,
+// where the swap is latched, is the end of this stage's last visible line.
+module video_out #(
+  parameter VAW        = 15,   // VRAM = 2^VAW 32-bit words
+  parameter LBW        = 19,   // bits of a line's byte offset in the buffer (y x W x bpp)
+  parameter PIX_DIV    = 1,    // core clocks per pixel: 1 or 2
+  parameter SCALE_LOG2 = 1,    // 0: 1:1, 1: every framebuffer pixel 2 x 2 on screen
+  parameter LINE_AW    = 8,    // 2^LINE_AW words per line buffer half
+  parameter OUT_BITS   = 4,    // bits per colour channel at the pins
+  parameter H_ACTIVE   = 640,
+  parameter H_FRONT    = 16,
+  parameter H_SYNC     = 96,
+  parameter H_BACK     = 48,
+  parameter V_ACTIVE   = 480,
+  parameter V_FRONT    = 10,
+  parameter V_SYNC     = 2,
+  parameter V_BACK     = 33,
+  parameter SYNC_NEG   = 1     // sync pulses low (640 x 480 at 60 Hz)
+) (
+  input  wire                clk,
+  input  wire                rst,
+  // swaps, as the scanout sees them
+  input  wire                swap_req,
+  input  wire [27:0]         swap_addr,     // byte address / 16
+  input  wire                frame_start,   // the scanout latched the pending swap (vertical sync)
+  input  wire [1:0]          frame_format,
+  input  wire [10:0]         frame_width,
+  input  wire [10:0]         frame_height,
+  // memory-arbiter client (reads inside VRAM only, answers in order)
+  output wire                req_valid,
+  input  wire                req_ready,
+  output wire [29:0]         req_addr,
+  input  wire                rsp_valid,
+  input  wire [31:0]         rsp_rdata,
+  // to the pins (registered): pixel clock enable, syncs at their pin level, data enable, colour
+  output wire                pix_en,
+  output reg                 hsync,
+  output reg                 vsync,
+  output reg                 de,
+  output reg  [OUT_BITS-1:0] red,
+  output reg  [OUT_BITS-1:0] green,
+  output reg  [OUT_BITS-1:0] blue
+);
+  localparam H_TOTAL = H_ACTIVE + H_FRONT + H_SYNC + H_BACK;
+  localparam V_TOTAL = V_ACTIVE + V_FRONT + V_SYNC + V_BACK;
+  localparam S = SCALE_LOG2;
+
+  // --- pixel enable and display timing ---
+  generate
+    if (PIX_DIV == 2) begin : g_div2
+      reg phase;
+      always @(posedge clk) phase <= rst ? 1'b0 : !phase;
+      assign pix_en = phase;
+    end else begin : g_div1
+      assign pix_en = 1'b1;
+    end
+  endgenerate
+  reg  [10:0] hc, vc;
+  wire        h_last = hc == 11'(H_TOTAL - 1);
+  wire [10:0] v_next = vc == 11'(V_TOTAL - 1) ? 11'd0 : vc + 11'd1;
+  wire [10:0] v_next2 = v_next == 11'(V_TOTAL - 1) ? 11'd0 : v_next + 11'd1;
+  wire        line_end = pix_en && h_last;
+
+  // --- the displayed buffer: latched at swap_req, shown from frame_start ---
+  reg  [27:0] pend_addr;
+  reg         shown;                       // a frame was swapped in since reset
+  reg  [VAW+2:0] base;                     // its first word (beyond VRAM: >= 2^VAW)
+  reg  [1:0]  ppw_l2;                      // log2 pixels per word: RGBA8888 0, RGB565 1, RGBA2222 2
+  reg  [10:0] fw, fh;
+  always @(posedge clk) begin
+    if (rst) begin
+      shown <= 1'b0;
+    end else begin
+      if (swap_req) pend_addr <= swap_addr;
+      if (frame_start) begin
+        shown <= 1'b1;
+        base <= pend_addr[27:VAW-2] != 0 ? {2'b01, {(VAW+1){1'b0}}} : {3'b000, pend_addr[VAW-3:0], 2'b00};
+        ppw_l2 <= frame_format == 2'd0 ? 2'd0 : frame_format == 2'd1 ? 2'd1 : 2'd2;
+        fw <= frame_width;
+        fh <= frame_height;
+      end
+    end
+  end
+  // placement on the screen (registered: used lines after the swap)
+  reg  [10:0] x0, x_end, y0, y_end;
+  reg  [LBW-1:0] stride;                   // bytes per framebuffer line
+  wire [11:0] sw = {1'b0, fw} << S, sh = {1'b0, fh} << S;
+  always @(posedge clk) begin
+    x0    <= sw >= 12'(H_ACTIVE) ? 11'd0 : 11'((12'(H_ACTIVE) - sw) >> 1);
+    x_end <= sw >= 12'(H_ACTIVE) ? 11'(H_ACTIVE) : 11'((12'(H_ACTIVE) - sw) >> 1) + sw[10:0];
+    y0    <= sh >= 12'(V_ACTIVE) ? 11'd0 : 11'((12'(V_ACTIVE) - sh) >> 1);
+    y_end <= sh >= 12'(V_ACTIVE) ? 11'(V_ACTIVE) : 11'((12'(V_ACTIVE) - sh) >> 1) + sh[10:0];
+    stride <= LBW'({fw, 2'b00}) >> ppw_l2;
+  end
+
+  // a screen line n shows the framebuffer line (n - y0) >> S when y0 <= n < y_end
+  wire        next_in  = shown && v_next >= y0 && v_next < y_end;
+  wire [10:0] next_rel = v_next - y0;
+  wire        fetch_in = shown && v_next2 >= y0 && v_next2 < y_end;
+  wire [10:0] fetch_rel = v_next2 - y0;
+  wire        fetch_new = fetch_in && (S == 0 || fetch_rel[0] == 1'b0);
+
+  // --- line buffer fill: at the end of screen line n, the framebuffer line of line n + 2 if it is new ---
+  reg  [31:0] lb [0:(2 << LINE_AW) - 1];
+  reg  [LBW-1:0] line_byte;                // byte offset of the next framebuffer line to fetch
+  reg  [VAW+2:0] f_addr;                   // next word to read (>= 2^VAW: beyond VRAM)
+  reg  [LINE_AW:0] f_left;                 // words still to read
+  reg  [LINE_AW-1:0] wr_idx;
+  reg         wr_half;
+  reg  [1:0]  lead [0:1];                  // pixels before the line's first pixel in its first word
+  reg  [3:0]  outstanding;
+  wire [LBW-1:0] byte0 = fetch_rel == 11'd0 ? {LBW{1'b0}} : line_byte;
+  wire [1:0]  lead0 = ppw_l2 == 2'd2 ? byte0[1:0] : ppw_l2 == 2'd1 ? {1'b0, byte0[1]} : 2'd0;
+  wire [12:0] lead_w = {11'd0, lead0} + {2'b00, fw} + ((13'd1 << ppw_l2) - 13'd1);
+  wire [12:0] n_words = lead_w >> ppw_l2;
+  wire        in_vram = f_addr[VAW+2:VAW] == 3'b000;
+  assign req_valid = f_left != 0 && in_vram;
+  assign req_addr  = 30'(f_addr[VAW-1:0]);
+  wire        issued = req_valid && req_ready;
+  wire        zero_fill = f_left != 0 && !in_vram && outstanding == 4'd0;
+  always @(posedge clk) begin
+    if (rst) begin
+      f_left <= 0;
+      outstanding <= 4'd0;
+      wr_idx <= {LINE_AW{1'b0}};
+    end else begin
+      outstanding <= outstanding + {3'd0, issued} - {3'd0, rsp_valid};
+      if (rsp_valid || zero_fill) begin
+        lb[{wr_half, wr_idx}] <= rsp_valid ? rsp_rdata : 32'd0;
+        wr_idx <= wr_idx + 1'b1;
+      end
+      if (issued || zero_fill) begin
+        f_addr <= f_addr + 1'b1;
+        f_left <= f_left - 1'b1;
+      end
+      if (line_end && fetch_new) begin
+        wr_half <= S == 0 ? fetch_rel[0] : fetch_rel[1];
+        wr_idx <= {LINE_AW{1'b0}};
+        lead[S == 0 ? fetch_rel[0] : fetch_rel[1]] <= lead0;
+        f_addr <= base + (VAW+3)'(byte0 >> 2);
+        f_left <= n_words > (13'd1 << LINE_AW) ? (LINE_AW+1)'(1 << LINE_AW) : n_words[LINE_AW:0];
+        line_byte <= byte0 + stride;
+      end
+    end
+  end
+
+  // --- display: line state at each line start, then a two-stage pixel pipeline ---
+  reg         l_show, l_half;
+  reg  [1:0]  l_lead;
+  always @(posedge clk) begin
+    if (rst) begin
+      hc <= 11'd0;
+      vc <= 11'd0;
+      l_show <= 1'b0;
+    end else if (pix_en) begin
+      hc <= h_last ? 11'd0 : hc + 11'd1;
+      if (h_last) begin
+        vc <= v_next;
+        l_show <= next_in;
+        l_half <= S == 0 ? next_rel[0] : next_rel[1];
+        l_lead <= lead[S == 0 ? next_rel[0] : next_rel[1]];
+      end
+    end
+  end
+  wire        active = hc < 11'(H_ACTIVE) && vc < 11'(V_ACTIVE);
+  wire        in_x = hc >= x0 && hc < x_end;
+  wire [10:0] slot = ((hc - x0) >> S) + {9'd0, l_lead};
+  wire [10:0] widx = slot >> ppw_l2;
+  wire        widx_ok = (widx >> LINE_AW) == 11'd0;
+  wire        hs0 = hc >= 11'(H_ACTIVE + H_FRONT) && hc < 11'(H_ACTIVE + H_FRONT + H_SYNC);
+  wire        vs0 = vc >= 11'(V_ACTIVE + V_FRONT) && vc < 11'(V_ACTIVE + V_FRONT + V_SYNC);
+  reg  [31:0] word1;
+  reg         on1, de1, hs1, vs1;
+  reg  [1:0]  sub1;
+  always @(posedge clk) begin
+    if (pix_en) begin
+      word1 <= lb[{l_half, widx[LINE_AW-1:0]}];
+      on1 <= active && l_show && in_x && widx_ok;
+      sub1 <= slot[1:0] & ((2'd1 << ppw_l2) - 2'd1);
+      de1 <= active;
+      hs1 <= hs0;
+      vs1 <= vs0;
+    end
+  end
+  // expansion to 8 bits (docs/protocol.md section 6); big-endian: the first pixel is the high part
+  wire [15:0] half = sub1[0] ? word1[15:0] : word1[31:16];
+  reg  [7:0]  byte_px;
+  always @* begin
+    case (sub1)
+      2'd0: byte_px = word1[31:24];
+      2'd1: byte_px = word1[23:16];
+      2'd2: byte_px = word1[15:8];
+      default: byte_px = word1[7:0];
+    endcase
+  end
+  wire [7:0] r8 = ppw_l2 == 2'd0 ? word1[31:24] : ppw_l2 == 2'd1 ? {half[15:11], half[15:13]} : {4{byte_px[7:6]}};
+  wire [7:0] g8 = ppw_l2 == 2'd0 ? word1[23:16] : ppw_l2 == 2'd1 ? {half[10:5], half[10:9]} : {4{byte_px[5:4]}};
+  wire [7:0] b8 = ppw_l2 == 2'd0 ? word1[15:8] : ppw_l2 == 2'd1 ? {half[4:0], half[4:2]} : {4{byte_px[3:2]}};
+  // the bits below OUT_BITS and the alpha of RGBA2222 do not leave; rows past the line parity are
+  // the fetch side's
+  wire unused_ok = &{1'b0, next_rel[10:2], byte_px[1:0], r8, g8, b8};
+  always @(posedge clk) begin
+    if (rst) begin
+      {hsync, vsync} <= SYNC_NEG != 0 ? 2'b11 : 2'b00;
+      de <= 1'b0;
+      {red, green, blue} <= {(3 * OUT_BITS){1'b0}};
+    end else if (pix_en) begin
+      hsync <= hs1 ^ (SYNC_NEG != 0);
+      vsync <= vs1 ^ (SYNC_NEG != 0);
+      de <= de1;
+      red   <= on1 ? r8[7 -: OUT_BITS] : {OUT_BITS{1'b0}};
+      green <= on1 ? g8[7 -: OUT_BITS] : {OUT_BITS{1'b0}};
+      blue  <= on1 ? b8[7 -: OUT_BITS] : {OUT_BITS{1'b0}};
+    end
+  end
+
+endmodule
