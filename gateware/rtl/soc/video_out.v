@@ -186,8 +186,12 @@ module video_out #(
   always @(posedge clk) begin
     if (pix_en) begin
       word1 <= lb[{l_half, widx[LINE_AW-1:0]}];
-      on1 <= active && l_show && in_x && widx_ok;
       sub1 <= slot[1:0] & ((2'd1 << ppw_l2) - 2'd1);
+    end
+    if (rst) begin
+      {on1, de1, hs1, vs1} <= 4'd0;
+    end else if (pix_en) begin
+      on1 <= active && l_show && in_x && widx_ok;
       de1 <= active;
       hs1 <= hs0;
       vs1 <= vs0;
