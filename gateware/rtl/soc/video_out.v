@@ -68,14 +68,15 @@ module video_out #(
   endgenerate
   reg  [10:0] hc, vc;
   wire        h_last = hc == 11'(H_TOTAL - 1);
-  wire [10:0] v_next = vc == 11'(V_TOTAL - 1) ? 11'd0 : vc + 11'd1;
-  wire [10:0] v_next2 = v_next == 11'(V_TOTAL - 1) ? 11'd0 : v_next + 11'd1;
   wire        line_end = pix_en && h_last;
+  // the line after next, whose framebuffer line is read during the next line
+  wire [10:0] v_next2 = vc == 11'(V_TOTAL - 2) ? 11'd0 : vc == 11'(V_TOTAL - 1) ? 11'd1 : vc + 11'd2;
 
   // --- the displayed buffer: latched at swap_req, shown from frame_start ---
   reg  [27:0] pend_addr;
   reg         shown;                       // a frame was swapped in since reset
-  reg  [VAW+2:0] base;                     // its first word (beyond VRAM: >= 2^VAW)
+  reg         beyond;                      // it starts beyond VRAM
+  reg  [VAW+1:0] base;                     // its first byte
   reg  [1:0]  ppw_l2;                      // log2 pixels per word: RGBA8888 0, RGB565 1, RGBA2222 2
   reg  [10:0] fw, fh;
   always @(posedge clk) begin
@@ -85,46 +86,58 @@ module video_out #(
       if (swap_req) pend_addr <= swap_addr;
       if (frame_start) begin
         shown <= 1'b1;
-        base <= pend_addr[27:VAW-2] != 0 ? {2'b01, {(VAW+1){1'b0}}} : {3'b000, pend_addr[VAW-3:0], 2'b00};
+        beyond <= pend_addr[27:VAW-2] != 0;
+        base <= {pend_addr[VAW-3:0], 4'd0};
         ppw_l2 <= frame_format == 2'd0 ? 2'd0 : frame_format == 2'd1 ? 2'd1 : 2'd2;
         fw <= frame_width;
         fh <= frame_height;
       end
     end
   end
-  // placement on the screen (registered: used lines after the swap)
+  // placement on the screen, centred: [x0, x_end) x [y0, y_end); cropped from the top left when larger
+  // (registered: used lines after the swap)
   reg  [10:0] x0, x_end, y0, y_end;
   reg  [LBW-1:0] stride;                   // bytes per framebuffer line
+  reg  [LINE_AW:0] n_words;                // words read per line: enough for any lead, at most a half
   wire [11:0] sw = {1'b0, fw} << S, sh = {1'b0, fh} << S;
+  wire [12:0] x_gap = 13'(H_ACTIVE) - {1'b0, sw}, y_gap = 13'(V_ACTIVE) - {1'b0, sh};
+  wire [12:0] x_sum = 13'(H_ACTIVE) + {1'b0, sw}, y_sum = 13'(V_ACTIVE) + {1'b0, sh};
+  wire [11:0] words_w = 12'({1'b0, fw} >> ppw_l2) + 12'd2;
   always @(posedge clk) begin
-    x0    <= sw >= 12'(H_ACTIVE) ? 11'd0 : 11'((12'(H_ACTIVE) - sw) >> 1);
-    x_end <= sw >= 12'(H_ACTIVE) ? 11'(H_ACTIVE) : 11'((12'(H_ACTIVE) - sw) >> 1) + sw[10:0];
-    y0    <= sh >= 12'(V_ACTIVE) ? 11'd0 : 11'((12'(V_ACTIVE) - sh) >> 1);
-    y_end <= sh >= 12'(V_ACTIVE) ? 11'(V_ACTIVE) : 11'((12'(V_ACTIVE) - sh) >> 1) + sh[10:0];
+    x0    <= x_gap[12] ? 11'd0 : x_gap[11:1];
+    x_end <= x_gap[12] ? 11'(H_ACTIVE) : x_sum[11:1];
+    y0    <= y_gap[12] ? 11'd0 : y_gap[11:1];
+    y_end <= y_gap[12] ? 11'(V_ACTIVE) : y_sum[11:1];
     stride <= LBW'({fw, 2'b00}) >> ppw_l2;
+    n_words <= words_w > 12'(1 << LINE_AW) ? (LINE_AW+1)'(1 << LINE_AW) : words_w[LINE_AW:0];
   end
 
-  // a screen line n shows the framebuffer line (n - y0) >> S when y0 <= n < y_end
-  wire        next_in  = shown && v_next >= y0 && v_next < y_end;
-  wire [10:0] next_rel = v_next - y0;
-  wire        fetch_in = shown && v_next2 >= y0 && v_next2 < y_end;
-  wire [10:0] fetch_rel = v_next2 - y0;
-  wire        fetch_new = fetch_in && (S == 0 || fetch_rel[0] == 1'b0);
+  // --- line decisions, at the end of each screen line: for the line after next, is it in the picture,
+  // does it start a framebuffer line (then read it now), and in which line buffer half is it ---
+  reg         f_in, f_rep, f_half;         // the line after next
+  reg         n_show, n_half;              // the next line (decided a line earlier)
+  reg         l_show, l_half;              // the line being shown
+  reg  [1:0]  l_lead;
+  wire        f_first = shown && v_next2 == y0 && y0 != y_end;
+  wire        f_in_new = f_first || (f_in && v_next2 != y_end);
+  wire        f_rep_new = f_first ? 1'b0 : S == 0 ? 1'b0 : !f_rep;   // second screen line of a 2x line
+  wire        f_half_new = f_first ? 1'b0 : f_rep_new ? f_half : !f_half;
+  wire        fetch_new = f_in_new && !f_rep_new;
 
   // --- line buffer fill: at the end of screen line n, the framebuffer line of line n + 2 if it is new ---
   reg  [31:0] lb [0:(2 << LINE_AW) - 1];
-  reg  [LBW-1:0] line_byte;                // byte offset of the next framebuffer line to fetch
-  reg  [VAW+2:0] f_addr;                   // next word to read (>= 2^VAW: beyond VRAM)
+  reg  [LBW-1:0] line_byte;                // offset of the next framebuffer line to read
+  wire [LBW-1:0] byte0 = f_first ? {LBW{1'b0}} : line_byte;
+  wire [LBW:0]   abs0 = {1'b0, byte0} + (LBW+1)'(base);
+  reg  [LBW-2:0] f_addr;                   // next word to read (>= 2^VAW: beyond VRAM)
+  reg         f_beyond;
   reg  [LINE_AW:0] f_left;                 // words still to read
   reg  [LINE_AW-1:0] wr_idx;
   reg         wr_half;
   reg  [1:0]  lead [0:1];                  // pixels before the line's first pixel in its first word
   reg  [3:0]  outstanding;
-  wire [LBW-1:0] byte0 = fetch_rel == 11'd0 ? {LBW{1'b0}} : line_byte;
   wire [1:0]  lead0 = ppw_l2 == 2'd2 ? byte0[1:0] : ppw_l2 == 2'd1 ? {1'b0, byte0[1]} : 2'd0;
-  wire [12:0] lead_w = {11'd0, lead0} + {2'b00, fw} + ((13'd1 << ppw_l2) - 13'd1);
-  wire [12:0] n_words = lead_w >> ppw_l2;
-  wire        in_vram = f_addr[VAW+2:VAW] == 3'b000;
+  wire        in_vram = !f_beyond && f_addr[LBW-2:VAW] == 0;
   assign req_valid = f_left != 0 && in_vram;
   assign req_addr  = 30'(f_addr[VAW-1:0]);
   wire        issued = req_valid && req_ready;
@@ -134,6 +147,7 @@ module video_out #(
       f_left <= 0;
       outstanding <= 4'd0;
       wr_idx <= {LINE_AW{1'b0}};
+      {f_in, f_rep, f_half, n_show, n_half, l_show} <= 6'd0;
     end else begin
       outstanding <= outstanding + {3'd0, issued} - {3'd0, rsp_valid};
       if (rsp_valid || zero_fill) begin
@@ -144,40 +158,55 @@ module video_out #(
         f_addr <= f_addr + 1'b1;
         f_left <= f_left - 1'b1;
       end
-      if (line_end && fetch_new) begin
-        wr_half <= S == 0 ? fetch_rel[0] : fetch_rel[1];
-        wr_idx <= {LINE_AW{1'b0}};
-        lead[S == 0 ? fetch_rel[0] : fetch_rel[1]] <= lead0;
-        f_addr <= base + (VAW+3)'(byte0 >> 2);
-        f_left <= n_words > (13'd1 << LINE_AW) ? (LINE_AW+1)'(1 << LINE_AW) : n_words[LINE_AW:0];
-        line_byte <= byte0 + stride;
+      if (line_end) begin
+        {f_in, f_rep, f_half} <= {f_in_new, f_rep_new, f_half_new};
+        {n_show, n_half} <= {f_in_new, f_half_new};
+        {l_show, l_half} <= {n_show, n_half};
+        l_lead <= lead[n_half];
+        if (fetch_new) begin
+          wr_half <= f_half_new;
+          wr_idx <= {LINE_AW{1'b0}};
+          lead[f_half_new] <= lead0;
+          f_addr <= abs0[LBW:2];
+          f_beyond <= beyond || abs0[LBW];
+          f_left <= n_words;
+          line_byte <= byte0 + stride;
+        end
       end
     end
   end
 
-  // --- display: line state at each line start, then a two-stage pixel pipeline ---
-  reg         l_show, l_half;
-  reg  [1:0]  l_lead;
+  // --- display: counters along the line, then a two-stage pixel pipeline ---
   always @(posedge clk) begin
     if (rst) begin
       hc <= 11'd0;
       vc <= 11'd0;
-      l_show <= 1'b0;
     end else if (pix_en) begin
       hc <= h_last ? 11'd0 : hc + 11'd1;
-      if (h_last) begin
-        vc <= v_next;
-        l_show <= next_in;
-        l_half <= S == 0 ? next_rel[0] : next_rel[1];
-        l_lead <= lead[S == 0 ? next_rel[0] : next_rel[1]];
-      end
+      if (h_last) vc <= vc == 11'(V_TOTAL - 1) ? 11'd0 : vc + 11'd1;
+    end
+  end
+  // the pixel's place in the framebuffer line: from x0 on, a pixel every 2^S screen pixels, a word
+  // every 2^ppw_l2 pixels (the first word from the line's lead on)
+  reg         x_in_r, rep_r;
+  reg  [1:0]  sub_r;
+  reg  [LINE_AW:0] widx_r;                 // the top bit: beyond the line buffer half (black)
+  wire        x_start = hc == x0;
+  wire        x_in = hc != x_end && (x_start || x_in_r);
+  wire        rep = x_start ? 1'b0 : rep_r;
+  wire [1:0]  sub = x_start ? l_lead : sub_r;
+  wire [LINE_AW:0] widx = x_start ? {(LINE_AW+1){1'b0}} : widx_r;
+  wire        advance = S == 0 || rep;
+  wire        word_end = sub == (2'd1 << ppw_l2) - 2'd1;
+  always @(posedge clk) begin
+    if (pix_en) begin
+      x_in_r <= x_in;
+      rep_r <= !rep;
+      sub_r <= advance ? (word_end ? 2'd0 : sub + 2'd1) : sub;
+      widx_r <= advance && word_end && !widx[LINE_AW] ? widx + 1'b1 : widx;
     end
   end
   wire        active = hc < 11'(H_ACTIVE) && vc < 11'(V_ACTIVE);
-  wire        in_x = hc >= x0 && hc < x_end;
-  wire [10:0] slot = ((hc - x0) >> S) + {9'd0, l_lead};
-  wire [10:0] widx = slot >> ppw_l2;
-  wire        widx_ok = (widx >> LINE_AW) == 11'd0;
   wire        hs0 = hc >= 11'(H_ACTIVE + H_FRONT) && hc < 11'(H_ACTIVE + H_FRONT + H_SYNC);
   wire        vs0 = vc >= 11'(V_ACTIVE + V_FRONT) && vc < 11'(V_ACTIVE + V_FRONT + V_SYNC);
   reg  [31:0] word1;
@@ -186,12 +215,12 @@ module video_out #(
   always @(posedge clk) begin
     if (pix_en) begin
       word1 <= lb[{l_half, widx[LINE_AW-1:0]}];
-      sub1 <= slot[1:0] & ((2'd1 << ppw_l2) - 2'd1);
+      sub1 <= sub;
     end
     if (rst) begin
       {on1, de1, hs1, vs1} <= 4'd0;
     end else if (pix_en) begin
-      on1 <= active && l_show && in_x && widx_ok;
+      on1 <= active && l_show && x_in && !widx[LINE_AW];
       de1 <= active;
       hs1 <= hs0;
       vs1 <= vs0;
@@ -213,7 +242,7 @@ module video_out #(
   wire [7:0] b8 = ppw_l2 == 2'd0 ? word1[15:8] : ppw_l2 == 2'd1 ? {half[4:0], half[4:2]} : {4{byte_px[3:2]}};
   // the bits below OUT_BITS and the alpha of RGBA2222 do not leave; rows past the line parity are
   // the fetch side's
-  wire unused_ok = &{1'b0, next_rel[10:2], byte_px[1:0], r8, g8, b8};
+  wire unused_ok = &{1'b0, byte_px[1:0], r8, g8, b8, x_gap[0], y_gap[0], x_sum[12], x_sum[0], y_sum[12], y_sum[0]};
   always @(posedge clk) begin
     if (rst) begin
       {hsync, vsync} <= SYNC_NEG != 0 ? 2'b11 : 2'b00;
