@@ -99,7 +99,8 @@ def icebreaker(out_dir, seeds, abc9):
         out, secs = run(cmd, "nextpnr-ice40", log_path)
         log = out.stdout + out.stderr
         used = utilisation(log)
-        over = [f"{k} {u:,} used of {a:,} ({100 * u / a:.0f} %)" for k, (u, a) in used.items() if u > a]
+        names = {v: k for k, v in ICE40_CELLS.items()}
+        over = [f"{names[k]} {u:,} used of {a:,} ({100 * u / a:.0f} %)" for k, (u, a) in used.items() if u > a]
         if over:
             raise Failure(f"icebreaker: the design does not fit the {ICEBREAKER['part']}: " + "; ".join(over)
                           + f" (nextpnr-ice40, log {log_path}; docs/gateware.md 'The up5k profile does not fit yet')",

@@ -1,7 +1,10 @@
-// Memory arbiter: one video-memory port shared by a board's video output (video_out, reads; tied off
-// in the co-simulation), the memory-access unit (MEM_ADDR / MEM_DATA), the scanout reader and the
+// Memory arbiter: one video-memory port shared by the memory-access unit (MEM_ADDR / MEM_DATA), a
+// board's video output (video_out, reads; tied off in the co-simulation), the scanout reader and the
 // render core, in that priority (the scanout reader wins over the core after waiting 16 clocks). The
-// video output comes first because a monitor does not wait: it reads one line buffer half per line. One request per clock; responses return in request order to whoever asked.
+// memory-access unit asks for at most two words per SPI frame and must reload its prefetch within
+// one (docs/protocol.md 2.4), so it stays first; the video output, which reads a line buffer half per
+// screen line and cannot wait for a frame, comes before the scanout and the core. One request per
+// clock; responses return in request order to whoever asked.
 //
 // VRAM bounds (docs/protocol.md section 6) for the core: a write beyond VRAM is dropped and a read
 // beyond returns 0, both raising ERR_MEM_RANGE. Such a read waits until no other read is in flight
@@ -86,15 +89,15 @@ module mem_arbiter #(
   wire c_ok  = c_req_valid && !c_oor && !c_block && (c_req_we || tags_room);
 
   // choice (independent of b_req_ready)
-  wire pick_v = v_req_valid && tags_room;
-  wire pick_m = !pick_v && m_ok;
+  wire pick_m = m_ok;
+  wire pick_v = !pick_m && v_req_valid && tags_room;
   wire pick_s = !pick_v && !pick_m && s_ok && (scan_wait == 4'd15 || !(c_ok || c_zero));
   wire pick_c = !pick_v && !pick_m && !pick_s && c_ok;
   wire pick_z = !pick_v && !pick_m && !pick_s && !c_ok && c_zero;
 
   assign b_req_valid = pick_v || pick_m || pick_s || pick_c;
   assign b_req_we    = pick_m ? m_req_we : pick_c ? c_req_we : 1'b0;
-  wire [29:0] addr   = pick_v ? v_req_addr : pick_m ? m_req_addr : pick_s ? s_req_addr : c_req_addr;
+  wire [29:0] addr   = pick_m ? m_req_addr : pick_v ? v_req_addr : pick_s ? s_req_addr : c_req_addr;
   assign b_req_addr  = addr[AW-1:0];
   assign b_req_wdata = pick_m ? m_req_wdata : c_req_wdata;
   assign b_req_be    = pick_c ? c_req_be : 4'hF;
@@ -105,7 +108,7 @@ module mem_arbiter #(
   assign c_req_ready = (pick_c && b_req_ready) || pick_z;
 
   wire granted_read = b_req_valid && b_req_ready && !b_req_we;
-  wire [1:0] granted_client = pick_v ? 2'd3 : pick_m ? 2'd0 : pick_s ? 2'd1 : 2'd2;
+  wire [1:0] granted_client = pick_m ? 2'd0 : pick_v ? 2'd3 : pick_s ? 2'd1 : 2'd2;
   wire [1:0] head = tag[tag_rd];
 
   assign v_rsp_valid = b_rsp_valid && head == 2'd3;
