@@ -35,6 +35,10 @@ def board_clock(report, board):
     return target, state
 
 
+def sentence(text):
+    return text[:1].upper() + text[1:] + ("" if text.endswith(".") else ".")
+
+
 def figures(report):
     """The resource and clock figures of each board report, as markdown."""
     lines = []
@@ -51,7 +55,8 @@ def figures(report):
             fm = ", ".join(f"`{c}` {f:.2f} MHz" for c, f in ice["fmax_mhz"].items())
             lines.append(f"  Post-route fmax (worst of {len(ice.get('seeds', []))} seed(s)): {fm}.")
         if "error" in ice:
-            lines.append(f"  **Fails:** {ice['error']}")
+            # the log's path is the build machine's: left out of the document
+            lines.append("  **Fails:** " + re.sub(r" \(nextpnr-ice40, log [^;]*; ", " (", ice["error"]))
     ulx = report.get("ulx3s")
     if ulx and "synth" in ulx:
         sy, m, sd = ulx["synth"], ulx["margin_pct"], ulx.get("sdram_ctrl", {})
@@ -60,7 +65,7 @@ def figures(report):
                      f"of 83,640 (margin {m['lut4']} %), {sy['ff']:,} FF (margin {m['ff']} %), {sy['ebr']} EBR of 208 "
                      f"(margin {m['ebr']} %), {sy['dsp']} MULT18X18D of 156 (margin {m['dsp']} %); the SDRAM controller "
                      f"alone {sd.get('lut4', 0):,} LUT4, {sd.get('ccu2c', 0)} CCU2C, {sd.get('ff', 0):,} FF. "
-                     + (ulx.get("pnr", "Placed and routed.").capitalize() if "fmax_mhz" not in ulx else
+                     + (sentence(ulx.get("pnr", "placed and routed")) if "fmax_mhz" not in ulx else
                         "Post-route fmax: " + ", ".join(f"`{c}` {f:.2f} MHz" for c, f in ulx["fmax_mhz"].items()) + "."))
     elif ulx and "error" in ulx:
         lines.append(f"- **ULX3S** fails: {ulx['error']}")
