@@ -50,7 +50,7 @@ def need(tool, package):
         raise ToolError(f"{tool} not found: install the Debian package {package} (scripts/install-deps.sh does)")
 
 
-def yosys(top_v, top, cmd, net, log_path):
+def yosys(top_v, top, cmd, net, log_path, params=""):
     need("yosys", "yosys")
     files = " ".join(synth.design_files())
     # the ecp5 profile has no SPRAM: its primitive (known to synth_ice40) is a black box there
@@ -59,7 +59,7 @@ def yosys(top_v, top, cmd, net, log_path):
     bdir = os.path.dirname(top_v)
     board_files = " ".join(os.path.relpath(os.path.join(bdir, f), GW) for f in sorted(os.listdir(bdir)) if f.endswith(".v"))
     script = (f"{lib}read_verilog -sv -Irtl/soc -Irtl/core {files} {board_files}; "
-              f"{cmd} -top {top} -json {net}; stat")
+              f"{params}{cmd} -top {top} -json {net}; stat")
     out, secs = run(["yosys", "-q", "-p", script, "-l", log_path + ".stat"], "yosys", log_path, cwd=GW)
     if out.returncode != 0:
         raise ToolError(f"yosys failed on {top} (log {log_path}):\n{(out.stdout + out.stderr)[-1500:]}")
@@ -81,12 +81,13 @@ def utilisation(log):
     return res
 
 
-def icebreaker(out_dir, seeds, abc9):
-    r = dict(ICEBREAKER, board="icebreaker")
+def icebreaker(out_dir, seeds, abc9, video):
+    r = dict(ICEBREAKER, board="icebreaker", video=video)
     net = os.path.join(out_dir, "icebreaker.json")
     cmd = "synth_ice40 -dsp" + (" -abc9 -device u" if abc9 else "")
     stat, secs = yosys(os.path.join(BOARDS_DIR, "icebreaker", "icebreaker_top.v"), "icebreaker_top", cmd, net,
-                       os.path.join(out_dir, "icebreaker.yosys.log"))
+                       os.path.join(out_dir, "icebreaker.yosys.log"),
+                       "" if video else "chparam -set VIDEO 0 icebreaker_top; ")
     r["synth"] = dict(synth.count(stat), seconds=round(secs, 1), command=cmd)
     need("nextpnr-ice40", "nextpnr-ice40")
     runs = []
@@ -205,6 +206,7 @@ def main():
     ap.add_argument("--board", choices=["icebreaker", "ulx3s", "all"], default="all")
     ap.add_argument("--seeds", type=int, default=1, help="nextpnr-ice40 seeds 1..N; the worst fmax is reported")
     ap.add_argument("--abc9", action="store_true", help="icebreaker: synth_ice40 -abc9 -device u")
+    ap.add_argument("--no-video", action="store_true", help="icebreaker: leave the video output out (headless)")
     ap.add_argument("--json", help="write the report as JSON")
     ap.add_argument("--out", default=os.path.join("build", "gateware", "boards"), help="bitstreams and logs")
     a = ap.parse_args()
@@ -215,7 +217,7 @@ def main():
     report, status = {}, 0
     for board in (["icebreaker", "ulx3s"] if a.board == "all" else [a.board]):
         try:
-            r = icebreaker(out_dir, a.seeds, a.abc9) if board == "icebreaker" else ulx3s(out_dir)
+            r = icebreaker(out_dir, a.seeds, a.abc9, not a.no_video) if board == "icebreaker" else ulx3s(out_dir)
             print(summary(r), flush=True)
         except Failure as e:
             r = dict(e.args[1]) if len(e.args) > 1 else {"board": board}
