@@ -51,6 +51,10 @@ def figures(report):
         sy = ice.get("synth", {})
         lines.append(f"- **iCEBreaker** ({ice['part']}, target {ice['target_mhz']} MHz): yosys `{sy.get('command', '')}` "
                      f"{sy.get('lut', 0):,} LUT4, {sy.get('ff', 0):,} FF, {sy.get('carry', 0):,} carry; nextpnr-ice40: {cells}.")
+        if "lc" in u:
+            share = u["lc"]["used"] / u["lc"]["available"]
+            lines.append(f"  Goal: at most 90 % of the logic cells ({int(0.9 * u['lc']['available']):,}): "
+                         + ("met" if share <= 0.9 else "**missed**") + f" ({100 * share:.0f} %).")
         if ice.get("fmax_mhz"):
             fm = ", ".join(f"`{c}` {f:.2f} MHz" for c, f in ice["fmax_mhz"].items())
             lines.append(f"  Post-route fmax (worst of {len(ice.get('seeds', []))} seed(s)): {fm}.")

@@ -102,7 +102,9 @@ module video_out #(
   wire [11:0] sw = {1'b0, fw} << S, sh = {1'b0, fh} << S;
   wire [12:0] x_gap = 13'(H_ACTIVE) - {1'b0, sw}, y_gap = 13'(V_ACTIVE) - {1'b0, sh};
   wire [12:0] x_sum = 13'(H_ACTIVE) + {1'b0, sw}, y_sum = 13'(V_ACTIVE) + {1'b0, sh};
-  wire [11:0] words_w = 12'({1'b0, fw} >> ppw_l2) + 12'd2;
+  // only the pixels the screen shows are read: at most H_ACTIVE / 2^S of a line
+  wire [10:0] w_shown = fw > 11'(H_ACTIVE >> S) ? 11'(H_ACTIVE >> S) : fw;
+  wire [11:0] words_w = {1'b0, w_shown >> ppw_l2} + 12'd2;
   always @(posedge clk) begin
     x0    <= x_gap[12] ? 11'd0 : x_gap[11:1];
     x_end <= x_gap[12] ? 11'(H_ACTIVE) : x_sum[11:1];
@@ -124,7 +126,10 @@ module video_out #(
   wire        f_half_new = f_first ? 1'b0 : f_rep_new ? f_half : !f_half;
   wire        fetch_new = f_in_new && !f_rep_new;
 
-  // --- line buffer fill: at the end of screen line n, the framebuffer line of line n + 2 if it is new ---
+  // --- line buffer fill: at the end of screen line n, the framebuffer line of line n + 2 if it is new.
+  // The reads must finish within one screen line (iCEBreaker: at most 256 SPRAM words in 800 clocks;
+  // ULX3S: 642 SDRAM words at 2 clocks each in 1,600, row misses, refreshes and MEM_* beside); a fill
+  // still running when the next one starts is abandoned, and its late answers would land in the new one ---
   reg  [31:0] lb [0:(2 << LINE_AW) - 1];
   reg  [LBW-1:0] line_byte;                // offset of the next framebuffer line to read
   wire [LBW-1:0] byte0 = f_first ? {LBW{1'b0}} : line_byte;
