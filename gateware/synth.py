@@ -67,13 +67,19 @@ def pack(files, cmd):
         return int(m.group(1))
 
 
+def design_files():
+    """The device's sources, relative to gateware/: spigpu_top and every soc and core module."""
+    files = [os.path.join("rtl", "spigpu_top.v")]
+    for d in ("soc", "core"):
+        files += sorted(os.path.join("rtl", d, f) for f in os.listdir(os.path.join(GW, "rtl", d)) if f.endswith(".v"))
+    return files
+
+
 def synth(profile, modules=False, abc9=False, packed=False):
     value, cmd = PROFILES[profile]
     if abc9 and profile == "up5k":
         cmd += " -abc9 -device u"
-    files = [os.path.join("rtl", "spigpu_top.v")]
-    for d in ("soc", "core"):
-        files += sorted(os.path.join("rtl", d, f) for f in os.listdir(os.path.join(GW, "rtl", d)) if f.endswith(".v"))
+    files = design_files()
     # the ecp5 profile has no SPRAM: its primitive (known to synth_ice40) is a black box there
     lib = "read_verilog -lib sim/SB_SPRAM256KA.v; " if profile == "ecp5" else ""
     flat = " -noflatten" if modules else ""

@@ -21,6 +21,7 @@ packages=(
   xvfb xauth x11-utils                        
   verilator yosys                             # gateware: rtl backend, ctest -L rtl (lint, co-simulation, yosys read)
   nextpnr-ice40 fpga-icestorm                 # gateware: iCE40 place and route, icepack (docs/gateware.md)
+  python3                                     # scripts/gateware.sh (gateware/boards/build.py), gateware/synth.py
   openfpgaloader                              # gpubridge flash (iceprog comes with fpga-icestorm)
 )
 

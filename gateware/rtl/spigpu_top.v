@@ -5,13 +5,22 @@
 //   PROFILE 1 "ecp5": ECP5-85F, 32 MiB SDR SDRAM as VRAM, 1024 x 768 at most, FIFO 1023, every feature.
 // Display timing is in core clocks (LINE_CLOCKS x V_TOTAL lines, V_ACTIVE visible); the board top
 // levels set it for 640 x 480 at 60 Hz, the co-simulation uses a short frame.
+// VIDEO = 1 adds a board's video output (soc/video_out.v: the displayed buffer every refresh, its own
+// memory-arbiter client and line buffer); the co-simulation and the rtl tests keep VIDEO = 0, where
+// the video_* outputs are 0 and the arbiter's video client is tied off. LINE_CLOCKS must then be
+// 800 x VIDEO_PIX_DIV, so that the scanout's vertical sync is the video's.
 module spigpu_top #(
   parameter PROFILE     = 0,
   parameter CLK_MHZ     = PROFILE == 0 ? 25 : 50,
   parameter LINE_CLOCKS = PROFILE == 0 ? 800 : 1600,
   parameter V_ACTIVE    = 480,
   parameter V_TOTAL     = 525,
-  parameter PERF        = 0       // 1: performance counters for the co-simulation
+  parameter PERF        = 0,      // 1: performance counters for the co-simulation
+  parameter VIDEO       = 0,      // 1: video output (board top levels)
+  parameter VIDEO_PIX_DIV    = 1, // core clocks per pixel
+  parameter VIDEO_SCALE_LOG2 = 1, // framebuffer pixels shown 2^n x 2^n
+  parameter VIDEO_LINE_AW    = 8, // line buffer: 2 x 2^n words
+  parameter VIDEO_BITS       = 4  // bits per colour channel at the pins
 ) (
   input  wire        clk,
   input  wire        rst,
@@ -55,7 +64,15 @@ module spigpu_top #(
   output wire [31:0] perf_textured,
   output wire [31:0] perf_core_busy,
   output wire [31:0] perf_setup,
-  output wire [31:0] perf_raster
+  output wire [31:0] perf_raster,
+  // video output (VIDEO = 1): pixel enable, syncs at pin level (low pulses), data enable, colour
+  output wire        video_pix_en,
+  output wire        video_hsync,
+  output wire        video_vsync,
+  output wire        video_de,
+  output wire [VIDEO_BITS-1:0] video_r,
+  output wire [VIDEO_BITS-1:0] video_g,
+  output wire [VIDEO_BITS-1:0] video_b
 );
   // CAPS.FEATURES: bit 0 bilinear, 1 blend, 2 dither, 3 strict link, 4 RGB565, 5 RGBA2222,
   // 6 temporal dither (protocol 1.1), 7 texturing (protocol 1.2). up5k: dither, strict link, RGB565,
@@ -85,6 +102,9 @@ module spigpu_top #(
   wire [29:0]  mem_req_addr;
   wire [31:0]  mem_req_wdata, mem_rsp_rdata;
   wire [3:0]   mem_req_be;
+  wire         disp_swap_req, v_req_valid, v_req_ready, v_rsp_valid;
+  wire [27:0]  disp_swap_addr;
+  wire [29:0]  v_req_addr;
 
   spigpu_soc #(
     .PROFILE(PROFILE), .FEATURES(FEATURES), .MAX_WIDTH(MAX_WIDTH), .MAX_HEIGHT(MAX_HEIGHT),
@@ -106,7 +126,28 @@ module spigpu_top #(
     .frame_word(frame_word), .frame_nbytes(frame_nbytes), .frame_start(frame_start), .frame_end(frame_end),
     .frame_format(frame_format), .frame_width(frame_width), .frame_height(frame_height), .perf_cycles(perf_cycles),
     .perf_work_cycles(perf_work_cycles), .perf_cmds(perf_cmds), .perf_frames(perf_frames),
-    .perf_core_stalls(perf_core_stalls), .perf_refreshes(perf_refreshes));
+    .perf_core_stalls(perf_core_stalls), .perf_refreshes(perf_refreshes), .disp_swap_req(disp_swap_req),
+    .disp_swap_addr(disp_swap_addr), .v_req_valid(v_req_valid), .v_req_ready(v_req_ready), .v_req_addr(v_req_addr),
+    .v_rsp_valid(v_rsp_valid));
+
+  generate
+    if (VIDEO != 0) begin : g_video
+      localparam VAW = PROFILE == 0 ? 15 : 23;
+      video_out #(.VAW(VAW), .LBW(VAW + 4), .PIX_DIV(VIDEO_PIX_DIV), .SCALE_LOG2(VIDEO_SCALE_LOG2),
+                  .LINE_AW(VIDEO_LINE_AW), .OUT_BITS(VIDEO_BITS)) u_video (
+        .clk(clk), .rst(rst), .swap_req(disp_swap_req), .swap_addr(disp_swap_addr), .frame_start(frame_start),
+        .frame_format(frame_format), .frame_width(frame_width), .frame_height(frame_height),
+        .req_valid(v_req_valid), .req_ready(v_req_ready), .req_addr(v_req_addr), .rsp_valid(v_rsp_valid),
+        .rsp_rdata(mem_rsp_rdata), .pix_en(video_pix_en), .hsync(video_hsync), .vsync(video_vsync), .de(video_de),
+        .red(video_r), .green(video_g), .blue(video_b));
+    end else begin : g_novideo
+      assign v_req_valid = 1'b0;
+      assign v_req_addr = 30'd0;
+      assign {video_pix_en, video_hsync, video_vsync, video_de} = 4'd0;
+      assign {video_r, video_g, video_b} = {(3 * VIDEO_BITS){1'b0}};
+      wire unused_video = &{1'b0, disp_swap_req, disp_swap_addr, v_req_ready, v_rsp_valid};
+    end
+  endgenerate
 
   spigpu_core #(.PROFILE(PROFILE), .FEATURES(CORE_FEATURES), .MAX_WIDTH(MAX_WIDTH), .MAX_HEIGHT(MAX_HEIGHT),
                 .VRAM_KIB(VRAM_KIB), .PERF(PERF)) u_core (

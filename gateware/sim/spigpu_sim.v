@@ -46,6 +46,10 @@ module spigpu_sim #(
   wire [12:0] sd_a;
   wire [15:0] sd_dq_o, sd_dq_i;
   wire        vsync;
+  // the board video output is not part of the co-simulation (VIDEO = 0: these read 0)
+  wire        video_pix_en, video_hsync, video_vsync, video_de;
+  wire [3:0]  video_r, video_g, video_b;
+  wire        unused_video = &{1'b0, video_pix_en, video_hsync, video_vsync, video_de, video_r, video_g, video_b};
 
   spigpu_top #(.PROFILE(PROFILE), .CLK_MHZ(CLK_MHZ), .LINE_CLOCKS(LINE_CLOCKS), .V_ACTIVE(V_ACTIVE),
                .V_TOTAL(V_TOTAL), .PERF(1)) dut (
@@ -58,7 +62,9 @@ module spigpu_sim #(
     .perf_work_cycles(perf_work_cycles), .perf_cmds(perf_cmds), .perf_frames(perf_frames),
     .perf_core_stalls(perf_core_stalls), .perf_refreshes(perf_refreshes), .perf_triangles(perf_triangles),
     .perf_pixels(perf_pixels), .perf_passed(perf_passed), .perf_textured(perf_textured),
-    .perf_core_busy(perf_core_busy), .perf_setup(perf_setup), .perf_raster(perf_raster));
+    .perf_core_busy(perf_core_busy), .perf_setup(perf_setup), .perf_raster(perf_raster),
+    .video_pix_en(video_pix_en), .video_hsync(video_hsync), .video_vsync(video_vsync), .video_de(video_de),
+    .video_r(video_r), .video_g(video_g), .video_b(video_b));
 
   generate
     if (PROFILE == 1) begin : g_sdram

@@ -1,6 +1,10 @@
-// Memory arbiter: one video-memory port shared by the memory-access unit (MEM_ADDR / MEM_DATA), the
-// scanout reader and the render core, in that priority (the scanout reader wins over the core after
-// waiting 16 clocks). One request per clock; responses return in request order to whoever asked.
+// Memory arbiter: one video-memory port shared by the memory-access unit (MEM_ADDR / MEM_DATA), a
+// board's video output (video_out, reads; tied off in the co-simulation), the scanout reader and the
+// render core, in that priority (the scanout reader wins over the core after waiting 16 clocks). The
+// memory-access unit asks for at most two words per SPI frame and must reload its prefetch within
+// one (docs/protocol.md 2.4), so it stays first; the video output, which reads a line buffer half per
+// screen line and cannot wait for a frame, comes before the scanout and the core. One request per
+// clock; responses return in request order to whoever asked.
 //
 // VRAM bounds (docs/protocol.md section 6) for the core: a write beyond VRAM is dropped and a read
 // beyond returns 0, both raising ERR_MEM_RANGE. Such a read waits until no other read is in flight
@@ -16,6 +20,11 @@ module mem_arbiter #(
 ) (
   input  wire        clk,
   input  wire        rst,
+  // video output (reads inside VRAM; constant 0 where there is none)
+  input  wire        v_req_valid,
+  output wire        v_req_ready,
+  input  wire [29:0] v_req_addr,
+  output wire        v_rsp_valid,
   // memory-access unit (32-bit words, all bytes)
   input  wire        m_req_valid,
   output wire        m_req_ready,
@@ -81,25 +90,28 @@ module mem_arbiter #(
 
   // choice (independent of b_req_ready)
   wire pick_m = m_ok;
-  wire pick_s = !pick_m && s_ok && (scan_wait == 4'd15 || !(c_ok || c_zero));
-  wire pick_c = !pick_m && !pick_s && c_ok;
-  wire pick_z = !pick_m && !pick_s && !c_ok && c_zero;
+  wire pick_v = !pick_m && v_req_valid && tags_room;
+  wire pick_s = !pick_v && !pick_m && s_ok && (scan_wait == 4'd15 || !(c_ok || c_zero));
+  wire pick_c = !pick_v && !pick_m && !pick_s && c_ok;
+  wire pick_z = !pick_v && !pick_m && !pick_s && !c_ok && c_zero;
 
-  assign b_req_valid = pick_m || pick_s || pick_c;
+  assign b_req_valid = pick_v || pick_m || pick_s || pick_c;
   assign b_req_we    = pick_m ? m_req_we : pick_c ? c_req_we : 1'b0;
-  wire [29:0] addr   = pick_m ? m_req_addr : pick_s ? s_req_addr : c_req_addr;
+  wire [29:0] addr   = pick_m ? m_req_addr : pick_v ? v_req_addr : pick_s ? s_req_addr : c_req_addr;
   assign b_req_addr  = addr[AW-1:0];
   assign b_req_wdata = pick_m ? m_req_wdata : c_req_wdata;
   assign b_req_be    = pick_c ? c_req_be : 4'hF;
 
+  assign v_req_ready = pick_v && b_req_ready;
   assign m_req_ready = pick_m && b_req_ready;
   assign s_req_ready = pick_s && b_req_ready;
   assign c_req_ready = (pick_c && b_req_ready) || pick_z;
 
   wire granted_read = b_req_valid && b_req_ready && !b_req_we;
-  wire [1:0] granted_client = pick_m ? 2'd0 : pick_s ? 2'd1 : 2'd2;
+  wire [1:0] granted_client = pick_m ? 2'd0 : pick_v ? 2'd3 : pick_s ? 2'd1 : 2'd2;
   wire [1:0] head = tag[tag_rd];
 
+  assign v_rsp_valid = b_rsp_valid && head == 2'd3;
   assign m_rsp_valid = b_rsp_valid && head == 2'd0;
   assign s_rsp_valid = b_rsp_valid && head == 2'd1;
   assign c_rsp_valid = (b_rsp_valid && head == 2'd2) || zero_rsp;

@@ -77,6 +77,14 @@ module spigpu_soc #(
   output wire [1:0]   frame_format,
   output wire [10:0]  frame_width,
   output wire [10:0]  frame_height,
+  // a board's video output (video_out): the swap requests and a memory-arbiter client (tie v_req_valid
+  // to 0 where there is none, as the co-simulation does)
+  output wire         disp_swap_req,
+  output wire [27:0]  disp_swap_addr,
+  input  wire         v_req_valid,
+  output wire         v_req_ready,
+  input  wire [29:0]  v_req_addr,
+  output wire         v_rsp_valid,
   // counters for the co-simulation and the timing model (PERF = 1)
   output wire [31:0]  perf_cycles,        // clocks since power-on
   output wire [31:0]  perf_work_cycles,   // clocks with work (a released command, the core, MEM_*)
@@ -214,7 +222,8 @@ module spigpu_soc #(
   wire [31:0]    b_req_wdata, b_rsp_rdata;
   wire [3:0]     b_req_be;
   mem_arbiter #(.VRAM_WORDS(VRAM_WORDS), .AW(VAW)) u_arb (
-    .clk(clk), .rst(rst), .m_req_valid(m_req_valid), .m_req_ready(m_req_ready), .m_req_we(m_req_we),
+    .clk(clk), .rst(rst), .v_req_valid(v_req_valid), .v_req_ready(v_req_ready), .v_req_addr(v_req_addr),
+    .v_rsp_valid(v_rsp_valid), .m_req_valid(m_req_valid), .m_req_ready(m_req_ready), .m_req_we(m_req_we),
     .m_req_addr(m_req_addr), .m_req_wdata(m_req_wdata), .m_rsp_valid(m_rsp_valid), .s_req_valid(s_req_valid),
     .s_req_ready(s_req_ready), .s_req_addr(s_req_addr), .s_rsp_valid(s_rsp_valid), .c_req_valid(mem_req_valid),
     .c_req_ready(mem_req_ready), .c_req_we(mem_req_we), .c_req_addr(mem_req_addr), .c_req_wdata(mem_req_wdata),
@@ -223,6 +232,8 @@ module spigpu_soc #(
     .b_req_ready(b_req_ready), .b_req_we(b_req_we), .b_req_addr(b_req_addr), .b_req_wdata(b_req_wdata),
     .b_req_be(b_req_be), .b_rsp_valid(b_rsp_valid), .b_rsp_rdata(b_rsp_rdata), .core_stall(core_stall));
   assign mem_rsp_rdata = rsp_rdata;
+  assign disp_swap_req = swap_req;
+  assign disp_swap_addr = swap_addr;
 
   wire refresh_pulse;
   generate
@@ -274,5 +285,5 @@ module spigpu_soc #(
     end
   endgenerate
 
-  wire unused_ok = &{1'b0, errors, swap_req};
+  wire unused_ok = &{1'b0, errors};
 endmodule

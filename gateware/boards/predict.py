@@ -1,0 +1,198 @@
+#!/usr/bin/env python3
+"""The boards' figures and predicted frames per second of every example and scene, from the
+scripts/gateware.sh --json reports and the RTL cycle counts (`gpubridge --json bench rtl`).
+
+    gateware/boards/predict.py --report ICEBREAKER.json --report ULX3S.json [--bench BENCH.json]
+                               [--core up5k=CORE_UP5K.json --core ecp5=CORE_ECP5.json] [--doc docs/gateware.md]
+
+--core takes build/gateware/tests/core/rtl_core_<profile>_bench --json: the core's pixels per clock
+per scene class, turned into fill rates at the board clocks and checked against the issue's goals
+(UP5K: >= 25 Mpixel/s untextured; ECP5-85F: >= 50 untextured, >= 25 bilinear-textured).
+
+A board runs at the clock its PLL makes (iCEBreaker 25.125 MHz, ULX3S 50 MHz), provided the routed
+design's fmax reaches it: the prediction is cycles / clock, and the report says whether the fmax was
+measured (placed and routed) or is still only the target. --doc rewrites the blocks between the
+"board-figures" and "predicted-fps" markers of docs/gateware.md; without it they go to stdout.
+"""
+import argparse, json, re, sys
+
+BOARD_OF = {"up5k": "icebreaker", "ecp5": "ulx3s"}
+
+
+def board_clock(report, board):
+    r = report.get(board)
+    if r is None:
+        return None, "no report"
+    target = r.get("target_mhz")
+    fmax = r.get("fmax_mhz")
+    if fmax:
+        worst = min(fmax.values())
+        state = f"routed, worst fmax {worst:.2f} MHz" + ("" if worst >= target else " (below the target)")
+    elif "error" in r:
+        state = "not routed yet: " + r["error"].split(":", 1)[-1].strip().split(" (")[0]
+    else:
+        state = "synthesised only, clock not verified by place and route"
+    return target, state
+
+
+def sentence(text):
+    return text[:1].upper() + text[1:] + ("" if text.endswith(".") else ".")
+
+
+def figures(report):
+    """The resource and clock figures of each board report, as markdown."""
+    lines = []
+    ice = report.get("icebreaker")
+    if ice:
+        u = ice.get("utilisation", {})
+        cells = ", ".join(f"{name} {u[k]['used']:,} of {u[k]['available']:,}" for k, name in
+                          (("lc", "logic cells"), ("bram", "block RAM"), ("spram", "SPRAM"), ("dsp", "DSP"),
+                           ("pll", "PLL"), ("io", "I/O")) if k in u)
+        sy = ice.get("synth", {})
+        lines.append(f"- **iCEBreaker** ({ice['part']}, target {ice['target_mhz']} MHz): yosys `{sy.get('command', '')}` "
+                     f"{sy.get('lut', 0):,} LUT4, {sy.get('ff', 0):,} FF, {sy.get('carry', 0):,} carry; nextpnr-ice40: {cells}.")
+        if "lc" in u:
+            share = u["lc"]["used"] / u["lc"]["available"]
+            lines.append(f"  Goal: at most 90 % of the logic cells ({int(0.9 * u['lc']['available']):,}): "
+                         + ("met" if share <= 0.9 else "**missed**") + f" ({100 * share:.0f} %).")
+        if ice.get("fmax_mhz"):
+            fm = ", ".join(f"`{c}` {f:.2f} MHz" for c, f in ice["fmax_mhz"].items())
+            lines.append(f"  Post-route fmax (worst of {len(ice.get('seeds', []))} seed(s)): {fm}.")
+        if "error" in ice:
+            # the log's path is the build machine's: left out of the document
+            lines.append("  **Fails:** " + re.sub(r" \(nextpnr-ice40, log [^;]*; ", " (", ice["error"]))
+    ulx = report.get("ulx3s")
+    if ulx and "synth" in ulx:
+        sy, m, sd = ulx["synth"], ulx["margin_pct"], ulx.get("sdram_ctrl", {})
+        lines.append(f"- **ULX3S** ({ulx['part']}, target {ulx['target_mhz']:g} MHz): yosys `synth_ecp5` {sy['lut4']:,} LUT4 + "
+                     f"{sy['ccu2c']:,} CCU2C + {sy['dpr16x4']:,} TRELLIS_DPR16X4 = {sy['lut4_equivalent']:,} LUT4 equivalent "
+                     f"of 83,640 (margin {m['lut4']} %), {sy['ff']:,} FF (margin {m['ff']} %), {sy['ebr']} EBR of 208 "
+                     f"(margin {m['ebr']} %), {sy['dsp']} MULT18X18D of 156 (margin {m['dsp']} %); the SDRAM controller "
+                     f"alone {sd.get('lut4', 0):,} LUT4, {sd.get('ccu2c', 0)} CCU2C, {sd.get('ff', 0):,} FF. "
+                     + (sentence(ulx.get("pnr", "placed and routed")) if "fmax_mhz" not in ulx else
+                        "Post-route fmax: " + ", ".join(f"`{c}` {f:.2f} MHz" for c, f in ulx["fmax_mhz"].items()) + "."))
+    elif ulx and "error" in ulx:
+        lines.append(f"- **ULX3S** fails: {ulx['error']}")
+    return "\n".join(lines)
+
+
+# the issue's fill-rate goals: (profile, core bench row, Mpixel/s)
+GOALS = [("up5k", "fill RGB565 flat", 25.0), ("ecp5", "fill RGBA8888 flat", 50.0),
+         ("ecp5", "RGBA8888 textured bilinear (64x64 RGBA8888)", 25.0)]
+
+
+def fill_rates(core, report):
+    """Fill rates of every scene class at the board clocks, and the goals met or missed."""
+    lines = ["| Scene class | " + " | ".join(f"{BOARD_OF[p]} Mpixel/s" for p in core) + " |",
+             "|---|" + "---|" * len(core)]
+    names = []
+    for rows in core.values():
+        names += [r["name"] for r in rows if r.get("unit") == "px/clk" and r["name"] not in names]
+    for name in names:
+        cells = []
+        for p, rows in core.items():
+            mhz, _ = board_clock(report, BOARD_OF[p])
+            row = next((r for r in rows if r["name"] == name), None)
+            cells.append("—" if row is None or not mhz or row["value"] == 0 else f"{row['value'] * mhz:.1f}")
+        lines.append(f"| {name} | " + " | ".join(cells) + " |")
+    lines.append("")
+    for p, name, goal in GOALS:
+        rows = core.get(p)
+        mhz, _ = board_clock(report, BOARD_OF[p])
+        row = next((r for r in rows or [] if r["name"] == name), None)
+        if row is None or not mhz:
+            continue
+        rate = row["value"] * mhz
+        verdict = "met" if rate >= goal else f"**missed**: needs {goal / row['value']:.2f} MHz"
+        lines.append(f"- goal {BOARD_OF[p]} {name}: {rate:.1f} Mpixel/s at {mhz:g} MHz ({row['value']:.3f} px/clock) "
+                     f"against {goal:g}: {verdict}")
+    return "\n".join(lines)
+
+
+def table(bench, report):
+    lines = []
+    clocks = {}
+    for profile, board in BOARD_OF.items():
+        mhz, state = board_clock(report, board)
+        clocks[profile] = mhz
+        if mhz:
+            lines.append(f"- {board} ({profile}): {mhz:g} MHz — {state}")
+    lines.append("")
+    head = "| Scene |"
+    rule = "|---|"
+    for profile, board in BOARD_OF.items():
+        if clocks.get(profile) and profile in bench:
+            head += f" {board} cycles | frames/s | Mpixel/s | triangles/s |"
+            rule += "---|---|---|---|"
+    lines += [head, rule]
+    scenes = []
+    for profile in BOARD_OF:
+        for row in bench.get(profile, {}).get("rows", []):
+            if row["scene"] not in scenes:
+                scenes.append(row["scene"])
+    for scene in scenes:
+        line = f"| {scene} |"
+        for profile in BOARD_OF:
+            if not clocks.get(profile) or profile not in bench:
+                continue
+            row = next((r for r in bench[profile]["rows"] if r["scene"] == scene), None)
+            if row is None:
+                line += " — | — | — | — |"
+                continue
+            fps = clocks[profile] * 1e6 / row["rtl_cycles"]
+            line += (f" {row['rtl_cycles']:,.0f} | {fps:,.1f} | {row['pixels'] * fps / 1e6:,.2f} |"
+                     f" {row['triangles'] * fps:,.0f} |")
+        lines.append(line)
+    return "\n".join(lines)
+
+
+def replace_block(doc, name, text, path):
+    begin, end = f"<!-- {name}:begin -->", f"<!-- {name}:end -->"
+    if begin not in doc or end not in doc:
+        sys.exit(f"predict.py: {path} has no {begin} ... {end} block")
+    return re.sub(re.escape(begin) + ".*?" + re.escape(end), lambda _: f"{begin}\n{text}\n{end}", doc, flags=re.S)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--report", action="append", default=[], help="scripts/gateware.sh --json output (repeatable)")
+    ap.add_argument("--bench", help="gpubridge --json bench rtl output (the predicted frame rates)")
+    ap.add_argument("--core", action="append", default=[], help="PROFILE=FILE: rtl_core_<profile>_bench --json output")
+    ap.add_argument("--doc", help="rewrite the board-figures, fill-rates and predicted-fps blocks of this markdown file")
+    a = ap.parse_args()
+    try:
+        report = {}
+        for path in a.report:
+            with open(path) as f:
+                report.update(json.load(f))
+        core = {}
+        for item in a.core:
+            profile, _, path = item.partition("=")
+            if profile not in BOARD_OF:
+                sys.exit(f"predict.py: --core {item}: expected up5k=FILE or ecp5=FILE")
+            with open(path) as f:
+                core[profile] = json.load(f)
+        bench = None
+        if a.bench:
+            with open(a.bench) as f:
+                bench = json.load(f)
+    except (OSError, ValueError) as e:
+        sys.exit(f"predict.py: {e}")
+    blocks = {"board-figures": figures(report)}
+    if core:
+        blocks["fill-rates"] = fill_rates(core, report)
+    if bench is not None:
+        blocks["predicted-fps"] = table(bench, report)
+    if not a.doc:
+        print("\n\n".join(blocks.values()))
+        return
+    with open(a.doc) as f:
+        doc = f.read()
+    for name, text in blocks.items():
+        doc = replace_block(doc, name, text, a.doc)
+    with open(a.doc, "w") as f:
+        f.write(doc)
+
+
+if __name__ == "__main__":
+    main()

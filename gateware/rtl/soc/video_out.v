@@ -1,0 +1,266 @@
+// Video output of a board (docs/gateware.md "Video out"): the displayed buffer, every refresh.
+//
+// The scanout reads a frame once per swap (FRAME_CRC, the co-simulation's frame port); a monitor needs
+// the displayed buffer 60 times a second. This stage keeps its own display timing (VESA 640 x 480 at
+// 60 Hz by default, a pixel every PIX_DIV core clocks), follows the swaps the scanout latches
+// (swap_req gives the address, frame_start commits it with the format and size at the vertical sync)
+// and fills a two-line block-RAM line buffer through its own memory-arbiter client: while one source
+// line is shown, the next is read. Pixels are expanded from RGBA8888 / RGB565 / RGBA2222 to 8 bits as
+// docs/protocol.md section 6 says and the top OUT_BITS bits leave (4 for the 12-bit DVI Pmod, 8 for
+// TMDS). A framebuffer is scaled by 2^SCALE_LOG2 and centred; what does not fit the screen is cropped,
+// and so are pixels beyond the 2^LINE_AW words a line buffer half holds. Words beyond VRAM show as 0.
+// The timing counters start with the scanout's (LINE_CLOCKS = H_TOTAL x PIX_DIV), so its vertical sync,
+// where the swap is latched, is the end of this stage's last visible line.
+module video_out #(
+  parameter VAW        = 15,   // VRAM = 2^VAW 32-bit words
+  parameter LBW        = 19,   // bits of a line's byte offset in the buffer (y x W x bpp)
+  parameter PIX_DIV    = 1,    // core clocks per pixel: 1 or 2
+  parameter SCALE_LOG2 = 1,    // 0: 1:1, 1: every framebuffer pixel 2 x 2 on screen
+  parameter LINE_AW    = 8,    // 2^LINE_AW words per line buffer half
+  parameter OUT_BITS   = 4,    // bits per colour channel at the pins
+  parameter H_ACTIVE   = 640,
+  parameter H_FRONT    = 16,
+  parameter H_SYNC     = 96,
+  parameter H_BACK     = 48,
+  parameter V_ACTIVE   = 480,
+  parameter V_FRONT    = 10,
+  parameter V_SYNC     = 2,
+  parameter V_BACK     = 33,
+  parameter SYNC_NEG   = 1     // sync pulses low (640 x 480 at 60 Hz)
+) (
+  input  wire                clk,
+  input  wire                rst,
+  // swaps, as the scanout sees them
+  input  wire                swap_req,
+  input  wire [27:0]         swap_addr,     // byte address / 16
+  input  wire                frame_start,   // the scanout latched the pending swap (vertical sync)
+  input  wire [1:0]          frame_format,
+  input  wire [10:0]         frame_width,
+  input  wire [10:0]         frame_height,
+  // memory-arbiter client (reads inside VRAM only, answers in order)
+  output wire                req_valid,
+  input  wire                req_ready,
+  output wire [29:0]         req_addr,
+  input  wire                rsp_valid,
+  input  wire [31:0]         rsp_rdata,
+  // to the pins (registered): pixel clock enable, syncs at their pin level, data enable, colour
+  output wire                pix_en,
+  output reg                 hsync,
+  output reg                 vsync,
+  output reg                 de,
+  output reg  [OUT_BITS-1:0] red,
+  output reg  [OUT_BITS-1:0] green,
+  output reg  [OUT_BITS-1:0] blue
+);
+  localparam H_TOTAL = H_ACTIVE + H_FRONT + H_SYNC + H_BACK;
+  localparam V_TOTAL = V_ACTIVE + V_FRONT + V_SYNC + V_BACK;
+  localparam S = SCALE_LOG2;
+
+  // --- pixel enable and display timing ---
+  generate
+    if (PIX_DIV == 2) begin : g_div2
+      reg phase;
+      always @(posedge clk) phase <= rst ? 1'b0 : !phase;
+      assign pix_en = phase;
+    end else begin : g_div1
+      assign pix_en = 1'b1;
+    end
+  endgenerate
+  reg  [10:0] hc, vc;
+  wire        h_last = hc == 11'(H_TOTAL - 1);
+  wire        line_end = pix_en && h_last;
+  // the line after next, whose framebuffer line is read during the next line
+  wire [10:0] v_next2 = vc == 11'(V_TOTAL - 2) ? 11'd0 : vc == 11'(V_TOTAL - 1) ? 11'd1 : vc + 11'd2;
+
+  // --- the displayed buffer: latched at swap_req, shown from frame_start ---
+  reg  [27:0] pend_addr;
+  reg         shown;                       // a frame was swapped in since reset
+  reg         beyond;                      // it starts beyond VRAM
+  reg  [VAW+1:0] base;                     // its first byte
+  reg  [1:0]  ppw_l2;                      // log2 pixels per word: RGBA8888 0, RGB565 1, RGBA2222 2
+  reg  [10:0] fw, fh;
+  always @(posedge clk) begin
+    if (rst) begin
+      shown <= 1'b0;
+    end else begin
+      if (swap_req) pend_addr <= swap_addr;
+      if (frame_start) begin
+        shown <= 1'b1;
+        beyond <= pend_addr[27:VAW-2] != 0;
+        base <= {pend_addr[VAW-3:0], 4'd0};
+        ppw_l2 <= frame_format == 2'd0 ? 2'd0 : frame_format == 2'd1 ? 2'd1 : 2'd2;
+        fw <= frame_width;
+        fh <= frame_height;
+      end
+    end
+  end
+  // placement on the screen, centred: [x0, x_end) x [y0, y_end); cropped from the top left when larger
+  // (registered: used lines after the swap)
+  reg  [10:0] x0, x_end, y0, y_end;
+  reg  [LBW-1:0] stride;                   // bytes per framebuffer line
+  reg  [LINE_AW:0] n_words;                // words read per line: enough for any lead, at most a half
+  wire [11:0] sw = {1'b0, fw} << S, sh = {1'b0, fh} << S;
+  wire [12:0] x_gap = 13'(H_ACTIVE) - {1'b0, sw}, y_gap = 13'(V_ACTIVE) - {1'b0, sh};
+  wire [12:0] x_sum = 13'(H_ACTIVE) + {1'b0, sw}, y_sum = 13'(V_ACTIVE) + {1'b0, sh};
+  // only the pixels the screen shows are read: at most H_ACTIVE / 2^S of a line
+  wire [10:0] w_shown = fw > 11'(H_ACTIVE >> S) ? 11'(H_ACTIVE >> S) : fw;
+  wire [11:0] words_w = {1'b0, w_shown >> ppw_l2} + 12'd2;
+  always @(posedge clk) begin
+    x0    <= x_gap[12] ? 11'd0 : x_gap[11:1];
+    x_end <= x_gap[12] ? 11'(H_ACTIVE) : x_sum[11:1];
+    y0    <= y_gap[12] ? 11'd0 : y_gap[11:1];
+    y_end <= y_gap[12] ? 11'(V_ACTIVE) : y_sum[11:1];
+    stride <= LBW'({fw, 2'b00}) >> ppw_l2;
+    n_words <= words_w > 12'(1 << LINE_AW) ? (LINE_AW+1)'(1 << LINE_AW) : words_w[LINE_AW:0];
+  end
+
+  // --- line decisions, at the end of each screen line: for the line after next, is it in the picture,
+  // does it start a framebuffer line (then read it now), and in which line buffer half is it ---
+  reg         f_in, f_rep, f_half;         // the line after next
+  reg         n_show, n_half;              // the next line (decided a line earlier)
+  reg         l_show, l_half;              // the line being shown
+  reg  [1:0]  l_lead;
+  wire        f_first = shown && v_next2 == y0 && y0 != y_end;
+  wire        f_in_new = f_first || (f_in && v_next2 != y_end);
+  wire        f_rep_new = f_first ? 1'b0 : S == 0 ? 1'b0 : !f_rep;   // second screen line of a 2x line
+  wire        f_half_new = f_first ? 1'b0 : f_rep_new ? f_half : !f_half;
+  wire        fetch_new = f_in_new && !f_rep_new;
+
+  // --- line buffer fill: at the end of screen line n, the framebuffer line of line n + 2 if it is new.
+  // The reads must finish within one screen line (iCEBreaker: at most 256 SPRAM words in 800 clocks;
+  // ULX3S: 642 SDRAM words at 2 clocks each in 1,600, row misses, refreshes and MEM_* beside); a fill
+  // still running when the next one starts is abandoned, and its late answers would land in the new one ---
+  reg  [31:0] lb [0:(2 << LINE_AW) - 1];
+  reg  [LBW-1:0] line_byte;                // offset of the next framebuffer line to read
+  wire [LBW-1:0] byte0 = f_first ? {LBW{1'b0}} : line_byte;
+  wire [LBW:0]   abs0 = {1'b0, byte0} + (LBW+1)'(base);
+  reg  [LBW-2:0] f_addr;                   // next word to read (>= 2^VAW: beyond VRAM)
+  reg         f_beyond;
+  reg  [LINE_AW:0] f_left;                 // words still to read
+  reg  [LINE_AW-1:0] wr_idx;
+  reg         wr_half;
+  reg  [1:0]  lead [0:1];                  // pixels before the line's first pixel in its first word
+  reg  [3:0]  outstanding;
+  wire [1:0]  lead0 = ppw_l2 == 2'd2 ? byte0[1:0] : ppw_l2 == 2'd1 ? {1'b0, byte0[1]} : 2'd0;
+  wire        in_vram = !f_beyond && f_addr[LBW-2:VAW] == 0;
+  assign req_valid = f_left != 0 && in_vram;
+  assign req_addr  = 30'(f_addr[VAW-1:0]);
+  wire        issued = req_valid && req_ready;
+  wire        zero_fill = f_left != 0 && !in_vram && outstanding == 4'd0;
+  always @(posedge clk) begin
+    if (rst) begin
+      f_left <= 0;
+      outstanding <= 4'd0;
+      wr_idx <= {LINE_AW{1'b0}};
+      {f_in, f_rep, f_half, n_show, n_half, l_show} <= 6'd0;
+    end else begin
+      outstanding <= outstanding + {3'd0, issued} - {3'd0, rsp_valid};
+      if (rsp_valid || zero_fill) begin
+        lb[{wr_half, wr_idx}] <= rsp_valid ? rsp_rdata : 32'd0;
+        wr_idx <= wr_idx + 1'b1;
+      end
+      if (issued || zero_fill) begin
+        f_addr <= f_addr + 1'b1;
+        f_left <= f_left - 1'b1;
+      end
+      if (line_end) begin
+        {f_in, f_rep, f_half} <= {f_in_new, f_rep_new, f_half_new};
+        {n_show, n_half} <= {f_in_new, f_half_new};
+        {l_show, l_half} <= {n_show, n_half};
+        l_lead <= lead[n_half];
+        if (fetch_new) begin
+          wr_half <= f_half_new;
+          wr_idx <= {LINE_AW{1'b0}};
+          lead[f_half_new] <= lead0;
+          f_addr <= abs0[LBW:2];
+          f_beyond <= beyond || abs0[LBW];
+          f_left <= n_words;
+          line_byte <= byte0 + stride;
+        end
+      end
+    end
+  end
+
+  // --- display: counters along the line, then a two-stage pixel pipeline ---
+  always @(posedge clk) begin
+    if (rst) begin
+      hc <= 11'd0;
+      vc <= 11'd0;
+    end else if (pix_en) begin
+      hc <= h_last ? 11'd0 : hc + 11'd1;
+      if (h_last) vc <= vc == 11'(V_TOTAL - 1) ? 11'd0 : vc + 11'd1;
+    end
+  end
+  // the pixel's place in the framebuffer line: from x0 on, a pixel every 2^S screen pixels, a word
+  // every 2^ppw_l2 pixels (the first word from the line's lead on)
+  reg         x_in_r, rep_r;
+  reg  [1:0]  sub_r;
+  reg  [LINE_AW:0] widx_r;                 // the top bit: beyond the line buffer half (black)
+  wire        x_start = hc == x0;
+  wire        x_in = hc != x_end && (x_start || x_in_r);
+  wire        rep = x_start ? 1'b0 : rep_r;
+  wire [1:0]  sub = x_start ? l_lead : sub_r;
+  wire [LINE_AW:0] widx = x_start ? {(LINE_AW+1){1'b0}} : widx_r;
+  wire        advance = S == 0 || rep;
+  wire        word_end = sub == (2'd1 << ppw_l2) - 2'd1;
+  always @(posedge clk) begin
+    if (pix_en) begin
+      x_in_r <= x_in;
+      rep_r <= !rep;
+      sub_r <= advance ? (word_end ? 2'd0 : sub + 2'd1) : sub;
+      widx_r <= advance && word_end && !widx[LINE_AW] ? widx + 1'b1 : widx;
+    end
+  end
+  wire        active = hc < 11'(H_ACTIVE) && vc < 11'(V_ACTIVE);
+  wire        hs0 = hc >= 11'(H_ACTIVE + H_FRONT) && hc < 11'(H_ACTIVE + H_FRONT + H_SYNC);
+  wire        vs0 = vc >= 11'(V_ACTIVE + V_FRONT) && vc < 11'(V_ACTIVE + V_FRONT + V_SYNC);
+  reg  [31:0] word1;
+  reg         on1, de1, hs1, vs1;
+  reg  [1:0]  sub1;
+  always @(posedge clk) begin
+    if (pix_en) begin
+      word1 <= lb[{l_half, widx[LINE_AW-1:0]}];
+      sub1 <= sub;
+    end
+    if (rst) begin
+      {on1, de1, hs1, vs1} <= 4'd0;
+    end else if (pix_en) begin
+      on1 <= active && l_show && x_in && !widx[LINE_AW];
+      de1 <= active;
+      hs1 <= hs0;
+      vs1 <= vs0;
+    end
+  end
+  // expansion to 8 bits (docs/protocol.md section 6); big-endian: the first pixel is the high part
+  wire [15:0] half = sub1[0] ? word1[15:0] : word1[31:16];
+  reg  [7:0]  byte_px;
+  always @* begin
+    case (sub1)
+      2'd0: byte_px = word1[31:24];
+      2'd1: byte_px = word1[23:16];
+      2'd2: byte_px = word1[15:8];
+      default: byte_px = word1[7:0];
+    endcase
+  end
+  wire [7:0] r8 = ppw_l2 == 2'd0 ? word1[31:24] : ppw_l2 == 2'd1 ? {half[15:11], half[15:13]} : {4{byte_px[7:6]}};
+  wire [7:0] g8 = ppw_l2 == 2'd0 ? word1[23:16] : ppw_l2 == 2'd1 ? {half[10:5], half[10:9]} : {4{byte_px[5:4]}};
+  wire [7:0] b8 = ppw_l2 == 2'd0 ? word1[15:8] : ppw_l2 == 2'd1 ? {half[4:0], half[4:2]} : {4{byte_px[3:2]}};
+  // the bits below OUT_BITS and the alpha of RGBA2222 do not leave; rows past the line parity are
+  // the fetch side's
+  wire unused_ok = &{1'b0, byte_px[1:0], r8, g8, b8, x_gap[0], y_gap[0], x_sum[12], x_sum[0], y_sum[12], y_sum[0]};
+  always @(posedge clk) begin
+    if (rst) begin
+      {hsync, vsync} <= SYNC_NEG != 0 ? 2'b11 : 2'b00;
+      de <= 1'b0;
+      {red, green, blue} <= {(3 * OUT_BITS){1'b0}};
+    end else if (pix_en) begin
+      hsync <= hs1 ^ (SYNC_NEG != 0);
+      vsync <= vs1 ^ (SYNC_NEG != 0);
+      de <= de1;
+      red   <= on1 ? r8[7 -: OUT_BITS] : {OUT_BITS{1'b0}};
+      green <= on1 ? g8[7 -: OUT_BITS] : {OUT_BITS{1'b0}};
+      blue  <= on1 ? b8[7 -: OUT_BITS] : {OUT_BITS{1'b0}};
+    end
+  end
+
+endmodule

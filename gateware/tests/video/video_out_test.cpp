@@ -1,0 +1,213 @@
+// gateware/rtl/soc/video_out.v alone, Verilated with one board's parameters (VIDEO_* definitions, see
+// CMakeLists.txt): a known framebuffer in a behavioural VRAM (answers in order after 1..4 clocks,
+// refuses requests at random, as the arbiter does when another client wins), a swap as the scanout
+// signals it (swap_req, then frame_start at the vertical sync), and two frames of output checked
+// sample by sample against VESA 640 x 480 at 60 Hz timing and the expected picture (scaled, centred,
+// expanded as docs/protocol.md section 6 says, black around it and before the first swap).
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <deque>
+#include <random>
+#include <vector>
+
+#include GPUBRIDGE_VIDEO_HEADER
+
+namespace {
+
+constexpr int kHTotal = 800, kVTotal = 525, kHActive = 640, kVActive = 480;
+constexpr int kPixDiv = GPUBRIDGE_VIDEO_PIX_DIV;
+constexpr int kScale = 1 << GPUBRIDGE_VIDEO_SCALE_LOG2;
+constexpr int kBits = GPUBRIDGE_VIDEO_BITS;
+constexpr int kVaw = GPUBRIDGE_VIDEO_VAW;
+
+struct Sample {
+  bool hs, vs, de;
+  int r, g, b;
+};
+
+struct Rgb {
+  int r, g, b;
+};
+
+// a framebuffer of the given format in big-endian VRAM bytes (docs/protocol.md section 6)
+struct Frame {
+  int format, width, height;
+  std::uint32_t addr;  // byte address, 16-byte aligned
+  std::vector<std::uint32_t> pixels;
+  int bpp() const { return format == 0 ? 4 : format == 1 ? 2 : 1; }
+  Rgb expanded(int x, int y) const {
+    const std::uint32_t p = pixels[static_cast<std::size_t>(y * width + x)];
+    if (format == 0) return {int(p >> 24), int(p >> 16 & 0xFF), int(p >> 8 & 0xFF)};
+    if (format == 1) {
+      const int r5 = int(p >> 11 & 31), g6 = int(p >> 5 & 63), b5 = int(p & 31);
+      return {r5 << 3 | r5 >> 2, g6 << 2 | g6 >> 4, b5 << 3 | b5 >> 2};
+    }
+    return {int(p >> 6 & 3) * 0x55, int(p >> 4 & 3) * 0x55, int(p >> 2 & 3) * 0x55};
+  }
+};
+
+class VideoBench {
+ public:
+  explicit VideoBench(std::uint32_t seed) : rng_(seed), mem_(std::size_t{1} << kVaw, 0xDEADBEEFu) {}
+
+  void store(const Frame& f) {
+    ASSERT_LE(f.addr + std::size_t(f.width * f.height * f.bpp()), mem_.size() * 4) << "the frame is beyond VRAM";
+    for (int i = 0; i < f.width * f.height; ++i)
+      for (int k = 0; k < f.bpp(); ++k) {
+        const std::uint32_t a = f.addr + static_cast<std::uint32_t>(i * f.bpp() + k);
+        const int shift = (f.bpp() - 1 - k) * 8;
+        const std::uint32_t byte = f.pixels[static_cast<std::size_t>(i)] >> shift & 0xFF;
+        std::uint32_t& w = mem_[a / 4];
+        const int lane = (3 - int(a % 4)) * 8;
+        w = (w & ~(0xFFu << lane)) | byte << lane;
+      }
+  }
+
+  // runs `cycles` core clocks from reset; the swap of `f` is requested at cycle 16 and latched where
+  // the scanout's vertical sync falls (end of visible line 479), as frame_start does on a board
+  std::vector<Sample> run(const Frame& f, long cycles) {
+    std::vector<Sample> out;
+    const long line_clocks = long(kHTotal) * kPixDiv;
+    const long vsync_cycle = (kVActive - 1) * line_clocks + line_clocks - 1;
+    m_.rst = 1;
+    for (int i = 0; i < 4; ++i) tick();
+    m_.rst = 0;
+    for (long k = 0; k < cycles; ++k) {
+      m_.swap_req = k == 16;
+      m_.swap_addr = f.addr / 16;
+      m_.frame_start = k == vsync_cycle;
+      m_.frame_format = static_cast<std::uint8_t>(f.format);
+      m_.frame_width = static_cast<std::uint16_t>(f.width);
+      m_.frame_height = static_cast<std::uint16_t>(f.height);
+      const bool pix = m_.pix_en;
+      tick();
+      if (pix) out.push_back({m_.hsync != 0, m_.vsync != 0, m_.de != 0, m_.red, m_.green, m_.blue});
+    }
+    return out;
+  }
+
+  long requests() const { return requests_; }
+
+ private:
+  void tick() {
+    // the memory answers the oldest read whose latency has passed
+    m_.rsp_valid = 0;
+    if (!inflight_.empty() && inflight_.front().due <= now_) {
+      m_.rsp_valid = 1;
+      m_.rsp_rdata = inflight_.front().data;
+      inflight_.pop_front();
+    }
+    m_.req_ready = dist_(rng_) < 70;
+    m_.clk = 0;
+    m_.eval();
+    if (m_.req_valid && m_.req_ready) {
+      const std::uint32_t a = m_.req_addr;
+      EXPECT_LT(a, mem_.size()) << "a read beyond VRAM";
+      const long latency = 1 + dist_(rng_) % 4;
+      const long due = std::max(now_ + latency, inflight_.empty() ? 0 : inflight_.back().due);
+      inflight_.push_back({due, a < mem_.size() ? mem_[a] : 0});
+      ++requests_;
+    }
+    m_.clk = 1;
+    m_.eval();
+    ++now_;
+  }
+
+  struct Read {
+    long due;
+    std::uint32_t data;
+  };
+  GPUBRIDGE_VIDEO_MODEL m_;
+  std::mt19937 rng_;
+  std::uniform_int_distribution<int> dist_{0, 99};
+  std::vector<std::uint32_t> mem_;
+  std::deque<Read> inflight_;
+  long now_ = 0, requests_ = 0;
+};
+
+int top_bits(int v8) { return v8 >> (8 - kBits); }
+
+// checks two frames of samples: the first black (nothing swapped in before its vertical sync), the
+// second the framebuffer, scaled and centred
+void check(const std::vector<Sample>& s, const Frame& f) {
+  // the pipeline's delay: the first data-enable sample is the first visible pixel
+  std::size_t o = 0;
+  while (o < s.size() && !s[o].de) ++o;
+  ASSERT_LT(o, std::size_t{kHTotal}) << "no data enable in the first line";
+  ASSERT_GE(s.size(), o + 2u * kHTotal * kVTotal);
+  const int sw = std::min(kHActive, f.width * kScale), sh = std::min(kVActive, f.height * kScale);
+  const int x0 = (kHActive - sw) / 2, y0 = (kVActive - sh) / 2;
+  int mismatches = 0;
+  for (std::size_t i = 0; i < 2u * kHTotal * kVTotal; ++i) {
+    const Sample& v = s[o + i];
+    const int p = int(i % kHTotal), l = int(i / kHTotal % kVTotal), frame = int(i / (kHTotal * kVTotal));
+    const bool de = p < kHActive && l < kVActive;
+    ASSERT_EQ(v.de, de) << "data enable at pixel " << p << " line " << l << " frame " << frame;
+    ASSERT_EQ(v.hs, !(p >= 656 && p < 752)) << "hsync at pixel " << p << " line " << l;
+    ASSERT_EQ(v.vs, !(l >= 490 && l < 492)) << "vsync at pixel " << p << " line " << l;
+    Rgb want{0, 0, 0};
+    if (frame == 1 && de && p >= x0 && p < x0 + sw && l >= y0 && l < y0 + sh) {
+      const Rgb e = f.expanded((p - x0) / kScale, (l - y0) / kScale);
+      want = {top_bits(e.r), top_bits(e.g), top_bits(e.b)};
+    }
+    if (v.r != want.r || v.g != want.g || v.b != want.b) {
+      if (++mismatches <= 5)
+        ADD_FAILURE() << "pixel " << p << " line " << l << " frame " << frame << ": got " << v.r << "," << v.g << ","
+                      << v.b << " want " << want.r << "," << want.g << "," << want.b;
+    }
+  }
+  EXPECT_EQ(mismatches, 0);
+}
+
+Frame pattern(int format, int width, int height, std::uint32_t addr, std::uint32_t seed) {
+  Frame f{format, width, height, addr, {}};
+  std::mt19937 rng(seed);
+  const std::uint32_t mask = format == 0 ? 0xFFFFFFFFu : format == 1 ? 0xFFFFu : 0xFFu;
+  for (int i = 0; i < width * height; ++i) f.pixels.push_back(rng() & mask);
+  return f;
+}
+
+long two_frames_and_a_bit() { return (2L * kVTotal + 1) * kHTotal * kPixDiv + 64; }
+
+}  // namespace
+
+// the board's own case: the largest buffer fills the screen exactly (iCEBreaker: 320 x 240 RGBA2222 shown
+// 2x, two of them fit the 128 KiB; ULX3S: 640 x 480 RGB565)
+TEST(VideoOut, FullScreen) {
+  const Frame f = pattern(kScale == 2 ? 2 : 1, kHActive / kScale, kVActive / kScale, 0x40, 1);
+  VideoBench bench(11);
+  bench.store(f);
+  check(bench.run(f, two_frames_and_a_bit()), f);
+}
+
+// a smaller RGBA2222 buffer with an odd width, so lines start inside a word: centred, black around
+TEST(VideoOut, Rgba2222OddWidthCentred) {
+  const Frame f = pattern(2, 101, 37, 0x1230, 2);
+  VideoBench bench(12);
+  bench.store(f);
+  check(bench.run(f, two_frames_and_a_bit()), f);
+}
+
+// RGB565 with an odd width (lines start on half words), and RGBA8888
+TEST(VideoOut, Rgb565OddWidthAndRgba8888) {
+  const Frame a = pattern(1, 77, 51, 0x800, 3);
+  VideoBench ba(13);
+  ba.store(a);
+  check(ba.run(a, two_frames_and_a_bit()), a);
+  const Frame b = pattern(0, 64, 40, 0x100, 4);
+  VideoBench bb(14);
+  bb.store(b);
+  check(bb.run(b, two_frames_and_a_bit()), b);
+}
+
+// a buffer larger than the screen is cropped at the right and bottom (shown from its top-left), and
+// only what is shown is read: one framebuffer line's shown words (plus the two a line's lead can add)
+// once per frame, a frame and a few lines being read in this run
+TEST(VideoOut, LargerThanTheScreenIsCropped) {
+  const Frame f = pattern(2, kHActive / kScale + 24, kVActive / kScale + 10, 0x0, 5);
+  VideoBench bench(15);
+  bench.store(f);
+  check(bench.run(f, two_frames_and_a_bit()), f);
+  EXPECT_LE(bench.requests(), long(kVActive / kScale + 3) * (kHActive / kScale / 4 + 2));
+}
