@@ -303,7 +303,7 @@ std::vector<Example> make() {
 
   all.push_back({"docs/boards.md", "Flashing", 0, "docs_boards_Flashing", {
       skip("build/tools/gpubridge flash --board icebreaker --dry-run",
-           "needs an iCEBreaker bitstream, which this version does not build yet; FlashCli.DryRunPrintsTheCommandAndRunsNothing runs it"),
+           "needs an iCEBreaker bitstream, which scripts/gateware.sh cannot build until the up5k design fits; FlashCli.DryRunPrintsTheCommandAndRunsNothing runs it"),
       skip("build/tools/gpubridge flash --board icebreaker",
            "needs an iCEBreaker; FlashCli.FlashesTheBoardsBuiltBitstreamWithOpenFpgaLoader runs it with a stand-in programmer"),
       skip("build/tools/gpubridge flash --board icebreaker --to sram",

@@ -114,13 +114,14 @@ TEST_F(FlashCli, AMissingProgrammerSaysWhichPackage) {
   EXPECT_EQ(args_of("iceprog"), "-d\ni:0x0403:0x6010\n-I\nA\n" + bitstream() + "\n");
 }
 
-TEST_F(FlashCli, NoBitstreamYetSaysWhereItLookedAndWhatToPass) {
+TEST_F(FlashCli, NoBitstreamSaysWhereItLookedAndHowToBuildOne) {
   std::filesystem::remove(bitstream());
   const auto r = flash({"flash", "--board", "icebreaker"});
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("no bitstream for icebreaker at " + bitstream()), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("gpubridge flash --board icebreaker FILE"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("GPUBRIDGE_BITSTREAM_DIR"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("scripts/gateware.sh --board icebreaker"), std::string::npos) << r.err;
   EXPECT_FALSE(ran("openFPGALoader"));
 }
 

@@ -165,7 +165,7 @@ int run_flash(const GlobalOptions& g, const FlashArgs& a) {
     if (!std::filesystem::exists(rq.bitstream, ec))
       return fail("no bitstream for " + a.board + " at " + rq.bitstream.string() + ": pass the file (gpubridge flash --board " + a.board +
                   " FILE) or set GPUBRIDGE_BITSTREAM_DIR to the directory holding " + board->recipe.bitstream +
-                  " (this version does not build board bitstreams yet: docs/boards.md, Flashing)");
+                  "; scripts/gateware.sh --board " + a.board + " builds it from the gateware (docs/boards.md, Flashing)");
   } else {
     return fail("board \"" + a.board + "\" runs a bitstream this project does not build: " + board->recipe.source +
                 "; then gpubridge flash --board " + a.board + " FILE");
@@ -231,7 +231,7 @@ GPUBRIDGE_COMMAND("flash", 65, [](CLI::App& app, GlobalOptions& g, auto& runners
   cmd->add_option("--board", a->board, "board profile name (configs/boards) or a .json file")->required();
   cmd->add_option("bitstream", a->bitstream,
                   "bitstream file (default: the board's file, `gpubridge boards` names it, in $GPUBRIDGE_BITSTREAM_DIR, else in "
-                  "the build tree's gateware/boards/)");
+                  "the build tree's gateware/boards/, where scripts/gateware.sh --board NAME writes it)");
   cmd->add_option("--to", a->target, "which memory: flash (kept across power cycles) or sram (a quick load, lost at power-off)")
       ->check(CLI::IsMember({"flash", "sram"}));
   cmd->add_option("--tool", a->tool, "programmer: openfpgaloader or iceprog (default: the first the board offers that is installed)")
