@@ -22,7 +22,7 @@ examples::DeviceCaps device_of(const usb::BoardProfile& p) {
 }
 
 examples::BoardLink link_of(const usb::BoardProfile& p) {
-  return {p.name, double(p.clock_mhz), p.spi_clock_hz / 1e6, p.scanout == usb::ScanoutMode::Readback};
+  return {p.name, p.clock_mhz, p.spi_clock_hz / 1e6, p.scanout == usb::ScanoutMode::Readback};
 }
 
 Result<std::vector<usb::BoardProfile>> chosen_boards(const std::vector<std::string>& names) {
@@ -153,7 +153,7 @@ int run_fit(const std::vector<std::string>& names, const std::vector<std::string
   for (const auto& board : *boards) {
     const auto device = device_of(board);
     if (!json && !markdown)
-      std::printf("%s (%s; %u KiB, %ux%u at most; %s SPI at %g MHz, core %u MHz)\n", board.name.c_str(), board.fpga.c_str(),
+      std::printf("%s (%s; %u KiB, %ux%u at most; %s SPI at %g MHz, core %g MHz)\n", board.name.c_str(), board.fpga.c_str(),
                   board.vram_kib, board.max_width, board.max_height, std::string(usb::to_string(board.chip)).c_str(),
                   board.spi_clock_hz / 1e6, board.clock_mhz);
     for (auto& ex : *list) {
@@ -190,7 +190,7 @@ int run_fit(const std::vector<std::string>& names, const std::vector<std::string
       std::printf("  %-12s %s\n", name.c_str(), fitted.summary().c_str());
       for (const auto& g : fitted.gave_up) std::printf("  %-12s gave up: %s\n", "", g.c_str());
       if (prediction)
-        std::printf("  %-12s %llu SPI frames, board %.2f ms at %u MHz, SPI %.2f ms at %g MHz: %s fps%s\n", "",
+        std::printf("  %-12s %llu SPI frames, board %.2f ms at %g MHz, SPI %.2f ms at %g MHz: %s fps%s\n", "",
                     static_cast<unsigned long long>(prediction->work.frames_received), prediction->estimate.board_ms,
                     board.clock_mhz, prediction->estimate.spi_ms, board.spi_clock_hz / 1e6, fps_text(prediction->fps).c_str(),
                     link_of(board).readback

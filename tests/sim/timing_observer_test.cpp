@@ -48,8 +48,8 @@ TEST(SimTiming, GatewarePresetsReplaceTheProfile) {
   BoardTiming b;
   ASSERT_TRUE(apply_timing_setting(b, "profile=up5k").ok());
   EXPECT_EQ(b.name, "up5k");
-  EXPECT_DOUBLE_EQ(b.clock_mhz, 30.0);
-  EXPECT_DOUBLE_EQ(b.spi_clock_mhz, 10.0);
+  EXPECT_DOUBLE_EQ(b.clock_mhz, 25.125);
+  EXPECT_DOUBLE_EQ(b.spi_clock_mhz, 7.5);
   EXPECT_GT(b.cycles_per_triangle, BoardTiming{}.cycles_per_triangle);  // bit-serial setup
   ASSERT_TRUE(apply_timing_setting(b, "clock_mhz=25").ok());
   EXPECT_DOUBLE_EQ(b.clock_mhz, 25.0);

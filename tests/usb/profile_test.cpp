@@ -22,6 +22,9 @@ TEST(BoardProfiles, ShippedProfilesLoad) {
   EXPECT_EQ(ice->chip, BridgeChip::FT2232H);
   EXPECT_EQ(ice->interface, 0);
   EXPECT_EQ(ice->pid, 0x6010);
+  // The iCEBreaker top's PLL clock and the FT2232H step its MISO timing allows (docs/gateware.md "Boards").
+  EXPECT_DOUBLE_EQ(ice->clock_mhz, 25.125);
+  EXPECT_EQ(ice->spi_clock_hz, 7'500'000u);
 }
 
 TEST(BoardProfiles, ShippedCablesLoad) {
@@ -32,6 +35,24 @@ TEST(BoardProfiles, ShippedCablesLoad) {
 
 const char* kGood = R"({"name":"x","bridge":{"chip":"ft232h","vid":"0x0403","pid":"0x6014","spi_clock_hz":30000000},
   "device":{"vram_kib":128,"max_width":320,"max_height":240,"fifo_depth":64}})";
+
+// device.clock_mhz is a number (the iCEBreaker's PLL makes 25.125 MHz), finite and within 1..1000.
+TEST(BoardProfiles, CoreClockIsAFractionalNumberInRange) {
+  const std::string at = "\"fifo_depth\":64";
+  std::string text = kGood;
+  text.replace(text.find(at), at.size(), at + ",\"clock_mhz\":25.125");
+  auto r = parse_board_profile(text, "frac.json");
+  ASSERT_TRUE(r) << r.error().message;
+  EXPECT_DOUBLE_EQ(r->clock_mhz, 25.125);
+  EXPECT_DOUBLE_EQ(parse_board_profile(kGood, "default.json")->clock_mhz, 50.0);
+  for (const char* bad : {"0.5", "1000.5", "-25", "\"25\"", "null"}) {
+    std::string t = kGood;
+    t.replace(t.find(at), at.size(), at + ",\"clock_mhz\":" + bad);
+    auto e = parse_board_profile(t, "boards/clk.json");
+    ASSERT_FALSE(e) << bad;
+    EXPECT_NE(e.error().message.find("boards/clk.json: device.clock_mhz"), std::string::npos) << e.error().message;
+  }
+}
 
 TEST(BoardProfiles, ErrorsNameFileAndKey) {
   ASSERT_TRUE(parse_board_profile(kGood, "good.json"));

@@ -21,7 +21,7 @@ GatewareCaps caps_of(GatewareProfile p) {
     c.max_height = 240;
     c.vram_kib = 128;
     c.variant = 0x0001;
-    c.core_hz = 30e6;
+    c.core_hz = 25.125e6;  // the iCEBreaker top's PLL (12 MHz x 67 / 32), also its pixel clock
   } else {
     c.features = 0xFF;  // every feature of protocol 1.2
     c.fifo_depth = 1023;

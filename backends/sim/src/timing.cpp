@@ -58,10 +58,10 @@ Result<BoardTiming> timing_preset(std::string_view name) {
   BoardTiming b;
   if (name == "ecp5-50mhz") return b;
   if (name == "up5k") {
-    // iCEBreaker: 30 MHz core, 128 KiB SPRAM (one 32-bit access per clock), SPI 10 MHz, no BUSY pin
+    // iCEBreaker: 25.125 MHz core (its PLL), 128 KiB SPRAM (one 32-bit access per clock), SPI 7.5 MHz, no BUSY pin
     b.name = "up5k";
-    b.clock_mhz = 30.0;
-    b.spi_clock_mhz = 10.0;
+    b.clock_mhz = 25.125;
+    b.spi_clock_mhz = 7.5;
     b.memory_bytes_per_cycle = 4.0;
     // least-squares fit on the RTL (gpubridge bench rtl --fit, docs/gateware.md "Timing model"):
     // the bit-serial setup and the time-shared steppers make triangles and pixels dear

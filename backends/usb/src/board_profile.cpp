@@ -1,6 +1,7 @@
 #include "gpubridge/usb/board_profile.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <set>
@@ -51,6 +52,16 @@ class Reader {
       return fail(key, "expected a non-negative integer");
     const auto x = v->get<std::uint64_t>();
     if (x < lo || x > hi) return fail(key, std::to_string(x) + " is out of range " + std::to_string(lo) + ".." + std::to_string(hi));
+    return x;
+  }
+  // A finite number in [lo, hi] (JSON has no NaN or Inf, but 1e999 parses as Inf in some readers).
+  Result<double> number(const std::string& key, double lo, double hi, double dflt) {
+    const json* v = get(key);
+    if (!v) return dflt;
+    if (!v->is_number()) return fail(key, "expected a number");
+    const auto x = v->get<double>();
+    if (!std::isfinite(x) || x < lo || x > hi)
+      return fail(key, v->dump() + " is out of range " + json(lo).dump() + ".." + json(hi).dump());
     return x;
   }
   Result<std::uint16_t> hex16(const std::string& key) {
@@ -319,7 +330,7 @@ Result<BoardProfile> parse_board_profile(std::string_view text, const std::strin
   GPUBRIDGE_TRY_SET(p.max_width, d.uint("max_width", 1, protocol::kMaxFramebufferDim));
   GPUBRIDGE_TRY_SET(p.max_height, d.uint("max_height", 1, protocol::kMaxFramebufferDim));
   GPUBRIDGE_TRY_SET(p.fifo_depth, d.uint("fifo_depth", 33, 1023));
-  GPUBRIDGE_TRY_SET(p.clock_mhz, d.uint("clock_mhz", 1, 1000, 50));
+  GPUBRIDGE_TRY_SET(p.clock_mhz, d.number("clock_mhz", 1, 1000, 50));
   if (auto r = d.no_unknown_keys(); !r) return r.error();
 
   if (const json* link = top.get("link")) {

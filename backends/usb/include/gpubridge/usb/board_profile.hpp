@@ -37,7 +37,7 @@ struct BoardProfile {
   // FPGA design.
   std::uint32_t vram_kib = 0;
   unsigned max_width = 0, max_height = 0, fifo_depth = 0;
-  unsigned clock_mhz = 50;    // core clock of the design, for the timing model (not sent anywhere)
+  double clock_mhz = 50;      // core clock of the design in MHz (25.125: the iCEBreaker's PLL), for the timing model (not sent anywhere)
   bool strict_link = true;
   ScanoutMode scanout = ScanoutMode::Readback;
   // The gateware this board runs (gateware/, docs/gateware.md): its profile ("up5k", "ecp5"; empty
