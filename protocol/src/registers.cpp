@@ -105,7 +105,11 @@ constexpr Field kFrameCrc[] = {
     F("FRAME", 32, 16, K::Unsigned, "FRAME_COUNT of the frame the CRC belongs to"),
     F("CRC", 0, 32, K::Unsigned, "CRC-32 (IEEE 802.3) of the scanned-out buffer bytes"),
 };
-constexpr Field kLinkCtrl[] = {F("STRICT", 0, 1, K::Flag, "hold queued writes until a matching LINK_CHECK")};
+constexpr Field kLinkCtrl[] = {
+    F("CLEAR_KEY", 32, 32, K::Unsigned,
+      "write-only, reads 0: must be 0x6F666621 (\"off!\") for a write of STRICT = 0 to leave strict mode (1.3)"),
+    F("STRICT", 0, 1, K::Flag, "hold queued writes until a matching LINK_CHECK"),
+};
 constexpr Field kLinkCheck[] = {F("CRC", 0, 32, K::Unsigned, "host's CRC-32 of all frames since the last check")};
 constexpr Field kLinkStatus[] = {
     F("GROUPS_BAD", 48, 16, K::Unsigned, "LINK_CHECKs that failed, modulo 2^16"),
@@ -128,7 +132,7 @@ constexpr Field kCaps[] = {
 constexpr Field kId[] = {
     F("MAGIC", 32, 32, K::Unsigned, "0x53504755 (\"SPGU\")"),
     F("MAJOR", 24, 8, K::Unsigned, "protocol major version (1)"),
-    F("MINOR", 16, 8, K::Unsigned, "protocol minor version (2)"),
+    F("MINOR", 16, 8, K::Unsigned, "protocol minor version (3)"),
     F("VARIANT", 0, 16, K::Unsigned, "implementation: 0 simulator, others per board profile"),
 };
 
@@ -159,7 +163,7 @@ constexpr RegisterDesc kTable[] = {
     {0x10, "STATUS", A::ReadOnly, P::Immediate, 0, kStatus, "FIFO level, busy, vblank, frame counter, error flags"},
     {0x11, "ERR_CLEAR", A::WriteOnly, P::Immediate, 0, kErrClear, "clears sticky error flags"},
     {0x12, "FRAME_CRC", A::ReadOnly, P::Immediate, 0, kFrameCrc, "CRC-32 of the last scanned-out frame"},
-    {0x13, "LINK_CTRL", A::ReadWrite, P::Immediate, 0, kLinkCtrl, "link integrity mode; any write restarts the link CRC"},
+    {0x13, "LINK_CTRL", A::ReadWrite, P::Immediate, 0, kLinkCtrl, "link integrity mode; an accepted write restarts the link CRC"},
     {0x14, "LINK_CHECK", A::WriteOnly, P::Immediate, 0, kLinkCheck, "compares the host's link CRC with the device's"},
     {0x15, "LINK_STATUS", A::ReadOnly, P::Immediate, 0, kLinkStatus, "link integrity counters"},
     {0x16, "HOST_TAG", A::ReadWrite, P::Immediate, 0, kHostTag, "host-owned value, reset to 0"},

@@ -2,6 +2,8 @@
 // check_write's reserved-bit and enum rules, and the CRC check value.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <bit>
 #include <string>
 
 #include "gpubridge/protocol/crc32.hpp"
@@ -148,6 +150,68 @@ TEST(Registers, NamesAreCaseInsensitiveAndUnique) {
     EXPECT_EQ(find_register(lower)->index, r.index);
     EXPECT_EQ(find_register(r.index), &r);
   }
+}
+
+// The fewest bit flips that turn a frame of register `r` (a write of any value the table allows,
+// or a read: data 0, HOST_TAG reads carry the host's tag) into a LINK_CTRL write that leaves strict
+// mode: STRICT = 0 and CLEAR_KEY = the key. Only the frame bits the device compares count (R/W̄, the
+// index, bits [63:32] and bit 0); fields are taken at their full width (ranges ignored), so this is
+// a lower bound. docs/protocol.md section 4 tabulates the same numbers.
+unsigned flips_to_clear(const RegisterDesc& r, bool read) {
+  constexpr std::uint64_t kClear = std::uint64_t{kLinkClearKey} << 32;
+  constexpr std::uint64_t kCompared = 0xFFFF'FFFF'0000'0001ull;
+  unsigned flips = static_cast<unsigned>(std::popcount(unsigned{r.index} ^ index_of(Reg::LINK_CTRL))) + (read ? 1 : 0);
+  if (read) return flips + (r.index == index_of(Reg::HOST_TAG) ? 0 : static_cast<unsigned>(std::popcount(kClear)));
+  // A host enables strict mode with CLEAR_KEY = 0 (section 4): STRICT is its only value.
+  if (r.index == index_of(Reg::LINK_CTRL)) return static_cast<unsigned>(std::popcount(kClear ^ 1));
+  std::uint64_t pinned = kCompared;  // compared bits a legal value cannot choose freely
+  unsigned data = 0;
+  for (const auto& f : r.fields) {
+    if (!(f.mask() & kCompared)) continue;
+    if (f.kind != FieldKind::Enum) {
+      pinned &= ~f.mask();
+      continue;
+    }
+    unsigned best = 64;
+    for (const auto& v : f.values)
+      best = std::min(best, static_cast<unsigned>(std::popcount((f.put(0, v.value) ^ kClear) & f.mask() & kCompared)));
+    data += best;
+    pinned &= ~f.mask();
+  }
+  return flips + data + static_cast<unsigned>(std::popcount(kClear & pinned));
+}
+
+// Protocol 1.3: the key is chosen so that no frame a host sends becomes a strict-mode clear by one
+// or two bit errors, except through two index flips in a frame whose upper data word is a free
+// host value (TEXCOORD.S, HOST_TAG), which would also have to equal the key exactly.
+TEST(Registers, NoFrameTurnsIntoAStrictModeClearByOneOrTwoBitErrors) {
+  unsigned free_two = 0;
+  for (const auto& r : register_table()) {
+    for (const bool read : {false, true}) {
+      if (read ? r.access == Access::WriteOnly : r.access == Access::ReadOnly) continue;
+      const unsigned n = flips_to_clear(r, read);
+      SCOPED_TRACE(std::string(r.name) + (read ? " read" : " write") + ": " + std::to_string(n) + " flips");
+      EXPECT_GE(n, 2u);
+      if (n == 2) {
+        EXPECT_TRUE(!read && (r.index == index_of(Reg::TEXCOORD) || r.index == index_of(Reg::HOST_TAG)));
+        ++free_two;
+      }
+    }
+  }
+  EXPECT_EQ(free_two, 2u);
+  // PRIM, the frame that found the hole (0x03 -> 0x13 is one flip): the key's 16 one bits on top.
+  EXPECT_EQ(flips_to_clear(describe(Reg::PRIM), false), 17u);
+  EXPECT_EQ(flips_to_clear(describe(Reg::RESET), false), 15u);  // 0x17 -> 0x13, MAGIC's [39:32] free
+  EXPECT_EQ(flips_to_clear(describe(Reg::VERTEX), false), 8u);  // Z covers [55:32]; [63:56] is reserved
+  EXPECT_EQ(flips_to_clear(describe(Reg::SCISSOR), false), 7u);
+}
+
+TEST(Registers, LinkCtrlClearValueFollowsTheDevicesMinorVersion) {
+  const std::uint64_t v12 = (std::uint64_t{kIdMagic} << 32) | (1ull << 24) | (2ull << 16) | 7;
+  EXPECT_EQ(link_ctrl_clear_value(v12), 0u) << "a 1.2 device has no CLEAR_KEY: its bits are reserved";
+  EXPECT_EQ(link_ctrl_clear_value(describe(Reg::ID).reset), 0x6F666621'00000000ull);
+  EXPECT_EQ(check_write(index_of(Reg::LINK_CTRL), link_ctrl_clear_value(describe(Reg::ID).reset)).errors, 0);
+  EXPECT_EQ(protocol_minor(describe(Reg::ID).reset), kVersionMinor);
 }
 
 TEST(Crc32, CheckValue) {

@@ -228,9 +228,48 @@ TEST_P(SocBench, StrictLinkHoldsReleasesAndDiscardsGroups) {
   rtl_->set_cs(false);
   sim_->frame_aborted();
   check(host_->take_crc());
-  burst({Frame{false, index_of(Reg::LINK_CTRL), 0}});
+  burst({Frame{false, index_of(Reg::LINK_CTRL), protocol::link_ctrl_clear_value(rtl_->caps().id_register())}});
   wait_idle();
   for (std::uint8_t i : {0x0A, 0x13, 0x15}) expect_read_equal(i);
+  expect_read_equal(index_of(Reg::STATUS), kStatusCompared);
+}
+
+// Protocol 1.3: leaving strict mode takes LINK_CTRL.CLEAR_KEY. A queued PRIM frame that a MOSI bit
+// error turns into LINK_CTRL (0x03 -> 0x13, TYPE LIST: data 0) is refused on both devices
+// (ERR_BAD_VALUE; STRICT, the held writes and the running CRC unchanged), so its group fails the
+// check and is discarded instead of executing unchecked; the key then leaves strict mode.
+TEST_P(SocBench, LeavingStrictModeTakesTheClearKey) {
+  if (!(rtl_->caps().features & 0x08)) GTEST_SKIP() << "profile without strict link";
+  burst({Frame{false, index_of(Reg::LINK_CTRL), 1}});
+  host_->restart_crc();
+  auto check = [&](std::uint32_t crc) { burst({Frame{false, index_of(Reg::LINK_CHECK), crc}}); };
+  auto read = [&](Reg r) {  // the gateware's value; the simulator sees the same read frame
+    sim_->read(index_of(r));
+    return host_->read(r);
+  };
+  const Frame sent{false, index_of(Reg::PRIM), 0};
+  const Frame received{false, index_of(Reg::LINK_CTRL), 0};
+  burst({Frame{false, index_of(Reg::CLEAR_COLOR), 0x11223344}});
+  burst({received});
+  host_->account(sent);  // the host believes it sent the PRIM frame
+  burst({Frame{false, index_of(Reg::FENCE), 5}, Frame{false, index_of(Reg::LINK_CTRL), 2},
+         Frame{false, index_of(Reg::LINK_CTRL), std::uint64_t{protocol::kLinkClearKey ^ 0x10000u} << 32}});
+  rtl_->idle_ns(5000);
+  for (std::uint8_t i : {0x0A, 0x13, 0x15, 0x18}) expect_read_equal(i);
+  expect_read_equal(index_of(Reg::STATUS), kStatusCompared | (1ull << 20) | 0xFFFF);  // LINK_PENDING, 2 held
+  EXPECT_EQ(read(Reg::LINK_CTRL), 1u);
+  EXPECT_EQ(read(Reg::STATUS) >> 48 & protocol::ERR_BAD_VALUE, protocol::ERR_BAD_VALUE);
+  check(host_->take_crc());  // fails: the device never received the PRIM frame
+  wait_idle();
+  for (std::uint8_t i : {0x0A, 0x13, 0x15, 0x18}) expect_read_equal(i);
+  EXPECT_EQ(read(Reg::CLEAR_COLOR), 0xFFu) << "the group was discarded";
+  // with the key: strict mode off, DISCARDING cleared; writes execute at once
+  burst({Frame{false, index_of(Reg::LINK_CTRL), protocol::link_ctrl_clear_value(rtl_->caps().id_register())}});
+  burst({Frame{false, index_of(Reg::CLEAR_COLOR), 0x55}});
+  wait_idle();
+  for (std::uint8_t i : {0x0A, 0x13, 0x15}) expect_read_equal(i);
+  EXPECT_EQ(read(Reg::LINK_CTRL), 0u);
+  EXPECT_EQ(read(Reg::CLEAR_COLOR), 0x55u);
   expect_read_equal(index_of(Reg::STATUS), kStatusCompared);
 }
 

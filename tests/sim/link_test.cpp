@@ -112,6 +112,47 @@ TEST(SimLink, FailedCheckDiscardsUntilLinkCtrl) {
   EXPECT_EQ(d->read_register(index_of(Reg::TRI_MODE)), 6u);
 }
 
+// Protocol 1.3: leaving strict mode takes LINK_CTRL.CLEAR_KEY. Without it the write is refused
+// whole (ERR_BAD_VALUE; STRICT, the held writes and the running CRC stay), so a queued frame that a
+// bit error turns into LINK_CTRL (PRIM 0x03 -> 0x13 with TYPE LIST or FAN) cannot switch the
+// protection off: the group it was in still fails its check.
+TEST(SimLink, LeavingStrictModeTakesTheClearKey) {
+  auto d = make_device();
+  Host h{*d};
+  h.ctrl(true);
+  h.send(Reg::TRI_MODE, 5);
+  d->write(write_frame(Reg::LINK_CTRL, 0));  // PRIM LIST garbled into LINK_CTRL: the host never sent it
+  EXPECT_EQ(d->errors(), ERR_BAD_VALUE);
+  EXPECT_EQ(d->read_register(index_of(Reg::LINK_CTRL)), 1u);
+  EXPECT_EQ(d->read_register(index_of(Reg::STATUS)) & 0xFFFF, 1u) << "the held write was discarded";
+  EXPECT_EQ(d->read_register(index_of(Reg::LINK_STATUS)) & 0xFFFFFF, h.frames) << "the CRC restarted";
+  d->write(write_frame(Reg::LINK_CTRL, 2));  // PRIM FAN: reserved bit 1 flagged, refused all the same
+  EXPECT_EQ(d->errors(), ERR_BAD_VALUE | ERR_RESERVED_BITS);
+  d->write(write_frame(Reg::LINK_CTRL, std::uint64_t{kLinkClearKey ^ 0x100} << 32));  // one bit off the key
+  EXPECT_EQ(d->read_register(index_of(Reg::LINK_CTRL)), 1u);
+  h.check();  // the group is intact: released
+  EXPECT_EQ(ok_groups(*d), 1);
+  EXPECT_EQ(d->read_register(index_of(Reg::TRI_MODE)), 5u);
+
+  d->write(write_frame(Reg::ERR_CLEAR, kAllErrors));
+  h.send(Reg::TRI_MODE, 6);
+  d->write(write_frame(Reg::LINK_CTRL, link_ctrl_clear_value(d->read_register(index_of(Reg::ID)))));
+  h.restart();
+  EXPECT_EQ(d->errors(), 0);
+  EXPECT_EQ(d->read_register(index_of(Reg::LINK_CTRL)), 0u) << "CLEAR_KEY is write-only";
+  EXPECT_EQ(d->read_register(index_of(Reg::TRI_MODE)), 5u) << "the unchecked write was discarded";
+  h.send(Reg::TRI_MODE, 7);
+  EXPECT_EQ(d->read_register(index_of(Reg::TRI_MODE)), 7u) << "strict mode is off";
+  // Outside strict mode there is nothing to leave: a plain 0 acts (restarts the CRC), unflagged.
+  d->write(write_frame(Reg::LINK_CTRL, 0));
+  EXPECT_EQ(d->errors(), 0);
+  EXPECT_EQ(d->read_register(index_of(Reg::LINK_STATUS)) & 0xFFFFFF, 0u);
+  // Enabling stays a plain write, and the key with STRICT = 1 is simply not stored.
+  d->write(write_frame(Reg::LINK_CTRL, (std::uint64_t{kLinkClearKey} << 32) | 1));
+  EXPECT_EQ(d->errors(), 0);
+  EXPECT_EQ(d->read_register(index_of(Reg::LINK_CTRL)), 1u);
+}
+
 TEST(SimLink, AbortedFrameFailsTheGroup) {
   auto d = make_device();
   Host h{*d};

@@ -38,11 +38,12 @@ TEST(SimRobustness, RandomFramesNeverBreakTheDevice) {
         default: f.data = (rng() % 3 == 0) ? 0 : (rng() & 0x0FFF'0FFF); break;
       }
       if (f.index == index_of(Reg::RESET) && rng() % 4 == 0) f.data = kResetMagic;
-      if (f.index == index_of(Reg::LINK_CTRL)) f.data &= 1;
+      if (f.index == index_of(Reg::LINK_CTRL))  // strict mode on, off (with the key half the time)
+        f.data = (f.data & 1) | (rng() % 2 ? std::uint64_t{kLinkClearKey} << 32 : 0);
       if (rng() % 500 == 0) d->frame_aborted();
       d->write(f);
     }
-    d->write(write_frame(Reg::LINK_CTRL, 0));
+    d->write(write_frame(Reg::LINK_CTRL, std::uint64_t{kLinkClearKey} << 32));
     d->write(write_frame(Reg::RESET, kResetMagic));
     EXPECT_EQ(d->read(index_of(Reg::ID)) >> 32, kIdMagic);
     EXPECT_EQ(d->read(index_of(Reg::STATUS)) >> 48, 0u);

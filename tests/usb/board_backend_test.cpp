@@ -119,6 +119,36 @@ TEST(BoardBackend, MosiBitFlipIsCaughtByTheLinkCheckAndResent) {
   EXPECT_EQ(*back, data);
 }
 
+// A board keeps its state between host sessions, strict link mode included, and a session whose
+// profile turns strict mode off would see every write held forever. Attaching without strict mode
+// therefore leaves it, with LINK_CTRL.CLEAR_KEY on a 1.3 device (which refuses a plain 0).
+TEST(BoardBackend, AttachWithoutStrictModeLeavesWhatAnEarlierSessionSwitchedOn) {
+  auto profile = test::profile_for(BridgeChip::FT232H);
+  auto earlier = emu::open_emulated_board(profile);
+  ASSERT_TRUE(earlier) << earlier.error().message;
+  ASSERT_TRUE(earlier->backend->strict_link());
+  earlier->backend.reset();  // the session ends; the board stays in strict mode
+  profile.strict_link = false;
+  auto bridge = open_bridge(profile, earlier->stack->transport());
+  ASSERT_TRUE(bridge) << bridge.error().message;
+  auto b = BoardBackend::attach(profile, earlier->stack, std::move(*bridge));
+  ASSERT_TRUE(b) << b.error().message;
+  EXPECT_FALSE((*b)->strict_link());
+  std::vector<std::uint8_t> bytes;
+  protocol::append(bytes, protocol::write_frame(Reg::CLEAR_COLOR, 0x10203040));
+  protocol::append(bytes, protocol::write_frame(Reg::FENCE, 3));
+  ASSERT_TRUE((*b)->write_frames(protocol::FrameView{bytes}));
+  ASSERT_TRUE((*b)->flush()) << "writes held by strict mode";
+  auto reg = [&](Reg r) {
+    auto v = (*b)->read_register(protocol::index_of(r));
+    EXPECT_TRUE(v) << v.error().message;
+    return v ? *v : ~0ull;
+  };
+  EXPECT_EQ(reg(Reg::LINK_CTRL), 0u);
+  EXPECT_EQ(reg(Reg::FENCE), 3u);
+  EXPECT_EQ(reg(Reg::STATUS) >> 48, 0u) << "the clear was refused or flagged";
+}
+
 TEST(BoardBackend, RejectsReadFramesAndLinkRegistersInWriteBatches) {
   auto board = emu::open_emulated_board(test::profile_for(BridgeChip::FT232H));
   ASSERT_TRUE(board);

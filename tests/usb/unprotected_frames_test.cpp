@@ -89,6 +89,30 @@ TEST(UnprotectedFrames, GarbledResetIsSentAgain) {
   EXPECT_EQ(t.reg(Reg::HOST_TAG), kTag);
 }
 
+// A queued frame can be garbled into an immediate one too: PRIM (0x03) with TYPE LIST becomes a
+// LINK_CTRL (0x13) write of 0. Before protocol 1.3 that switched strict mode off: the writes held
+// ahead of it in the first group were discarded, the rest of the batch executed unchecked, and the
+// second group's check matched, so the host counted the first group as accepted and lost its
+// writes. Since 1.3 leaving strict mode takes LINK_CTRL.CLEAR_KEY: the write is refused
+// (ERR_BAD_VALUE), the first group fails its check and the whole batch is resent.
+TEST(UnprotectedFrames, PrimGarbledIntoLinkCtrlLeavesStrictModeOn) {
+  auto t = open_bench();
+  std::vector<std::uint8_t> bytes;
+  protocol::append(bytes, protocol::write_frame(Reg::CLEAR_COLOR, 0x11223344));
+  for (int i = 1; i < 40; ++i)  // 40 payload frames: groups of 32 and 8
+    protocol::append(bytes, i == 5 ? protocol::write_frame(Reg::PRIM, 0) : protocol::write_frame(Reg::FENCE, static_cast<std::uint64_t>(i)));
+  t.flip(5, 3);  // index bit 4 of PRIM: 0x03 -> 0x13
+  auto r = t.b().write_frames(protocol::FrameView{bytes});
+  ASSERT_TRUE(r) << r.error().message;
+  ASSERT_TRUE(t.flipped());
+  EXPECT_EQ(t.b().link_stats().groups_resent, 2u) << "the first group failed its check, the second was discarded";
+  ASSERT_TRUE(t.b().flush());
+  EXPECT_EQ(t.reg(Reg::CLEAR_COLOR), 0x11223344u) << "the first group's writes were lost";
+  EXPECT_EQ(t.reg(Reg::FENCE), 39u);
+  EXPECT_EQ(t.reg(Reg::LINK_CTRL), 1u);
+  EXPECT_EQ((t.reg(Reg::STATUS) >> 48) & protocol::ERR_BAD_VALUE, protocol::ERR_BAD_VALUE) << "the garbled LINK_CTRL was refused";
+}
+
 // After RESET: RESET, HOST_TAG read, then attach: ID, ID, CAPS, CAPS, HOST_TAG write, HOST_TAG read.
 TEST(UnprotectedFrames, GarbledIdReadAfterResetIsReadAgain) {
   auto t = open_bench();

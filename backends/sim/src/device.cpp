@@ -353,7 +353,13 @@ struct Device::State {
         break;
       }
       case Reg::LINK_CTRL:
-        regs[index] = data;
+        // Leaving strict mode takes CLEAR_KEY (1.3): a frame garbled into LINK_CTRL by a bit
+        // error must not switch the protection off. Refused: nothing changes (section 4).
+        if (strict && !(data & 1) && (raw >> 32) != kLinkClearKey) {
+          errors |= ERR_BAD_VALUE;
+          break;
+        }
+        regs[index] = data & 1;  // CLEAR_KEY reads 0
         strict = data & 1;
         discard_held();
         discarding = false;

@@ -91,11 +91,15 @@ Result<void> BoardBackend::attach_locked() {
   // Register echo through HOST_TAG: proves writes land and lets us detect board resets later.
   tag_ = opts_.host_tag;
   if (!tag_) tag_ = static_cast<std::uint64_t>(std::chrono::steady_clock::now().time_since_epoch().count()) | 1;
+  // Never the LINK_CTRL.CLEAR_KEY in the upper half: HOST_TAG (0x16) is two index flips from
+  // LINK_CTRL (0x13), and a clear must stay out of reach of bit errors (docs/protocol.md section 4).
+  if ((tag_ >> 32) == protocol::kLinkClearKey) tag_ ^= 1ull << 32;
   if (auto r = write_host_tag(); !r) return r;
 
   const bool design_strict = (caps_ >> 56) & 0x08;
   strict_ = profile_.strict_link && design_strict;
   if (strict_) return restart_link();
+  if (design_strict) return leave_strict_mode();
   return {};
 }
 
@@ -174,7 +178,7 @@ Result<void> BoardBackend::reset() {
   std::uint64_t tag = 0;
   for (unsigned attempt = 0; attempt < 3; ++attempt) {
     if (attempt > 0) ++stats_.reset_retries;
-    auto r = write_then_read_tag(protocol::write_frame(Reg::RESET, protocol::kResetMagic));
+    auto r = write_then_read(protocol::write_frame(Reg::RESET, protocol::kResetMagic), Reg::HOST_TAG);
     if (!r) {
       if (auto fr = on_fault(r.error()); !fr) return fr;
       return r.error();

@@ -86,6 +86,23 @@ Result<void> BoardBackend::restart_link() {
   return {};
 }
 
+// Strict mode unwanted on a design that has it: a previous session (another profile) may have left
+// it on, and its held writes would never execute. Leaving it takes LINK_CTRL.CLEAR_KEY since
+// protocol 1.3; to older devices those bits are reserved (ERR_RESERVED_BITS), so they get a plain
+// 0 (docs/protocol.md section 4). Immediate and unprotected: read back, sent again while STRICT
+// still reads 1.
+Result<void> BoardBackend::leave_strict_mode() {
+  const Frame clear = protocol::write_frame(Reg::LINK_CTRL, protocol::link_ctrl_clear_value(id_));
+  for (unsigned attempt = 0; attempt < 3; ++attempt) {
+    auto strict = write_then_read(clear, Reg::LINK_CTRL);
+    if (!strict) return strict.error();
+    if (!(*strict & 1)) return {};
+  }
+  return make_error("board '" + profile_.name + "': LINK_CTRL still reads STRICT = 1 after 3 writes leaving strict mode; " +
+                        "SPI bit errors: lower bridge.spi_clock_hz",
+                    backends::kDeviceProtocol);
+}
+
 // LINK_STATUS read twice in one window: the counters (bits 63..24) must agree, so a MISO bit
 // error cannot make us believe a group was accepted.
 Result<std::uint64_t> BoardBackend::read_link_status_stable() {
@@ -99,11 +116,11 @@ Result<std::uint64_t> BoardBackend::read_link_status_stable() {
                     backends::kDeviceProtocol);
 }
 
-// One transfer: the immediate write `w`, then a HOST_TAG read; returns what the read returned (the
+// One transfer: the immediate write `w`, then a read of `read`; returns what the read returned (the
 // host's way to see that an immediate write acted).
-Result<std::uint64_t> BoardBackend::write_then_read_tag(const Frame& w) {
+Result<std::uint64_t> BoardBackend::write_then_read(const Frame& w, Reg read) {
   std::vector<std::uint8_t> mosi;
-  const Frame frames[] = {w, read_request(index_of(Reg::HOST_TAG))};
+  const Frame frames[] = {w, read_request(index_of(read))};
   append_frame(mosi, frames[0]);
   append_frame(mosi, frames[1]);
   const SpiWindow windows[] = {{std::span(mosi).first(kFrameBytes), false, {}}, {std::span(mosi).subspan(kFrameBytes), true, {}}};
@@ -117,7 +134,7 @@ Result<std::uint64_t> BoardBackend::write_then_read_tag(const Frame& w) {
 Result<void> BoardBackend::write_host_tag() {
   std::uint64_t got = 0;
   for (unsigned attempt = 0; attempt < 3; ++attempt) {
-    auto echo = write_then_read_tag(protocol::write_frame(Reg::HOST_TAG, tag_));
+    auto echo = write_then_read(protocol::write_frame(Reg::HOST_TAG, tag_), Reg::HOST_TAG);
     if (!echo) return echo.error();
     got = *echo;
     if (got == tag_) return {};

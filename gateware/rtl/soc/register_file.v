@@ -78,6 +78,7 @@ module register_file #(
   localparam ERR_FRAMING = 0, ERR_OVERFLOW = 1, ERR_LINK_CRC = 2, ERR_RESERVED = 3, ERR_BAD_VALUE = 4,
              ERR_BAD_REGISTER = 5, ERR_MEM_RANGE = 6;
   localparam [63:0] RESET_MAGIC = 64'h0000005245534554;
+  localparam [31:0] CLEAR_KEY   = 32'h6F666621;   // LINK_CTRL.CLEAR_KEY, "off!" (protocol 1.3)
 
   // --- writes arriving ---
   wire [1:0]  wclass   = reg_class(frame_idx);
@@ -103,8 +104,11 @@ module register_file #(
   wire [63:0] imm_data = frame_data & ~rsv_mask;
 
   wire strict_refused = is_link_ctrl && imm_data[0] && !FEATURES[3];
+  // leaving strict mode takes the key, so no single bit error can switch the protection off:
+  // without it the write is refused whole (no restart, no discard, the value stays)
+  wire clear_refused  = is_link_ctrl && link_strict && !imm_data[0] && imm_data[63:32] != CLEAR_KEY;
   wire reset_ok       = wr_imm && is_reset && frame_data == RESET_MAGIC;
-  wire imm_bad_value  = wr_imm && ((is_reset && frame_data != RESET_MAGIC) || strict_refused);
+  wire imm_bad_value  = wr_imm && ((is_reset && frame_data != RESET_MAGIC) || strict_refused || clear_refused);
 
   assign fifo_push      = wr_queue && !link_discarding && !fifo_full;
   assign fifo_push_held = link_strict;
@@ -112,7 +116,7 @@ module register_file #(
   assign drop_overflow  = wr_queue && !link_discarding && fifo_full;
   assign link_check_strobe = wr_imm && is_check;
   assign link_check_crc    = imm_data[31:0];
-  assign link_ctrl_strobe  = wr_imm && is_link_ctrl;
+  assign link_ctrl_strobe  = wr_imm && is_link_ctrl && !clear_refused;
   assign link_ctrl_strict  = imm_data[0] && FEATURES[3];
   assign soft_reset        = reset_ok;
 
@@ -121,7 +125,7 @@ module register_file #(
   reg  [63:0] shadow_q;
   reg         seq_active;
   reg  [4:0]  seq_idx;
-  wire        imm_wr = wr_imm && (is_host_tag || is_link_ctrl);
+  wire        imm_wr = wr_imm && (is_host_tag || link_ctrl_strobe);
   wire        sh_we  = seq_active || imm_wr || ex_wr_req;
   wire [4:0]  sh_wa  = seq_active ? seq_idx : imm_wr ? frame_idx[4:0] : ex_wr_idx;
   wire [63:0] sh_wd  = seq_active ? reg_reset({2'b00, seq_idx})

@@ -117,7 +117,7 @@ function automatic [63:0] reg_reserved(input [6:0] idx);
     `SPIGPU_REG_STATUS: reg_reserved = 64'hFFE00000;
     `SPIGPU_REG_ERR_CLEAR: reg_reserved = 64'hFFFFFFFFFFFF0000;
     `SPIGPU_REG_FRAME_CRC: reg_reserved = 64'hFFFF000000000000;
-    `SPIGPU_REG_LINK_CTRL: reg_reserved = 64'hFFFFFFFFFFFFFFFE;
+    `SPIGPU_REG_LINK_CTRL: reg_reserved = 64'hFFFFFFFE;
     `SPIGPU_REG_LINK_CHECK: reg_reserved = 64'hFFFFFFFF00000000;
     `SPIGPU_REG_LINK_STATUS: reg_reserved = 64'hFE000000;
     `SPIGPU_REG_RESET: reg_reserved = 64'hFFFFFF0000000000;
@@ -135,7 +135,7 @@ function automatic [63:0] reg_reset(input [6:0] idx);
     `SPIGPU_REG_CLEAR_COLOR: reg_reset = 64'hFF;
     `SPIGPU_REG_CLEAR_DEPTH: reg_reset = 64'hFFFFFF;
     `SPIGPU_REG_FB_FORMAT: reg_reset = 64'h1E00280;
-    `SPIGPU_REG_ID: reg_reset = 64'h5350475501020000;
+    `SPIGPU_REG_ID: reg_reset = 64'h5350475501030000;
     default: reg_reset = 64'h0;
   endcase
 endfunction

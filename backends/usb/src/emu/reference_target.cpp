@@ -126,6 +126,10 @@ void ReferenceTarget::write_immediate(std::uint8_t index, std::uint64_t data) {
   switch (index) {
     case index_of(Reg::ERR_CLEAR): errors_ &= static_cast<std::uint16_t>(~data); break;
     case index_of(Reg::LINK_CTRL):
+      if (strict_ && !(data & 1) && (data >> 32) != protocol::kLinkClearKey) {  // leaving strict mode needs the key
+        errors_ |= protocol::ERR_BAD_VALUE;
+        break;
+      }
       strict_ = (data & 1) != 0;
       discarding_ = false;
       group_tainted_ = false;

@@ -160,8 +160,18 @@ constexpr bool miso_status_valid(std::uint8_t b) { return (b & MISO_MARKER_MASK)
 // Fixed identification values.
 inline constexpr std::uint32_t kIdMagic = 0x53504755;  // "SPGU" in ID[63:32]
 inline constexpr std::uint8_t kVersionMajor = 1;
-inline constexpr std::uint8_t kVersionMinor = 2;  // 1.1: TRI_MODE.TEMPORAL / DITHER_PHASE; 1.2: CAPS.FEATURES bit 7 (texturing)
+// 1.1: TRI_MODE.TEMPORAL / DITHER_PHASE; 1.2: CAPS.FEATURES bit 7 (texturing); 1.3: LINK_CTRL.CLEAR_KEY.
+inline constexpr std::uint8_t kVersionMinor = 3;
 inline constexpr std::uint64_t kResetMagic = 0x5245534554ull;  // "RESET": RESET's required data
+// "off!" in LINK_CTRL.CLEAR_KEY: a LINK_CTRL write with STRICT = 0 leaves strict mode only with it
+// (protocol 1.3, docs/protocol.md section 4), so no single bit error can turn strict mode off.
+inline constexpr std::uint32_t kLinkClearKey = 0x6F666621;
+constexpr unsigned protocol_minor(std::uint64_t id) { return static_cast<unsigned>((id >> 16) & 0xFF); }
+// The LINK_CTRL data that leaves strict mode on the device whose ID register reads `id`: the key
+// from 1.3 on; 0 before, where the key's bits are reserved (a 1.2 device would flag them).
+constexpr std::uint64_t link_ctrl_clear_value(std::uint64_t id) {
+  return protocol_minor(id) >= 3 ? std::uint64_t{kLinkClearKey} << 32 : 0;
+}
 inline constexpr unsigned kMaxFramebufferDim = 1024;
 inline constexpr unsigned kMinTextureLog2 = 3;
 inline constexpr unsigned kMaxTextureLog2 = 10;

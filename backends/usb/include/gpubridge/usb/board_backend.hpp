@@ -32,7 +32,7 @@ class BoardBackend final : public backends::Backend {
  public:
   // `lower` keeps whatever sits below the bridge alive (libusb handle, chip model chain); it is
   // destroyed after the bridge. Attaching checks ID and CAPS, writes HOST_TAG and enables strict
-  // link mode when the profile and the design both support it.
+  // link mode when the profile and the design both support it (else makes sure it is off).
   static Result<std::unique_ptr<BoardBackend>> attach(BoardProfile profile, std::shared_ptr<void> lower,
                                                       std::unique_ptr<SpiBridge> bridge, BoardOptions opts = {});
   ~BoardBackend() override;
@@ -71,9 +71,10 @@ class BoardBackend final : public backends::Backend {
                                              std::span<const protocol::Frame> sent_in_order);
   Result<void> on_fault(const Error& e);
   Result<void> restart_link();
+  Result<void> leave_strict_mode();
   Result<std::uint64_t> read_link_status_stable();
   protocol::Frame read_request(std::uint8_t index) const;
-  Result<std::uint64_t> write_then_read_tag(const protocol::Frame& w);
+  Result<std::uint64_t> write_then_read(const protocol::Frame& w, protocol::Reg read);
   Result<void> write_host_tag();
   Result<void> check_host_tag();
   Result<std::uint64_t> poll_status(std::uint64_t mask, std::uint64_t want, const char* waiting_for);
