@@ -2,7 +2,8 @@
 // profiles through the board path (rtl:BOARD), with the simulator fed the same command stream:
 // the RTL's cycles per frame against the timing model's prediction (docs/protocol.md section 19),
 // before and after calibration, and the co-simulation's speed (simulated clocks/s, frames/s).
-// --fit prints the least-squares timing parameters for a profile (what timing_preset() holds).
+// --fit adds calibration frames (rtl_calibration.hpp) and prints the staged least-squares fit of the
+// model's gateware terms (rtl_fit.hpp): what timing_preset() holds.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -304,7 +305,9 @@ GPUBRIDGE_COMMAND("bench-rtl", 63, [](CLI::App& app, GlobalOptions& g, auto& run
       "rtl", "the gateware co-simulated: RTL cycles per frame of every example and scene against the timing model, "
              "before and after calibration, and the co-simulation's speed");
   sub->add_option("--profile", a->profiles, "gateware profiles to run (up5k, ecp5)")->capture_default_str();
-  sub->add_flag("--fit", a->fit, "print the least-squares timing parameters (the calibration behind timing_preset)");
+  sub->add_flag("--fit", a->fit,
+                "also run the calibration frames (every render-state class, four triangle shapes) and print the staged "
+                "least-squares fit of the timing model's gateware terms (what timing_preset holds) and its error per frame");
   sub->add_flag("--quick", a->quick, "two examples only (a smoke run)");
   sub->add_option("--config-dir", a->config_dir, "directory holding boards/");
   runners.emplace_back(sub, [&g, a] { return run_bench_rtl(g, *a); });

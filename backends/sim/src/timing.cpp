@@ -90,37 +90,62 @@ DeviceStats stats_difference(const DeviceStats& a, const DeviceStats& b) {
 Result<BoardTiming> timing_preset(std::string_view name) {
   BoardTiming b;
   if (name == "ecp5-50mhz") return b;
+  if (name == "up5k" || name == "ecp5") {
+    // The gateware profiles (gateware/rtl/spigpu_top.v) at their co-simulated clocks; every cycle
+    // term from `gpubridge bench rtl --fit` (docs/gateware.md "Timing model", 2026-11-26): the
+    // staged least-squares fit on the RTL's setup, rasteriser and remaining clocks of every example,
+    // scene and calibration frame. Classes: flat, gouraud, z, gouraud_z, tex, tex_gouraud, tex_z,
+    // tex_gouraud_z. The terms hold the memory's time: no byte bound.
+    b.name = std::string(name);
+    b.cycles_per_scanned_pixel = b.cycles_per_pixel = b.cycles_per_textured_pixel = 0;
+    b.memory_bound = false;
+  }
   if (name == "up5k") {
-    // iCEBreaker: 25.125 MHz core (its PLL), 128 KiB SPRAM (one 32-bit access per clock), SPI 7.5 MHz, no BUSY pin
-    b.name = "up5k";
+    // iCEBreaker: 25.125 MHz core (its PLL), 128 KiB SPRAM (one 32-bit access per clock), SPI 7.5 MHz,
+    // no BUSY pin. The setup is a bit-serial program (gen_setup_prog.py: 220 cycles flat .. 1,289 Gouraud + Z on
+    // the core bench); the one time-shared stepper costs a cycle per interpolated attribute per
+    // rasteriser move (rows, boundary columns and pixels); clears are drawn as rectangles.
     b.clock_mhz = 25.125;
     b.spi_clock_mhz = 7.5;
     b.memory_bytes_per_cycle = 4.0;
-    // least-squares fit on the RTL (gpubridge bench rtl --fit, docs/gateware.md "Timing model"):
-    // the bit-serial setup and the time-shared steppers make triangles and pixels dear
-    b.cycles_per_command = 94.89;
-    b.cycles_per_triangle = 521.4;
-    b.cycles_per_scanned_pixel = 3.894;
-    b.cycles_per_pixel = 0.0;
-    b.cycles_per_textured_pixel = 0.0;  // no texture unit
-    b.cycles_per_blended_pixel = 0.0;   // no blending
-    b.clear_bytes_per_cycle = 1.0 / 0.389;
+    b.setup_cycles = {222.1, 1067.0, 510.1, 1292.0, 0.0, 0.0, 0.0, 0.0};  // no texture unit
+    b.row_cycles = {2.24, 4.892, 0.7314, 3.853, 0.0, 0.0, 0.0, 0.0};
+    b.column_cycles = {0.8081, 4.047, 1.257, 3.189, 0.0, 0.0, 0.0, 0.0};
+    b.pixel_cycles = {1.029, 3.209, 4.077, 5.271, 0.0, 0.0, 0.0, 0.0};
+    b.cycles_per_command = 0.1592;
+    b.cycles_per_triangle = 6.461;
+    b.cycles_per_blended_pixel = 0.0;  // no blending
+    b.cycles_per_rejected_triangle = 66.81;
+    b.cycles_per_clear = 888.1;
+    b.cycles_per_clear_row = 0.0;
+    b.cycles_per_clear_pixel = 1.4;
+    b.cycles_per_mem_write = 5.875;
+    b.clear_bytes_per_cycle = 1e9;  // a clear costs by pixel (one SPRAM write each), not by byte
     return b;
   }
   if (name == "ecp5") {
-    // ULX3S: 50 MHz core, 16-bit SDR SDRAM (BL2 words every other clock at best), SPI 15 MHz
-    b.name = "ecp5";
+    // ULX3S: 50 MHz core, 16-bit SDR SDRAM (a 32-bit word per 2 clocks at best), SPI 15 MHz. Parallel
+    // setup (38 cycles flat .. 336 textured Gouraud + Z on the core bench), one pixel a clock on
+    // spans, memory stalls per depth read, colour byte and texel fetch (texel cache), clears a word
+    // per 2 clocks beside the rasteriser.
     b.clock_mhz = 50.0;
     b.spi_clock_mhz = 15.0;
     b.memory_bytes_per_cycle = 2.0;
-    // least-squares fit on the RTL (gpubridge bench rtl --fit, docs/gateware.md "Timing model")
-    b.cycles_per_command = 7.488;
-    b.cycles_per_triangle = 224.2;
-    b.cycles_per_scanned_pixel = 0.7575;
-    b.cycles_per_pixel = 0.0;
-    b.cycles_per_textured_pixel = 4.29;
-    b.cycles_per_blended_pixel = 3.154;
-    b.clear_bytes_per_cycle = 1.0 / 0.7211;
+    b.setup_cycles = {42.54, 173.0, 98.98, 203.8, 166.5, 280.1, 205.6, 315.4};
+    b.row_cycles = {1.725, 0.7712, 2.873, 2.361, 1.996, 1.617, 5.105, 2.512};
+    b.column_cycles = {0.379, 0.0, 1.117, 0.3836, 0.7652, 1.507, 2.744, 0.3189};
+    b.pixel_cycles = {0.3477, 0.5947, 4.491, 4.86, 1.992, 1.746, 5.244, 6.739};
+    b.cycles_per_command = 2.33;
+    b.cycles_per_triangle = 0.0;
+    b.cycles_per_blended_pixel = 3.198;
+    b.cycles_per_rejected_triangle = 0.0;
+    b.cycles_per_clear = 9.541;
+    b.cycles_per_clear_row = 0.0;
+    b.cycles_per_clear_pixel = 0.01171;
+    b.cycles_per_mem_write = 11.98;
+    b.cycles_per_texel_byte = 0.1716;
+    b.cycles_per_color_byte = 0.3643;
+    b.clear_bytes_per_cycle = 1.983;
     return b;
   }
   return make_error("unknown timing profile '" + std::string(name) + "' (ecp5-50mhz, up5k, ecp5)");
