@@ -78,8 +78,8 @@ nlohmann::json counters_json(const sim::DeviceStats& w, const rtl::RtlCounters& 
   nlohmann::json modes = nlohmann::json::object();
   for (unsigned m = 0; m < sim::DeviceStats::kModeClasses; ++m)
     if (w.by_mode[m].triangles)
-      modes[sim::mode_class_name(m)] = {{"triangles", w.by_mode[m].triangles}, {"rows", w.by_mode[m].rows}, {"columns", w.by_mode[m].columns},
-                                         {"pixels", w.by_mode[m].pixels}};
+      modes[sim::mode_class_name(m)] = {{"triangles", w.by_mode[m].triangles}, {"rows", w.by_mode[m].rows},
+                                         {"columns", w.by_mode[m].columns}, {"pixels", w.by_mode[m].pixels}};
   return {{"sim",
            {{"frames_received", w.frames_received}, {"queued_executed", w.queued_executed},
             {"triangles_kicked", w.triangles_kicked}, {"triangles_rasterised", w.triangles_rasterised},
