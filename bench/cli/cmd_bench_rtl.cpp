@@ -2,7 +2,8 @@
 // profiles through the board path (rtl:BOARD), with the simulator fed the same command stream:
 // the RTL's cycles per frame against the timing model's prediction (docs/protocol.md section 19),
 // before and after calibration, and the co-simulation's speed (simulated clocks/s, frames/s).
-// --fit prints the least-squares timing parameters for a profile (what timing_preset() holds).
+// --fit adds calibration frames (rtl_calibration.hpp) and prints the staged least-squares fit of the
+// model's gateware terms (rtl_fit.hpp): what timing_preset() holds.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -25,6 +26,8 @@
 #include "gpubridge/usb/board_profile.hpp"
 #include "gpubridge/usb/emu/emulated_stack.hpp"
 #include "gpubridge/usb/emu/rtl_pins.hpp"
+#include "rtl_calibration.hpp"
+#include "rtl_fit.hpp"
 
 namespace gpubridge::cli {
 namespace {
@@ -42,6 +45,7 @@ struct RtlBenchArgs {
 struct Sample {
   std::string scene, profile;
   double rtl_cycles = 0;      // gateware clocks with work between the previous swap and this one
+  rtl::RtlCounters rtl;       // the gateware's counters for the frame (differences)
   sim::DeviceStats work;      // the simulator's counters for the same frame
   unsigned bpp = 4;
   double wall_s = 0;          // co-simulation time of the run
@@ -50,6 +54,47 @@ struct Sample {
 };
 
 const char* board_of(const std::string& gw) { return gw == "up5k" ? "icebreaker" : "ulx3s"; }
+
+rtl::RtlCounters counters_difference(const rtl::RtlCounters& a, const rtl::RtlCounters& b) {
+  rtl::RtlCounters d;
+  d.cycles = a.cycles - b.cycles;
+  d.work_cycles = a.work_cycles - b.work_cycles;
+  d.commands = a.commands - b.commands;
+  d.spi_frames = a.spi_frames - b.spi_frames;
+  d.core_mem_stalls = a.core_mem_stalls - b.core_mem_stalls;
+  d.triangles = a.triangles - b.triangles;
+  d.pixels = a.pixels - b.pixels;
+  d.passed = a.passed - b.passed;
+  d.textured = a.textured - b.textured;
+  d.core_busy_cycles = a.core_busy_cycles - b.core_busy_cycles;
+  d.setup_cycles = a.setup_cycles - b.setup_cycles;
+  d.raster_cycles = a.raster_cycles - b.raster_cycles;
+  d.refreshes = a.refreshes - b.refreshes;
+  return d;
+}
+
+// Both sides' counters of a frame (bench rtl --json): what a model is fitted on.
+nlohmann::json counters_json(const sim::DeviceStats& w, const rtl::RtlCounters& r) {
+  nlohmann::json modes = nlohmann::json::object();
+  for (unsigned m = 0; m < sim::DeviceStats::kModeClasses; ++m)
+    if (w.by_mode[m].triangles)
+      modes[sim::mode_class_name(m)] = {{"triangles", w.by_mode[m].triangles}, {"rows", w.by_mode[m].rows},
+                                         {"columns", w.by_mode[m].columns}, {"pixels", w.by_mode[m].pixels}};
+  return {{"sim",
+           {{"frames_received", w.frames_received}, {"queued_executed", w.queued_executed},
+            {"triangles_kicked", w.triangles_kicked}, {"triangles_rasterised", w.triangles_rasterised},
+            {"triangles_rejected", w.triangles_rejected}, {"pixels_scanned", w.pixels_scanned},
+            {"pixels_covered", w.pixels_covered}, {"pixels_depth_passed", w.pixels_depth_passed},
+            {"pixels_textured", w.pixels_textured}, {"pixels_blended", w.pixels_blended}, {"texel_bytes", w.texel_bytes},
+            {"clears", w.clears}, {"clear_rows", w.clear_rows}, {"clear_pixels", w.clear_pixels},
+            {"clear_bytes", w.clear_bytes}, {"mem_data_writes", w.mem_data_writes}, {"swaps", w.swaps},
+            {"by_mode", modes}}},
+          {"rtl",
+           {{"work_cycles", r.work_cycles}, {"commands", r.commands}, {"core_busy_cycles", r.core_busy_cycles},
+            {"setup_cycles", r.setup_cycles}, {"raster_cycles", r.raster_cycles}, {"core_mem_stalls", r.core_mem_stalls},
+            {"triangles", r.triangles}, {"pixels", r.pixels}, {"passed", r.passed}, {"textured", r.textured},
+            {"refreshes", r.refreshes}}}};
+}
 
 // Plays `stream` on the gateware board and on a simulator with the same CAPS; one sample per frame.
 Result<std::vector<Sample>> measure(const std::string& scene, const std::string& gw, const protocol::CommandStream& stream,
@@ -67,12 +112,12 @@ Result<std::vector<Sample>> measure(const std::string& scene, const std::string&
   if (!sim) return sim.error();
 
   std::vector<Sample> out;
-  std::vector<double> rtl_frames;
-  double last_work = double(g.counters().work_cycles);
+  std::vector<rtl::RtlCounters> rtl_frames;
+  rtl::RtlCounters last_rtl = g.counters();
   board->backend->set_scanout_callback([&](std::shared_ptr<const backends::ScanoutFrame>) {
-    const double w = double(g.counters().work_cycles);
-    rtl_frames.push_back(w - last_work);
-    last_work = w;
+    const rtl::RtlCounters now = g.counters();
+    rtl_frames.push_back(counters_difference(now, last_rtl));
+    last_rtl = now;
   });
   std::vector<std::pair<sim::DeviceStats, unsigned>> sim_frames;
   sim::DeviceStats last;
@@ -92,8 +137,16 @@ Result<std::vector<Sample>> measure(const std::string& scene, const std::string&
       if (u->address >= vram) continue;
       const auto n = std::min<std::uint64_t>(u->data.size(), vram - u->address);
       if (auto r = board->backend->upload(u->address, std::span(u->data).first(n)); !r) return r.error();
-      auto m = (*sim)->memory();
-      std::copy(u->data.begin(), u->data.begin() + static_cast<std::ptrdiff_t>(n), m.begin() + u->address);
+      // the simulator gets what the board driver sends (MEM_ADDR, then MEM_DATA words; a partial
+      // last word keeps the bytes in memory), so its counters see the upload as the gateware does
+      const auto m = (*sim)->memory();
+      std::vector<protocol::Frame> words{protocol::write_frame(protocol::Reg::MEM_ADDR, u->address)};
+      for (std::uint64_t off = 0; off < n; off += 8) {
+        std::uint64_t v = 0;
+        for (std::uint64_t b = 0; b < 8; ++b) v = v << 8 | (off + b < n ? u->data[off + b] : m[u->address + off + b]);
+        words.push_back(protocol::write_frame(protocol::Reg::MEM_DATA, v));
+      }
+      for (const auto& wf : words) (*sim)->write(wf);
     }
   }
   if (auto r = board->backend->flush(); !r) return r.error();
@@ -103,7 +156,8 @@ Result<std::vector<Sample>> measure(const std::string& scene, const std::string&
     Sample s;
     s.scene = scene;
     s.profile = gw;
-    s.rtl_cycles = rtl_frames[i];
+    s.rtl_cycles = double(rtl_frames[i].work_cycles);
+    s.rtl = rtl_frames[i];
     s.work = sim_frames[i].first;
     s.bpp = sim_frames[i].second;
     s.wall_s = wall;
@@ -141,28 +195,6 @@ Result<std::vector<std::pair<std::string, protocol::CommandStream>>> streams(boo
   return out;
 }
 
-// Non-negative least squares on relative error: measured ≈ Σ p_j x_j, each row weighted 1/measured
-// (projected gradient; the problem is tiny).
-std::vector<double> fit_linear(const std::vector<std::vector<double>>& x, const std::vector<double>& y) {
-  const std::size_t n = x.front().size();
-  std::vector<double> p(n, 0.0), scale(n, 0.0);
-  for (std::size_t r = 0; r < x.size(); ++r)
-    for (std::size_t j = 0; j < n; ++j) scale[j] = std::max(scale[j], x[r][j] / y[r]);
-  for (std::size_t j = 0; j < n; ++j) p[j] = scale[j] > 0 ? 0.1 / scale[j] : 0;
-  for (int it = 0; it < 200000; ++it) {
-    std::vector<double> grad(n, 0.0);
-    for (std::size_t r = 0; r < x.size(); ++r) {
-      double pred = 0;
-      for (std::size_t j = 0; j < n; ++j) pred += p[j] * x[r][j];
-      const double e = (pred - y[r]) / y[r];
-      for (std::size_t j = 0; j < n; ++j) grad[j] += 2 * e * x[r][j] / y[r];
-    }
-    for (std::size_t j = 0; j < n; ++j)
-      if (scale[j] > 0) p[j] = std::max(0.0, p[j] - 0.02 * grad[j] / (scale[j] * scale[j] * double(x.size())));
-  }
-  return p;
-}
-
 int run_bench_rtl(const GlobalOptions& g, const RtlBenchArgs& a) {
   if (!rtl::RtlDevice::available()) {
     std::fprintf(stderr, "gpubridge bench rtl: %s\n", rtl::RtlDevice::unavailable_reason().c_str());
@@ -182,14 +214,33 @@ int run_bench_rtl(const GlobalOptions& g, const RtlBenchArgs& a) {
     }
     auto preset = sim::timing_preset(gw);
     auto before = sim::timing_preset("ecp5-50mhz");
-    std::vector<Sample> samples;
-    for (const auto& [name, stream] : *all) {
+    // the measured frame of each stream: its last one, both sides' counters over the same work
+    auto run = [&](const std::string& name, const protocol::CommandStream& stream, std::vector<Sample>& out) -> bool {
       auto s = measure(name, gw, stream, config_dir);
       if (!s) {
         std::fprintf(stderr, "gpubridge bench rtl: %s on %s: %s\n", name.c_str(), gw.c_str(), s.error().message.c_str());
-        return 1;
+        return false;
       }
-      if (!s->empty()) samples.push_back(s->back());  // the measured frame: the last one
+      if (s->empty()) return true;
+      const Sample& last = s->back();
+      // Frames are paired by index (a board reports one swap per WRITE_FRAMES batch): both sides
+      // must have drawn the same pixels, or the pair is not one frame.
+      if (last.rtl.pixels != last.work.pixels_covered) {
+        std::fprintf(stderr, "gpubridge bench rtl: %s on %s: the frames do not pair (RTL %llu pixels, simulator %llu)\n",
+                     name.c_str(), gw.c_str(), static_cast<unsigned long long>(last.rtl.pixels),
+                     static_cast<unsigned long long>(last.work.pixels_covered));
+        return false;
+      }
+      out.push_back(last);
+      return true;
+    };
+    std::vector<Sample> samples, calibration;
+    for (const auto& [name, stream] : *all)
+      if (!run(name, stream, samples)) return 1;
+    if (a.fit) {
+      const bool texturing = gw == "ecp5";  // CAPS.FEATURES bit 7 (docs/gateware.md, the profiles' CAPS)
+      for (const auto& c : calibration_streams(texturing))
+        if (!run(c.name, c.stream, calibration)) return 1;
     }
     nlohmann::json rows = nlohmann::json::array();
     if (!g.json)
@@ -205,47 +256,40 @@ int run_bench_rtl(const GlobalOptions& g, const RtlBenchArgs& a) {
       const double cps = s.simulated_clocks / s.wall_s, fps = s.frames / s.wall_s;
       rows.push_back({{"scene", s.scene}, {"rtl_cycles", s.rtl_cycles}, {"default_cycles", d}, {"default_error_pct", ed},
                       {"calibrated_cycles", c}, {"calibrated_error_pct", ec}, {"simulated_clocks_per_s", cps},
-                      {"frames_per_s", fps}, {"triangles", s.work.triangles_rasterised}, {"pixels", s.work.pixels_covered}});
+                      {"frames_per_s", fps}, {"triangles", s.work.triangles_rasterised}, {"pixels", s.work.pixels_covered},
+                      {"counters", counters_json(s.work, s.rtl)}});
       if (!g.json)
         std::printf("  %-20s %12.0f %12.0f %+7.1f%% %12.0f %+7.1f%% %12.0f %9.2f\n", s.scene.c_str(), s.rtl_cycles, d, ed, c, ec,
                     cps, fps);
     }
     if (!g.json) std::printf("  worst calibrated error %.1f%%\n", worst);
     report[gw] = {{"board", board_of(gw)}, {"rows", rows}, {"worst_calibrated_error_pct", worst}};
-    if (a.fit && samples.size() >= 2) {
-      std::vector<std::vector<double>> x;
-      std::vector<double> y;
-      for (const auto& s : samples) {
-        const auto& w = s.work;
-        x.push_back({double(w.queued_executed), double(w.triangles_rasterised), double(w.pixels_scanned),
-                     double(w.pixels_depth_passed), double(w.pixels_textured), double(w.pixels_blended), double(w.clear_bytes)});
-        y.push_back(s.rtl_cycles);
-      }
-      const auto p = fit_linear(x, y);
-      const char* names[] = {"cycles_per_command", "cycles_per_triangle", "cycles_per_scanned_pixel", "cycles_per_pixel",
-                             "cycles_per_textured_pixel", "cycles_per_blended_pixel", "cycles_per_clear_byte"};
-      nlohmann::json fit;
-      for (std::size_t j = 0; j < p.size(); ++j) fit[names[j]] = p[j];
-      // the fit as a profile (memory bound included), and its error on the same frames
-      sim::BoardTiming fitted = *preset;
-      fitted.cycles_per_command = p[0];
-      fitted.cycles_per_triangle = p[1];
-      fitted.cycles_per_scanned_pixel = p[2];
-      fitted.cycles_per_pixel = p[3];
-      fitted.cycles_per_textured_pixel = p[4];
-      fitted.cycles_per_blended_pixel = p[5];
-      fitted.clear_bytes_per_cycle = p[6] > 0 ? 1.0 / p[6] : 1e9;
-      double worst_fit = 0;
-      for (const auto& s : samples) {
-        const double f = sim::estimate_timing(s.work, fitted, s.bpp).board_cycles;
-        worst_fit = std::max(worst_fit, std::fabs((f - s.rtl_cycles) / s.rtl_cycles * 100));
-      }
-      fit["worst_error_pct"] = worst_fit;
-      report[gw]["fit"] = fit;
+    if (a.fit && samples.size() + calibration.size() >= 2) {
+      std::vector<FitSample> fs;
+      for (const auto* set : {&samples, &calibration})
+        for (const auto& s : *set) fs.push_back({s.work, s.rtl, s.bpp});
+      const TimingFit fit = fit_timing(fs, *preset);
+      nlohmann::json params = nlohmann::json::object(), errors = nlohmann::json::array();
+      for (const auto& [k, v] : fit.parameters) params[k] = v;
+      double worst_fit = 0, worst_calibration = 0;
+      for (const auto* set : {&samples, &calibration})
+        for (const auto& s : *set) {
+          const auto e = sim::estimate_timing(s.work, fit.timing, s.bpp);
+          const double err = (e.board_cycles - s.rtl_cycles) / s.rtl_cycles * 100;
+          double& worst_of_set = set == &samples ? worst_fit : worst_calibration;
+          worst_of_set = std::max(worst_of_set, std::fabs(err));
+          errors.push_back({{"scene", s.scene}, {"rtl_cycles", s.rtl_cycles}, {"fitted_cycles", e.board_cycles},
+                            {"memory_bound", e.memory_cycles > e.pipeline_cycles}, {"error_pct", err},
+                            {"counters", counters_json(s.work, s.rtl)}});
+        }
+      report[gw]["fit"] = {{"parameters", params}, {"rows", errors}, {"worst_error_pct", worst_fit},
+                           {"worst_calibration_error_pct", worst_calibration}, {"calibration_frames", calibration.size()}};
       if (!g.json) {
-        std::printf("  least-squares fit:");
-        for (std::size_t j = 0; j < p.size(); ++j) std::printf(" %s=%.4g", names[j], p[j]);
-        std::printf("\n  worst error with the fit %.1f%%\n", worst_fit);
+        std::printf("  least-squares fit on %zu scenes and %zu calibration frames (settings of --board-timing):\n   ",
+                    samples.size(), calibration.size());
+        for (const auto& [k, v] : fit.parameters) std::printf(" %s=%.4g", k.c_str(), v);
+        std::printf("\n  worst error with the fit: %.1f%% on the scenes, %.1f%% on the calibration frames\n", worst_fit,
+                    worst_calibration);
       }
     }
   }
@@ -261,7 +305,9 @@ GPUBRIDGE_COMMAND("bench-rtl", 63, [](CLI::App& app, GlobalOptions& g, auto& run
       "rtl", "the gateware co-simulated: RTL cycles per frame of every example and scene against the timing model, "
              "before and after calibration, and the co-simulation's speed");
   sub->add_option("--profile", a->profiles, "gateware profiles to run (up5k, ecp5)")->capture_default_str();
-  sub->add_flag("--fit", a->fit, "print the least-squares timing parameters (the calibration behind timing_preset)");
+  sub->add_flag("--fit", a->fit,
+                "also run the calibration frames (every render-state class, four triangle shapes) and print the staged "
+                "least-squares fit of the timing model's gateware terms (what timing_preset holds) and its error per frame");
   sub->add_flag("--quick", a->quick, "two examples only (a smoke run)");
   sub->add_option("--config-dir", a->config_dir, "directory holding boards/");
   runners.emplace_back(sub, [&g, a] { return run_bench_rtl(g, *a); });

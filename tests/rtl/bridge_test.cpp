@@ -11,6 +11,7 @@
 #include "gpubridge/draw/sink.hpp"
 #include "gpubridge/examples/example.hpp"
 #include "gpubridge/scene/scene.hpp"
+#include "gpubridge/sim/timing.hpp"
 
 namespace gpubridge::test {
 namespace {
@@ -104,7 +105,17 @@ TEST_P(Scenes, MatchTheSimulatorThroughTheBridge) {
     }
   }
   EXPECT_EQ((*g)->compare(), "") << GetParam().scene << " on " << GetParam().board;
-  EXPECT_GE((*g)->gateware_frames().size(), 1u);
+  ASSERT_GE((*g)->gateware_frames().size(), 1u);
+  // The timing model's preset for the gateware profile predicts the gateware's work cycles from the
+  // simulator's counters of the same stream (docs/gateware.md "Timing model": the scene files are
+  // within 10 % on both profiles).
+  auto preset = sim::timing_preset(profile.gateware);
+  ASSERT_TRUE(preset) << preset.error().message;
+  const double rtl_cycles = double((*g)->gateware().counters().work_cycles);
+  const unsigned bpp = protocol::bytes_per_pixel((*g)->gateware_frames().back().format);
+  const double model = sim::estimate_timing((*g)->sim().stats(), *preset, bpp).board_cycles;
+  EXPECT_NEAR(model / rtl_cycles, 1.0, 0.10) << GetParam().scene << " on " << profile.gateware << ": model " << model
+                                             << " cycles, RTL " << rtl_cycles;
 }
 
 std::vector<SceneCase> scene_cases() {

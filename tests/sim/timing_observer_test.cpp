@@ -50,14 +50,22 @@ TEST(SimTiming, GatewarePresetsReplaceTheProfile) {
   EXPECT_EQ(b.name, "up5k");
   EXPECT_DOUBLE_EQ(b.clock_mhz, 25.125);
   EXPECT_DOUBLE_EQ(b.spi_clock_mhz, 7.5);
-  EXPECT_GT(b.cycles_per_triangle, BoardTiming{}.cycles_per_triangle);  // bit-serial setup
+  // the bit-serial setup of Gouraud + Z (docs/gateware.md: 1,289 cycles on the RTL's core bench)
+  EXPECT_GT(b.setup_cycles[3], 1200.0);
+  EXPECT_LT(b.setup_cycles[3], 1400.0);
+  EXPECT_DOUBLE_EQ(b.setup_cycles[4], 0.0);  // no texture unit
+  EXPECT_FALSE(b.memory_bound);
   ASSERT_TRUE(apply_timing_setting(b, "clock_mhz=25").ok());
   EXPECT_DOUBLE_EQ(b.clock_mhz, 25.0);
   ASSERT_TRUE(apply_timing_setting(b, "profile=ecp5").ok());
   EXPECT_EQ(b.name, "ecp5");
   EXPECT_DOUBLE_EQ(b.memory_bytes_per_cycle, 2.0);  // 16-bit SDR SDRAM
+  EXPECT_GT(b.setup_cycles[7], b.setup_cycles[0]);  // textured Gouraud + Z sets up 8 planes, flat none
+  EXPECT_GT(b.setup_cycles[7], 250.0);               // 336 cycles on the core bench
   ASSERT_TRUE(apply_timing_setting(b, "profile=ecp5-50mhz").ok());
   EXPECT_DOUBLE_EQ(b.cycles_per_triangle, BoardTiming{}.cycles_per_triangle);
+  EXPECT_DOUBLE_EQ(b.setup_cycles[7], 0.0);
+  EXPECT_TRUE(b.memory_bound);
   const auto bad = apply_timing_setting(b, "profile=ice40");
   ASSERT_FALSE(bad.ok());
   EXPECT_NE(bad.error().message.find("up5k"), std::string::npos) << bad.error().message;

@@ -27,6 +27,7 @@ void expect_same(const Case& c, const Rendered& v, const Rendered& s, int i) {
   EXPECT_EQ(v.stats.pixels_textured, s.stats.pixels_textured) << i;
   EXPECT_EQ(v.stats.pixels_blended, s.stats.pixels_blended) << i;
   EXPECT_EQ(v.stats.texel_bytes, s.stats.texel_bytes) << i;
+  EXPECT_TRUE(v.stats == s.stats) << i << ": the timing counters too";
 }
 
 TEST(SimVectorRoutines, SameBytesAndCountersAsScalar) {

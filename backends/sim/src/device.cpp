@@ -280,6 +280,9 @@ struct Device::State {
     std::vector<std::uint8_t> row(std::size_t{cols} * bpp);
     for (unsigned i = 0; i < cols; ++i) std::copy(value, value + bpp, row.begin() + std::size_t{i} * bpp);
     bool dropped = false;
+    ++stats.clears;
+    stats.clear_rows += static_cast<std::uint64_t>(st.clip.y1 - st.clip.y0);
+    stats.clear_pixels += std::uint64_t{cols} * static_cast<std::uint64_t>(st.clip.y1 - st.clip.y0);
     for (int y = st.clip.y0; y < st.clip.y1; ++y) {
       const std::uint64_t at = base + (std::uint64_t(y) * st.fb_width + st.clip.x0) * bpp;
       dropped |= !mem.write(at, row.data(), row.size());
@@ -566,6 +569,8 @@ const DeviceStats& Device::stats() const {
   st.pixels_textured = c.textured;
   st.pixels_blended = c.blended;
   st.texel_bytes = c.texel_bytes;
+  st.by_mode = s_->renderer.mode_work();
+  st.triangles_rejected = s_->renderer.triangles_rejected();
   return st;
 }
 void Device::reset_stats() {

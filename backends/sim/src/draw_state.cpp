@@ -79,6 +79,10 @@ DrawState decode_draw_state(const RegisterValues& r, std::uint64_t vram_bytes) {
   s.buffers_disjoint = s.fb_draw + clen <= s.fb_z || s.fb_z + zlen <= s.fb_draw;
   s.simple_color = s.fb_format == PixelFormat::RGBA8888 && s.blend == BlendMode::Off && !some_masked;
   s.keep_bits = keep_bits_of(s.fb_format, s.keep_mask);
+  // Timing class (section 19): colour planes only when a colour channel is written (the
+  // gateware's setup skips them otherwise), Z for the test or the write, S/T/Q when textured.
+  s.mode_class = ((s.gouraud && !all_masked) ? 1u : 0u) | ((s.z_test || s.z_write) ? 2u : 0u) |
+                 ((s.textured && !all_masked) ? 4u : 0u);
   return s;
 }
 

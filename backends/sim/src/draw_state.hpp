@@ -49,6 +49,7 @@ struct DrawState {
   bool simple_color = false;     // RGBA8888, no blend, no mask: store the 4 bytes directly
   bool buffers_disjoint = false; // colour and depth buffers share no byte (pixel order between them is free)
   std::uint32_t keep_bits = 0;   // the stored bits of a pixel that the write mask keeps (RGBA8888: bytes, byte c = channel c)
+  unsigned mode_class = 0;       // DeviceStats::by_mode index: the planes a gateware sets up and steps (timing only)
 };
 
 // Register indices into the device's register file.

@@ -62,10 +62,15 @@ void Renderer::draw(const Vertex& a, const Vertex& b, const Vertex& c, const std
                                                         : setup_triangle(a, b, c, st, knobs_.subpixel_bits, observing, t);
   if (!ok) {
     if (batching) batch_.pop_back();
+    ++rejected_;
     return;
   }
   t.index = index;
   ++rasterised_;
+  auto& mode = modes_[st.mode_class];
+  ++mode.triangles;
+  mode.rows += static_cast<std::uint64_t>(t.y1 - t.y0);
+  mode.columns += static_cast<std::uint64_t>(t.x1 - t.x0);
   if (observing) observe_triangle(t, st, observer_);
   if (!batching) {
     if (st.writes_nothing) return;
@@ -86,7 +91,7 @@ void Renderer::draw_pending() {
   RasterContext ctx{mem_, recip_, knobs_.z_bits, 0, {}, vector_};
   rasterize_rows(t, *pending_state_, ctx, t.y0, t.y1);
   errors_ |= ctx.errors;
-  counters_.add(ctx.counters);
+  add_counters(ctx.counters, *pending_state_);
   pending_ = -1;  // pending_state_ stays: the next triangle most likely uses it again
 }
 
@@ -139,7 +144,7 @@ void Renderer::wait_drawing() {
   pool_.wait();
   for (const auto& c : drawing_ctx_) {
     errors_ |= c.errors;
-    counters_.add(c.counters);
+    add_counters(c.counters, *drawing_state_);  // one state per batch
   }
   drawing_.clear();
   drawing_state_.reset();

@@ -5,6 +5,7 @@
 // their own 16-row bands (band i → worker i % N), so the bytes are identical for any N. The
 // calling thread (the device front end) decodes and sets up the next batch while the workers draw
 // the previous one; batches are drawn one after another, and flush() waits for both.
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -39,9 +40,14 @@ class Renderer {
   std::uint16_t take_errors();
   std::uint64_t triangles_rasterised() const { return rasterised_; }
   const RasterCounters& counters() const { return counters_; }
+  // Triangles, box rows and covered pixels per render-state class; triangles set up for nothing.
+  const std::array<DeviceStats::ModeWork, DeviceStats::kModeClasses>& mode_work() const { return modes_; }
+  std::uint64_t triangles_rejected() const { return rejected_; }
   void reset_counters() {
     counters_ = {};
     rasterised_ = 0;
+    rejected_ = 0;
+    modes_ = {};
   }
 
   static constexpr int kBandRows = 16;
@@ -75,7 +81,13 @@ class Renderer {
   std::shared_ptr<const DrawState> pending_state_;
   std::uint16_t errors_ = 0;
   std::uint64_t rasterised_ = 0;
+  std::uint64_t rejected_ = 0;
   RasterCounters counters_;
+  std::array<DeviceStats::ModeWork, DeviceStats::kModeClasses> modes_{};
+  void add_counters(const RasterCounters& c, const DrawState& st) {
+    counters_.add(c);
+    modes_[st.mode_class].pixels += c.covered;
+  }
 };
 
 }  // namespace gpubridge::sim

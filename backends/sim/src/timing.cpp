@@ -7,6 +7,29 @@
 
 namespace gpubridge::sim {
 
+namespace {
+
+// The gateware-shaped terms of section 19: setup, row and pixel cycles by render-state class,
+// rejected setups, clears by rectangle, row and pixel, MEM_DATA writes.
+double structure_cycles(const DeviceStats& w, const BoardTiming& b, unsigned color_bpp) {
+  double c = double(w.triangles_rejected) * b.cycles_per_rejected_triangle + double(w.clears) * b.cycles_per_clear +
+             double(w.clear_rows) * b.cycles_per_clear_row + double(w.clear_pixels) * b.cycles_per_clear_pixel +
+             double(w.mem_data_writes) * b.cycles_per_mem_write + double(w.texel_bytes) * b.cycles_per_texel_byte +
+             double(w.pixels_depth_passed) * color_bpp * b.cycles_per_color_byte;
+  for (unsigned m = 0; m < DeviceStats::kModeClasses; ++m)
+    c += double(w.by_mode[m].triangles) * b.setup_cycles[m] + double(w.by_mode[m].rows) * b.row_cycles[m] +
+         double(w.by_mode[m].columns) * b.column_cycles[m] + double(w.by_mode[m].pixels) * b.pixel_cycles[m];
+  return c;
+}
+
+}  // namespace
+
+const char* mode_class_name(unsigned index) {
+  static constexpr const char* kNames[DeviceStats::kModeClasses] = {"flat", "gouraud",     "z",     "gouraud_z",
+                                                                    "tex",  "tex_gouraud", "tex_z", "tex_gouraud_z"};
+  return index < DeviceStats::kModeClasses ? kNames[index] : "?";
+}
+
 TimingEstimate estimate_timing(const DeviceStats& w, const BoardTiming& b, unsigned color_bpp, bool depth_buffer) {
   TimingEstimate e;
   e.pipeline_cycles = double(w.queued_executed) * b.cycles_per_command +
@@ -15,14 +38,14 @@ TimingEstimate estimate_timing(const DeviceStats& w, const BoardTiming& b, unsig
                       double(w.pixels_depth_passed) * b.cycles_per_pixel +
                       double(w.pixels_textured) * b.cycles_per_textured_pixel +
                       double(w.pixels_blended) * b.cycles_per_blended_pixel +
-                      double(w.clear_bytes) / b.clear_bytes_per_cycle;
+                      double(w.clear_bytes) / b.clear_bytes_per_cycle + structure_cycles(w, b, color_bpp);
   // Memory: depth read + write (4 + 4) for every covered pixel (an upper bound: not every draw
   // tests or writes Z), colour write, destination read when blending, texels fetched, clears,
   // uploads (8 bytes per MEM_DATA). No depth buffer, no depth traffic.
   e.memory_bytes = (depth_buffer ? w.pixels_covered * 8 : 0) + w.pixels_depth_passed * color_bpp + w.pixels_blended * color_bpp +
                    w.texel_bytes + w.clear_bytes + w.mem_data_writes * 8;
   e.memory_cycles = double(e.memory_bytes) / b.memory_bytes_per_cycle;
-  e.board_cycles = std::max(e.pipeline_cycles, e.memory_cycles);
+  e.board_cycles = b.memory_bound ? std::max(e.pipeline_cycles, e.memory_cycles) : e.pipeline_cycles;
   e.board_ms = e.board_cycles / (b.clock_mhz * 1e3);
   e.spi_ms = spi_link_ms(double(w.frames_received), b);
   e.frame_ms = std::max(e.board_ms, e.spi_ms);
@@ -51,43 +74,78 @@ DeviceStats stats_difference(const DeviceStats& a, const DeviceStats& b) {
   d.clear_bytes = a.clear_bytes - b.clear_bytes;
   d.mem_data_writes = a.mem_data_writes - b.mem_data_writes;
   d.swaps = a.swaps - b.swaps;
+  for (unsigned m = 0; m < DeviceStats::kModeClasses; ++m) {
+    d.by_mode[m].triangles = a.by_mode[m].triangles - b.by_mode[m].triangles;
+    d.by_mode[m].rows = a.by_mode[m].rows - b.by_mode[m].rows;
+    d.by_mode[m].columns = a.by_mode[m].columns - b.by_mode[m].columns;
+    d.by_mode[m].pixels = a.by_mode[m].pixels - b.by_mode[m].pixels;
+  }
+  d.triangles_rejected = a.triangles_rejected - b.triangles_rejected;
+  d.clears = a.clears - b.clears;
+  d.clear_rows = a.clear_rows - b.clear_rows;
+  d.clear_pixels = a.clear_pixels - b.clear_pixels;
   return d;
 }
 
 Result<BoardTiming> timing_preset(std::string_view name) {
   BoardTiming b;
   if (name == "ecp5-50mhz") return b;
+  if (name == "up5k" || name == "ecp5") {
+    // The gateware profiles (gateware/rtl/spigpu_top.v) at their co-simulated clocks; every cycle
+    // term from `gpubridge bench rtl --fit` (docs/gateware.md "Timing model", 2026-11-26): the
+    // staged least-squares fit on the RTL's setup, rasteriser and remaining clocks of every example,
+    // scene and calibration frame. Classes: flat, gouraud, z, gouraud_z, tex, tex_gouraud, tex_z,
+    // tex_gouraud_z. The terms hold the memory's time: no byte bound.
+    b.name = std::string(name);
+    b.cycles_per_scanned_pixel = b.cycles_per_pixel = b.cycles_per_textured_pixel = 0;
+    b.memory_bound = false;
+  }
   if (name == "up5k") {
-    // iCEBreaker: 25.125 MHz core (its PLL), 128 KiB SPRAM (one 32-bit access per clock), SPI 7.5 MHz, no BUSY pin
-    b.name = "up5k";
+    // iCEBreaker: 25.125 MHz core (its PLL), 128 KiB SPRAM (one 32-bit access per clock), SPI 7.5 MHz,
+    // no BUSY pin. The setup is a bit-serial program (gen_setup_prog.py: 220 cycles flat .. 1,289 Gouraud + Z on
+    // the core bench); the one time-shared stepper costs a cycle per interpolated attribute per
+    // rasteriser move (rows, boundary columns and pixels); clears are drawn as rectangles.
     b.clock_mhz = 25.125;
     b.spi_clock_mhz = 7.5;
     b.memory_bytes_per_cycle = 4.0;
-    // least-squares fit on the RTL (gpubridge bench rtl --fit, docs/gateware.md "Timing model"):
-    // the bit-serial setup and the time-shared steppers make triangles and pixels dear
-    b.cycles_per_command = 94.89;
-    b.cycles_per_triangle = 521.4;
-    b.cycles_per_scanned_pixel = 3.894;
-    b.cycles_per_pixel = 0.0;
-    b.cycles_per_textured_pixel = 0.0;  // no texture unit
-    b.cycles_per_blended_pixel = 0.0;   // no blending
-    b.clear_bytes_per_cycle = 1.0 / 0.389;
+    b.setup_cycles = {222.1, 1067.0, 510.1, 1292.0, 0.0, 0.0, 0.0, 0.0};  // no texture unit
+    b.row_cycles = {2.24, 4.892, 0.7314, 3.853, 0.0, 0.0, 0.0, 0.0};
+    b.column_cycles = {0.8081, 4.047, 1.257, 3.189, 0.0, 0.0, 0.0, 0.0};
+    b.pixel_cycles = {1.029, 3.209, 4.077, 5.271, 0.0, 0.0, 0.0, 0.0};
+    b.cycles_per_command = 0.1592;
+    b.cycles_per_triangle = 6.461;
+    b.cycles_per_blended_pixel = 0.0;  // no blending
+    b.cycles_per_rejected_triangle = 66.81;
+    b.cycles_per_clear = 888.1;
+    b.cycles_per_clear_row = 0.0;
+    b.cycles_per_clear_pixel = 1.4;
+    b.cycles_per_mem_write = 5.875;
+    b.clear_bytes_per_cycle = 1e9;  // a clear costs by pixel (one SPRAM write each), not by byte
     return b;
   }
   if (name == "ecp5") {
-    // ULX3S: 50 MHz core, 16-bit SDR SDRAM (BL2 words every other clock at best), SPI 15 MHz
-    b.name = "ecp5";
+    // ULX3S: 50 MHz core, 16-bit SDR SDRAM (a 32-bit word per 2 clocks at best), SPI 15 MHz. Parallel
+    // setup (38 cycles flat .. 336 textured Gouraud + Z on the core bench), one pixel a clock on
+    // spans, memory stalls per depth read, colour byte and texel fetch (texel cache), clears a word
+    // per 2 clocks beside the rasteriser.
     b.clock_mhz = 50.0;
     b.spi_clock_mhz = 15.0;
     b.memory_bytes_per_cycle = 2.0;
-    // least-squares fit on the RTL (gpubridge bench rtl --fit, docs/gateware.md "Timing model")
-    b.cycles_per_command = 7.488;
-    b.cycles_per_triangle = 224.2;
-    b.cycles_per_scanned_pixel = 0.7575;
-    b.cycles_per_pixel = 0.0;
-    b.cycles_per_textured_pixel = 4.29;
-    b.cycles_per_blended_pixel = 3.154;
-    b.clear_bytes_per_cycle = 1.0 / 0.7211;
+    b.setup_cycles = {42.54, 173.0, 98.98, 203.8, 166.5, 280.1, 205.6, 315.4};
+    b.row_cycles = {1.725, 0.7712, 2.873, 2.361, 1.996, 1.617, 5.105, 2.512};
+    b.column_cycles = {0.379, 0.0, 1.117, 0.3836, 0.7652, 1.507, 2.744, 0.3189};
+    b.pixel_cycles = {0.3477, 0.5947, 4.491, 4.86, 1.992, 1.746, 5.244, 6.739};
+    b.cycles_per_command = 2.33;
+    b.cycles_per_triangle = 0.0;
+    b.cycles_per_blended_pixel = 3.198;
+    b.cycles_per_rejected_triangle = 0.0;
+    b.cycles_per_clear = 9.541;
+    b.cycles_per_clear_row = 0.0;
+    b.cycles_per_clear_pixel = 0.01171;
+    b.cycles_per_mem_write = 11.98;
+    b.cycles_per_texel_byte = 0.1716;
+    b.cycles_per_color_byte = 0.3643;
+    b.clear_bytes_per_cycle = 1.983;
     return b;
   }
   return make_error("unknown timing profile '" + std::string(name) + "' (ecp5-50mhz, up5k, ecp5)");
@@ -110,6 +168,13 @@ Result<void> apply_timing_setting(BoardTiming& b, std::string_view setting) {
       {"memory_bytes_per_cycle", &BoardTiming::memory_bytes_per_cycle},
       {"spi_clock_mhz", &BoardTiming::spi_clock_mhz},
       {"cs_gap_us", &BoardTiming::cs_gap_us},
+      {"cycles_per_rejected_triangle", &BoardTiming::cycles_per_rejected_triangle},
+      {"cycles_per_clear", &BoardTiming::cycles_per_clear},
+      {"cycles_per_clear_row", &BoardTiming::cycles_per_clear_row},
+      {"cycles_per_clear_pixel", &BoardTiming::cycles_per_clear_pixel},
+      {"cycles_per_mem_write", &BoardTiming::cycles_per_mem_write},
+      {"cycles_per_texel_byte", &BoardTiming::cycles_per_texel_byte},
+      {"cycles_per_color_byte", &BoardTiming::cycles_per_color_byte},
   };
   const auto eq = setting.find('=');
   if (eq == std::string_view::npos) return make_error("timing setting '" + std::string(setting) + "' is not KEY=VALUE");
@@ -124,10 +189,35 @@ Result<void> apply_timing_setting(BoardTiming& b, std::string_view setting) {
   char* end = nullptr;
   const double v = std::strtod(text.c_str(), &end);
   const bool ok = !text.empty() && end == text.c_str() + text.size() && std::isfinite(v) && v >= 0 && v <= 1e9;
+  if (name == "memory_bound") {
+    if (text != "0" && text != "1") return make_error("timing memory_bound=" + text + ": expected 0 or 1");
+    b.memory_bound = text == "1";
+    return {};
+  }
   if (name == "frames_per_burst") {
     if (!ok || v < 1 || v != std::floor(v)) return make_error("timing frames_per_burst=" + text + ": expected an integer >= 1");
     b.frames_per_burst = static_cast<unsigned>(v);
     return {};
+  }
+  // per-class keys: setup_cycles_CLASS, row_cycles_CLASS, pixel_cycles_CLASS
+  struct ClassKey {
+    std::string_view prefix;
+    std::array<double, DeviceStats::kModeClasses> BoardTiming::*field;
+  };
+  static constexpr ClassKey kClassKeys[] = {
+      {"setup_cycles_", &BoardTiming::setup_cycles},
+      {"row_cycles_", &BoardTiming::row_cycles},
+      {"column_cycles_", &BoardTiming::column_cycles},
+      {"pixel_cycles_", &BoardTiming::pixel_cycles},
+  };
+  for (const auto& k : kClassKeys) {
+    if (name.substr(0, k.prefix.size()) != k.prefix) continue;
+    for (unsigned m = 0; m < DeviceStats::kModeClasses; ++m) {
+      if (name.substr(k.prefix.size()) != mode_class_name(m)) continue;
+      if (!ok) return make_error("timing " + std::string(name) + "=" + text + ": expected a finite number >= 0");
+      (b.*k.field)[m] = v;
+      return {};
+    }
   }
   for (const auto& k : kKeys) {
     if (k.name != name) continue;

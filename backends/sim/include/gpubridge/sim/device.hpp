@@ -8,6 +8,7 @@
 //    arriving on the link (reads feed the link CRC too), memory() exposes video memory.
 // The device is single-threaded from the caller's point of view (one caller at a time); with
 // options.threads > 1 it rasterises with internal workers and produces identical bytes.
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -38,7 +39,28 @@ struct DeviceStats {
   std::uint64_t clear_bytes = 0;          // bytes written by CLEAR / CLEAR_Z
   std::uint64_t mem_data_writes = 0;      // MEM_DATA writes (8 bytes each)
   std::uint64_t swaps = 0;                // scanned-out frames
+  // The work a gateware's stages see (docs/protocol.md section 19), by render-state class: the
+  // attribute planes a triangle's setup computes and its pixels interpolate. Class index bit 0:
+  // Gouraud colour (R, G, B, A), bit 1: depth (Z; test or write), bit 2: textured (S, T, Q); a
+  // plane counts only when the colour stage is not fully masked (depth excepted).
+  struct ModeWork {
+    std::uint64_t triangles = 0;  // triangles rasterised with this class
+    std::uint64_t rows = 0;       // rows of their clipped bounding boxes (the rasteriser visits each)
+    std::uint64_t columns = 0;    // columns of those boxes (a boundary-following walk crosses them)
+    std::uint64_t pixels = 0;     // their covered pixels
+    bool operator==(const ModeWork&) const = default;
+  };
+  static constexpr unsigned kModeClasses = 8;
+  std::array<ModeWork, kModeClasses> by_mode{};
+  std::uint64_t triangles_rejected = 0;   // set up, then nothing to draw (D = 0 or an empty clipped box)
+  std::uint64_t clears = 0;               // CLEAR / CLEAR_Z with a non-empty clipping rectangle
+  std::uint64_t clear_rows = 0;           // rows they filled
+  std::uint64_t clear_pixels = 0;         // pixels they filled
+  bool operator==(const DeviceStats&) const = default;
 };
+// The class index of DeviceStats::by_mode as a name: "flat", "gouraud", "z", "gouraud_z", "tex",
+// "tex_gouraud", "tex_z", "tex_gouraud_z".
+const char* mode_class_name(unsigned index);
 
 // One covered pixel as the interpolator sees it, before quantisation to the framebuffer
 // (render --dump-attributes). Values are the exact rationals N/D of docs/protocol.md section 9

@@ -3,6 +3,7 @@
 // (usually one scanned-out frame), from the device's counters and a board profile, plus the SPI
 // time of the frames that carried it. Not part of the device contract; the simulator never
 // sleeps or stalls because of it.
+#include <array>
 #include <string>
 
 #include "gpubridge/common/result.hpp"
@@ -24,6 +25,26 @@ struct BoardTiming {
   double spi_clock_mhz = 40.0;
   double cs_gap_us = 1.0;               // chip-select high time between bursts
   unsigned frames_per_burst = 32;       // flow-control group size
+  // The gateware's structure (0 in the default profile; the presets "up5k" and "ecp5" use them),
+  // per render-state class of DeviceStats::by_mode (index bit 0 Gouraud, 1 depth, 2 textured):
+  // setup cycles per triangle (the planes it computes), rasteriser cycles per bounding-box row
+  // (entering and leaving the row), per bounding-box column (the walk along the boundary to the
+  // next row's span) and per covered pixel (steppers, depth read, memory).
+  std::array<double, DeviceStats::kModeClasses> setup_cycles{};
+  std::array<double, DeviceStats::kModeClasses> row_cycles{};
+  std::array<double, DeviceStats::kModeClasses> column_cycles{};
+  std::array<double, DeviceStats::kModeClasses> pixel_cycles{};
+  double cycles_per_rejected_triangle = 0;  // setup that finds D = 0 or an empty box
+  double cycles_per_clear = 0;              // start of a CLEAR / CLEAR_Z (up5k: its rectangle's setup)
+  double cycles_per_clear_row = 0;
+  double cycles_per_clear_pixel = 0;
+  double cycles_per_mem_write = 0;          // MEM_DATA write (8 bytes through the arbiter)
+  double cycles_per_texel_byte = 0;         // texture bytes fetched (bilinear: four texels a sample)
+  double cycles_per_color_byte = 0;         // colour bytes written (bpp per passed pixel)
+  // true: cycles = max(pipeline, bytes / memory_bytes_per_cycle). false: the pipeline terms
+  // already hold the memory's time (the gateware presets, fitted on the RTL with its SDRAM and
+  // texel cache, which the byte count does not see); memory_cycles is then only reported.
+  bool memory_bound = true;
 };
 
 struct TimingEstimate {
@@ -48,7 +69,8 @@ double spi_link_ms(double frames, const BoardTiming& board);
 // a − b, field by field.
 DeviceStats stats_difference(const DeviceStats& a, const DeviceStats& b);
 // "clock_mhz=25 spi_clock_mhz=10 ..." settings applied to a profile (errors name the key);
-// "profile=NAME" replaces every value with a preset's.
+// "profile=NAME" replaces every value with a preset's. The per-class parameters are
+// setup_cycles_CLASS, row_cycles_CLASS, column_cycles_CLASS and pixel_cycles_CLASS (CLASS: mode_class_name()).
 Result<void> apply_timing_setting(BoardTiming& board, std::string_view setting);
 // Named profiles: "ecp5-50mhz" (the default above, an estimate), and "up5k" / "ecp5": the gateware
 // profiles (gateware/rtl/spigpu_top.v) at their co-simulated clocks, calibrated on the RTL's cycles

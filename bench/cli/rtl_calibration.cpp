@@ -1,0 +1,129 @@
+#include "rtl_calibration.hpp"
+
+#include <random>
+
+#include "gpubridge/protocol/frame.hpp"
+#include "gpubridge/protocol/registers.hpp"
+#include "gpubridge/sim/device.hpp"
+#include "gpubridge/sim/timing.hpp"
+
+namespace gpubridge::cli {
+namespace {
+
+using protocol::Reg;
+
+constexpr unsigned kW = 160, kH = 120;
+// RGB565 colour, depth and texture fit the up5k's 128 KiB; RGBA8888 colour (ecp5 only) moves the others up
+constexpr std::uint32_t kColor = 0, kDepth565 = kW * kH * 2, kDepth8888 = kW * kH * 4;  // 16-byte aligned
+constexpr std::uint32_t kTexture = kDepth8888 + kW * kH * 4;
+constexpr unsigned kTexLog2 = 6;
+
+struct Shape {
+  const char* name;
+  int count;             // triangles in the frame
+  int w_min, w_max;      // box width and height ranges, pixels
+  int h_min, h_max;
+};
+// small: setup and per-triangle costs; tall: rows; wide: columns; fat: pixels
+constexpr Shape kShapes[] = {
+    {"small", 120, 1, 6, 1, 6}, {"tall", 40, 2, 6, 30, 110}, {"wide", 40, 30, 150, 2, 6}, {"fat", 24, 20, 70, 20, 70}};
+
+class Writer {
+ public:
+  explicit Writer(protocol::CommandStream& s) : s_(s) {}
+  void write(Reg r, std::uint64_t v) { frames_.push_back(protocol::write_frame(r, v)); }
+  void upload(std::uint32_t address, std::vector<std::uint8_t> data) {
+    flush();
+    s_.commands.push_back({0, protocol::UploadCmd{address, std::move(data)}});
+  }
+  void flush() {
+    for (std::size_t i = 0; i < frames_.size(); i += protocol::kMaxFramesPerBatch) {
+      protocol::FramesCmd cmd;
+      for (std::size_t k = i; k < frames_.size() && k < i + protocol::kMaxFramesPerBatch; ++k) cmd.push(frames_[k]);
+      s_.commands.push_back({0, std::move(cmd)});
+    }
+    frames_.clear();
+  }
+
+ private:
+  protocol::CommandStream& s_;
+  std::vector<protocol::Frame> frames_;
+};
+
+std::uint64_t scissor(unsigned x0, unsigned y0, unsigned x1, unsigned y1) {
+  return (std::uint64_t{y1} << 48) | (std::uint64_t{x1} << 32) | (std::uint64_t{y0} << 16) | x0;
+}
+
+protocol::CommandStream frame(unsigned mode_class, const Shape& shape, bool bilinear, bool rgba8888, std::uint32_t seed) {
+  protocol::CommandStream s;
+  Writer w(s);
+  std::mt19937 rng(seed);
+  w.write(Reg::FB_FORMAT, (std::uint64_t{rgba8888 ? 0u : 1u} << 32) | (std::uint64_t{kH} << 16) | kW);
+  w.write(Reg::FB_DRAW, kColor);
+  w.write(Reg::FB_Z, rgba8888 ? kDepth8888 : kDepth565);
+  // clears: the whole buffer, a wide strip and a tall one (rows and pixels vary apart)
+  w.write(Reg::CLEAR_COLOR, rng());
+  w.write(Reg::CLEAR_DEPTH, 0xFFFFFF);
+  w.write(Reg::SCISSOR, scissor(0, 0, kW, kH));
+  w.write(Reg::CLEAR, 0);
+  w.write(Reg::CLEAR_Z, 0);
+  const unsigned strip = 4 + rng() % 8;
+  w.write(Reg::SCISSOR, scissor(0, 10, kW, 10 + strip));
+  w.write(Reg::CLEAR, 0);
+  w.write(Reg::SCISSOR, scissor(20, 0, 20 + strip, kH));
+  w.write(Reg::CLEAR_Z, 0);
+  w.write(Reg::SCISSOR, scissor(0, 0, kW, kH));
+  const bool textured = mode_class & 4;
+  if (textured) {
+    std::vector<std::uint8_t> texels(std::size_t{4} << (2 * kTexLog2));
+    for (auto& b : texels) b = static_cast<std::uint8_t>(rng());
+    w.upload(kTexture, std::move(texels));
+    w.write(Reg::TEX_BASE, kTexture);
+    w.write(Reg::TEX_FMT, kTexLog2 | (kTexLog2 << 4) | (std::uint64_t{bilinear} << 12));
+  }
+  // class bits: 1 Gouraud, 2 depth (test LESS and write), 4 textured
+  const std::uint64_t mode = (mode_class & 1 ? 1u : 0u) | (textured ? 2u : 0u) | (mode_class & 2 ? 4u | (1u << 3) | (1u << 6) : 0u);
+  w.write(Reg::TRI_MODE, mode);
+  w.write(Reg::PRIM, 0);  // list
+  std::uniform_int_distribution<int> wd(shape.w_min * 16, shape.w_max * 16), ht(shape.h_min * 16, shape.h_max * 16);
+  for (int i = 0; i < shape.count; ++i) {
+    const int bw = wd(rng), bh = ht(rng);
+    const int x = static_cast<int>(rng() % (kW * 16 - std::min<unsigned>(bw, kW * 16 - 16)));
+    const int y = static_cast<int>(rng() % (kH * 16 - std::min<unsigned>(bh, kH * 16 - 16)));
+    // a triangle spanning the box: one corner, the opposite side's two ends at random offsets
+    const int xs[3] = {x + static_cast<int>(rng() % (bw + 1)), x, x + bw};
+    const int ys[3] = {y, y + bh, y + bh - static_cast<int>(rng() % (bh / 2 + 1))};
+    for (int k = 0; k < 3; ++k) {
+      const std::uint64_t q = 0xFFFFFFFFu;
+      w.write(Reg::COLOR, (q << 32) | static_cast<std::uint32_t>(rng()));
+      const std::int32_t st = static_cast<std::int32_t>(rng() % (2u << 24)), tt = static_cast<std::int32_t>(rng() % (2u << 24));
+      if (textured) w.write(Reg::TEXCOORD, (std::uint64_t{static_cast<std::uint32_t>(st)} << 32) | static_cast<std::uint32_t>(tt));
+      const std::uint64_t z = rng() & 0xFFFFFF;
+      w.write(Reg::VERTEX, (z << 32) | (std::uint64_t{static_cast<std::uint16_t>(ys[k])} << 16) | static_cast<std::uint16_t>(xs[k]));
+    }
+  }
+  w.write(Reg::FB_DISPLAY, kColor);
+  w.flush();
+  return s;
+}
+
+}  // namespace
+
+std::vector<CalibrationStream> calibration_streams(bool texturing) {
+  std::vector<CalibrationStream> out;
+  std::uint32_t seed = 20261126;
+  for (unsigned m = 0; m < sim::DeviceStats::kModeClasses; ++m) {
+    if ((m & 4) && !texturing) continue;
+    for (const Shape& shape : kShapes) {
+      const std::string base = std::string("calib/") + sim::mode_class_name(m) + "/" + shape.name;
+      out.push_back({base, frame(m, shape, false, false, seed++)});
+      if (shape.name != std::string_view("fat")) continue;
+      if (m & 4) out.push_back({base + "-bilinear", frame(m, shape, true, false, seed++)});
+      // 4 bytes a pixel (the ecp5's 16-bit SDRAM: two clocks a colour write); the up5k has no room
+      if (texturing) out.push_back({base + "-rgba8888", frame(m, shape, false, true, seed++)});
+    }
+  }
+  return out;
+}
+
+}  // namespace gpubridge::cli
