@@ -1,5 +1,7 @@
 #include "preview_plain.hpp"
 
+#include <cstring>
+
 #include "setup.hpp"
 #include "simd_lanes.hpp"
 
@@ -21,14 +23,22 @@ bool preview_plain_applies(const DrawState& st) {
 }
 
 // The kernel twice: for AVX2 and for the baseline, picked once per process.
+#if defined(__clang__)
+#pragma clang attribute push(__attribute__((target("avx2"))), apply_to = function)
+#else
 #pragma GCC push_options
 #pragma GCC target("avx2")
+#endif
 namespace plain_avx2 {
 #define PREVIEW_PLAIN_AVX2 1
 #include "preview_plain_kernel.inc"
 #undef PREVIEW_PLAIN_AVX2
 }  // namespace plain_avx2
+#if defined(__clang__)
+#pragma clang attribute pop
+#else
 #pragma GCC pop_options
+#endif
 
 namespace plain_baseline {
 #define PREVIEW_PLAIN_AVX2 0

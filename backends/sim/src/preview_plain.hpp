@@ -8,9 +8,10 @@
 // Planes are fixed point, set up once per triangle from the preview setup's double planes
 // (FixedPlanes, setup.hpp): colour in 8.24 and Z in 32.32, stepped with integer adds modulo 2^32 /
 // 2^64. Integer steps are exact, so a pixel's value does not depend on where the stepping started
-// (band, thread, span): the same bytes for any thread count. A covered pixel's value is within
-// 2^-20 of the plane's double value, far inside [0, 256) / [0, 2^24) once rounded, so the top bits
-// are the pixel's value with no clamp and no float-to-integer conversion in the lanes.
+// (band, thread, span): the same bytes for any thread count. At box pixel (kx, ky) the fixed-point
+// value is within (1 + kx + ky)·2^-25 (colour) / ·2^-33 (Z) of the plane's double value, and a
+// covered pixel's value lies inside its vertices' range, so the top bits are the pixel's rounded
+// value with no clamp and no float-to-integer conversion in the lanes.
 #include <cstddef>
 #include <cstdint>
 
