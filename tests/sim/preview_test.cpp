@@ -93,7 +93,9 @@ TEST(SimPreview, PlainDrawsColourAndZWithinOneLsbOfExact) {
   // close to a rounding boundary round the other way, by one.
   EXPECT_LE(err.max_c, 1);
   EXPECT_LE(err.max_z, 1);
-  EXPECT_GT(err.max_z, 0);  // Z is not exact (the test would not notice if preview were off)
+  // Nothing asserts that some pixel differs: whether one of these values lies that close to a half
+  // depends on the compiler's double arithmetic in setup (gcc 12: one Z value of the 60 cases;
+  // clang 14: none). SameBytesForAnyThreadCountAndRun checks that preview differs from exact.
 }
 
 TEST(SimPreview, FloatDrawsZWithinEightLsbOfExact) {
