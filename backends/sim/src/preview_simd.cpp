@@ -27,41 +27,6 @@ namespace {
   return (u32x8)(t + (__builtin_convertvector(t, f32x8) > v));  // a true compare lane is −1
 }
 
-// The row's covered span [kl, kr] of a box wider than 8 pixels: each edge's crossing estimated in
-// double from its exact integer value, then moved to the exact crossing (E + k·ex >= 0) by
-// integer checks, so the span is the integer test's (the estimate is off by far less than a pixel;
-// the loops run once or twice). Returns false when the row is empty.
-[[gnu::always_inline]] inline bool solve_span(const PreviewRows& t, const std::int64_t* e, int& kl, int& kr) {
-  std::int64_t lo = 0, hi = t.width - 1;
-  for (int i = 0; i < 3; ++i) {
-    const std::int64_t ex = t.ex[i];
-    if (ex == 0) {
-      if (e[i] < 0) return false;
-      continue;
-    }
-    const std::int64_t w = t.width;
-    double k = -static_cast<double>(e[i]) * t.inv_ex[i];  // the crossing, E + k·ex = 0
-    k = k > -1.0 ? k : -1.0;                               // clamped into the box before the
-    k = k < w + 1.0 ? k : w + 1.0;                         // conversion
-    std::int64_t c = static_cast<std::int64_t>(k);
-    if (ex > 0) {  // covered for k >= crossing: the first covered pixel in [0, w] (w: none)
-      c = c < 0 ? 0 : c > w ? w : c;
-      while (c < w && e[i] + c * ex < 0) ++c;
-      while (c > 0 && e[i] + (c - 1) * ex >= 0) --c;
-      lo = c > lo ? c : lo;
-    } else {  // covered for k <= crossing: the last covered pixel in [-1, w - 1] (-1: none)
-      c = c < -1 ? -1 : c > w - 1 ? w - 1 : c;
-      while (c >= 0 && e[i] + c * ex < 0) --c;
-      while (c < w - 1 && e[i] + (c + 1) * ex >= 0) ++c;
-      hi = c < hi ? c : hi;
-    }
-  }
-  if (lo > hi) return false;
-  kl = static_cast<int>(lo);
-  kr = static_cast<int>(hi);
-  return true;
-}
-
 template <bool kTextured, PixelFormat kFormat, bool kNarrow>
 [[gnu::always_inline]] inline PreviewCounts shade_preview(const PreviewRows& t) {
   constexpr std::size_t kBpp = protocol::bytes_per_pixel(kFormat);
@@ -74,13 +39,18 @@ template <bool kTextured, PixelFormat kFormat, bool kNarrow>
   u32x8 covered = {}, passed = {};
   std::uint8_t* crow = t.color;
   std::uint8_t* zrow = t.depth;
+  // Wide boxes walk their rows' spans; narrow ones test the edges in lanes.
+  SpanWalk walk;
+  if constexpr (!kNarrow) walk.start(t.e, t.ex, t.ey, t.ky0);
   for (int r = 0; r < t.rows; ++r, crow += t.color_pitch, zrow += flags.depth ? t.pitch : 0) {
     const int ky = t.ky0 + r;
     std::int64_t e[3];
     for (int i = 0; i < 3; ++i) e[i] = t.e[i] + ky * t.ey[i];
     int kl = 0, kr = t.width - 1;
     if constexpr (!kNarrow) {
-      if (!solve_span(t, e, kl, kr)) continue;
+      const bool any = walk.span(t.width, kl, kr);
+      walk.next_row();
+      if (!any) continue;
     }
     const unsigned count = static_cast<unsigned>(kr - kl + 1);
     counts.scanned += count;

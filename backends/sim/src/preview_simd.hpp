@@ -32,7 +32,6 @@ struct PreviewRows {
   // No default member initialisers for the arrays: this is built per triangle and band, and
   // zeroing them cost 10-px triangles a tenth of their time. The caller fills what is read.
   std::int64_t e[3], ex[3], ey[3];       // biased edge values at the box origin, steps
-  double inv_ex[3];                      // boxes wider than 8: 1 / ex (0 when ex = 0), the span estimate
   const double* base = nullptr;          // FloatPlanes (setup.hpp) of the triangle
   const double* dx = nullptr;
   const double* dy = nullptr;
@@ -53,5 +52,63 @@ struct PreviewCounts {
 };
 
 PreviewCounts shade_preview_simd(const PreviewRows& t);
+
+// The covered span [kl, kr] of each row of a box wider than 8 pixels, walked row by row in exact
+// integers. Pixel k of a row is inside edge i when E + k·ex >= 0 (E its biased value at the row's
+// first pixel). With a = |ex| and E = f·a + m (0 <= m < a, a floor division once per call): for
+// ex > 0 the first covered pixel is −f, for ex < 0 the last one is f, and an edge with ex = 0
+// (a = 1, f = E) covers the whole row when f >= 0. The next row adds ey = qy·a + ry: f += qy,
+// m += ry and one carry, with no division per row (the previous version estimated each crossing
+// in double and corrected it by integer checks: its conversions and correction loops were most of
+// the time of thin triangles). Exact, so the span of a row does not depend on the row the walk
+// started from (bands, threads).
+class SpanWalk {
+ public:
+  // e, ex, ey: the biased edge values at the box origin and their steps; the walk starts at row ky.
+  SpanWalk(const std::int64_t* e, const std::int64_t* ex, const std::int64_t* ey, int ky) { start(e, ex, ey, ky); }
+  SpanWalk() = default;  // start() before use
+  void start(const std::int64_t* e, const std::int64_t* ex, const std::int64_t* ey, int ky) {
+    for (int i = 0; i < 3; ++i) {
+      kind_[i] = ex[i] > 0 ? 1 : ex[i] < 0 ? -1 : 0;
+      a_[i] = kind_[i] == 0 ? 1 : ex[i] > 0 ? ex[i] : -ex[i];
+      floor_divmod(e[i] + ky * ey[i], a_[i], f_[i], m_[i]);
+      floor_divmod(ey[i], a_[i], qy_[i], ry_[i]);
+    }
+  }
+  // This row's covered span within [0, width): false when it is empty.
+  [[gnu::always_inline]] bool span(int width, int& kl, int& kr) const {
+    std::int64_t lo = 0, hi = width - 1;
+    for (int i = 0; i < 3; ++i) {
+      if (kind_[i] > 0) lo = -f_[i] > lo ? -f_[i] : lo;
+      else if (kind_[i] < 0) hi = f_[i] < hi ? f_[i] : hi;
+      else if (f_[i] < 0) return false;
+    }
+    if (lo > hi) return false;
+    kl = static_cast<int>(lo);  // both inside [0, width) now
+    kr = static_cast<int>(hi);
+    return true;
+  }
+  [[gnu::always_inline]] void next_row() {
+    for (int i = 0; i < 3; ++i) {
+      f_[i] += qy_[i];
+      m_[i] += ry_[i];
+      const bool carry = m_[i] >= a_[i];
+      m_[i] -= carry ? a_[i] : 0;
+      f_[i] += carry;
+    }
+  }
+
+ private:
+  static void floor_divmod(std::int64_t n, std::int64_t d, std::int64_t& q, std::int64_t& r) {
+    q = n / d;
+    r = n % d;
+    if (r < 0) {
+      --q;
+      r += d;
+    }
+  }
+  std::int64_t f_[3] = {}, m_[3] = {}, a_[3] = {1, 1, 1}, qy_[3] = {}, ry_[3] = {};
+  int kind_[3] = {};
+};
 
 }  // namespace gpubridge::sim

@@ -8,6 +8,7 @@
 
 #include "narrow_simd.hpp"
 #include "pixel.hpp"
+#include "preview_plain.hpp"
 #include "preview_simd.hpp"
 #include "span_simd.hpp"
 #include "texture.hpp"
@@ -449,7 +450,6 @@ void draw_preview(const Triangle& t, const DrawState& st, RasterContext& ctx, in
     p.e[i] = t.edge[i].e;
     p.ex[i] = t.edge[i].ex;
     p.ey[i] = t.edge[i].ey;
-    if (p.width > 8) p.inv_ex[i] = t.edge[i].ex != 0 ? 1.0 / static_cast<double>(t.edge[i].ex) : 0.0;
   }
   p.base = t.fplane.base;
   p.dx = t.fplane.dx;
@@ -488,6 +488,35 @@ void draw_preview(const Triangle& t, const DrawState& st, RasterContext& ctx, in
   }
 }
 
+// The plain-draw preview kernel (preview_plain.hpp) for rows [ya, yz); preview_plain_applies(st).
+void draw_preview_plain(const Triangle& t, const DrawState& st, RasterContext& ctx, int ya, int yz, bool depth) {
+  PreviewPlain p;
+  p.width = t.x1 - t.x0;
+  for (int i = 0; i < 3; ++i) {
+    p.e[i] = t.edge[i].e;
+    p.ex[i] = t.edge[i].ex;
+    p.ey[i] = t.edge[i].ey;
+  }
+  p.planes = &t.xplane;
+  p.ky0 = ya - t.y0;
+  p.rows = yz - ya;
+  const std::size_t pix = static_cast<std::size_t>(ya) * st.fb_width + static_cast<std::size_t>(t.x0);
+  p.color = ctx.mem.data() + st.fb_draw + pix * 4;
+  p.depth = depth ? ctx.mem.data() + st.fb_z + pix * 4 : nullptr;
+  p.pitch = std::size_t{st.fb_width} * 4;
+  p.room = st.fb_width - static_cast<unsigned>(t.x0);
+  p.zmask = z_mask(ctx);
+  p.z_func = st.z_test ? st.z_func : protocol::DepthFunc::Always;
+  p.blend = st.blend;
+  p.depth_on = depth;
+  p.z_write = st.z_write;
+  const PreviewCounts c = shade_preview_plain(p);
+  ctx.counters.scanned += c.scanned;
+  ctx.counters.covered += c.covered;
+  ctx.counters.passed += c.passed;
+  if (st.blend != protocol::BlendMode::Off) ctx.counters.blended += c.passed;
+}
+
 }  // namespace
 
 bool preview_applies(const DrawState& st) {
@@ -505,7 +534,10 @@ void rasterize_rows(const Triangle& t, const DrawState& st, RasterContext& ctx, 
   for (unsigned ch = 0; ch < 4; ++ch) colors_differ |= !t.plane[kR + ch].constant;
   const bool gouraud = st.gouraud && colors_differ;   // Gouraud only when colours differ
   const bool depth = st.z_test || st.z_write;
-  if (t.preview) return draw_preview(t, st, ctx, ya, yz, gouraud, depth);
+  if (t.preview) {
+    if (preview_plain_applies(st)) return draw_preview_plain(t, st, ctx, ya, yz, depth);
+    return draw_preview(t, st, ctx, ya, yz, gouraud, depth);
+  }
   if (ctx.vector && draw_narrow(t, st, ctx, ya, yz, gouraud, depth)) return;
   const unsigned key = (gouraud ? 1u : 0u) | (st.textured ? 2u : 0u) | (depth ? 4u : 0u) | (st.simple_color ? 8u : 0u);
   kKernels[key](t, st, ctx, ya, yz);

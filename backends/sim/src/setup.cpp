@@ -3,6 +3,8 @@
 #include "color_planes.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <cstring>
 #include <utility>
 
 namespace gpubridge::sim {
@@ -100,12 +102,60 @@ bool setup_coverage(const Vertex& va, const Vertex& vb, const Vertex& vc, const 
 // One attribute as a plane a(kx, ky) = base + kx·dx + ky·dy over the box (kx, ky relative to its
 // origin) in double, from the same barycentric weights as the exact plane. `offset` is added to
 // base (0.5 for values rounded by truncation).
-void setup_float_plane(FloatPlanes& f, unsigned i, double a0, double a1, double a2, const Edge& b1, const Edge& b2,
+[[gnu::always_inline]] inline void setup_float_plane(FloatPlanes& f, unsigned i, double a0, double a1, double a2, const Edge& b1, const Edge& b2,
                        double inv_d, double offset) {
   const double d1 = a1 - a0, d2 = a2 - a0;
   f.base[i] = a0 + (d1 * static_cast<double>(b1.e) + d2 * static_cast<double>(b2.e)) * inv_d + offset;
   f.dx[i] = (d1 * static_cast<double>(b1.ex) + d2 * static_cast<double>(b2.ex)) * inv_d;
   f.dy[i] = (d1 * static_cast<double>(b1.ey) + d2 * static_cast<double>(b2.ey)) * inv_d;
+}
+
+// x rounded to an integer (halves up), modulo 2^64. Below 2^62 in magnitude (every value but
+// those of extreme slivers' far box corners) one conversion; beyond, x is reduced modulo 2^64
+// first (exact in double: a multiple of 2^64 subtracted from a value that is a multiple of its own
+// unit), so no conversion ever sees a value out of range (NaN becomes 0).
+std::uint64_t round_mod64(double x) {
+  if (x > -0x1p62 && x < 0x1p62) {
+    const double h = x + 0.5;
+    auto i = static_cast<std::int64_t>(h);  // truncation; floor below
+    i -= static_cast<double>(i) > h;
+    return static_cast<std::uint64_t>(i);
+  }
+  x -= 0x1p64 * std::floor(x * 0x1p-64);
+  x = std::floor(x + 0.5);
+  return x >= 0 && x < 0x1p64 ? static_cast<std::uint64_t>(x) : 0u;  // 2^64 is 0 modulo 2^64
+}
+
+// round_mod64(x) modulo 2^32 for the colour planes: below 2^50 in magnitude (all but extreme
+// slivers) one add puts round(x) (to nearest, ties to even) in the low bits of a double whose unit
+// is 1, with no conversion at all.
+inline std::uint32_t round_mod32(double x) {
+  if (x > -0x1p50 && x < 0x1p50) {
+    const double m = x + 0x1.8p52;
+    std::uint64_t bits;
+    std::memcpy(&bits, &m, sizeof bits);
+    return static_cast<std::uint32_t>(bits);  // 2^51 + round(x) in the mantissa; 2^51 is 0 modulo 2^32
+  }
+  return static_cast<std::uint32_t>(round_mod64(x));
+}
+
+// The planes of an untextured preview draw in the fixed point of the plain kernel (setup.hpp).
+void setup_fixed_planes(const FloatPlanes& f, const DrawState& state, const Triangle& t, FixedPlanes& x) {
+  for (unsigned ch = 0; ch < 4; ++ch) {
+    if (state.gouraud) {
+      x.c[ch] = round_mod32(f.base[kR + ch] * 0x1p24);
+      x.cdx[ch] = round_mod32(f.dx[kR + ch] * 0x1p24);
+      x.cdy[ch] = round_mod32(f.dy[kR + ch] * 0x1p24);
+    } else {  // the flat colour: its byte and a half, no steps
+      x.c[ch] = (std::uint32_t{t.flat[ch]} << 24) | 0x800000u;
+      x.cdx[ch] = x.cdy[ch] = 0;
+    }
+  }
+  if (state.z_test || state.z_write) {
+    x.z = round_mod64(f.base[kZ] * 0x1p32);
+    x.zdx = round_mod64(f.dx[kZ] * 0x1p32);
+    x.zdy = round_mod64(f.dy[kZ] * 0x1p32);
+  }
 }
 
 }  // namespace
@@ -140,10 +190,14 @@ bool setup_triangle(const Vertex& va, const Vertex& vb, const Vertex& vc, const 
 
 bool setup_triangle_preview(const Vertex& va, const Vertex& vb, const Vertex& vc, const DrawState& state,
                             unsigned subpixel_bits, bool observing, Triangle& t) {
+  Edge e20, e01;  // the raw weights of vertices 1 and 2 at the box origin's sample point
   if (observing) {  // the observer reports the exact interpolants: set those up too
     if (!setup_triangle(va, vb, vc, state, subpixel_bits, true, t)) return false;
+    // setup_triangle does not return the raw weights: cheap integer products.
+    const std::int64_t sx = 16 * std::int64_t{t.x0} + 8, sy = 16 * std::int64_t{t.y0} + 8;
+    e20 = make_edge(t.v[2], t.v[0], sx, sy);
+    e01 = make_edge(t.v[0], t.v[1], sx, sy);
   } else {
-    Edge e20, e01;
     std::int64_t D = 0;
     if (!setup_coverage(va, vb, vc, state, subpixel_bits, t, e20, e01, D)) return false;
     // The preview routine reads only whether the colours differ and the flat colour (t.flat).
@@ -152,9 +206,6 @@ bool setup_triangle_preview(const Vertex& va, const Vertex& vb, const Vertex& vc
       t.plane[kR + ch].q = va.c[ch];
     }
   }
-  // Recompute the raw weights (setup_triangle does not return them): cheap integer products.
-  const std::int64_t sx = 16 * std::int64_t{t.x0} + 8, sy = 16 * std::int64_t{t.y0} + 8;
-  const Edge e20 = make_edge(t.v[2], t.v[0], sx, sy), e01 = make_edge(t.v[0], t.v[1], sx, sy);
   const Vertex* v = t.v;
   const double inv_d = 2.0 / static_cast<double>(t.den);  // 1 / D: the setup's one float divide
   FloatPlanes& f = t.fplane;
@@ -165,6 +216,8 @@ bool setup_triangle_preview(const Vertex& va, const Vertex& vb, const Vertex& vc
     setup_float_plane(f, kS, v[0].s, v[1].s, v[2].s, e20, e01, inv_d, 0.0);
     setup_float_plane(f, kT, v[0].t, v[1].t, v[2].t, e20, e01, inv_d, 0.0);
     setup_float_plane(f, kQ, v[0].q, v[1].q, v[2].q, e20, e01, inv_d, 0.0);
+  } else {
+    setup_fixed_planes(f, state, t, t.xplane);
   }
   t.preview = true;
   return true;

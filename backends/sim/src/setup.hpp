@@ -54,6 +54,14 @@ struct FloatPlanes {
   double base[kAttrCount], dx[kAttrCount], dy[kAttrCount];
 };
 
+// The same planes in fixed point for the preview's plain-draw kernel (preview_plain.hpp): colour in
+// 8.24 and Z in 32.32, each the double value times 2^24 / 2^32 rounded, modulo 2^32 / 2^64 (a
+// covered pixel's value is in range; the steps may wrap, and wrap back, on the way to it).
+struct FixedPlanes {
+  std::uint32_t c[4], cdx[4], cdy[4];  // R, G, B, A (+0.5: the top byte is the rounded value)
+  std::uint64_t z, zdx, zdy;           // Z (+0.5: the high word is the rounded value)
+};
+
 struct Triangle {
   Vertex v[3];          // after the exchange of section 8.1 (D > 0)
   std::int64_t den = 0; // 2D
@@ -64,6 +72,7 @@ struct Triangle {
   std::uint64_t index = 0;              // kicked-triangle number
   bool preview = false;                 // set up by setup_triangle_preview: drawn from fplane
   FloatPlanes fplane;                   // preview only (the planes the state needs)
+  FixedPlanes xplane;                   // preview of an untextured state: fplane in fixed point
 };
 
 // Returns false when the triangle draws nothing (D = 0 or an empty clipped box). Planes are set up

@@ -1,0 +1,47 @@
+#pragma once
+// The preview routine's plain-draw kernel (`--accuracy preview`, docs/simulator.md "Preview"): the
+// draws most scenes are made of — an RGBA8888 buffer, no texture, no write mask, blend OFF or
+// ALPHA, depth off or a LESS/LEQUAL/GREATER/GEQUAL/ALWAYS test with or without the Z write —
+// specialised per draw (one instance per depth function and blend) and kept in the lane layout
+// the memory already has. Other preview draws use preview_simd.cpp.
+//
+// Planes are fixed point, set up once per triangle from the preview setup's double planes
+// (FixedPlanes, setup.hpp): colour in 8.24 and Z in 32.32, stepped with integer adds modulo 2^32 /
+// 2^64. Integer steps are exact, so a pixel's value does not depend on where the stepping started
+// (band, thread, span): the same bytes for any thread count. At box pixel (kx, ky) the fixed-point
+// value is within (1 + kx + ky)·2^-25 (colour) / ·2^-33 (Z) of the plane's double value, and a
+// covered pixel's value lies inside its vertices' range, so the top bits are the pixel's rounded
+// value with no clamp and no float-to-integer conversion in the lanes.
+#include <cstddef>
+#include <cstdint>
+
+#include "draw_state.hpp"
+#include "gpubridge/protocol/registers.hpp"
+#include "preview_simd.hpp"
+
+namespace gpubridge::sim {
+
+struct FixedPlanes;
+
+struct PreviewPlain {
+  std::int64_t e[3], ex[3], ey[3];  // biased edge values at the box origin, steps
+  const FixedPlanes* planes = nullptr;
+  int width = 0;                    // box width
+  int ky0 = 0, rows = 0;            // first row drawn (from the box origin), rows drawn
+  std::uint8_t* color = nullptr;    // box origin column, first row drawn
+  std::uint8_t* depth = nullptr;    // its depth word (when the draw tests or writes depth)
+  std::size_t pitch = 0;            // bytes per row of either buffer (both 4 bytes per pixel)
+  unsigned room = 0;                // pixels from the box origin column to the end of a buffer row
+  std::uint32_t zmask = 0xFFFFFF;   // the Z bits compared and stored (z_bits)
+  protocol::DepthFunc z_func = protocol::DepthFunc::Always;  // with depth: the test (ALWAYS when off)
+  protocol::BlendMode blend = protocol::BlendMode::Off;
+  bool depth_on = false;            // depth test or write
+  bool z_write = false;
+};
+
+// Whether the plain kernel draws this state (the caller also checks preview_applies).
+bool preview_plain_applies(const DrawState& st);
+
+PreviewCounts shade_preview_plain(const PreviewPlain& t);
+
+}  // namespace gpubridge::sim
