@@ -42,6 +42,7 @@ module core_setup_tm #(
     output reg          draw,
     output wire [3:0]   vp_addr,      // the soc's vertex read port: {vertex, word}; words are
     input  wire [31:0]  vp_data,      // 0 {Y, X}, 1 Z, 2 COLOR (RGBA, R in [31:24]); a clock later
+    input  wire [3:0]   vp_idle,      // the port's address while idle (the value the core copies)
     input  wire [10:0]  clip_x0,
     input  wire [10:0]  clip_y0,
     input  wire [10:0]  clip_x1,      // exclusive, already min(SCISSOR.X1, WIDTH)
@@ -90,14 +91,14 @@ module core_setup_tm #(
   // ---------------------------------------------------------------- field multiplexer
   // fsel = {kind, vertex}: kind 0 X, 1 Y, 2 the attribute ak, 3 the sample point (vertex 0:
   // 16 y0 + 8, 1: 16 x_start + 8). The vertex fields come through the soc's read port: an
-  // instruction that writes one waits a clock for it (fw_ok). Idle, the port reads v0's COLOR
-  // (the core's flat colour).
+  // instruction that writes one waits a clock for it (fw_ok). Idle, the port reads what the
+  // core copies when it accepts the command (vp_idle: v0's COLOR, CLEAR_COLOR or CLEAR_DEPTH).
   wire [31:0] I;        // the instruction (registered block RAM read of pc_next)
   wire [3:0] fsel = I[21:18];
   reg  [2:0] ak;
   reg  [6:0] pc;
   reg        fw_ok;     // vp_data is the word the instruction's field select names
-  assign vp_addr = (pc == 7'd0) ? 4'b0010 : {fsel[1:0], !fsel[3] ? 2'd0 : ak[2] ? 2'd1 : 2'd2};
+  assign vp_addr = (pc == 7'd0) ? vp_idle : {fsel[1:0], !fsel[3] ? 2'd0 : ak[2] ? 2'd1 : 2'd2};
   reg  [AW-1:0] fld;
   always @(*) begin
     case (fsel[3:2])

@@ -13,7 +13,10 @@
 // (VPORT = 1, up5k): the executor keeps three vertex slots in block RAM, three 32-bit words each
 // ({Y, X}, Z, COLOR; no texture coordinates), and the core reads word w of triangle vertex k as
 // vp_addr = {k, w}, vp_data a clock later. A VERTEX writes its three words (three clocks) before
-// it executes; STRIP and FAN rotate slot numbers instead of copying vertices.
+// it executes; STRIP and FAN rotate slot numbers instead of copying vertices. "Vertex" 3 is
+// CLEAR_COLOR (word 0) and CLEAR_DEPTH (word 1), which a clear reads the same way: written when
+// they execute, and with their reset values in the two clocks after a reset (nothing executes
+// before); cmd_clear_color / cmd_clear_depth are then 0.
 // Plain register writes take one clock each. Read-write registers are also written, validated, to
 // the register file's shadow RAM when they execute (a clock later if the SPI side is writing it); a
 // kicking VERTEX writes it first and then offers the triangle to the core, so cmd_valid, once high,
@@ -213,8 +216,8 @@ module command_exec #(
   assign cmd_fb_format = fb_format;
   assign cmd_fb_width = 11'(fb_width);
   assign cmd_fb_height = 11'(fb_height);
-  assign cmd_clear_color = clear_color;
-  assign cmd_clear_depth = clear_depth;
+  assign cmd_clear_color = VPORT != 0 ? 32'd0 : clear_color;
+  assign cmd_clear_depth = VPORT != 0 ? 24'd0 : clear_depth;
   assign cmd_v0 = VPORT != 0 ? 184'd0 : stored0;
   assign cmd_v1 = VPORT != 0 ? 184'd0 : stored1;
   assign cmd_v2 = VPORT != 0 ? 184'd0 : vertex;
@@ -228,18 +231,28 @@ module command_exec #(
       reg  [1:0] sl0, sl1, sl2, wc;
       wire [1:0] wslot = (vcount == 2'd0) ? sl0 : (vcount == 2'd1) ? sl1 : sl2;
       wire [1:0] rslot = (vp_addr[3:2] == 2'd0) ? sl0 : (vp_addr[3:2] == 2'd1) ? sl1 : sl2;
-      wire       vwrite = in_valid && is_vertex && wc != 2'd3;
-      assign vert_ok = !is_vertex || wc == 2'd3;
+      wire       rslot3 = vp_addr[3:2] == 2'd3;
+      reg  [1:0] cinit;   // 0, 1: writing CLEAR_COLOR's, CLEAR_DEPTH's reset value; 2: done
+      wire       vwrite = in_valid && is_vertex && wc != 2'd3 && cinit[1];
+      wire       is_cd  = idx == `SPIGPU_REG_CLEAR_DEPTH;
+      wire       cwrite = go && (idx == `SPIGPU_REG_CLEAR_COLOR || is_cd);
+      wire       iwrite = !cinit[1];
+      // CLEAR_COLOR and CLEAR_DEPTH are d[31:0] (validation clears the bits above CLEAR_DEPTH's 24)
+      wire [31:0] wdata = iwrite ? (cinit[0] ? RESET_CLEAR_DEPTH[31:0] : RESET_CLEAR_COLOR[31:0])
+                        : (vwrite && wc == 2'd1) ? {8'd0, d[55:32]} : (vwrite && wc == 2'd2) ? color[31:0] : d[31:0];
+      wire [3:0]  waddr = vwrite ? {wslot, wc} : iwrite ? {3'b110, cinit[0]} : {3'b110, is_cd};
+      assign vert_ok = (!is_vertex || wc == 2'd3) && !iwrite;
       always @(posedge clk) begin
-        if (vwrite)
-          vmem[{wslot, wc}] <= (wc == 2'd0) ? d[31:0] : (wc == 2'd1) ? {8'd0, d[55:32]} : color[31:0];
-        vp_data <= vmem[{rslot, vp_addr[1:0]}];
+        if (vwrite || cwrite || iwrite) vmem[waddr] <= wdata;
+        vp_data <= vmem[{rslot3 ? 2'd3 : rslot, vp_addr[1:0]}];
         if (rst) begin
+          cinit <= 2'd0;
           wc <= 2'd0;
           sl0 <= 2'd0;
           sl1 <= 2'd1;
           sl2 <= 2'd2;
         end else begin
+          if (iwrite) cinit <= cinit + 2'd1;
           if (vwrite) wc <= wc + 2'd1;
           if (go) wc <= 2'd0;
           if (go && kick && prim_type == 2'd1) begin         // STRIP
@@ -252,7 +265,7 @@ module command_exec #(
           end
         end
       end
-      wire unused_vp = &{1'b0, color[63:32], texcoord, stored0, stored1};
+      wire unused_vp = &{1'b0, color[63:32], texcoord, stored0, stored1, clear_color, clear_depth};
     end else begin : g_vflat
       assign vert_ok = 1'b1;
       always @(*) vp_data = 32'd0;
