@@ -98,6 +98,8 @@ module spigpu_top #(
   wire [10:0]  cmd_fb_width, cmd_fb_height;
   wire [23:0]  cmd_clear_depth;
   wire [183:0] cmd_v0, cmd_v1, cmd_v2;
+  wire [3:0]   vp_addr;
+  wire [31:0]  vp_data;
   wire         mem_req_valid, mem_req_ready, mem_req_we, mem_rsp_valid;
   wire [29:0]  mem_req_addr;
   wire [31:0]  mem_req_wdata, mem_rsp_rdata;
@@ -119,7 +121,8 @@ module spigpu_top #(
     .cmd_tri_mode(cmd_tri_mode), .cmd_tex_base(cmd_tex_base), .cmd_tex_fmt(cmd_tex_fmt), .cmd_scissor(cmd_scissor),
     .cmd_fb_draw(cmd_fb_draw), .cmd_fb_z(cmd_fb_z), .cmd_fb_format(cmd_fb_format), .cmd_fb_width(cmd_fb_width),
     .cmd_fb_height(cmd_fb_height), .cmd_clear_color(cmd_clear_color), .cmd_clear_depth(cmd_clear_depth),
-    .cmd_v0(cmd_v0), .cmd_v1(cmd_v1), .cmd_v2(cmd_v2), .core_idle(core_idle), .mem_req_valid(mem_req_valid),
+    .cmd_v0(cmd_v0), .cmd_v1(cmd_v1), .cmd_v2(cmd_v2), .vp_addr(vp_addr), .vp_data(vp_data),
+    .core_idle(core_idle), .mem_req_valid(mem_req_valid),
     .mem_req_ready(mem_req_ready), .mem_req_we(mem_req_we), .mem_req_addr(mem_req_addr),
     .mem_req_wdata(mem_req_wdata), .mem_req_be(mem_req_be), .mem_rsp_valid(mem_rsp_valid),
     .mem_rsp_rdata(mem_rsp_rdata), .vblank(vblank), .vsync(vsync), .frame_valid(frame_valid),
@@ -155,7 +158,8 @@ module spigpu_top #(
     .cmd_tri_mode(cmd_tri_mode), .cmd_tex_base(cmd_tex_base), .cmd_tex_fmt(cmd_tex_fmt), .cmd_scissor(cmd_scissor),
     .cmd_fb_draw(cmd_fb_draw), .cmd_fb_z(cmd_fb_z), .cmd_fb_format(cmd_fb_format), .cmd_fb_width(cmd_fb_width),
     .cmd_fb_height(cmd_fb_height), .cmd_clear_color(cmd_clear_color), .cmd_clear_depth(cmd_clear_depth),
-    .cmd_v0(cmd_v0), .cmd_v1(cmd_v1), .cmd_v2(cmd_v2), .core_idle(core_idle), .mem_req_valid(mem_req_valid),
+    .cmd_v0(cmd_v0), .cmd_v1(cmd_v1), .cmd_v2(cmd_v2), .vp_addr(vp_addr), .vp_data(vp_data),
+    .core_idle(core_idle), .mem_req_valid(mem_req_valid),
     .mem_req_ready(mem_req_ready), .mem_req_we(mem_req_we), .mem_req_addr(mem_req_addr),
     .mem_req_wdata(mem_req_wdata), .mem_req_be(mem_req_be), .mem_rsp_valid(mem_rsp_valid),
     .mem_rsp_rdata(mem_rsp_rdata), .perf_triangles(perf_triangles), .perf_pixels(perf_pixels),

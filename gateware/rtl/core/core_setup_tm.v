@@ -40,9 +40,9 @@ module core_setup_tm #(
     output wire         busy,
     output reg          done,         // pulse: results valid; `draw` says whether to rasterise
     output reg          draw,
-    input  wire [183:0] v0,
-    input  wire [183:0] v1,
-    input  wire [183:0] v2,
+    output wire [3:0]   vp_addr,      // the soc's vertex read port: {vertex, word}; words are
+    input  wire [31:0]  vp_data,      // 0 {Y, X}, 1 Z, 2 COLOR (RGBA, R in [31:24]); a clock later
+    input  wire [3:0]   vp_idle,      // the port's address while idle (the value the core copies)
     input  wire [10:0]  clip_x0,
     input  wire [10:0]  clip_y0,
     input  wire [10:0]  clip_x1,      // exclusive, already min(SCISSOR.X1, WIDTH)
@@ -90,23 +90,26 @@ module core_setup_tm #(
 
   // ---------------------------------------------------------------- field multiplexer
   // fsel = {kind, vertex}: kind 0 X, 1 Y, 2 the attribute ak, 3 the sample point (vertex 0:
-  // 16 y0 + 8, 1: 16 x_start + 8)
+  // 16 y0 + 8, 1: 16 x_start + 8). The vertex fields come through the soc's read port: an
+  // instruction that writes one waits a clock for it (fw_ok). Idle, the port reads what the
+  // core copies when it accepts the command (vp_idle: v0's COLOR, CLEAR_COLOR or CLEAR_DEPTH).
   wire [31:0] I;        // the instruction (registered block RAM read of pc_next)
   wire [3:0] fsel = I[21:18];
   reg  [2:0] ak;
-  wire [87:0] fv = (fsel[1:0] == 2'd0) ? v0[87:0] : (fsel[1:0] == 2'd1) ? v1[87:0] : v2[87:0];
+  reg  [6:0] pc;
+  reg        fw_ok;     // vp_data is the word the instruction's field select names
+  assign vp_addr = (pc == 7'd0) ? vp_idle : {fsel[1:0], !fsel[3] ? 2'd0 : ak[2] ? 2'd1 : 2'd2};
   reg  [AW-1:0] fld;
-  wire unused_v = &{1'b0, v0[183:88], v1[183:88], v2[183:88]};  // S, T, Q: no texturing here
   always @(*) begin
     case (fsel[3:2])
-      2'd0: fld = AW'($signed(fv[15:0]));
-      2'd1: fld = AW'($signed(fv[31:16]));
+      2'd0: fld = AW'($signed(vp_data[15:0]));
+      2'd1: fld = AW'($signed(vp_data[31:16]));
       2'd2: case (ak)
-              3'd0: fld = AW'(fv[87:80]);
-              3'd1: fld = AW'(fv[79:72]);
-              3'd2: fld = AW'(fv[71:64]);
-              3'd3: fld = AW'(fv[63:56]);
-              default: fld = AW'(fv[55:32]);
+              3'd0: fld = AW'(vp_data[31:24]);
+              3'd1: fld = AW'(vp_data[23:16]);
+              3'd2: fld = AW'(vp_data[15:8]);
+              3'd3: fld = AW'(vp_data[7:0]);
+              default: fld = AW'(vp_data[23:0]);
             endcase
       default: fld = AW'({fsel[0] ? x_start : box_y0, 4'b1000});
     endcase
@@ -128,7 +131,6 @@ module core_setup_tm #(
                    A_XT = 4'd6, A_BOX = 4'd7, A_ORG = 4'd8, A_BRRECT = 4'd9, A_TODO = 4'd10,
                    A_NEXTA = 4'd11, A_DIV = 4'd12, A_DONE = 4'd13, A_NODRAW = 4'd14;
   localparam [1:0] P_DX = 2'd1, P_E = 2'd2;
-  reg  [6:0] pc;
   wire [6:0] pc_next;
   core_setup_prog prog (.clk(clk), .addr(pc_next), .word(I));
   assign busy = (pc != 7'd0);
@@ -240,6 +242,7 @@ module core_setup_tm #(
       2'd2: adv = !fr;
       default: adv = quiet && !dv_pend;
     endcase
+    if (i_wf && fsel[3:2] != 2'd3 && !fw_ok) adv = 1'b0;  // the port answers a clock later
     if (pc == 7'd0) adv = start;
   end
   reg taken;
@@ -263,6 +266,7 @@ module core_setup_tm #(
     pw_en <= 1'b0;
     xl_next <= 1'b0;
     pc <= pc_next;
+    fw_ok <= !adv && pc != 7'd0;
     // pipeline
     v1_ <= 1'b0; w1 <= 1'b0; dv1 <= 1'b0;
     v2_ <= v1_; w2 <= w1; dv2 <= dv1; op2 <= op1; wa2 <= wa1;

@@ -38,6 +38,9 @@ module spigpu_core #(
     input  wire [183:0] cmd_v0,
     input  wire [183:0] cmd_v1,
     input  wire [183:0] cmd_v2,
+    output wire [3:0]   vp_addr,          // PROFILE 0: the vertices through the soc's read port
+    input  wire [31:0]  vp_data,          // ({vertex, word} in, the word a clock later), not cmd_v*;
+                                          // {3, 0} CLEAR_COLOR, {3, 1} CLEAR_DEPTH (not cmd_clear_*)
     output wire         core_idle,
     // memory port
     output wire         mem_req_valid,
@@ -116,10 +119,11 @@ module spigpu_core #(
       // a sequencer whose operands are block RAM words (no operand buses); the rasteriser's
       // edge values are not read back
       wire [23:0] q24;
-      wire unused_e = &{1'b0, ras_e1, ras_e2, need[7:5]};
+      wire unused_e = &{1'b0, ras_e1, ras_e2, need[7:5], cmd_v0, cmd_v1, cmd_v2, cmd_clear_color, cmd_clear_depth};
       core_setup_tm #(.IDX_W(IDX_W)) setup (
           .clk(clk), .rst(rst), .start(su_go), .rect(su_rect), .busy(su_busy), .done(su_done),
-          .draw(su_draw), .v0(cmd_v0), .v1(cmd_v1), .v2(cmd_v2),
+          .draw(su_draw), .vp_addr(vp_addr), .vp_data(vp_data),
+          .vp_idle((cmd_op == OP_TRI) ? 4'b0010 : {3'b110, cmd_op == OP_CLEAR_Z}),
           .clip_x0(sc_x0), .clip_y0(sc_y0), .clip_x1(clip_x1), .clip_y1(clip_y1), .width(cmd_fb_width),
           .need(need[4:0]),
           .dx0(su_dx0), .dx1(su_dx1), .dx2(su_dx2), .dy0(su_dy0), .dy1(su_dy1), .dy2(su_dy2),
@@ -129,6 +133,8 @@ module spigpu_core #(
           .den(su_den), .pw_en(pw_en), .pw_attr(pw_attr), .pw_field(pw_field), .pw_q(q24), .pw_r(pw_r));
       assign pw_q = {8'd0, q24};
     end else begin : setup_par
+      assign vp_addr = 4'd0;
+      wire unused_vp = &{1'b0, vp_data};
       core_setup #(.TEX(TEX), .IDX_W(IDX_W), .SKIP(1), .XREJECT(1), .NDIV(3)) setup (
           .clk(clk), .rst(rst), .start(su_go), .rect(su_rect), .busy(su_busy), .done(su_done), .draw(su_draw),
           .v0(cmd_v0), .v1(cmd_v1), .v2(cmd_v2),
@@ -452,7 +458,8 @@ module spigpu_core #(
             r_phase     <= cmd_tri_mode[19:16];
             r_keep      <= m_keep;
             r_decal     <= cmd_tri_mode[14];
-            r_flat      <= cmd_v0[87:56];
+            // v0's COLOR: the setup leaves the read port on it when idle (up5k)
+            r_flat      <= (SMALL != 0) ? vp_data : cmd_v0[87:56];
             r_serial    <= serial_n;
             r_need      <= need;
             r_need_dst  <= (cmd_tri_mode[8:7] != 2'd0) || (some_masked && !all_masked && cmd_fb_format != 2'd0);
@@ -469,7 +476,8 @@ module spigpu_core #(
             r_temporal  <= 1'b0;
             r_keep      <= 4'd0;
             // CLEAR_Z writes no colour, so r_flat carries its depth (one register, not two)
-            r_flat      <= (cmd_op == OP_CLEAR_Z) ? {8'd0, cmd_clear_depth} : cmd_clear_color;
+            // (up5k: the value through the read port, which the idle setup leaves on it)
+            r_flat      <= (SMALL != 0) ? vp_data : (cmd_op == OP_CLEAR_Z) ? {8'd0, cmd_clear_depth} : cmd_clear_color;
             r_serial    <= 1'b0;
             r_need      <= 8'd0;
             r_need_dst  <= 1'b0;

@@ -8,6 +8,15 @@
 //     has written everything and the previous swap has been scanned out);
 //   - MEM_ADDR / MEM_DATA become operations of the memory-access unit (after the core is idle);
 //   - FENCE records its ID when everything before it has completed.
+// Vertices reach the core in one of two ways (VPORT): as three flat 184-bit buses held in
+// flip-flops (cmd_v0..2, the parallel setup of the ecp5 profile), or through a read port
+// (VPORT = 1, up5k): the executor keeps three vertex slots in block RAM, three 32-bit words each
+// ({Y, X}, Z, COLOR; no texture coordinates), and the core reads word w of triangle vertex k as
+// vp_addr = {k, w}, vp_data a clock later. A VERTEX writes its three words (three clocks) before
+// it executes; STRIP and FAN rotate slot numbers instead of copying vertices. "Vertex" 3 is
+// CLEAR_COLOR (word 0) and CLEAR_DEPTH (word 1), which a clear reads the same way: written when
+// they execute, and with their reset values in the two clocks after a reset (nothing executes
+// before); cmd_clear_color / cmd_clear_depth are then 0.
 // Plain register writes take one clock each. Read-write registers are also written, validated, to
 // the register file's shadow RAM when they execute (a clock later if the SPI side is writing it); a
 // kicking VERTEX writes it first and then offers the triangle to the core, so cmd_valid, once high,
@@ -16,7 +25,8 @@ module command_exec #(
   parameter [7:0] FEATURES = 8'h3F,
   parameter       MAX_WIDTH = 1024,
   parameter       MAX_HEIGHT = 1024,
-  parameter       VRAM_KIB = 32768
+  parameter       VRAM_KIB = 32768,
+  parameter       VPORT = 0           // 1: vertices through the read port, cmd_v0..2 are 0
 ) (
   input  wire         clk,
   input  wire         rst,           // power-on or RESET
@@ -49,6 +59,8 @@ module command_exec #(
   output wire [183:0] cmd_v0,
   output wire [183:0] cmd_v1,
   output wire [183:0] cmd_v2,
+  input  wire [3:0]   vp_addr,       // {triangle vertex 0-2, word 0-2} (VPORT = 1)
+  output reg  [31:0]  vp_data,       // the word, a clock later
   input  wire         core_idle,
   // memory-access unit: the operation's data stays in the FIFO head until mem_op_ack
   output wire         mem_set_addr,  // MEM_ADDR offered
@@ -187,12 +199,13 @@ module command_exec #(
   wire wait_ok    = is_mem ? core_quiet : (is_display || is_fence) ? quiet : 1'b1;
   wire swap_ok    = !is_display || swap_ready;
   wire shadow_ok  = !to_shadow || sh_wr_ack || kick_shadowed;
-  wire go         = in_valid && core_ok && wait_ok && swap_ok && shadow_ok && mem_ok;
+  wire vert_ok;                                                // VPORT: the vertex's words are written
+  wire go         = in_valid && core_ok && wait_ok && swap_ok && shadow_ok && mem_ok && vert_ok;
 
   assign in_pop    = go;
   // Stable until cmd_ready: mem_idle and kick_shadowed only become true while the entry waits, and
   // core_drain only becomes false. A kick offers its triangle once its shadow entry is written.
-  assign cmd_valid = in_valid && to_core && mem_idle && !core_drain && (!to_shadow || kick_shadowed);
+  assign cmd_valid = in_valid && to_core && mem_idle && !core_drain && (!to_shadow || kick_shadowed) && vert_ok;
   assign cmd_op    = is_clear ? 2'd1 : is_clear_z ? 2'd2 : 2'd0;
   assign cmd_tri_mode = tri_mode;
   assign cmd_tex_base = tex_base;
@@ -203,11 +216,62 @@ module command_exec #(
   assign cmd_fb_format = fb_format;
   assign cmd_fb_width = 11'(fb_width);
   assign cmd_fb_height = 11'(fb_height);
-  assign cmd_clear_color = clear_color;
-  assign cmd_clear_depth = clear_depth;
-  assign cmd_v0 = stored0;
-  assign cmd_v1 = stored1;
-  assign cmd_v2 = vertex;
+  assign cmd_clear_color = VPORT != 0 ? 32'd0 : clear_color;
+  assign cmd_clear_depth = VPORT != 0 ? 24'd0 : clear_depth;
+  assign cmd_v0 = VPORT != 0 ? 184'd0 : stored0;
+  assign cmd_v1 = VPORT != 0 ? 184'd0 : stored1;
+  assign cmd_v2 = VPORT != 0 ? 184'd0 : vertex;
+
+  // --- vertex slots (VPORT = 1): the vertex being formed goes to slot sl[vcount]; a triangle is
+  // (sl[0], sl[1], sl[2]); after it, STRIP rotates the slots left, FAN exchanges sl[1] and sl[2]
+  // (the first vertex stays), LIST starts again at sl[0].
+  generate
+    if (VPORT != 0) begin : g_vport
+      (* ram_style = "block", no_rw_check *) reg [31:0] vmem[0:15];
+      reg  [1:0] sl0, sl1, sl2, wc;
+      wire [1:0] wslot = (vcount == 2'd0) ? sl0 : (vcount == 2'd1) ? sl1 : sl2;
+      wire [1:0] rslot = (vp_addr[3:2] == 2'd0) ? sl0 : (vp_addr[3:2] == 2'd1) ? sl1 : sl2;
+      wire       rslot3 = vp_addr[3:2] == 2'd3;
+      reg  [1:0] cinit;   // 0, 1: writing CLEAR_COLOR's, CLEAR_DEPTH's reset value; 2: done
+      wire       vwrite = in_valid && is_vertex && wc != 2'd3 && cinit[1];
+      wire       is_cd  = idx == `SPIGPU_REG_CLEAR_DEPTH;
+      wire       cwrite = go && (idx == `SPIGPU_REG_CLEAR_COLOR || is_cd);
+      wire       iwrite = !cinit[1];
+      // CLEAR_COLOR and CLEAR_DEPTH are d[31:0] (validation clears the bits above CLEAR_DEPTH's 24)
+      wire [31:0] wdata = iwrite ? (cinit[0] ? RESET_CLEAR_DEPTH[31:0] : RESET_CLEAR_COLOR[31:0])
+                        : (vwrite && wc == 2'd1) ? {8'd0, d[55:32]} : (vwrite && wc == 2'd2) ? color[31:0] : d[31:0];
+      wire [3:0]  waddr = vwrite ? {wslot, wc} : iwrite ? {3'b110, cinit[0]} : {3'b110, is_cd};
+      assign vert_ok = (!is_vertex || wc == 2'd3) && !iwrite;
+      always @(posedge clk) begin
+        if (vwrite || cwrite || iwrite) vmem[waddr] <= wdata;
+        vp_data <= vmem[{rslot3 ? 2'd3 : rslot, vp_addr[1:0]}];
+        if (rst) begin
+          cinit <= 2'd0;
+          wc <= 2'd0;
+          sl0 <= 2'd0;
+          sl1 <= 2'd1;
+          sl2 <= 2'd2;
+        end else begin
+          if (iwrite) cinit <= cinit + 2'd1;
+          if (vwrite) wc <= wc + 2'd1;
+          if (go) wc <= 2'd0;
+          if (go && kick && prim_type == 2'd1) begin         // STRIP
+            sl0 <= sl1;
+            sl1 <= sl2;
+            sl2 <= sl0;
+          end else if (go && kick && prim_type == 2'd2) begin  // FAN
+            sl1 <= sl2;
+            sl2 <= sl1;
+          end
+        end
+      end
+      wire unused_vp = &{1'b0, color[63:32], texcoord, stored0, stored1, clear_color, clear_depth};
+    end else begin : g_vflat
+      assign vert_ok = 1'b1;
+      always @(*) vp_data = 32'd0;
+      wire unused_vp = &{1'b0, vp_addr};
+    end
+  endgenerate
 
   wire   mem_offer    = in_valid && core_quiet;
   assign mem_set_addr = mem_offer && is_memaddr;

@@ -57,6 +57,8 @@ module spigpu_soc #(
   output wire [183:0] cmd_v0,
   output wire [183:0] cmd_v1,
   output wire [183:0] cmd_v2,
+  input  wire [3:0]   vp_addr,        // the vertex read port (up5k; docs/gateware.md "soc <-> core")
+  output wire [31:0]  vp_data,
   input  wire         core_idle,
   input  wire         mem_req_valid,
   output wire         mem_req_ready,
@@ -178,14 +180,16 @@ module spigpu_soc #(
   wire [63:0] mem_op_data;
   wire        swap_req, swap_ready, waiting_vsync;
   wire [27:0] swap_addr;
-  command_exec #(.FEATURES(FEATURES), .MAX_WIDTH(MAX_WIDTH), .MAX_HEIGHT(MAX_HEIGHT), .VRAM_KIB(VRAM_KIB)) u_exec (
+  command_exec #(.FEATURES(FEATURES), .MAX_WIDTH(MAX_WIDTH), .MAX_HEIGHT(MAX_HEIGHT), .VRAM_KIB(VRAM_KIB),
+                 .VPORT(PROFILE == 0 ? 1 : 0)) u_exec (
     .clk(clk), .rst(rst_any), .in_valid(fifo_out_valid), .in_entry(fifo_out), .in_pop(fifo_pop),
     .sh_wr_req(sh_wr_req), .sh_wr_idx(sh_wr_idx), .sh_wr_data(sh_wr_data), .sh_wr_ack(sh_wr_ack),
     .err_set(ex_err), .core_drain(core_drain), .cmd_valid(cmd_valid), .cmd_ready(cmd_ready), .cmd_op(cmd_op),
     .cmd_tri_mode(cmd_tri_mode), .cmd_tex_base(cmd_tex_base), .cmd_tex_fmt(cmd_tex_fmt), .cmd_scissor(cmd_scissor),
     .cmd_fb_draw(cmd_fb_draw), .cmd_fb_z(cmd_fb_z), .cmd_fb_format(cmd_fb_format), .cmd_fb_width(cmd_fb_width),
     .cmd_fb_height(cmd_fb_height), .cmd_clear_color(cmd_clear_color), .cmd_clear_depth(cmd_clear_depth),
-    .cmd_v0(cmd_v0), .cmd_v1(cmd_v1), .cmd_v2(cmd_v2), .core_idle(core_idle), .mem_set_addr(mem_set_addr),
+    .cmd_v0(cmd_v0), .cmd_v1(cmd_v1), .cmd_v2(cmd_v2), .vp_addr(vp_addr), .vp_data(vp_data),
+    .core_idle(core_idle), .mem_set_addr(mem_set_addr),
     .mem_write(mem_write), .mem_op_data(mem_op_data), .mem_op_ack(mem_op_ack), .mem_idle(mem_ex_idle),
     .swap_req(swap_req), .swap_addr(swap_addr), .swap_ready(swap_ready), .waiting_vsync(waiting_vsync),
     .executed(executed));

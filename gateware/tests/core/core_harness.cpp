@@ -22,6 +22,19 @@ void put_vertex(VlWide<6>& w, const CoreVertex& v) {
   for (int i = 0; i < 6; ++i) w[i] = words[i];
 }
 
+// Word w of a vertex slot of the soc's read port (command_exec, VPORT = 1): {Y, X}, Z, COLOR;
+// "vertex" 3 holds CLEAR_COLOR and CLEAR_DEPTH.
+std::uint32_t port_word(const CoreCommand& c, unsigned slot, unsigned w) {
+  if (slot == 3) return w == 0 ? c.clear_color : w == 1 ? (c.clear_depth & 0xFFFFFF) : 0xDEADBEEFu;
+  const CoreVertex& v = c.v[slot];
+  switch (w) {
+    case 0: return std::uint32_t(std::uint16_t(v.x)) | (std::uint32_t(std::uint16_t(v.y)) << 16);
+    case 1: return v.z & 0xFFFFFF;
+    case 2: return v.rgba;
+    default: return 0xDEADBEEFu;
+  }
+}
+
 }  // namespace
 
 CoreHarness::CoreHarness(std::uint64_t vram_bytes, std::uint32_t seed, MemoryTiming timing)
@@ -58,8 +71,11 @@ void CoreHarness::tick() {
   const std::uint64_t addr = std::uint64_t(top_->mem_req_addr) * 4;
   const std::uint32_t wdata = top_->mem_req_wdata;
   const unsigned be = top_->mem_req_be;
+  const unsigned vp = top_->vp_addr;
   top_->clk = 1;
   top_->eval();
+  // the read port answers the address of this edge a clock later, as the block RAM does
+  top_->vp_data = port_word(port_, vp >> 2, vp & 3);
   ++cycles_;
   if (rsp) reads_.pop_front();
   if (req) {
@@ -99,6 +115,7 @@ void CoreHarness::submit(const CoreCommand& c) {
   put_vertex(top_->cmd_v0, c.v[0]);
   put_vertex(top_->cmd_v1, c.v[1]);
   put_vertex(top_->cmd_v2, c.v[2]);
+  port_ = c;
   top_->cmd_valid = 1;
   for (std::uint64_t n = 0;; ++n) {
     top_->clk = 0;

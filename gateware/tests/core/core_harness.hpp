@@ -77,6 +77,9 @@ class CoreHarness {
     std::uint32_t data;
   };
   std::deque<Pending> reads_;
+  // the soc's vertex read port (up5k core): the command's vertices and clear values, as the
+  // executor's block RAM holds them
+  CoreCommand port_;
   std::uint64_t cycles_ = 0;
   bool range_error_ = false;
 };
