@@ -19,7 +19,7 @@ TEST(SimRegisters, ResetValuesIdAndCaps) {
   o.max_width = 320;
   o.max_height = 240;
   auto d = make_device(o);
-  EXPECT_EQ(rd(*d, Reg::ID), 0x5350475501020007ull);  // protocol 1.2
+  EXPECT_EQ(rd(*d, Reg::ID), 0x5350475501030007ull);  // protocol 1.3
   const std::uint64_t caps = rd(*d, Reg::CAPS);
   EXPECT_EQ(caps & 0xFFFFFF, 2048u);                // VRAM_KIB
   EXPECT_EQ((caps >> 24) & 0x7FF, 320u);            // MAX_WIDTH
