@@ -2,6 +2,8 @@
 
 #include <random>
 
+#include "gpubridge/geometry/encode.hpp"
+#include "gpubridge/protocol/command_stream.hpp"
 #include "gpubridge/protocol/frame.hpp"
 #include "gpubridge/protocol/registers.hpp"
 #include "gpubridge/sim/device.hpp"
@@ -28,35 +30,12 @@ struct Shape {
 constexpr Shape kShapes[] = {
     {"small", 120, 1, 6, 1, 6}, {"tall", 40, 2, 6, 30, 110}, {"wide", 40, 30, 150, 2, 6}, {"fat", 24, 20, 70, 20, 70}};
 
-class Writer {
- public:
-  explicit Writer(protocol::CommandStream& s) : s_(s) {}
-  void write(Reg r, std::uint64_t v) { frames_.push_back(protocol::write_frame(r, v)); }
-  void upload(std::uint32_t address, std::vector<std::uint8_t> data) {
-    flush();
-    s_.commands.push_back({0, protocol::UploadCmd{address, std::move(data)}});
-  }
-  void flush() {
-    for (std::size_t i = 0; i < frames_.size(); i += protocol::kMaxFramesPerBatch) {
-      protocol::FramesCmd cmd;
-      for (std::size_t k = i; k < frames_.size() && k < i + protocol::kMaxFramesPerBatch; ++k) cmd.push(frames_[k]);
-      s_.commands.push_back({0, std::move(cmd)});
-    }
-    frames_.clear();
-  }
-
- private:
-  protocol::CommandStream& s_;
-  std::vector<protocol::Frame> frames_;
-};
-
-std::uint64_t scissor(unsigned x0, unsigned y0, unsigned x1, unsigned y1) {
-  return (std::uint64_t{y1} << 48) | (std::uint64_t{x1} << 32) | (std::uint64_t{y0} << 16) | x0;
-}
+// Every rectangle here lies within 160 x 120, which scissor_word always accepts.
+std::uint64_t scissor(unsigned x0, unsigned y0, unsigned x1, unsigned y1) { return *geometry::scissor_word(x0, y0, x1, y1); }
 
 protocol::CommandStream frame(unsigned mode_class, const Shape& shape, bool bilinear, bool rgba8888, std::uint32_t seed) {
   protocol::CommandStream s;
-  Writer w(s);
+  protocol::CommandStreamWriter w(s);
   std::mt19937 rng(seed);
   w.write(Reg::FB_FORMAT, (std::uint64_t{rgba8888 ? 0u : 1u} << 32) | (std::uint64_t{kH} << 16) | kW);
   w.write(Reg::FB_DRAW, kColor);

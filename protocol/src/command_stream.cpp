@@ -1,6 +1,8 @@
 // Commands <-> socket messages, and the limits a command must respect to fit one message.
 #include "gpubridge/protocol/command_stream.hpp"
 
+#include <algorithm>
+
 namespace gpubridge::protocol {
 namespace {
 template <class... F>
@@ -85,6 +87,22 @@ std::string command_problem(const Command& c) {
           },
       },
       c);
+}
+
+void CommandStreamWriter::upload(std::uint32_t address, std::vector<std::uint8_t> data) {
+  flush();
+  s_.commands.push_back({0, UploadCmd{address, std::move(data)}});
+}
+
+void CommandStreamWriter::flush() {
+  for (std::size_t i = 0; i < frames_.size(); i += kMaxFramesPerBatch) {
+    FramesCmd cmd;
+    const std::size_t end = std::min(frames_.size(), i + kMaxFramesPerBatch);
+    cmd.bytes.reserve((end - i) * kFrameBytes);
+    for (std::size_t k = i; k < end; ++k) cmd.push(frames_[k]);
+    s_.commands.push_back({0, std::move(cmd)});
+  }
+  frames_.clear();
 }
 
 }  // namespace gpubridge::protocol

@@ -15,32 +15,6 @@ using protocol::Reg;
 
 std::uint64_t align_up(std::uint64_t v, std::uint64_t a) { return (v + a - 1) / a * a; }
 
-// Accumulates frames into WRITE_FRAMES-sized batches and keeps commands in order.
-class StreamWriter {
- public:
-  explicit StreamWriter(protocol::CommandStream& s) : s_(s) {}
-  void write(Reg r, std::uint64_t data) { frames_.push_back(protocol::write_frame(r, data)); }
-  std::vector<protocol::Frame>& frames() { return frames_; }
-  void upload(std::uint32_t address, std::vector<std::uint8_t> data) {
-    flush();
-    s_.commands.push_back({0, protocol::UploadCmd{address, std::move(data)}});
-  }
-  void flush() {
-    for (std::size_t i = 0; i < frames_.size(); i += protocol::kMaxFramesPerBatch) {
-      protocol::FramesCmd cmd;
-      const std::size_t end = std::min(frames_.size(), i + protocol::kMaxFramesPerBatch);
-      cmd.bytes.reserve((end - i) * protocol::kFrameBytes);
-      for (std::size_t k = i; k < end; ++k) cmd.push(frames_[k]);
-      s_.commands.push_back({0, std::move(cmd)});
-    }
-    frames_.clear();
-  }
-
- private:
-  protocol::CommandStream& s_;
-  std::vector<protocol::Frame> frames_;
-};
-
 template <class T>
 Result<T> in_scene(const Scene& s, Result<T> r) {
   if (r) return r;
@@ -84,7 +58,7 @@ Result<BuiltScene> build_commands(const Scene& scene, const BuildOptions& option
                                                       {"width", scene.width},
                                                       {"height", scene.height},
                                                       {"format", protocol::to_string(scene.format)}});
-  StreamWriter w(out.stream);
+  protocol::CommandStreamWriter w(out.stream);
 
   // Setup: buffers, full scissor, clears.
   auto fb = in_scene(scene, geometry::fb_format_word(scene.width, scene.height, scene.format));

@@ -70,6 +70,21 @@ inline constexpr std::uint32_t kMaxReadbackBytes = 64u << 20;
 // Largest number of frames in one WRITE_FRAMES message.
 inline constexpr std::size_t kMaxFramesPerBatch = kMaxPayload / kFrameBytes;
 
+// Builds a CommandStream from register writes and uploads as a host program would send them: writes
+// gather into WRITE_FRAMES commands of at most kMaxFramesPerBatch frames, and an upload first closes
+// the open batch so that commands keep their order. Call flush() after the last write.
+class CommandStreamWriter {
+ public:
+  explicit CommandStreamWriter(CommandStream& s) : s_(s) {}
+  void write(Reg r, std::uint64_t value) { frames_.push_back(write_frame(r, value)); }
+  void upload(std::uint32_t address, std::vector<std::uint8_t> data);
+  void flush();
+
+ private:
+  CommandStream& s_;
+  std::vector<Frame> frames_;
+};
+
 // The socket message carrying a command (request id chosen by the caller). Never fails.
 Message to_message(const Command& c, std::uint32_t request_id);
 // The command a message carries, or nullopt for message types that do not affect the device
