@@ -77,6 +77,8 @@ class CommandStreamWriter {
  public:
   explicit CommandStreamWriter(CommandStream& s) : s_(s) {}
   void write(Reg r, std::uint64_t value) { frames_.push_back(write_frame(r, value)); }
+  // The open batch, for encoders that append frames themselves (geometry::encode_triangle).
+  std::vector<Frame>& frames() { return frames_; }
   void upload(std::uint32_t address, std::vector<std::uint8_t> data);
   void flush();
 
