@@ -7,6 +7,7 @@
 
 #include "gpubridge/common/json_text.hpp"
 #include "gpubridge/examples/prediction.hpp"
+#include "gpubridge/rtl/gateware_profile.hpp"
 #include "gpubridge/usb/board_profile.hpp"
 
 namespace gpubridge::demo {
@@ -18,7 +19,10 @@ examples::DeviceCaps device_of(const usb::BoardProfile& p) {
   d.vram_bytes = std::uint64_t{p.vram_kib} * 1024;
   d.max_width = p.max_width;
   d.max_height = p.max_height;
-  return d;  // the emulated design has every feature
+  // A board that names its gateware profile has exactly that profile's CAPS.FEATURES (the iCEBreaker's
+  // up5k: no texturing, bilinear or blending); the generic profiles stand for any design and keep every feature.
+  if (const auto g = rtl::parse_gateware_profile(p.gateware)) d.features = rtl::caps_of(*g).features;
+  return d;
 }
 
 examples::BoardLink link_of(const usb::BoardProfile& p) {
