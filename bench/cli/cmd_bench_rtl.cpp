@@ -4,6 +4,7 @@
 // before and after calibration, and the co-simulation's speed (simulated clocks/s, frames/s).
 // --fit adds calibration frames (rtl_calibration.hpp) and prints the staged least-squares fit of the
 // model's gateware terms (rtl_fit.hpp): what timing_preset() holds.
+// --fill measures the whole device's fill rate per scene class instead (rtl_fill.hpp).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -27,6 +28,7 @@
 #include "gpubridge/usb/emu/emulated_stack.hpp"
 #include "gpubridge/usb/emu/rtl_pins.hpp"
 #include "rtl_calibration.hpp"
+#include "rtl_fill.hpp"
 #include "rtl_fit.hpp"
 
 namespace gpubridge::cli {
@@ -37,6 +39,7 @@ namespace fs = std::filesystem;
 struct RtlBenchArgs {
   std::vector<std::string> profiles{"up5k", "ecp5"};
   bool fit = false;
+  bool fill = false;
   bool quick = false;
   std::string config_dir;
 };
@@ -195,12 +198,53 @@ Result<std::vector<std::pair<std::string, protocol::CommandStream>>> streams(boo
   return out;
 }
 
+// --fill: pixels per device clock of each scene class (rtl_fill.hpp) and Mpixel/s at the core clock.
+int run_bench_rtl_fill(const GlobalOptions& g, const RtlBenchArgs& a, const fs::path& config_dir) {
+  nlohmann::json report = nlohmann::json::object();
+  for (const auto& gw : a.profiles) {
+    const auto profile = rtl::parse_gateware_profile(gw);
+    const auto caps = rtl::caps_of(*profile);
+    auto rows = measure_fill(*profile, a.quick, config_dir);
+    if (!rows) {
+      std::fprintf(stderr, "gpubridge bench rtl --fill: %s: %s\n", gw.c_str(), rows.error().message.c_str());
+      return 1;
+    }
+    if (!g.json)
+      std::printf("%s (board %s, %g MHz): whole-device fill, one rectangle as two triangles, device work clocks\n"
+                  "  %-44s %9s %10s %8s %10s %7s %7s\n",
+                  gw.c_str(), board_of(gw), caps.core_hz / 1e6, "scene class", "size", "clocks", "px/clk", "Mpixel/s",
+                  "setup", "stalls");
+    nlohmann::json out = nlohmann::json::array();
+    for (const auto& r : *rows) {
+      const double clocks = double(std::max<std::uint64_t>(r.draw_clocks, 1));
+      out.push_back({{"name", r.name}, {"width", r.width}, {"height", r.height}, {"bytes_per_pixel", r.bytes_per_pixel},
+                     {"depth", r.depth}, {"blend", r.blend}, {"textured", r.textured}, {"bilinear", r.bilinear},
+                     {"pixels", r.pixels}, {"draw_clocks", r.draw_clocks}, {"core_busy_clocks", r.core_busy_clocks},
+                     {"setup_clocks", r.setup_clocks}, {"mem_stall_clocks", r.mem_stall_clocks},
+                     {"refreshes", r.refreshes}, {"px_per_clock", r.px_per_clock}, {"mpixel_per_s", r.mpixel_per_s}});
+      if (!g.json)
+        std::printf("  %-44s %4ux%-4u %10llu %8.3f %10.1f %6.1f%% %6.1f%%\n", r.name.c_str(), r.width, r.height,
+                    static_cast<unsigned long long>(r.draw_clocks), r.px_per_clock, r.mpixel_per_s,
+                    100 * double(r.setup_clocks) / clocks, 100 * double(r.mem_stall_clocks) / clocks);
+    }
+    report[gw] = {{"board", board_of(gw)}, {"core_hz", caps.core_hz}, {"quick", a.quick}, {"rows", out}};
+  }
+  if (g.json) std::puts(json_text(report, 2).c_str());
+  return 0;
+}
+
 int run_bench_rtl(const GlobalOptions& g, const RtlBenchArgs& a) {
   if (!rtl::RtlDevice::available()) {
     std::fprintf(stderr, "gpubridge bench rtl: %s\n", rtl::RtlDevice::unavailable_reason().c_str());
     return 1;
   }
   const fs::path config_dir = a.config_dir.empty() ? usb::default_config_dir() : fs::path(a.config_dir);
+  for (const auto& gw : a.profiles)
+    if (!rtl::parse_gateware_profile(gw)) {
+      std::fprintf(stderr, "gpubridge bench rtl: --profile %s: expected up5k or ecp5\n", gw.c_str());
+      return 2;
+    }
+  if (a.fill) return run_bench_rtl_fill(g, a, config_dir);
   auto all = streams(a.quick);
   if (!all) {
     std::fprintf(stderr, "gpubridge bench rtl: %s\n", all.error().message.c_str());
@@ -208,10 +252,6 @@ int run_bench_rtl(const GlobalOptions& g, const RtlBenchArgs& a) {
   }
   nlohmann::json report = nlohmann::json::object();
   for (const auto& gw : a.profiles) {
-    if (!rtl::parse_gateware_profile(gw)) {
-      std::fprintf(stderr, "gpubridge bench rtl: --profile %s: expected up5k or ecp5\n", gw.c_str());
-      return 2;
-    }
     auto preset = sim::timing_preset(gw);
     auto before = sim::timing_preset("ecp5-50mhz");
     // the measured frame of each stream: its last one, both sides' counters over the same work
@@ -308,7 +348,11 @@ GPUBRIDGE_COMMAND("bench-rtl", 63, [](CLI::App& app, GlobalOptions& g, auto& run
   sub->add_flag("--fit", a->fit,
                 "also run the calibration frames (every render-state class, four triangle shapes) and print the staged "
                 "least-squares fit of the timing model's gateware terms (what timing_preset holds) and its error per frame");
-  sub->add_flag("--quick", a->quick, "two examples only (a smoke run)");
+  sub->add_flag("--fill", a->fill,
+                "instead: the whole device's fill rate per scene class (a framebuffer-sized rectangle as two triangles, "
+                "SPI slave to SPRAM / SDRAM co-simulated; the device's work clocks of the draw, SPI transfer time "
+                "excluded) in px/clock and Mpixel/s at the profile's core clock");
+  sub->add_flag("--quick", a->quick, "two examples only (a smoke run); with --fill, 64 x 48 rectangles");
   sub->add_option("--config-dir", a->config_dir, "directory holding boards/");
   runners.emplace_back(sub, [&g, a] { return run_bench_rtl(g, *a); });
 });

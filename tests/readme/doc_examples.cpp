@@ -176,6 +176,10 @@ std::vector<Example> make() {
       skip("build/tools/gpubridge bench rtl --quick",
            "co-simulates two examples on both gateware profiles for minutes on a machine shared with the rest of "
            "the suite; CTest rtl.cli.bench_quick runs it"),
+      run("build/tools/gpubridge bench rtl --fill --quick")
+          .prints(R"(ecp5 \(board ulx3s, 50 MHz\): whole-device fill)")
+          .prints(R"(fill RGBA8888 flat +64x48 )")
+          .within(300),
       skip("build/bench/protocol/protocol_parser_bench",
            "Google Benchmark runs for minutes (and is built only with libbenchmark)"),
   }});
@@ -228,6 +232,8 @@ std::vector<Example> make() {
            "CTest daemon_mirror_tests (*Gateware*) runs it through the FT2232H driver and checks every frame"),
       skip("build/tools/gpubridge bench rtl --quick", "minutes of co-simulation; CTest rtl.cli.bench_quick runs it"),
       skip("build/tools/gpubridge bench rtl --fit", "the full calibration run, an hour of co-simulation, by hand"),
+      skip("build/tools/gpubridge bench rtl --fill",
+           "framebuffer-sized rectangles, minutes of co-simulation; CTest rtl.cli.bench_fill runs the --quick form"),
       skip("gateware/synth.py --pack --check", "yosys synthesis of both profiles and nextpnr packing take many minutes (and up5k does not fit yet: exit 1), by hand"),
       skip("gateware/tests/core/synth_core.py", "yosys synthesis per stage takes many minutes, by hand"),
       skip("build/gateware/tests/core/rtl_core_ecp5_bench", "a measurement, by hand; the core's tests run in ctest -L rtl"),
@@ -240,8 +246,8 @@ std::vector<Example> make() {
       skip("scripts/gateware.sh --board ulx3s --json build/gateware/boards/ulx3s-report.json",
            "minutes of yosys synth_ecp5; CTest gateware.ulx3s.synth runs it"),
       skip("gateware/boards/predict.py --report build/gateware/boards/icebreaker-report.json --report "
-           "build/gateware/boards/ulx3s-report.json --bench bench-rtl.json --core up5k=core-up5k.json --core "
-           "ecp5=core-ecp5.json --doc docs/gateware.md",
+           "build/gateware/boards/ulx3s-report.json --bench bench-rtl.json --fill fill.json --core up5k=core-up5k.json "
+           "--core ecp5=core-ecp5.json --doc docs/gateware.md",
            "rewrites docs/gateware.md from reports that take an hour of synthesis and co-simulation, by hand"),
   }});
   all.push_back({"docs/gateware.md", "Building the bitstreams", 1, "docs_gateware_BuildingTheBitstreamsEcp5", {

@@ -1,0 +1,56 @@
+#!/usr/bin/env python3
+"""gateware.predict: predict.py judges the fill-rate goals by the whole device's figure
+(`bench rtl --fill`), never by the core alone's (ideal memory port), and shows both."""
+import os, sys, unittest
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import predict  # noqa: E402
+
+REPORT = {"icebreaker": {"target_mhz": 25.125}, "ulx3s": {"target_mhz": 50}}
+CORE = {"ecp5": [{"name": "fill RGBA8888 flat", "value": 0.977, "unit": "px/clk"},
+                 {"name": "RGBA8888 textured bilinear (64x64 RGBA8888)", "value": 0.636, "unit": "px/clk"}],
+        "up5k": [{"name": "fill RGB565 flat", "value": 0.966, "unit": "px/clk"}]}
+
+
+def fill_row(name, px):
+    return {"name": name, "width": 640, "height": 480, "px_per_clock": px}
+
+
+FILL = {"ecp5": {"rows": [fill_row("fill RGBA8888 flat", 0.45),
+                          fill_row("RGBA8888 textured bilinear (64x64 RGBA8888)", 0.55)]},
+        "up5k": {"rows": [fill_row("fill RGB565 flat", 0.995)]}}
+
+
+def goal_line(text, board, name):
+    return next(line for line in text.splitlines() if line.startswith(f"- goal {board} {name}"))
+
+
+class PredictFill(unittest.TestCase):
+    def test_goals_use_the_device_figure(self):
+        text = predict.fill_rates(CORE, FILL, REPORT)
+        flat = goal_line(text, "ulx3s", "fill RGBA8888 flat")
+        # 0.45 px/clock x 50 MHz = 22.5, against 50: missed, although the core alone makes 48.9
+        self.assertIn("22.5 Mpixel/s", flat)
+        self.assertIn("**missed**", flat)
+        self.assertIn("the core alone 48.9", flat)
+        bilinear = goal_line(text, "ulx3s", "RGBA8888 textured bilinear")
+        self.assertIn("27.5 Mpixel/s", bilinear)
+        self.assertTrue(bilinear.endswith(": met"))
+        up5k = goal_line(text, "icebreaker", "fill RGB565 flat")
+        self.assertIn("25.0 Mpixel/s", up5k)  # 0.995 x 25.125 = 24.999...
+        self.assertIn("**missed**", up5k)
+
+    def test_table_shows_both_figures(self):
+        text = predict.fill_rates(CORE, FILL, REPORT)
+        row = next(line for line in text.splitlines() if line.startswith("| fill RGBA8888 flat |"))
+        self.assertIn("| 640 × 480 | 0.977 | 0.450 | 22.5 |", row)
+
+    def test_core_alone_never_meets_a_goal(self):
+        text = predict.fill_rates(CORE, {}, REPORT)
+        flat = goal_line(text, "ulx3s", "RGBA8888 textured bilinear")
+        self.assertIn("not judged", flat)
+        self.assertNotIn(": met", text)
+
+
+if __name__ == "__main__":
+    unittest.main()
