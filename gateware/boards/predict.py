@@ -15,7 +15,8 @@ untextured, >= 25 bilinear-textured). --core takes build/gateware/tests/core/rtl
 A board runs at the clock its PLL makes (iCEBreaker 25.125 MHz, ULX3S 50 MHz), provided the routed
 design's fmax reaches it: the prediction is cycles / clock, and the report says whether the fmax was
 measured (placed and routed) or is still only the target. --doc rewrites the blocks between the
-"board-figures" and "predicted-fps" markers of docs/gateware.md; without it they go to stdout.
+"board-figures" (with --report), "fill-rates" (--fill, --core) and "predicted-fps" (--bench) markers
+of docs/gateware.md; without it they go to stdout.
 """
 import argparse, json, re, sys
 
@@ -92,6 +93,13 @@ def px_per_clock(rows, name, key):
     return row[key], row
 
 
+def clock_mhz(report, fill, profile):
+    """The board's clock: its report's target, else the profile's core clock the fill bench ran."""
+    mhz, _ = board_clock(report, BOARD_OF[profile])
+    hz = fill.get(profile, {}).get("core_hz")
+    return mhz or (hz / 1e6 if hz else None)
+
+
 def fill_rates(core, fill, report):
     """Fill rates of every scene class at the board clocks, the whole device's (gpubridge bench rtl
     --fill) beside the core alone's (ideal memory port), and the goals met or missed by the device's."""
@@ -106,7 +114,7 @@ def fill_rates(core, fill, report):
     for name in names:
         cells = []
         for p in profiles:
-            mhz, _ = board_clock(report, BOARD_OF[p])
+            mhz = clock_mhz(report, fill, p)
             c, _ = px_per_clock(core.get(p), name, "value")
             d, row = px_per_clock(fill.get(p, {}).get("rows"), name, "px_per_clock")
             cells += [f"{row['width']} × {row['height']}" if row else "—", f"{c:.3f}" if c else "—",
@@ -114,7 +122,7 @@ def fill_rates(core, fill, report):
         lines.append(f"| {name} | " + " | ".join(cells) + " |")
     lines.append("")
     for p, name, goal in GOALS:
-        mhz, _ = board_clock(report, BOARD_OF[p])
+        mhz = clock_mhz(report, fill, p)
         if not mhz or (p not in core and p not in fill):
             continue
         d, _ = px_per_clock(fill.get(p, {}).get("rows"), name, "px_per_clock")
@@ -205,7 +213,7 @@ def main():
                 bench = json.load(f)
     except (OSError, ValueError) as e:
         sys.exit(f"predict.py: {e}")
-    blocks = {"board-figures": figures(report)}
+    blocks = {"board-figures": figures(report)} if report else {}
     if any(v.get("quick") for v in fill.values()) and a.doc:
         sys.exit(f"predict.py: --fill {a.fill} is a --quick run (64 x 48 rectangles); the document takes the full one")
     if core or fill:

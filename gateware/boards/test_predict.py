@@ -45,6 +45,11 @@ class PredictFill(unittest.TestCase):
         row = next(line for line in text.splitlines() if line.startswith("| fill RGBA8888 flat |"))
         self.assertIn("| 640 × 480 | 0.977 | 0.450 | 22.5 |", row)
 
+    def test_clock_from_the_fill_report_without_board_reports(self):
+        fill = {p: dict(v, core_hz=hz) for (p, v), hz in zip(FILL.items(), (50e6, 25.125e6))}
+        text = predict.fill_rates(CORE, fill, {})
+        self.assertIn("22.5 Mpixel/s at 50 MHz", goal_line(text, "ulx3s", "fill RGBA8888 flat"))
+
     def test_core_alone_never_meets_a_goal(self):
         text = predict.fill_rates(CORE, {}, REPORT)
         flat = goal_line(text, "ulx3s", "RGBA8888 textured bilinear")
