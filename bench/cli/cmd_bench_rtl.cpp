@@ -345,13 +345,14 @@ GPUBRIDGE_COMMAND("bench-rtl", 63, [](CLI::App& app, GlobalOptions& g, auto& run
       "rtl", "the gateware co-simulated: RTL cycles per frame of every example and scene against the timing model, "
              "before and after calibration, and the co-simulation's speed");
   sub->add_option("--profile", a->profiles, "gateware profiles to run (up5k, ecp5)")->capture_default_str();
-  sub->add_flag("--fit", a->fit,
+  auto* fit = sub->add_flag("--fit", a->fit,
                 "also run the calibration frames (every render-state class, four triangle shapes) and print the staged "
                 "least-squares fit of the timing model's gateware terms (what timing_preset holds) and its error per frame");
   sub->add_flag("--fill", a->fill,
                 "instead: the whole device's fill rate per scene class (a framebuffer-sized rectangle as two triangles, "
                 "SPI slave to SPRAM / SDRAM co-simulated; the device's work clocks of the draw, SPI transfer time "
-                "excluded) in px/clock and Mpixel/s at the profile's core clock");
+                "excluded) in px/clock and Mpixel/s at the profile's core clock")
+      ->excludes(fit);
   sub->add_flag("--quick", a->quick, "two examples only (a smoke run); with --fill, 64 x 48 rectangles");
   sub->add_option("--config-dir", a->config_dir, "directory holding boards/");
   runners.emplace_back(sub, [&g, a] { return run_bench_rtl(g, *a); });
