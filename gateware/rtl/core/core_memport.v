@@ -12,7 +12,8 @@
 // OR together) while the pipeline keeps producing them; the pending word is sent when a write to
 // another word arrives or on `flush`. No read of a draw can observe the pending bytes: within a
 // draw the buffers are disjoint unless the core runs in serial mode, which flushes after every
-// pixel, and the core drains (flushes) between draws.
+// pixel, and the core drains (flushes) between draws. COMBINE = 0 (the up5k profile) leaves the
+// combiner out: each colour write is a request of its own.
 module core_memport #(
     parameter integer TAGS_AW = 3,   // log2 of reads in flight
     parameter integer COMBINE = 1
@@ -64,28 +65,45 @@ module core_memport #(
     output wire        pending_write  // the combiner holds a word
 );
   // ---- write combiner ----
-  reg        p_valid;
-  reg [29:0] p_addr;
-  reg [31:0] p_data;
-  reg [3:0]  p_be;
-  wire same = p_valid && (p_addr == cw_addr) && (COMBINE != 0);
-  wire p_req = p_valid && ((cw_valid && !same) || flush || COMBINE == 0);
-  wire p_gnt;
-  // an incoming colour write merges, fills an empty combiner, or replaces the word being sent
-  assign cw_ready = same || !p_valid || p_gnt;
-  wire [31:0] merged = {cw_be[3] ? cw_data[31:24] : p_data[31:24], cw_be[2] ? cw_data[23:16] : p_data[23:16],
-                        cw_be[1] ? cw_data[15:8] : p_data[15:8], cw_be[0] ? cw_data[7:0] : p_data[7:0]};
-  always @(posedge clk) begin
-    if (rst) begin
-      p_valid <= 1'b0;
-    end else if (cw_valid && cw_ready) begin
-      p_valid <= 1'b1;
-      p_addr  <= cw_addr;
-      p_data  <= (same && !p_gnt) ? merged : cw_data;
-      p_be    <= (same && !p_gnt) ? (p_be | cw_be) : cw_be;
-    end else if (p_gnt) begin
-      p_valid <= 1'b0;
+  // COMBINE = 0 (up5k) has none: colour writes go to the grant as they come, one request a pixel
+  // (RGB565 and RGBA2222 pixels sharing a word take a request each), and the 66 flip-flops of the
+  // pending word and its byte merge go; what lands in memory is the same.
+  wire        p_valid;
+  wire [29:0] p_addr;
+  wire [31:0] p_data;
+  wire [3:0]  p_be;
+  wire        p_req;
+  wire        p_gnt;
+  if (COMBINE != 0) begin : combiner
+    reg        q_valid;
+    reg [29:0] q_addr;
+    reg [31:0] q_data;
+    reg [3:0]  q_be;
+    wire same = q_valid && (q_addr == cw_addr);
+    assign p_req = q_valid && ((cw_valid && !same) || flush);
+    // an incoming colour write merges, fills an empty combiner, or replaces the word being sent
+    assign cw_ready = same || !q_valid || p_gnt;
+    wire [31:0] merged = {cw_be[3] ? cw_data[31:24] : q_data[31:24], cw_be[2] ? cw_data[23:16] : q_data[23:16],
+                          cw_be[1] ? cw_data[15:8] : q_data[15:8], cw_be[0] ? cw_data[7:0] : q_data[7:0]};
+    always @(posedge clk) begin
+      if (rst) begin
+        q_valid <= 1'b0;
+      end else if (cw_valid && cw_ready) begin
+        q_valid <= 1'b1;
+        q_addr  <= cw_addr;
+        q_data  <= (same && !p_gnt) ? merged : cw_data;
+        q_be    <= (same && !p_gnt) ? (q_be | cw_be) : cw_be;
+      end else if (p_gnt) begin
+        q_valid <= 1'b0;
+      end
     end
+    assign {p_valid, p_addr, p_data, p_be} = {q_valid, q_addr, q_data, q_be};
+  end else begin : no_combiner
+    wire unused_flush = flush;
+    assign p_req    = cw_valid;
+    assign cw_ready = p_gnt;
+    assign p_valid  = 1'b0;  // nothing is held here
+    assign {p_addr, p_data, p_be} = {cw_addr, cw_data, cw_be};
   end
   assign pending_write = p_valid;
 
