@@ -58,6 +58,8 @@ inline void set_pixel_lanes(PixelLanes& px, const DrawState& st, const RasterCon
 constexpr int kSpanSolveWidth = 16;
 // Jumps along a span shorter than this are stepped instead of divided.
 constexpr std::int64_t kStepJump = 4;
+// Rows this far ahead of the one being drawn are prefetched.
+constexpr int kPrefetchRows = 4;
 
 template <bool kGouraud, bool kTextured, bool kDepth, bool kSimple>
 class Kernel {
@@ -66,7 +68,7 @@ class Kernel {
   // Shortest span handed to the vector routine. A textured pixel costs the scalar routine a
   // reciprocal and four texel reads one by one, so even two-pixel spans win in lanes (cubes
   // +5 %, road +1 %, A/B alternating x3); untextured pixels are cheap enough scalar below 8.
-  static constexpr std::int64_t kMinSimdSpan = kTextured ? 2 : 8;
+  static constexpr std::int64_t kMinSimdSpan = kTextured ? 2 : 1;
 
   Kernel(const Triangle& t, const DrawState& st, RasterContext& ctx)
       : t_(t), st_(st), ctx_(ctx), tex_(st.tex, ctx.mem), den_div_(t.den) {
@@ -118,12 +120,12 @@ class Kernel {
           else if (e[i] < 0) kr = -1;
         }
         if (kl <= kr) {
-          if (simd_ && y + 2 < yz) prefetch_row(y + 2, t_.x0 + static_cast<int>(kl), static_cast<int>(kr - kl + 1));
-          Steppers s = row;
-          jump_x(s, kl);
+          if (simd_ && y + kPrefetchRows < yz) prefetch_row(y + kPrefetchRows, t_.x0 + static_cast<int>(kl), static_cast<int>(kr - kl + 1));
           if (kr - kl + 1 >= kMinSimdSpan && simd_ready()) {
-            simd_span(s, t_.x0 + static_cast<int>(kl), y, static_cast<unsigned>(kr - kl + 1));
+            simd_span(row, kl, t_.x0 + static_cast<int>(kl), y, static_cast<unsigned>(kr - kl + 1));
           } else {
+            Steppers s = row;
+            jump_x(s, kl);
             for (std::int64_t kx = kl; kx <= kr; ++kx) {
               pixel(t_.x0 + static_cast<int>(kx), y, s);
               step_x(s);
@@ -217,14 +219,18 @@ class Kernel {
     if (kTextured && (!tex_.direct() || !texture_disjoint(st_, kDepth))) return;
     if (t_.den >= (std::int64_t{1} << 30)) return;
     simd_tpl_.den = static_cast<std::uint32_t>(t_.den);
+    simd_tpl_.inv_den = 1.0 / static_cast<double>(t_.den);
     for (unsigned p = 0; p < SimdSpan::kPlanes; ++p) {
       const Plane& pl = t_.plane[kR + p];
       if (!simd_plane_used(p)) {
-        simd_tpl_.q8[p] = simd_tpl_.r8[p] = 0;
+        simd_tpl_.q8[p] = simd_tpl_.r8[p] = simd_tpl_.qx[p] = 0;
+        simd_tpl_.rx[p] = 0;
         for (unsigned k = 0; k < 8; ++k) simd_tpl_.qk[p][k] = simd_tpl_.rk[p][k] = 0;
         continue;
       }
-      const DivMod d = floor_divmod(8 * pl.rx, t_.den);
+      simd_tpl_.rx[p] = static_cast<double>(pl.rx);
+      simd_tpl_.qx[p] = static_cast<std::uint32_t>(pl.qx);
+      const DivMod d = den_div_(8 * pl.rx);
       const std::int64_t q8 = 8 * pl.qx + d.q;
       simd_tpl_.q8[p] = static_cast<std::uint32_t>(q8);
       simd_tpl_.r8[p] = static_cast<std::uint32_t>(d.r);
@@ -255,13 +261,16 @@ class Kernel {
       for (std::size_t b = 0; b < depth_bytes; b += 64) __builtin_prefetch(zbuf_ + pix * 4 + b, 1);
   }
 
-  void simd_span(const Steppers& s, int x, int y, unsigned count) {
+  // A span `skip` pixels from the box row's start, whose planes are `row`: the routine does the
+  // jump itself (SimdSpan::skip).
+  void simd_span(const Steppers& row, std::int64_t skip, int x, int y, unsigned count) {
     SimdSpan& sp = simd_tpl_;
     for (unsigned p = 0; p < SimdSpan::kPlanes; ++p) {
       const bool used = simd_plane_used(p);
-      sp.q0[p] = used ? static_cast<std::uint32_t>(s.q[kR + p]) : 0;
-      sp.r0[p] = used ? static_cast<std::uint32_t>(s.r[kR + p]) : 0;
+      sp.q0[p] = used ? static_cast<std::uint32_t>(row.q[kR + p]) : 0;
+      sp.r0[p] = used ? static_cast<std::uint32_t>(row.r[kR + p]) : 0;
     }
+    sp.skip = static_cast<std::uint32_t>(skip);
     const std::size_t pix = static_cast<std::size_t>(y) * width_ + static_cast<std::size_t>(x);
     sp.color = color_ + pix * st_.bpp;
     if (st_.dither.on && st_.fb_format != protocol::PixelFormat::RGBA8888)
