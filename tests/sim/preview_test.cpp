@@ -106,6 +106,43 @@ TEST(SimPreview, FloatDrawsZWithinEightLsbOfExact) {
   EXPECT_GT(err.max_z, 0);
 }
 
+// Textured RGBA8888 draws take the plain kernel's texture stage (preview_plain_kernel.inc: lanes,
+// gathers); with the alpha channel write-masked the same draws take the float routine and the
+// shared texture stage (preview_simd.cpp, texture8.hpp). Both compute the texel coordinates with
+// the same float operations, so with a decal texture or a flat colour, and no depth, the RGB
+// bytes must be the same in every wrap mode, texture size and filter; any difference is the new
+// stage's addressing, fetch, filter or combine.
+TEST(SimPreview, TexturedPlainKernelSamplesAsTheFloatRoutine) {
+  std::mt19937 rng(424242);
+  unsigned textured_pixels = 0, wraps_seen = 0, filters_seen = 0;
+  for (int i = 0; i < 80; ++i) {
+    Case c = random_case(rng);
+    const bool decal = i % 2 == 0;
+    const bool alpha_blend = i % 3 == 0;
+    // Textured, decal or flat modulate, no depth, blend OFF or ALPHA, no write mask, no dither.
+    c.tri_mode = 2u | (decal ? 1u << 14 : 0u) | (alpha_blend ? 1u << 7 : 0u);
+    c.tex_fmt &= ~(std::uint64_t{3} << 16);  // RGBA8888 texture
+    c.fb_fmt = fb_format(kW, kH, 0);
+    c.fb_draw = 0;
+    c.fb_z = Canvas::kZBase;
+    c.tex_base = kTexBase;
+    wraps_seen |= 1u << ((c.tex_fmt >> 8) & 3);
+    filters_seen |= 1u << ((c.tex_fmt >> 12) & 1);
+    Case masked = c;
+    masked.tri_mode |= 1u << 13;  // keep alpha: the float routine
+    const Rendered plain = render(c, preview_options(1)), lanes = render(masked, preview_options(1 + i % 2));
+    EXPECT_EQ(plain.stats.pixels_covered, lanes.stats.pixels_covered) << i;
+    for (std::size_t px = 0; px < std::size_t{kW} * kH; ++px)
+      for (std::size_t ch = 0; ch < 3; ++ch)
+        ASSERT_EQ(plain.memory[px * 4 + ch], lanes.memory[px * 4 + ch])
+            << "case " << i << " pixel " << px << " channel " << ch << " TEX_FMT 0x" << std::hex << c.tex_fmt;
+    textured_pixels += static_cast<unsigned>(plain.stats.pixels_textured);
+  }
+  EXPECT_GT(textured_pixels, 10000u);
+  EXPECT_EQ(wraps_seen, 7u);    // REPEAT, CLAMP, MIRROR
+  EXPECT_EQ(filters_seen, 3u);  // nearest and bilinear
+}
+
 // Vertices anywhere in the s12.4 range (edge values up to 2^36), S/T anywhere in s8.24, Q anywhere
 // including 0: no undefined behaviour (UBSan), coverage still the exact test, and the same bytes
 // with one and two threads.

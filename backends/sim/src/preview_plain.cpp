@@ -9,7 +9,8 @@ namespace gpubridge::sim {
 
 bool preview_plain_applies(const DrawState& st) {
   using protocol::DepthFunc;
-  if (st.textured || st.fb_format != protocol::PixelFormat::RGBA8888 || st.keep_bits != 0) return false;
+  if (st.fb_format != protocol::PixelFormat::RGBA8888 || st.keep_bits != 0) return false;
+  if (st.textured && st.tex.format != protocol::PixelFormat::RGBA8888) return false;
   if (st.blend != protocol::BlendMode::Off && st.blend != protocol::BlendMode::Alpha) return false;
   if (!st.z_test) return true;
   switch (st.z_func) {

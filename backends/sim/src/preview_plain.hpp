@@ -3,7 +3,9 @@
 // draws most scenes are made of — an RGBA8888 buffer, no texture, no write mask, blend OFF or
 // ALPHA, depth off or a LESS/LEQUAL/GREATER/GEQUAL/ALWAYS test with or without the Z write —
 // specialised per draw (one instance per depth function and blend) and kept in the lane layout
-// the memory already has. Other preview draws use preview_simd.cpp.
+// the memory already has; textured draws of an RGBA8888 texture too (any wrap, nearest or bilinear,
+// decal or modulate: the texture stage in lanes, preview_plain_kernel.inc). Other preview draws use
+// preview_simd.cpp.
 //
 // Planes are fixed point, set up once per triangle from the preview setup's double planes
 // (FixedPlanes, setup.hpp): colour in 8.24 and Z in 32.32, stepped with integer adds modulo 2^32 /
@@ -22,6 +24,17 @@
 namespace gpubridge::sim {
 
 struct FixedPlanes;
+struct FloatPlanes;
+
+// A textured plain draw's texture: an RGBA8888 texture inside VRAM, disjoint from both buffers.
+struct PreviewTexels {
+  const std::uint8_t* texels = nullptr;  // the texture's first texel (null: untextured)
+  const FloatPlanes* planes = nullptr;   // S, T, Q of the triangle (double, as preview_simd.cpp)
+  unsigned wl = 3, hl = 3;               // log2 width / height
+  protocol::Wrap wrap_s = protocol::Wrap::Repeat, wrap_t = protocol::Wrap::Repeat;
+  bool bilinear = false, decal = false;
+  float scale_u = 0, scale_v = 0;        // 2^(20 + log2 size): texel units of 1/4096 per S/Q
+};
 
 struct PreviewPlain {
   std::int64_t e[3], ex[3], ey[3];  // biased edge values at the box origin, steps
@@ -37,9 +50,11 @@ struct PreviewPlain {
   protocol::BlendMode blend = protocol::BlendMode::Off;
   bool depth_on = false;            // depth test or write
   bool z_write = false;
+  PreviewTexels tex;                // textured draws only
 };
 
-// Whether the plain kernel draws this state (the caller also checks preview_applies).
+// Whether the plain kernel draws this state (the caller also checks preview_applies): with or
+// without an RGBA8888 texture.
 bool preview_plain_applies(const DrawState& st);
 
 PreviewCounts shade_preview_plain(const PreviewPlain& t);

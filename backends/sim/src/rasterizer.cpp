@@ -521,11 +521,20 @@ void draw_preview_plain(const Triangle& t, const DrawState& st, RasterContext& c
   p.blend = st.blend;
   p.depth_on = depth;
   p.z_write = st.z_write;
+  if (st.textured) {
+    p.tex = {ctx.mem.data() + st.tex.base, &t.fplane, st.tex.wl, st.tex.hl, st.tex.wrap_s, st.tex.wrap_t,
+             st.tex.bilinear, st.decal, std::ldexp(1.0f, 20 + static_cast<int>(st.tex.wl)),
+             std::ldexp(1.0f, 20 + static_cast<int>(st.tex.hl))};
+  }
   const PreviewCounts c = shade_preview_plain(p);
   ctx.counters.scanned += c.scanned;
   ctx.counters.covered += c.covered;
   ctx.counters.passed += c.passed;
   if (st.blend != protocol::BlendMode::Off) ctx.counters.blended += c.passed;
+  if (st.textured) {
+    ctx.counters.textured += c.passed;
+    ctx.counters.texel_bytes += c.passed * (st.tex.bilinear ? 4u : 1u) * 4u;
+  }
 }
 
 }  // namespace

@@ -216,9 +216,8 @@ bool setup_triangle_preview(const Vertex& va, const Vertex& vb, const Vertex& vc
     setup_float_plane(f, kS, v[0].s, v[1].s, v[2].s, e20, e01, inv_d, 0.0);
     setup_float_plane(f, kT, v[0].t, v[1].t, v[2].t, e20, e01, inv_d, 0.0);
     setup_float_plane(f, kQ, v[0].q, v[1].q, v[2].q, e20, e01, inv_d, 0.0);
-  } else {
-    setup_fixed_planes(f, state, t, t.xplane);
   }
+  setup_fixed_planes(f, state, t, t.xplane);  // colour and Z of the plain kernel (textured too)
   t.preview = true;
   return true;
 }
