@@ -104,8 +104,9 @@ module spigpu_top #(
   wire [29:0]  mem_req_addr;
   wire [31:0]  mem_req_wdata, mem_rsp_rdata;
   wire [3:0]   mem_req_be;
-  wire         disp_swap_req, v_req_valid, v_req_ready, v_rsp_valid;
-  wire [27:0]  disp_swap_addr;
+  wire         v_req_valid, v_req_ready, v_rsp_valid;
+  wire [10:0]  disp_hcount, disp_vcount;
+  wire [27:0]  disp_frame_addr;
   wire [29:0]  v_req_addr;
 
   spigpu_soc #(
@@ -129,16 +130,17 @@ module spigpu_top #(
     .frame_word(frame_word), .frame_nbytes(frame_nbytes), .frame_start(frame_start), .frame_end(frame_end),
     .frame_format(frame_format), .frame_width(frame_width), .frame_height(frame_height), .perf_cycles(perf_cycles),
     .perf_work_cycles(perf_work_cycles), .perf_cmds(perf_cmds), .perf_frames(perf_frames),
-    .perf_core_stalls(perf_core_stalls), .perf_refreshes(perf_refreshes), .disp_swap_req(disp_swap_req),
-    .disp_swap_addr(disp_swap_addr), .v_req_valid(v_req_valid), .v_req_ready(v_req_ready), .v_req_addr(v_req_addr),
+    .perf_core_stalls(perf_core_stalls), .perf_refreshes(perf_refreshes), .disp_hcount(disp_hcount),
+    .disp_vcount(disp_vcount), .disp_frame_addr(disp_frame_addr), .v_req_valid(v_req_valid), .v_req_ready(v_req_ready), .v_req_addr(v_req_addr),
     .v_rsp_valid(v_rsp_valid));
 
   generate
     if (VIDEO != 0) begin : g_video
       localparam VAW = PROFILE == 0 ? 15 : 23;
-      video_out #(.VAW(VAW), .LBW(VAW + 4), .PIX_DIV(VIDEO_PIX_DIV), .SCALE_LOG2(VIDEO_SCALE_LOG2),
+      video_out #(.VAW(VAW), .PIX_DIV(VIDEO_PIX_DIV), .SCALE_LOG2(VIDEO_SCALE_LOG2),
                   .LINE_AW(VIDEO_LINE_AW), .OUT_BITS(VIDEO_BITS)) u_video (
-        .clk(clk), .rst(rst), .swap_req(disp_swap_req), .swap_addr(disp_swap_addr), .frame_start(frame_start),
+        .clk(clk), .rst(rst), .hcount(disp_hcount), .vcount(disp_vcount), .frame_start(frame_start),
+        .frame_addr(disp_frame_addr),
         .frame_format(frame_format), .frame_width(frame_width), .frame_height(frame_height),
         .req_valid(v_req_valid), .req_ready(v_req_ready), .req_addr(v_req_addr), .rsp_valid(v_rsp_valid),
         .rsp_rdata(mem_rsp_rdata), .pix_en(video_pix_en), .hsync(video_hsync), .vsync(video_vsync), .de(video_de),
@@ -148,7 +150,7 @@ module spigpu_top #(
       assign v_req_addr = 30'd0;
       assign {video_pix_en, video_hsync, video_vsync, video_de} = 4'd0;
       assign {video_r, video_g, video_b} = {(3 * VIDEO_BITS){1'b0}};
-      wire unused_video = &{1'b0, disp_swap_req, disp_swap_addr, v_req_ready, v_rsp_valid};
+      wire unused_video = &{1'b0, disp_hcount, disp_vcount, disp_frame_addr, v_req_ready, v_rsp_valid};
     end
   endgenerate
 

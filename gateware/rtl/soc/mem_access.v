@@ -10,7 +10,7 @@
 // The executor offers an operation with its data (the head of the command FIFO) until op_ack; a
 // read is taken first. A reload started while another is in flight discards the older responses.
 module mem_access #(
-  parameter [28:0] VRAM_UNITS = 29'd16384   // VRAM size / 8 bytes
+  parameter        UNITS_L2 = 14            // VRAM size / 8 bytes = 2^UNITS_L2
 ) (
   input  wire        clk,
   input  wire        rst,          // power-on
@@ -58,7 +58,8 @@ module mem_access #(
   wire issued   = req_valid && req_ready;
   wire reading  = issued && !req_we;
   wire writing  = phase == WR0 || phase == WR1;
-  wire in_vram  = addr < VRAM_UNITS;
+  // VRAM is a power of two: "below it" is a test of the pointer's upper bits, no comparator
+  wire in_vram  = addr[28:UNITS_L2] == 0;
   wire [1:0] outstanding_next = outstanding + {1'b0, reading} - {1'b0, rsp_valid};
   wire [1:0] discard_next = discard - {1'b0, rsp_valid && discard != 2'd0};
 
@@ -70,12 +71,24 @@ module mem_access #(
   assign op_ack = do_set || (do_write && !in_vram) || wr_done;
   wire        do_load   = do_read || do_set || (do_write && !in_vram) || wr_done;
   wire [28:0] load_addr = do_set ? op_data[31:3] : addr + 29'd1;
+  wire        load_in_vram = load_addr[28:UNITS_L2] == 0;
+  // the prefetch buffer: zeroed at reset and by a load beyond VRAM, else each half taken from its
+  // response (a load's own zero wins over a response in the same clock); one enable and one reset
+  // per half, the data straight from the memory
+  wire        take = rsp_valid && discard == 2'd0;
+  always @(posedge clk) begin
+    if (rst || soft_reset || (do_load && !load_in_vram)) begin
+      prefetch <= 64'd0;
+    end else begin
+      if (take && !got_first) prefetch[63:32] <= rsp_rdata;
+      if (take && got_first) prefetch[31:0] <= rsp_rdata;
+    end
+  end
 
   always @(posedge clk) begin
     err_range <= 1'b0;
     if (rst || soft_reset) begin
       addr <= 29'd0;
-      prefetch <= 64'd0;
       mem_ready <= 1'b0;
       phase <= IDLE;
       pend_read <= 1'b0;
@@ -90,11 +103,9 @@ module mem_access #(
       discard <= discard_next;
       if (read_strobe) pend_read <= 1'b1;
       // responses of the current load
-      if (rsp_valid && discard == 2'd0) begin
+      if (take) begin
         got_first <= !got_first;
-        if (!got_first) prefetch[63:32] <= rsp_rdata;
-        else begin
-          prefetch[31:0] <= rsp_rdata;
+        if (got_first) begin
           mem_ready <= 1'b1;
           phase <= IDLE;
         end
@@ -123,11 +134,10 @@ module mem_access #(
         got_first <= 1'b0;
         discard <= outstanding_next;
         owner_ex <= !do_read;   // a read's reload supersedes an executor reload
-        if (load_addr < VRAM_UNITS) begin
+        if (load_in_vram) begin
           phase <= RD0;
           beyond <= 1'b0;
         end else begin
-          prefetch <= 64'd0;
           beyond <= 1'b1;
           mem_ready <= 1'b1;
           phase <= IDLE;

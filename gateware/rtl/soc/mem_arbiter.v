@@ -15,8 +15,10 @@
 // The scanned frame is therefore the buffer as it was when FB_DISPLAY executed, exactly the
 // simulator's frame; rendering into another buffer never waits.
 module mem_arbiter #(
-  parameter [29:0] VRAM_WORDS = 30'd32768,
-  parameter        AW = 15                  // back-end word address bits
+  parameter        AW = 15,                 // back-end word address bits: VRAM is 2^AW words
+  // in-flight reads tracked: 2^TAG_AW. The SPRAM answers every read in the next clock, so at most
+  // one is ever in flight there (TAG_AW = 1 never runs out); the SDRAM controller keeps up to 8.
+  parameter        TAG_AW = 3
 ) (
   input  wire        clk,
   input  wire        rst,
@@ -63,14 +65,15 @@ module mem_arbiter #(
   output wire          core_stall      // a core request waits this clock (protection, priority, back end)
 );
   // in-flight reads: the client of each, oldest first
-  reg [1:0] tag [0:7];
-  reg [2:0] tag_rd, tag_wr;
-  reg [3:0] tag_count;
+  localparam [TAG_AW:0] TAGS = {1'b1, {TAG_AW{1'b0}}};
+  reg [1:0] tag [0:(1 << TAG_AW) - 1];
+  reg [TAG_AW-1:0] tag_rd, tag_wr;
+  reg [TAG_AW:0] tag_count;
   reg       zero_rsp;     // answer a core read beyond VRAM with 0 in this cycle
   reg [3:0] scan_wait;
 
-  wire tags_room  = tag_count < 4'd8;
-  wire tags_empty = tag_count == 4'd0;
+  wire tags_room  = tag_count != TAGS;
+  wire tags_empty = tag_count == 0;
   // One comparator pair: the memory-access unit writes only while the core is idle (the executor
   // starts MEM_* after the core finished and no core command during them).
   wire        m_writes = m_req_valid && m_req_we;
@@ -81,7 +84,7 @@ module mem_arbiter #(
   wire        w_prot   = prot_active && w_vram >= prot_lo && w_vram < prot_hi;
   wire m_block = m_writes && w_prot;
   wire c_block = !m_writes && c_req_we && w_prot;
-  wire c_oor   = c_req_addr >= VRAM_WORDS;
+  wire c_oor   = c_req_addr[29:AW] != 0;   // beyond VRAM: an upper bit, no comparator
 
   wire m_ok  = m_req_valid && !m_block && (m_req_we || tags_room);
   wire s_ok  = s_req_valid && tags_room;
@@ -122,19 +125,19 @@ module mem_arbiter #(
     c_range_err <= pick_z;
     zero_rsp <= pick_z && !c_req_we;
     if (rst) begin
-      tag_rd <= 3'd0;
-      tag_wr <= 3'd0;
-      tag_count <= 4'd0;
+      tag_rd <= 0;
+      tag_wr <= 0;
+      tag_count <= 0;
       scan_wait <= 4'd0;
       zero_rsp <= 1'b0;
       c_range_err <= 1'b0;
     end else begin
       if (granted_read) begin
         tag[tag_wr] <= granted_client;
-        tag_wr <= tag_wr + 3'd1;
+        tag_wr <= tag_wr + 1'b1;
       end
-      if (b_rsp_valid) tag_rd <= tag_rd + 3'd1;
-      tag_count <= tag_count + {3'd0, granted_read} - {3'd0, b_rsp_valid};
+      if (b_rsp_valid) tag_rd <= tag_rd + 1'b1;
+      tag_count <= tag_count + (TAG_AW+1)'(granted_read) - (TAG_AW+1)'(b_rsp_valid);
       if (s_req_valid && !s_req_ready) scan_wait <= scan_wait == 4'd15 ? scan_wait : scan_wait + 4'd1;
       else scan_wait <= 4'd0;
     end

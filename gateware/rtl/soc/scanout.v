@@ -18,7 +18,8 @@ module scanout #(
   parameter        V_ACTIVE = 480,
   parameter        V_TOTAL = 525,
   parameter        CRC_BYTES = 1,         // bytes folded into the CRC per clock: 1 or 4
-  parameter        BUF_WORDS = 2          // read-ahead words (2 or 4)
+  parameter        BUF_WORDS = 2,         // read-ahead words (2 or 4)
+  parameter        BYTES_W = 24           // bits of the largest frame's W x H x 4 (the sizes FB_FORMAT can hold)
 ) (
   input  wire        clk,
   input  wire        rst,
@@ -33,8 +34,10 @@ module scanout #(
   output wire        swap_pending, // STATUS.SWAP_PENDING
   output reg         err_range,
   // timing
-  output wire        vblank,
+  output reg         vblank,
   output wire        vsync,        // one clock at the start of vertical blanking
+  output reg  [10:0] hcount,       // clock in the line, 0 .. LINE_CLOCKS - 1 (a board's video output
+  output reg  [10:0] vcount,       // runs on these), line 0 .. V_TOTAL - 1
   // memory (reads, in VRAM only)
   output wire        req_valid,
   input  wire        req_ready,
@@ -55,46 +58,48 @@ module scanout #(
   output wire [2:0]  frame_nbytes,
   output wire        frame_start,  // the clock a frame's reading starts (frame_format/width/height valid)
   output wire        frame_end,    // the clock of its last byte
+  output wire [27:0] frame_addr,   // with frame_start: the frame's byte address / 16 (beyond VRAM: all ones)
   output reg  [1:0]  frame_format,
   output reg  [10:0] frame_width,
   output reg  [10:0] frame_height
 );
   // --- display timing ---
-  reg [10:0] hcount;
-  reg [10:0] vcount;
   wire line_end = hcount == LINE_CLOCKS[10:0] - 11'd1;
-  assign vblank = vcount >= V_ACTIVE[10:0];
+  wire frame_last = vcount == V_TOTAL[10:0] - 11'd1;
   assign vsync  = line_end && vcount == V_ACTIVE[10:0] - 11'd1;
+  // vblank = vcount >= V_ACTIVE, as a flag turned at the two edges (no magnitude comparator)
   always @(posedge clk) begin
     if (rst) begin
       hcount <= 11'd0;
       vcount <= 11'd0;
+      vblank <= 1'b0;
     end else begin
       hcount <= line_end ? 11'd0 : hcount + 11'd1;
-      if (line_end) vcount <= vcount == V_TOTAL[10:0] - 11'd1 ? 11'd0 : vcount + 11'd1;
+      if (line_end) vcount <= frame_last ? 11'd0 : vcount + 11'd1;
+      if (vsync) vblank <= 1'b1;
+      else if (line_end && frame_last) vblank <= 1'b0;
     end
   end
 
   // --- swap request: length, end and range ---
   reg        computing, pending, reading;
   reg [3:0]  mul_step;
-  reg [21:0] mul_acc;          // width x height
+  reg [BYTES_W-3:0] mul_acc;   // width x height
   // Addresses in VRAM words: the reader stops at the end of VRAM (what lies beyond reads as 0), so
   // the next word to read needs VAW + 1 bits, plus `above` for a frame starting beyond VRAM.
   reg [VAW:0] rd_addr;         // next word to read (the frame's first word until reading starts)
   reg         above;           // the frame starts beyond VRAM
   reg [VAW:0] end_vram;        // min(first word after the frame, 2^VAW)
   localparam [VAW:0] VRAM_END = {1'b1, {VAW{1'b0}}};
-  reg [23:0] bytes_left;       // bytes still to fold
+  reg [BYTES_W-1:0] bytes_left; // bytes still to fold
   reg [31:0] crc, crc_value;
   assign swap_ready   = !computing && !pending && !reading;
   assign swap_pending = computing || pending || reading;
   assign frame_crc    = {frame_count, crc_value};  // the frame number is FRAME_COUNT itself
 
-  // bytes of the frame, W x H x bpp (into bytes_left one clock before the end is computed), and
-  // its words ceil(bytes / 4): one adder for every format
-  wire [23:0] bytes = frame_format == 2'd0 ? {mul_acc, 2'b00} : frame_format == 2'd1 ? {1'b0, mul_acc, 1'b0} : {2'b00, mul_acc};
-  wire [21:0] words = 22'((bytes_left + 24'd3) >> 2);  // no carry out: bytes <= 4 (2^22 - 1)
+  // bytes of the frame, W x H x bpp (into bytes_left one clock before the end is computed); its
+  // words are ceil(bytes / 4), the rounding the carry into the end's adder below
+  wire [BYTES_W-1:0] bytes = frame_format == 2'd0 ? {mul_acc, 2'b00} : frame_format == 2'd1 ? {1'b0, mul_acc, 1'b0} : {2'b00, mul_acc};
 
   // --- frame reading ---
   localparam       BAW = BUF_WORDS == 4 ? 2 : 1;
@@ -114,10 +119,15 @@ module scanout #(
   assign prot_lo     = above ? VRAM_END : rd_addr;
   // while the end is being computed, everything from the frame's start up is protected
   assign prot_hi     = computing ? VRAM_END : end_vram;
-  // the frame's end in words, from its start inside VRAM (beyond it: above)
-  localparam integer EW = (VAW + 2 > 23) ? VAW + 2 : 23;
-  wire [EW-1:0] end_in = EW'(rd_addr) + EW'(words);
-  wire          end_beyond = above || end_in > EW'(VRAM_END);
+  // the frame's end in words, rd_addr + ceil(bytes / 4), from its start inside VRAM (beyond it:
+  // above): one adder, the rounding as its carry in (bit 0 of the doubled operands)
+  localparam integer EW = (VAW + 2 > BYTES_W - 1) ? VAW + 2 : BYTES_W - 1;
+  wire [EW:0]   end_x2 = {EW'(rd_addr), 1'b1} + {EW'(bytes_left[BYTES_W-1:2]), bytes_left[1:0] != 2'b00};
+  wire [EW-1:0] end_in = end_x2[EW:1];
+  wire [21:0]   product = frame_width * frame_height;
+  wire          unused_ok = &{1'b0, end_x2[0], product};
+  // end_in > 2^VAW: a bit above VRAM's, or VRAM's own bit and any below it
+  wire          end_beyond = above || end_in[EW-1:VAW+1] != 0 || (end_in[VAW] && end_in[VAW-1:0] != 0);
 
   // the head word: from memory while there are answers; zeros once the reader left VRAM
   wire        mem_done  = !in_frame && outstanding == 3'd0 && buf_count == 3'd0;
@@ -141,7 +151,7 @@ module scanout #(
   always @* begin
     if (CRC_BYTES == 4) begin
       fold_word = head_word;
-      n_fold = bytes_left >= 24'd4 ? 3'd4 : bytes_left[2:0];
+      n_fold = bytes_left >= BYTES_W'(4) ? 3'd4 : bytes_left[2:0];
       word_done = 1'b1;
       crc_next = crc;
       if (n_fold >= 3'd1) crc_next = crc_byte(crc_next, fold_word[31:24]);
@@ -156,19 +166,21 @@ module scanout #(
         default: fold_word = {head_word[7:0], 24'd0};
       endcase
       n_fold = 3'd1;
-      word_done = byte_in_word == 2'd3 || bytes_left == 24'd1;
+      word_done = byte_in_word == 2'd3 || bytes_left == BYTES_W'(1);
       crc_next = crc_byte(crc, fold_word[31:24]);
     end
   end
-  wire folding = reading && have_word && bytes_left != 24'd0;
+  wire folding = reading && have_word && bytes_left != 0;
   wire popping = folding && word_done && buf_count != 3'd0;
   wire issued  = req_valid && req_ready;
   wire take    = rsp_valid && drop == 3'd0;
-  wire last    = folding && bytes_left == {21'd0, n_fold};
+  wire last    = folding && bytes_left == BYTES_W'(n_fold);
   assign frame_valid  = folding;
   assign frame_word   = fold_word;
   assign frame_nbytes = n_fold;
   assign frame_start  = vsync && pending;
+  // until reading starts, rd_addr is the frame's first word (and above says it lies beyond VRAM)
+  assign frame_addr   = above ? 28'hFFFFFFF : 28'(rd_addr[VAW-1:2]);
   assign frame_end    = last;
 
   always @(posedge clk) begin
@@ -209,7 +221,7 @@ module scanout #(
         // mul_acc = width x height, on a multiplier; the swap keeps its 12 clocks
         // (no frame is being read while a swap is computed, so bytes_left is free)
         if (mul_step != 4'd11) begin
-          mul_acc <= frame_width * frame_height;
+          mul_acc <= product[BYTES_W-3:0];
           mul_step <= mul_step + 4'd1;
           if (mul_step == 4'd10) bytes_left <= bytes;
         end else begin
@@ -227,7 +239,7 @@ module scanout #(
         byte_in_word <= 2'd0;
       end else if (folding) begin
         crc <= crc_next;
-        bytes_left <= bytes_left - {21'd0, n_fold};
+        bytes_left <= bytes_left - BYTES_W'(n_fold);
         byte_in_word <= word_done ? 2'd0 : byte_in_word + 2'd1;
         if (last) begin
           reading <= 1'b0;

@@ -79,10 +79,11 @@ module spigpu_soc #(
   output wire [1:0]   frame_format,
   output wire [10:0]  frame_width,
   output wire [10:0]  frame_height,
-  // a board's video output (video_out): the swap requests and a memory-arbiter client (tie v_req_valid
-  // to 0 where there is none, as the co-simulation does)
-  output wire         disp_swap_req,
-  output wire [27:0]  disp_swap_addr,
+  // a board's video output (video_out): the scanout's display timing, the latched frame's address
+  // and a memory-arbiter client (tie v_req_valid to 0 where there is none, as the co-simulation does)
+  output wire [10:0]  disp_hcount,
+  output wire [10:0]  disp_vcount,
+  output wire [27:0]  disp_frame_addr,
   input  wire         v_req_valid,
   output wire         v_req_ready,
   input  wire [29:0]  v_req_addr,
@@ -96,8 +97,6 @@ module spigpu_soc #(
   output wire [31:0]  perf_refreshes      // SDRAM auto refreshes
 );
 `include "spigpu_regs.vh"
-  localparam [29:0] VRAM_WORDS = VRAM_KIB * 256;
-  localparam [28:0] VRAM_UNITS = VRAM_KIB * 128;
   localparam [9:0]  FIFO_D10 = FIFO_DEPTH;
   localparam [10:0] MAXW11 = MAX_WIDTH, MAXH11 = MAX_HEIGHT;
   localparam [23:0] VRAM24 = VRAM_KIB;
@@ -105,6 +104,8 @@ module spigpu_soc #(
   localparam [63:0] ID_RESET = reg_reset(`SPIGPU_REG_ID);   // magic and protocol version from the table
   localparam [63:0] ID = {ID_RESET[63:16], VARIANT};
   localparam        VAW = PROFILE == 0 ? 15 : 23;      // back-end word address bits
+  // the largest frame's bytes: FB_FORMAT holds at most MAX_WIDTH x MAX_HEIGHT, or its 640 x 480 reset value
+  localparam integer SCAN_BYTES_W = $clog2((MAX_WIDTH > 640 ? MAX_WIDTH : 640) * (MAX_HEIGHT > 480 ? MAX_HEIGHT : 480) * 4 + 1);
 
   // --- SPI slave ---
   wire        rd_strobe, rd_from_ram;
@@ -203,7 +204,7 @@ module spigpu_soc #(
   wire [31:0] rsp_rdata;
   wire        prot_active;
   wire [VAW:0] prot_lo, prot_hi;
-  mem_access #(.VRAM_UNITS(VRAM_UNITS)) u_mem (
+  mem_access #(.UNITS_L2(VAW - 1)) u_mem (
     .clk(clk), .rst(rst), .soft_reset(soft_reset), .set_addr(mem_set_addr), .write(mem_write),
     .op_data(mem_op_data), .op_ack(mem_op_ack), .ex_idle(mem_ex_idle), .read_strobe(mem_read_strobe), .addr(mem_addr),
     .prefetch(prefetch), .mem_ready(mem_ready), .err_range(mem_err), .req_valid(m_req_valid),
@@ -211,11 +212,12 @@ module spigpu_soc #(
     .rsp_valid(m_rsp_valid), .rsp_rdata(rsp_rdata));
 
   scanout #(.VAW(VAW), .LINE_CLOCKS(LINE_CLOCKS), .V_ACTIVE(V_ACTIVE), .V_TOTAL(V_TOTAL),
-            .CRC_BYTES(CRC_BYTES), .BUF_WORDS(SCAN_BUF)) u_scan (
+            .CRC_BYTES(CRC_BYTES), .BUF_WORDS(SCAN_BUF), .BYTES_W(SCAN_BYTES_W)) u_scan (
     .clk(clk), .rst(rst), .soft_reset(soft_reset), .swap_req(swap_req), .swap_addr(swap_addr),
     .swap_format(cmd_fb_format), .swap_width(cmd_fb_width), .swap_height(cmd_fb_height), .swap_ready(swap_ready),
     .swap_pending(swap_pending_w), .err_range(scan_err), .vblank(vblank), .vsync(vsync),
     .req_valid(s_req_valid), .req_ready(s_req_ready), .req_addr(s_req_addr), .rsp_valid(s_rsp_valid),
+    .hcount(disp_hcount), .vcount(disp_vcount), .frame_addr(disp_frame_addr),
     .rsp_rdata(rsp_rdata), .prot_active(prot_active), .prot_lo(prot_lo), .prot_hi(prot_hi),
     .frame_count(frame_count), .frame_crc(frame_crc), .frame_valid(frame_valid), .frame_word(frame_word),
     .frame_nbytes(frame_nbytes), .frame_start(frame_start), .frame_end(frame_end), .frame_format(frame_format),
@@ -225,7 +227,7 @@ module spigpu_soc #(
   wire [VAW-1:0] b_req_addr;
   wire [31:0]    b_req_wdata, b_rsp_rdata;
   wire [3:0]     b_req_be;
-  mem_arbiter #(.VRAM_WORDS(VRAM_WORDS), .AW(VAW)) u_arb (
+  mem_arbiter #(.AW(VAW), .TAG_AW(PROFILE == 0 ? 1 : 3)) u_arb (
     .clk(clk), .rst(rst), .v_req_valid(v_req_valid), .v_req_ready(v_req_ready), .v_req_addr(v_req_addr),
     .v_rsp_valid(v_rsp_valid), .m_req_valid(m_req_valid), .m_req_ready(m_req_ready), .m_req_we(m_req_we),
     .m_req_addr(m_req_addr), .m_req_wdata(m_req_wdata), .m_rsp_valid(m_rsp_valid), .s_req_valid(s_req_valid),
@@ -236,8 +238,6 @@ module spigpu_soc #(
     .b_req_ready(b_req_ready), .b_req_we(b_req_we), .b_req_addr(b_req_addr), .b_req_wdata(b_req_wdata),
     .b_req_be(b_req_be), .b_rsp_valid(b_rsp_valid), .b_rsp_rdata(b_rsp_rdata), .core_stall(core_stall));
   assign mem_rsp_rdata = rsp_rdata;
-  assign disp_swap_req = swap_req;
-  assign disp_swap_addr = swap_addr;
 
   wire refresh_pulse;
   generate

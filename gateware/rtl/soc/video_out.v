@@ -1,19 +1,18 @@
 // Video output of a board (docs/gateware.md "Video out"): the displayed buffer, every refresh.
 //
 // The scanout reads a frame once per swap (FRAME_CRC, the co-simulation's frame port); a monitor needs
-// the displayed buffer 60 times a second. This stage keeps its own display timing (VESA 640 x 480 at
-// 60 Hz by default, a pixel every PIX_DIV core clocks), follows the swaps the scanout latches
-// (swap_req gives the address, frame_start commits it with the format and size at the vertical sync)
-// and fills a two-line block-RAM line buffer through its own memory-arbiter client: while one source
+// the displayed buffer 60 times a second. This stage runs on the scanout's display timing (its line
+// and clock counters: VESA 640 x 480 at 60 Hz when the scanout's line is H_TOTAL x PIX_DIV clocks, a
+// pixel every PIX_DIV core clocks; no counters of its own), follows the swaps the scanout latches
+// (frame_start gives the address, format and size at the vertical sync) and fills a two-line block-RAM line buffer through its own memory-arbiter client: while one source
 // line is shown, the next is read. Pixels are expanded from RGBA8888 / RGB565 / RGBA2222 to 8 bits as
 // docs/protocol.md section 6 says and the top OUT_BITS bits leave (4 for the 12-bit DVI Pmod, 8 for
 // TMDS). A framebuffer is scaled by 2^SCALE_LOG2 and centred; what does not fit the screen is cropped,
 // and so are pixels beyond the 2^LINE_AW words a line buffer half holds. Words beyond VRAM show as 0.
-// The timing counters start with the scanout's (LINE_CLOCKS = H_TOTAL x PIX_DIV), so its vertical sync,
-// where the swap is latched, is the end of this stage's last visible line.
+// The timing is the scanout's (LINE_CLOCKS = H_TOTAL x PIX_DIV), so its vertical sync, where the swap is
+// latched, is the end of this stage's last visible line.
 module video_out #(
   parameter VAW        = 15,   // VRAM = 2^VAW 32-bit words
-  parameter LBW        = 19,   // bits of a line's byte offset in the buffer (y x W x bpp)
   parameter PIX_DIV    = 1,    // core clocks per pixel: 1 or 2
   parameter SCALE_LOG2 = 1,    // 0: 1:1, 1: every framebuffer pixel 2 x 2 on screen
   parameter LINE_AW    = 8,    // 2^LINE_AW words per line buffer half
@@ -30,10 +29,12 @@ module video_out #(
 ) (
   input  wire                clk,
   input  wire                rst,
-  // swaps, as the scanout sees them
-  input  wire                swap_req,
-  input  wire [27:0]         swap_addr,     // byte address / 16
+  // the scanout's display timing: clock in the line (0 .. H_TOTAL x PIX_DIV - 1) and line
+  input  wire [10:0]         hcount,
+  input  wire [10:0]         vcount,
+  // swaps, as the scanout latches them
   input  wire                frame_start,   // the scanout latched the pending swap (vertical sync)
+  input  wire [27:0]         frame_addr,    // its byte address / 16 (valid with frame_start)
   input  wire [1:0]          frame_format,
   input  wire [10:0]         frame_width,
   input  wire [10:0]         frame_height,
@@ -56,62 +57,60 @@ module video_out #(
   localparam V_TOTAL = V_ACTIVE + V_FRONT + V_SYNC + V_BACK;
   localparam S = SCALE_LOG2;
 
-  // --- pixel enable and display timing ---
+  // --- pixel enable and display timing: the scanout's counters (a pixel in the last clock of each
+  // PIX_DIV) ---
+  wire [10:0] hc, vc;
   generate
     if (PIX_DIV == 2) begin : g_div2
-      reg phase;
-      always @(posedge clk) phase <= rst ? 1'b0 : !phase;
-      assign pix_en = phase;
+      assign pix_en = hcount[0];
+      assign hc = {1'b0, hcount[10:1]};
     end else begin : g_div1
       assign pix_en = 1'b1;
+      assign hc = hcount;
     end
   endgenerate
-  reg  [10:0] hc, vc;
+  assign vc = vcount;
   wire        h_last = hc == 11'(H_TOTAL - 1);
   wire        line_end = pix_en && h_last;
   // the line after next, whose framebuffer line is read during the next line
-  wire [10:0] v_next2 = vc == 11'(V_TOTAL - 2) ? 11'd0 : vc == 11'(V_TOTAL - 1) ? 11'd1 : vc + 11'd2;
 
-  // --- the displayed buffer: latched at swap_req, shown from frame_start ---
-  reg  [27:0] pend_addr;
+  // --- the displayed buffer, from frame_start on: where it is and its placement on the screen,
+  // centred: [x0, x_end) x [y0, y_end), cropped from the top left when larger (only these are kept,
+  // not the buffer's size) ---
   reg         shown;                       // a frame was swapped in since reset
   reg         beyond;                      // it starts beyond VRAM
   reg  [VAW+1:0] base;                     // its first byte
   reg  [1:0]  ppw_l2;                      // log2 pixels per word: RGBA8888 0, RGB565 1, RGBA2222 2
-  reg  [10:0] fw, fh;
+  reg  [10:0] x0, x_end;
+  reg  [10:0] y0_m2, y_end_m2;             // y0 and y_end two lines earlier (mod V_TOTAL): the line
+                                           // decisions are made two lines ahead, at vc
+  reg  [12:0] stride;                      // bytes per framebuffer line
+  reg  [LINE_AW:0] n_words;                // words read per line: enough for any lead, at most a half
+  wire [1:0]  ppw_new = frame_format == 2'd0 ? 2'd0 : frame_format == 2'd1 ? 2'd1 : 2'd2;
+  wire [11:0] sw = {1'b0, frame_width} << S, sh = {1'b0, frame_height} << S;
+  wire [12:0] x_gap = 13'(H_ACTIVE) - {1'b0, sw}, x_sum = 13'(H_ACTIVE) + {1'b0, sw};
+  // y0 - 2 = (V_ACTIVE - sh - 4) / 2 and y_end - 2 = (V_ACTIVE + sh - 4) / 2: the same adders with
+  // another constant; y0 = 1 (gap -2 or -1) is V_TOTAL - 1 and y0 = 0 (cropped too) V_TOTAL - 2
+  wire [12:0] y_gap4 = 13'(V_ACTIVE - 4) - {1'b0, sh}, y_sum4 = 13'(V_ACTIVE - 4) + {1'b0, sh};
+  wire        y_crop = y_gap4[12] && !(&y_gap4[12:2]);   // sh > V_ACTIVE
+  // only the pixels the screen shows are read: at most H_ACTIVE / 2^S of a line
+  wire [10:0] w_shown = frame_width > 11'(H_ACTIVE >> S) ? 11'(H_ACTIVE >> S) : frame_width;
+  wire [11:0] words_w = {1'b0, w_shown >> ppw_new} + 12'd2;
   always @(posedge clk) begin
     if (rst) begin
       shown <= 1'b0;
-    end else begin
-      if (swap_req) pend_addr <= swap_addr;
-      if (frame_start) begin
-        shown <= 1'b1;
-        beyond <= pend_addr[27:VAW-2] != 0;
-        base <= {pend_addr[VAW-3:0], 4'd0};
-        ppw_l2 <= frame_format == 2'd0 ? 2'd0 : frame_format == 2'd1 ? 2'd1 : 2'd2;
-        fw <= frame_width;
-        fh <= frame_height;
-      end
+    end else if (frame_start) begin
+      shown <= 1'b1;
+      beyond <= frame_addr[27:VAW-2] != 0;
+      base <= {frame_addr[VAW-3:0], 4'd0};
+      ppw_l2 <= ppw_new;
+      x0    <= x_gap[12] ? 11'd0 : x_gap[11:1];
+      x_end <= x_gap[12] ? 11'(H_ACTIVE) : x_sum[11:1];
+      y0_m2    <= !y_gap4[12] ? y_gap4[11:1] : &y_gap4[12:1] ? 11'(V_TOTAL - 1) : 11'(V_TOTAL - 2);
+      y_end_m2 <= y_crop ? 11'(V_ACTIVE - 2) : y_sum4[11:1];
+      stride <= {frame_width, 2'b00} >> ppw_new;
+      n_words <= words_w > 12'(1 << LINE_AW) ? (LINE_AW+1)'(1 << LINE_AW) : words_w[LINE_AW:0];
     end
-  end
-  // placement on the screen, centred: [x0, x_end) x [y0, y_end); cropped from the top left when larger
-  // (registered: used lines after the swap)
-  reg  [10:0] x0, x_end, y0, y_end;
-  reg  [LBW-1:0] stride;                   // bytes per framebuffer line
-  reg  [LINE_AW:0] n_words;                // words read per line: enough for any lead, at most a half
-  wire [11:0] sw = {1'b0, fw} << S, sh = {1'b0, fh} << S;
-  wire [12:0] x_gap = 13'(H_ACTIVE) - {1'b0, sw}, y_gap = 13'(V_ACTIVE) - {1'b0, sh};
-  wire [12:0] x_sum = 13'(H_ACTIVE) + {1'b0, sw}, y_sum = 13'(V_ACTIVE) + {1'b0, sh};
-  // only the pixels the screen shows are read: at most H_ACTIVE / 2^S of a line
-  wire [10:0] w_shown = fw > 11'(H_ACTIVE >> S) ? 11'(H_ACTIVE >> S) : fw;
-  wire [11:0] words_w = {1'b0, w_shown >> ppw_l2} + 12'd2;
-  always @(posedge clk) begin
-    x0    <= x_gap[12] ? 11'd0 : x_gap[11:1];
-    x_end <= x_gap[12] ? 11'(H_ACTIVE) : x_sum[11:1];
-    y0    <= y_gap[12] ? 11'd0 : y_gap[11:1];
-    y_end <= y_gap[12] ? 11'(V_ACTIVE) : y_sum[11:1];
-    stride <= LBW'({fw, 2'b00}) >> ppw_l2;
-    n_words <= words_w > 12'(1 << LINE_AW) ? (LINE_AW+1)'(1 << LINE_AW) : words_w[LINE_AW:0];
   end
 
   // --- line decisions, at the end of each screen line: for the line after next, is it in the picture,
@@ -120,8 +119,8 @@ module video_out #(
   reg         n_show, n_half;              // the next line (decided a line earlier)
   reg         l_show, l_half;              // the line being shown
   reg  [1:0]  l_lead;
-  wire        f_first = shown && v_next2 == y0 && y0 != y_end;
-  wire        f_in_new = f_first || (f_in && v_next2 != y_end);
+  wire        f_first = shown && vc == y0_m2 && y0_m2 != y_end_m2;
+  wire        f_in_new = f_first || (f_in && vc != y_end_m2);
   wire        f_rep_new = f_first ? 1'b0 : S == 0 ? 1'b0 : !f_rep;   // second screen line of a 2x line
   wire        f_half_new = f_first ? 1'b0 : f_rep_new ? f_half : !f_half;
   wire        fetch_new = f_in_new && !f_rep_new;
@@ -131,10 +130,13 @@ module video_out #(
   // ULX3S: 642 SDRAM words at 2 clocks each in 1,600, row misses, refreshes and MEM_* beside); a fill
   // still running when the next one starts is abandoned, and its late answers would land in the new one ---
   reg  [31:0] lb [0:(2 << LINE_AW) - 1];
-  reg  [LBW-1:0] line_byte;                // offset of the next framebuffer line to read
-  wire [LBW-1:0] byte0 = f_first ? {LBW{1'b0}} : line_byte;
-  wire [LBW:0]   abs0 = {1'b0, byte0} + (LBW+1)'(base);
-  reg  [LBW-2:0] f_addr;                   // next word to read (>= 2^VAW: beyond VRAM)
+  // the next framebuffer line's first byte, and whether it (so every later line) starts beyond VRAM
+  reg  [VAW+1:0] line_byte;
+  reg         line_beyond;
+  wire [VAW+1:0] byte0 = f_first ? base : line_byte;
+  wire        beyond0 = f_first ? beyond : line_beyond;
+  wire [VAW+2:0] byte_next = {1'b0, byte0} + (VAW+3)'(stride);
+  reg  [VAW:0] f_addr;                     // next word to read (>= 2^VAW: the line ran beyond VRAM)
   reg         f_beyond;
   reg  [LINE_AW:0] f_left;                 // words still to read
   reg  [LINE_AW-1:0] wr_idx;
@@ -142,7 +144,7 @@ module video_out #(
   reg  [1:0]  lead [0:1];                  // pixels before the line's first pixel in its first word
   reg  [3:0]  outstanding;
   wire [1:0]  lead0 = ppw_l2 == 2'd2 ? byte0[1:0] : ppw_l2 == 2'd1 ? {1'b0, byte0[1]} : 2'd0;
-  wire        in_vram = !f_beyond && f_addr[LBW-2:VAW] == 0;
+  wire        in_vram = !f_beyond && !f_addr[VAW];
   assign req_valid = f_left != 0 && in_vram;
   assign req_addr  = 30'(f_addr[VAW-1:0]);
   wire        issued = req_valid && req_ready;
@@ -172,25 +174,17 @@ module video_out #(
           wr_half <= f_half_new;
           wr_idx <= {LINE_AW{1'b0}};
           lead[f_half_new] <= lead0;
-          f_addr <= abs0[LBW:2];
-          f_beyond <= beyond || abs0[LBW];
+          f_addr <= {1'b0, byte0[VAW+1:2]};
+          f_beyond <= beyond0;
           f_left <= n_words;
-          line_byte <= byte0 + stride;
+          line_byte <= byte_next[VAW+1:0];
+          line_beyond <= beyond0 || byte_next[VAW+2];
         end
       end
     end
   end
 
-  // --- display: counters along the line, then a two-stage pixel pipeline ---
-  always @(posedge clk) begin
-    if (rst) begin
-      hc <= 11'd0;
-      vc <= 11'd0;
-    end else if (pix_en) begin
-      hc <= h_last ? 11'd0 : hc + 11'd1;
-      if (h_last) vc <= vc == 11'(V_TOTAL - 1) ? 11'd0 : vc + 11'd1;
-    end
-  end
+  // --- display: a two-stage pixel pipeline ---
   // the pixel's place in the framebuffer line: from x0 on, a pixel every 2^S screen pixels, a word
   // every 2^ppw_l2 pixels (the first word from the line's lead on)
   reg         x_in_r, rep_r;
@@ -211,9 +205,28 @@ module video_out #(
       widx_r <= advance && word_end && !widx[LINE_AW] ? widx + 1'b1 : widx;
     end
   end
-  wire        active = hc < 11'(H_ACTIVE) && vc < 11'(V_ACTIVE);
-  wire        hs0 = hc >= 11'(H_ACTIVE + H_FRONT) && hc < 11'(H_ACTIVE + H_FRONT + H_SYNC);
-  wire        vs0 = vc >= 11'(V_ACTIVE + V_FRONT) && vc < 11'(V_ACTIVE + V_FRONT + V_SYNC);
+  // visible part and sync pulses of the line and the frame, as flags for the current hc / vc that
+  // turn where the counters pass an edge (equality compares: no magnitude comparators)
+  reg         h_act, h_sync, v_act, v_sync;
+  always @(posedge clk) begin
+    if (rst) begin
+      {h_act, h_sync, v_act, v_sync} <= 4'b1010;   // hc = vc = 0
+    end else if (pix_en) begin
+      if (h_last) h_act <= 1'b1;
+      else if (hc == 11'(H_ACTIVE - 1)) h_act <= 1'b0;
+      if (hc == 11'(H_ACTIVE + H_FRONT - 1)) h_sync <= 1'b1;
+      else if (hc == 11'(H_ACTIVE + H_FRONT + H_SYNC - 1)) h_sync <= 1'b0;
+      if (h_last) begin
+        if (vc == 11'(V_TOTAL - 1)) v_act <= 1'b1;
+        else if (vc == 11'(V_ACTIVE - 1)) v_act <= 1'b0;
+        if (vc == 11'(V_ACTIVE + V_FRONT - 1)) v_sync <= 1'b1;
+        else if (vc == 11'(V_ACTIVE + V_FRONT + V_SYNC - 1)) v_sync <= 1'b0;
+      end
+    end
+  end
+  wire        active = h_act && v_act;
+  wire        hs0 = h_sync;
+  wire        vs0 = v_sync;
   reg  [31:0] word1;
   reg         on1, de1, hs1, vs1;
   reg  [1:0]  sub1;
@@ -247,7 +260,7 @@ module video_out #(
   wire [7:0] b8 = ppw_l2 == 2'd0 ? word1[15:8] : ppw_l2 == 2'd1 ? {half[4:0], half[4:2]} : {4{byte_px[3:2]}};
   // the bits below OUT_BITS and the alpha of RGBA2222 do not leave; rows past the line parity are
   // the fetch side's
-  wire unused_ok = &{1'b0, byte_px[1:0], r8, g8, b8, x_gap[0], y_gap[0], x_sum[12], x_sum[0], y_sum[12], y_sum[0]};
+  wire unused_ok = &{1'b0, byte_px[1:0], r8, g8, b8, x_gap[0], y_gap4[0], x_sum[12], x_sum[0], y_sum4[12], y_sum4[0]};
   always @(posedge clk) begin
     if (rst) begin
       {hsync, vsync} <= SYNC_NEG != 0 ? 2'b11 : 2'b00;

@@ -1,7 +1,8 @@
 // gateware/rtl/soc/video_out.v alone, Verilated with one board's parameters (VIDEO_* definitions, see
 // CMakeLists.txt): a known framebuffer in a behavioural VRAM (answers in order after 1..4 clocks,
-// refuses requests at random, as the arbiter does when another client wins), a swap as the scanout
-// signals it (swap_req, then frame_start at the vertical sync), and two frames of output checked
+// refuses requests at random, as the arbiter does when another client wins), the scanout's display
+// counters (hcount, vcount: a line of 800 x PIX_DIV clocks, 525 lines), a swap as the scanout latches
+// it (frame_start with the frame's address at the vertical sync), and two frames of output checked
 // sample by sample against VESA 640 x 480 at 60 Hz timing and the expected picture (scaled, centred,
 // expanded as docs/protocol.md section 6 says, black around it and before the first swap).
 #include <gtest/gtest.h>
@@ -20,6 +21,7 @@ constexpr int kPixDiv = GPUBRIDGE_VIDEO_PIX_DIV;
 constexpr int kScale = 1 << GPUBRIDGE_VIDEO_SCALE_LOG2;
 constexpr int kBits = GPUBRIDGE_VIDEO_BITS;
 constexpr int kVaw = GPUBRIDGE_VIDEO_VAW;
+constexpr long kLineWords = 1L << GPUBRIDGE_VIDEO_LINE_AW;  // words of a line buffer half
 
 struct Sample {
   bool hs, vs, de;
@@ -51,11 +53,15 @@ class VideoBench {
  public:
   explicit VideoBench(std::uint32_t seed) : rng_(seed), mem_(std::size_t{1} << kVaw, 0xDEADBEEFu) {}
 
-  void store(const Frame& f) {
-    ASSERT_LE(f.addr + std::size_t(f.width * f.height * f.bpp()), mem_.size() * 4) << "the frame is beyond VRAM";
+  // beyond_ok: the frame may run past the end of VRAM (its bytes there are not stored)
+  void store(const Frame& f, bool beyond_ok = false) {
+    if (!beyond_ok) {
+      ASSERT_LE(f.addr + std::size_t(f.width * f.height * f.bpp()), mem_.size() * 4) << "the frame is beyond VRAM";
+    }
     for (int i = 0; i < f.width * f.height; ++i)
       for (int k = 0; k < f.bpp(); ++k) {
         const std::uint32_t a = f.addr + static_cast<std::uint32_t>(i * f.bpp() + k);
+        if (a / 4 >= mem_.size()) continue;
         const int shift = (f.bpp() - 1 - k) * 8;
         const std::uint32_t byte = f.pixels[static_cast<std::size_t>(i)] >> shift & 0xFF;
         std::uint32_t& w = mem_[a / 4];
@@ -64,19 +70,22 @@ class VideoBench {
       }
   }
 
-  // runs `cycles` core clocks from reset; the swap of `f` is requested at cycle 16 and latched where
+  // runs `cycles` core clocks from reset with the scanout's counters; the swap of `f` is latched where
   // the scanout's vertical sync falls (end of visible line 479), as frame_start does on a board
   std::vector<Sample> run(const Frame& f, long cycles) {
     std::vector<Sample> out;
     const long line_clocks = long(kHTotal) * kPixDiv;
     const long vsync_cycle = (kVActive - 1) * line_clocks + line_clocks - 1;
     m_.rst = 1;
+    m_.hcount = 0;
+    m_.vcount = 0;
     for (int i = 0; i < 4; ++i) tick();
     m_.rst = 0;
     for (long k = 0; k < cycles; ++k) {
-      m_.swap_req = k == 16;
-      m_.swap_addr = f.addr / 16;
+      m_.hcount = static_cast<std::uint16_t>(k % line_clocks);
+      m_.vcount = static_cast<std::uint16_t>(k / line_clocks % kVTotal);
       m_.frame_start = k == vsync_cycle;
+      m_.frame_addr = k == vsync_cycle ? f.addr / 16 : 0xFFFFFFFu;  // valid with frame_start only
       m_.frame_format = static_cast<std::uint8_t>(f.format);
       m_.frame_width = static_cast<std::uint16_t>(f.width);
       m_.frame_height = static_cast<std::uint16_t>(f.height);
@@ -129,8 +138,8 @@ class VideoBench {
 int top_bits(int v8) { return v8 >> (8 - kBits); }
 
 // checks two frames of samples: the first black (nothing swapped in before its vertical sync), the
-// second the framebuffer, scaled and centred
-void check(const std::vector<Sample>& s, const Frame& f) {
+// second the framebuffer, scaled and centred; its pixels from byte vram_bytes on (beyond VRAM) black
+void check(const std::vector<Sample>& s, const Frame& f, std::size_t vram_bytes = SIZE_MAX) {
   // the pipeline's delay: the first data-enable sample is the first visible pixel
   std::size_t o = 0;
   while (o < s.size() && !s[o].de) ++o;
@@ -148,8 +157,13 @@ void check(const std::vector<Sample>& s, const Frame& f) {
     ASSERT_EQ(v.vs, !(l >= 490 && l < 492)) << "vsync at pixel " << p << " line " << l;
     Rgb want{0, 0, 0};
     if (frame == 1 && de && p >= x0 && p < x0 + sw && l >= y0 && l < y0 + sh) {
-      const Rgb e = f.expanded((p - x0) / kScale, (l - y0) / kScale);
-      want = {top_bits(e.r), top_bits(e.g), top_bits(e.b)};
+      const int x = (p - x0) / kScale, y = (l - y0) / kScale;
+      const Rgb e = f.expanded(x, y);
+      // pixels beyond VRAM and beyond the line buffer half (counted from the line's first word) are black
+      const long line_first = (long(f.addr) + long(y) * f.width * f.bpp()) / 4;
+      const long byte = long(f.addr) + (long(y) * f.width + x) * f.bpp();
+      if (std::size_t(byte) < vram_bytes && byte / 4 - line_first < kLineWords)
+        want = {top_bits(e.r), top_bits(e.g), top_bits(e.b)};
     }
     if (v.r != want.r || v.g != want.g || v.b != want.b) {
       if (++mismatches <= 5)
@@ -210,4 +224,15 @@ TEST(VideoOut, LargerThanTheScreenIsCropped) {
   bench.store(f);
   check(bench.run(f, two_frames_and_a_bit()), f);
   EXPECT_LE(bench.requests(), long(kVActive / kScale + 3) * (kHActive / kScale / 4 + 2));
+}
+
+// FB_FORMAT's reset value, 640 x 480 RGBA8888 (1.2 MB), shown as it is: cropped to the screen, and on
+// the iCEBreaker (128 KiB of VRAM) black from line 52 on, where its bytes lie beyond VRAM (docs/protocol.md
+// section 6) — including lines whose offset passes 512 KiB (from line 205), which a line offset
+// wrapping at 2^19 bytes showed as VRAM from its start
+TEST(VideoOut, ResetSizeRgba8888BeyondVramIsBlack) {
+  const Frame f = pattern(0, 640, 480, 0x0, 6);
+  VideoBench bench(16);
+  bench.store(f, true);
+  check(bench.run(f, two_frames_and_a_bit()), f, std::size_t{4} << kVaw);
 }
