@@ -4,8 +4,9 @@
 // the displayed buffer 60 times a second. This stage runs on the scanout's display timing (its line
 // and clock counters: VESA 640 x 480 at 60 Hz when the scanout's line is H_TOTAL x PIX_DIV clocks, a
 // pixel every PIX_DIV core clocks; no counters of its own), follows the swaps the scanout latches
-// (frame_start gives the address, format and size at the vertical sync) and fills a two-line block-RAM line buffer through its own memory-arbiter client: while one source
-// line is shown, the next is read. Pixels are expanded from RGBA8888 / RGB565 / RGBA2222 to 8 bits as
+// (frame_start gives the address, format and size at the vertical sync) and fills a two-line
+// block-RAM line buffer through its own memory-arbiter client: while one source line is shown, the
+// next is read. Pixels are expanded from RGBA8888 / RGB565 / RGBA2222 to 8 bits as
 // docs/protocol.md section 6 says and the top OUT_BITS bits leave (4 for the 12-bit DVI Pmod, 8 for
 // TMDS). A framebuffer is scaled by 2^SCALE_LOG2 and centred; what does not fit the screen is cropped,
 // and so are pixels beyond the 2^LINE_AW words a line buffer half holds. Words beyond VRAM show as 0.
@@ -72,7 +73,6 @@ module video_out #(
   assign vc = vcount;
   wire        h_last = hc == 11'(H_TOTAL - 1);
   wire        line_end = pix_en && h_last;
-  // the line after next, whose framebuffer line is read during the next line
 
   // --- the displayed buffer, from frame_start on: where it is and its placement on the screen,
   // centred: [x0, x_end) x [y0, y_end), cropped from the top left when larger (only these are kept,
