@@ -37,7 +37,8 @@ protocol::CommandStream frame(unsigned mode_class, const Shape& shape, bool bili
   protocol::CommandStream s;
   protocol::CommandStreamWriter w(s);
   std::mt19937 rng(seed);
-  w.write(Reg::FB_FORMAT, (std::uint64_t{rgba8888 ? 0u : 1u} << 32) | (std::uint64_t{kH} << 16) | kW);
+  w.write(Reg::FB_FORMAT, *geometry::fb_format_word(kW, kH, rgba8888 ? protocol::PixelFormat::RGBA8888
+                                                                     : protocol::PixelFormat::RGB565));
   w.write(Reg::FB_DRAW, kColor);
   w.write(Reg::FB_Z, rgba8888 ? kDepth8888 : kDepth565);
   // clears: the whole buffer, a wide strip and a tall one (rows and pixels vary apart)
@@ -58,11 +59,17 @@ protocol::CommandStream frame(unsigned mode_class, const Shape& shape, bool bili
     for (auto& b : texels) b = static_cast<std::uint8_t>(rng());
     w.upload(kTexture, std::move(texels));
     w.write(Reg::TEX_BASE, kTexture);
-    w.write(Reg::TEX_FMT, kTexLog2 | (kTexLog2 << 4) | (std::uint64_t{bilinear} << 12));
+    geometry::TextureFormat tf;
+    tf.width = tf.height = 1u << kTexLog2;
+    tf.bilinear = bilinear;
+    w.write(Reg::TEX_FMT, *geometry::tex_fmt_word(tf));
   }
   // class bits: 1 Gouraud, 2 depth (test LESS and write), 4 textured
-  const std::uint64_t mode = (mode_class & 1 ? 1u : 0u) | (textured ? 2u : 0u) | (mode_class & 2 ? 4u | (1u << 3) | (1u << 6) : 0u);
-  w.write(Reg::TRI_MODE, mode);
+  geometry::RenderState mode;
+  mode.gouraud = mode_class & 1;
+  mode.z_test = mode.z_write = mode_class & 2;
+  mode.textured = textured;
+  w.write(Reg::TRI_MODE, geometry::tri_mode_word(mode));
   w.write(Reg::PRIM, 0);  // list
   std::uniform_int_distribution<int> wd(shape.w_min * 16, shape.w_max * 16), ht(shape.h_min * 16, shape.h_max * 16);
   for (int i = 0; i < shape.count; ++i) {
@@ -72,14 +79,14 @@ protocol::CommandStream frame(unsigned mode_class, const Shape& shape, bool bili
     // a triangle spanning the box: one corner, the opposite side's two ends at random offsets
     const int xs[3] = {x + static_cast<int>(rng() % (bw + 1)), x, x + bw};
     const int ys[3] = {y, y + bh, y + bh - static_cast<int>(rng() % (bh / 2 + 1))};
-    for (int k = 0; k < 3; ++k) {
-      const std::uint64_t q = 0xFFFFFFFFu;
-      w.write(Reg::COLOR, (q << 32) | static_cast<std::uint32_t>(rng()));
+    geometry::DeviceTriangle tri;
+    for (int k = 0; k < 3; ++k) {  // the draws in this order: colour, S, T, Z
+      const auto rgba = static_cast<std::uint32_t>(rng());
       const std::int32_t st = static_cast<std::int32_t>(rng() % (2u << 24)), tt = static_cast<std::int32_t>(rng() % (2u << 24));
-      if (textured) w.write(Reg::TEXCOORD, (std::uint64_t{static_cast<std::uint32_t>(st)} << 32) | static_cast<std::uint32_t>(tt));
-      const std::uint64_t z = rng() & 0xFFFFFF;
-      w.write(Reg::VERTEX, (z << 32) | (std::uint64_t{static_cast<std::uint16_t>(ys[k])} << 16) | static_cast<std::uint16_t>(xs[k]));
+      const auto z = static_cast<std::uint32_t>(rng() & 0xFFFFFF);
+      tri[k] = {static_cast<std::int16_t>(xs[k]), static_cast<std::int16_t>(ys[k]), z, rgba, 0xFFFFFFFFu, st, tt};
     }
+    geometry::encode_triangle(tri, textured, w.frames());
   }
   w.write(Reg::FB_DISPLAY, kColor);
   w.flush();

@@ -1,6 +1,5 @@
 #include "rtl_fill.hpp"
 
-#include "gpubridge/geometry/encode.hpp"
 #include "gpubridge/protocol/frame.hpp"
 #include "gpubridge/protocol/registers.hpp"
 #include "gpubridge/rtl/rtl_device.hpp"
@@ -14,36 +13,48 @@ namespace {
 
 using protocol::Reg;
 
-constexpr std::uint64_t kDepth = 0x4 | (1u << 3) | 0x40;  // TRI_MODE: depth test LESS, depth write
-constexpr std::uint64_t kBlend = 1u << 7;                 // TRI_MODE.BLEND = alpha
-constexpr unsigned kTexLog2 = 6;                          // 64 x 64 RGBA8888, as the core bench
+constexpr unsigned kTexLog2 = 6;  // 64 x 64 RGBA8888, as the core bench
 constexpr std::uint32_t kTexBytes = 4u << (2 * kTexLog2);
+
+geometry::RenderState state(bool gouraud, bool depth, protocol::BlendMode blend = protocol::BlendMode::Off,
+                            bool textured = false, bool dither = false) {
+  geometry::RenderState s;
+  s.gouraud = gouraud;
+  s.z_test = s.z_write = depth;  // LESS
+  s.blend = blend;
+  s.textured = textured;
+  s.dither = dither;
+  return s;
+}
 
 // The core bench's classes (gateware/tests/core/core_bench.cpp), in its order and with its names.
 const std::vector<FillClass>& classes() {
+  using protocol::BlendMode;
+  using protocol::PixelFormat;
   static const std::vector<FillClass> all = {
-      {"fill RGBA8888 flat", 0, 0},
-      {"fill RGB565 flat", 1, 0},
-      {"fill RGBA2222 flat", 2, 0},
-      {"RGBA8888 Gouraud", 0, 0x1},
-      {"RGBA8888 flat, Z test + write", 0, kDepth},
-      {"RGBA8888 Gouraud, Z test + write", 0, 0x1 | kDepth},
-      {"RGBA2222 Gouraud, dithered", 2, 0x1 | (1u << 9)},
-      {"RGBA8888 alpha blend", 0, 0x1 | kBlend},
-      {"RGBA8888 textured nearest (64x64 RGBA8888)", 0, 0x2},
-      {"RGBA8888 textured bilinear (64x64 RGBA8888)", 0, 0x2, true},
+      {"fill RGBA8888 flat", PixelFormat::RGBA8888, state(false, false)},
+      {"fill RGB565 flat", PixelFormat::RGB565, state(false, false)},
+      {"fill RGBA2222 flat", PixelFormat::RGBA2222, state(false, false)},
+      {"RGBA8888 Gouraud", PixelFormat::RGBA8888, state(true, false)},
+      {"RGBA8888 flat, Z test + write", PixelFormat::RGBA8888, state(false, true)},
+      {"RGBA8888 Gouraud, Z test + write", PixelFormat::RGBA8888, state(true, true)},
+      {"RGBA2222 Gouraud, dithered", PixelFormat::RGBA2222, state(true, false, BlendMode::Off, false, true)},
+      {"RGBA8888 alpha blend", PixelFormat::RGBA8888, state(true, false, BlendMode::Alpha)},
+      {"RGBA8888 textured nearest (64x64 RGBA8888)", PixelFormat::RGBA8888, state(false, false, BlendMode::Off, true)},
+      {"RGBA8888 textured bilinear (64x64 RGBA8888)", PixelFormat::RGBA8888, state(false, false, BlendMode::Off, true),
+       true},
   };
   return all;
 }
 
-unsigned bpp_of(unsigned format) { return protocol::bytes_per_pixel(static_cast<protocol::PixelFormat>(format)); }
-bool has_depth(const FillClass& c) { return c.mode & 0x4; }
-bool has_texture(const FillClass& c) { return c.mode & 0x2; }
-bool has_blend(const FillClass& c) { return (c.mode >> 7) & 3; }
+unsigned bpp_of(const FillClass& c) { return protocol::bytes_per_pixel(c.format); }
+bool has_depth(const FillClass& c) { return c.state.z_test; }
+bool has_texture(const FillClass& c) { return c.state.textured; }
+bool has_blend(const FillClass& c) { return c.state.blend != protocol::BlendMode::Off; }
 
 bool supported(const FillClass& c, std::uint32_t features) {
-  if (c.format == 1 && !(features & sim::FEATURE_RGB565)) return false;
-  if (c.format == 2 && !(features & sim::FEATURE_RGBA2222)) return false;
+  if (c.format == protocol::PixelFormat::RGB565 && !(features & sim::FEATURE_RGB565)) return false;
+  if (c.format == protocol::PixelFormat::RGBA2222 && !(features & sim::FEATURE_RGBA2222)) return false;
   if (has_texture(c) && !(features & sim::FEATURE_TEXTURE)) return false;
   if (c.bilinear && !(features & sim::FEATURE_BILINEAR)) return false;
   if (has_blend(c) && !(features & sim::FEATURE_BLEND)) return false;
@@ -66,7 +77,7 @@ struct Layout {
 };
 Layout layout(const FillClass& c, unsigned w, unsigned h) {
   Layout l;
-  const std::uint64_t colour = std::uint64_t{w} * h * bpp_of(c.format);
+  const std::uint64_t colour = std::uint64_t{w} * h * bpp_of(c);
   l.depth = in_bank(colour, 2);
   const std::uint64_t depth_end = has_depth(c) ? l.depth + std::uint64_t{w} * h * 4 : colour;
   l.texture = in_bank(depth_end, 1);
@@ -74,14 +85,15 @@ Layout layout(const FillClass& c, unsigned w, unsigned h) {
   return l;
 }
 
+// Every size here (at most 640 x 480, 16-byte aligned addresses) is one the encoders accept.
 FillDraw make_draw(const FillClass& c, unsigned w, unsigned h) {
   FillDraw d{c, w, h, {}, {}};
   const Layout l = layout(c, w, h);
   {
     protocol::CommandStreamWriter s(d.setup);
-    s.write(Reg::FB_FORMAT, (std::uint64_t{c.format} << 32) | (std::uint64_t{h} << 16) | w);
-    s.write(Reg::FB_DRAW, 0);
-    s.write(Reg::FB_Z, l.depth);
+    s.write(Reg::FB_FORMAT, *geometry::fb_format_word(w, h, c.format));
+    s.write(Reg::FB_DRAW, *geometry::address16_word(0));
+    s.write(Reg::FB_Z, *geometry::address16_word(l.depth));
     s.write(Reg::SCISSOR, *geometry::scissor_word(0, 0, w, h));
     if (has_depth(c)) {  // the depth test LESS passes against the far plane everywhere
       s.write(Reg::CLEAR_DEPTH, 0xFFFFFF);
@@ -91,29 +103,28 @@ FillDraw make_draw(const FillClass& c, unsigned w, unsigned h) {
       std::vector<std::uint8_t> texels(kTexBytes);
       for (std::size_t i = 0; i < texels.size(); ++i) texels[i] = static_cast<std::uint8_t>(i * 37 + (i >> 8));
       s.upload(l.texture, std::move(texels));
-      s.write(Reg::TEX_BASE, l.texture);
-      s.write(Reg::TEX_FMT, kTexLog2 | (kTexLog2 << 4) | (std::uint64_t{c.bilinear} << 12));
+      s.write(Reg::TEX_BASE, *geometry::address16_word(l.texture));
+      geometry::TextureFormat tf;
+      tf.width = tf.height = 1u << kTexLog2;
+      tf.bilinear = c.bilinear;
+      s.write(Reg::TEX_FMT, *geometry::tex_fmt_word(tf));
     }
-    s.write(Reg::TRI_MODE, c.mode);
+    s.write(Reg::TRI_MODE, geometry::tri_mode_word(c.state));
     s.write(Reg::PRIM, 0);  // list
     s.flush();
   }
   protocol::CommandStreamWriter s(d.draw);
   // The core bench's rectangle scaled to w x h: the texture repeats at half a texel per pixel
   // (S reaches w / 128, T h / 128 in 8.24), the colours and depths are its.
-  const int X = int(w) * 16, Y = int(h) * 16;
+  const auto X = static_cast<std::int16_t>(w * 16), Y = static_cast<std::int16_t>(h * 16);
   const std::int32_t S = std::int32_t(w) << 17, T = std::int32_t(h) << 17;
-  auto vertex = [&](int x16, int y16, std::uint32_t z, std::uint32_t rgba, std::int32_t st, std::int32_t tt) {
-    s.write(Reg::COLOR, (std::uint64_t{0xFFFFFFFFu} << 32) | rgba);
-    if (has_texture(c)) s.write(Reg::TEXCOORD, (std::uint64_t{std::uint32_t(st)} << 32) | std::uint32_t(tt));
-    s.write(Reg::VERTEX, (std::uint64_t{z} << 32) | (std::uint64_t{std::uint16_t(y16)} << 16) | std::uint16_t(x16));
+  auto vertex = [](std::int16_t x, std::int16_t y, std::uint32_t z, std::uint32_t rgba, std::int32_t st, std::int32_t tt) {
+    return geometry::DeviceVertex{x, y, z, rgba, 0xFFFFFFFFu, st, tt};
   };
-  vertex(0, 0, 100, 0xFF0000FF, 0, 0);
-  vertex(X, 0, 200, 0x00FF00FF, S, 0);
-  vertex(X, Y, 300, 0x0000FFFF, S, T);
-  vertex(0, 0, 100, 0xFF0000FF, 0, 0);
-  vertex(X, Y, 300, 0x0000FFFF, S, T);
-  vertex(0, Y, 400, 0xFFFFFF80, 0, T);
+  const geometry::DeviceVertex a = vertex(0, 0, 100, 0xFF0000FF, 0, 0), b = vertex(X, 0, 200, 0x00FF00FF, S, 0),
+                               e = vertex(X, Y, 300, 0x0000FFFF, S, T), f = vertex(0, Y, 400, 0xFFFFFF80, 0, T);
+  geometry::encode_triangle({a, b, e}, has_texture(c), s.frames());
+  geometry::encode_triangle({a, e, f}, has_texture(c), s.frames());
   s.flush();
   return d;
 }
@@ -186,7 +197,7 @@ Result<std::vector<FillResult>> measure_fill(rtl::GatewareProfile profile, bool 
     f.name = d.cls.name;
     f.width = d.width;
     f.height = d.height;
-    f.bytes_per_pixel = bpp_of(d.cls.format);
+    f.bytes_per_pixel = bpp_of(d.cls);
     f.depth = has_depth(d.cls);
     f.blend = has_blend(d.cls);
     f.textured = has_texture(d.cls);

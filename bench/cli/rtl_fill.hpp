@@ -12,16 +12,17 @@
 #include <vector>
 
 #include "gpubridge/common/result.hpp"
+#include "gpubridge/geometry/encode.hpp"
 #include "gpubridge/protocol/command_stream.hpp"
 #include "gpubridge/rtl/gateware_profile.hpp"
 
 namespace gpubridge::cli {
 
 struct FillClass {
-  std::string name;        // as rtl_core_<profile>_bench names the class (predict.py pairs them)
-  unsigned format = 0;     // FB_FORMAT: 0 RGBA8888, 1 RGB565, 2 RGBA2222
-  std::uint64_t mode = 0;  // TRI_MODE
-  bool bilinear = false;
+  std::string name;  // as rtl_core_<profile>_bench names the class (predict.py pairs them)
+  protocol::PixelFormat format = protocol::PixelFormat::RGBA8888;
+  geometry::RenderState state;  // TRI_MODE
+  bool bilinear = false;        // textured: the filter
 };
 
 struct FillDraw {
