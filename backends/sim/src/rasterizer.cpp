@@ -377,6 +377,30 @@ void run_kernel(const Triangle& t, const DrawState& st, RasterContext& ctx, int 
 
 using KernelFn = void (*)(const Triangle&, const DrawState&, RasterContext&, int, int);
 
+// What a vector kernel drew, into the timing model's counters: `passed` pixels were blended when
+// `blended` and textured (their texel reads by the filter's footprint) when `textured`.
+void count_drawn(RasterContext& ctx, const DrawState& st, std::uint64_t scanned, std::uint64_t covered,
+                 std::uint64_t passed, bool blended, bool textured) {
+  ctx.counters.scanned += scanned;
+  ctx.counters.covered += covered;
+  ctx.counters.passed += passed;
+  if (blended) ctx.counters.blended += passed;
+  if (textured) {
+    ctx.counters.textured += passed;
+    ctx.counters.texel_bytes += passed * (st.tex.bilinear ? 4u : 1u) * protocol::bytes_per_pixel(st.tex.format);
+  }
+}
+
+// The preview kernels' edge values at the box origin and their steps (PreviewRows, PreviewPlain).
+template <class Rows>
+void copy_edges(const Triangle& t, Rows& p) {
+  for (int i = 0; i < 3; ++i) {
+    p.e[i] = t.edge[i].e;
+    p.ex[i] = t.edge[i].ex;
+    p.ey[i] = t.edge[i].ey;
+  }
+}
+
 // Specialisation table over the boolean axes (DuckStation-style, no JIT).
 template <unsigned... I>
 constexpr auto make_table(std::integer_sequence<unsigned, I...>) {
@@ -441,14 +465,8 @@ bool draw_narrow(const Triangle& t, const DrawState& st, RasterContext& ctx, int
     for (int j = 0; j < 4; ++j)
       for (int lane = 0; lane < 8; ++lane) n.bayer[j][lane] = dither_threshold(st.dither, t.x0 + lane, ya + j);
   const NarrowCounts c = shade_narrow_simd(n);
-  ctx.counters.scanned += static_cast<std::uint64_t>(w) * static_cast<std::uint64_t>(rows);
-  ctx.counters.covered += c.covered;
-  ctx.counters.passed += c.passed;
-  if (st.blend != protocol::BlendMode::Off && color_stage) ctx.counters.blended += c.passed;
-  if (textured) {
-    ctx.counters.textured += c.passed;
-    ctx.counters.texel_bytes += c.passed * (st.tex.bilinear ? 4u : 1u) * protocol::bytes_per_pixel(st.tex.format);
-  }
+  count_drawn(ctx, st, static_cast<std::uint64_t>(w) * static_cast<std::uint64_t>(rows), c.covered, c.passed,
+              st.blend != protocol::BlendMode::Off && color_stage, textured);
   return true;
 }
 
@@ -457,11 +475,7 @@ bool draw_narrow(const Triangle& t, const DrawState& st, RasterContext& ctx, int
 void draw_preview(const Triangle& t, const DrawState& st, RasterContext& ctx, int ya, int yz, bool gouraud, bool depth) {
   PreviewRows p;
   p.width = t.x1 - t.x0;
-  for (int i = 0; i < 3; ++i) {
-    p.e[i] = t.edge[i].e;
-    p.ex[i] = t.edge[i].ex;
-    p.ey[i] = t.edge[i].ey;
-  }
+  copy_edges(t, p);
   p.base = t.fplane.base;
   p.dx = t.fplane.dx;
   p.dy = t.fplane.dy;
@@ -489,25 +503,14 @@ void draw_preview(const Triangle& t, const DrawState& st, RasterContext& ctx, in
     p.scale_v = std::ldexp(1.0f, 20 + static_cast<int>(st.tex.hl));
   }
   const PreviewCounts c = shade_preview_simd(p);
-  ctx.counters.scanned += c.scanned;
-  ctx.counters.covered += c.covered;
-  ctx.counters.passed += c.passed;
-  if (st.blend != protocol::BlendMode::Off) ctx.counters.blended += c.passed;
-  if (st.textured) {
-    ctx.counters.textured += c.passed;
-    ctx.counters.texel_bytes += c.passed * (st.tex.bilinear ? 4u : 1u) * protocol::bytes_per_pixel(st.tex.format);
-  }
+  count_drawn(ctx, st, c.scanned, c.covered, c.passed, st.blend != protocol::BlendMode::Off, st.textured);
 }
 
 // The plain-draw preview kernel (preview_plain.hpp) for rows [ya, yz); preview_plain_applies(st).
 void draw_preview_plain(const Triangle& t, const DrawState& st, RasterContext& ctx, int ya, int yz, bool depth) {
   PreviewPlain p;
   p.width = t.x1 - t.x0;
-  for (int i = 0; i < 3; ++i) {
-    p.e[i] = t.edge[i].e;
-    p.ex[i] = t.edge[i].ex;
-    p.ey[i] = t.edge[i].ey;
-  }
+  copy_edges(t, p);
   p.planes = &t.xplane;
   p.ky0 = ya - t.y0;
   p.rows = yz - ya;
@@ -527,14 +530,7 @@ void draw_preview_plain(const Triangle& t, const DrawState& st, RasterContext& c
              std::ldexp(1.0f, 20 + static_cast<int>(st.tex.hl))};
   }
   const PreviewCounts c = shade_preview_plain(p);
-  ctx.counters.scanned += c.scanned;
-  ctx.counters.covered += c.covered;
-  ctx.counters.passed += c.passed;
-  if (st.blend != protocol::BlendMode::Off) ctx.counters.blended += c.passed;
-  if (st.textured) {
-    ctx.counters.textured += c.passed;
-    ctx.counters.texel_bytes += c.passed * (st.tex.bilinear ? 4u : 1u) * 4u;
-  }
+  count_drawn(ctx, st, c.scanned, c.covered, c.passed, st.blend != protocol::BlendMode::Off, st.textured);
 }
 
 }  // namespace
