@@ -58,24 +58,6 @@ struct Sample {
 
 const char* board_of(const std::string& gw) { return gw == "up5k" ? "icebreaker" : "ulx3s"; }
 
-rtl::RtlCounters counters_difference(const rtl::RtlCounters& a, const rtl::RtlCounters& b) {
-  rtl::RtlCounters d;
-  d.cycles = a.cycles - b.cycles;
-  d.work_cycles = a.work_cycles - b.work_cycles;
-  d.commands = a.commands - b.commands;
-  d.spi_frames = a.spi_frames - b.spi_frames;
-  d.core_mem_stalls = a.core_mem_stalls - b.core_mem_stalls;
-  d.triangles = a.triangles - b.triangles;
-  d.pixels = a.pixels - b.pixels;
-  d.passed = a.passed - b.passed;
-  d.textured = a.textured - b.textured;
-  d.core_busy_cycles = a.core_busy_cycles - b.core_busy_cycles;
-  d.setup_cycles = a.setup_cycles - b.setup_cycles;
-  d.raster_cycles = a.raster_cycles - b.raster_cycles;
-  d.refreshes = a.refreshes - b.refreshes;
-  return d;
-}
-
 // Both sides' counters of a frame (bench rtl --json): what a model is fitted on.
 nlohmann::json counters_json(const sim::DeviceStats& w, const rtl::RtlCounters& r) {
   nlohmann::json modes = nlohmann::json::object();
@@ -119,7 +101,7 @@ Result<std::vector<Sample>> measure(const std::string& scene, const std::string&
   rtl::RtlCounters last_rtl = g.counters();
   board->backend->set_scanout_callback([&](std::shared_ptr<const backends::ScanoutFrame>) {
     const rtl::RtlCounters now = g.counters();
-    rtl_frames.push_back(counters_difference(now, last_rtl));
+    rtl_frames.push_back(now - last_rtl);
     last_rtl = now;
   });
   std::vector<std::pair<sim::DeviceStats, unsigned>> sim_frames;

@@ -191,8 +191,8 @@ Result<std::vector<FillResult>> measure_fill(rtl::GatewareProfile profile, bool 
     const rtl::RtlCounters c0 = dev.counters();
     if (auto r = play(*board->backend, d.draw); !r) return fail(r.error());
     if (auto r = drain(dev); !r) return fail(r.error());
-    const rtl::RtlCounters c1 = dev.counters();
-    if (c1.sdram_violations != c0.sdram_violations) return fail(make_error("the SDRAM model saw timing violations"));
+    const rtl::RtlCounters c = dev.counters() - c0;
+    if (c.sdram_violations) return fail(make_error("the SDRAM model saw timing violations"));
     FillResult f;
     f.name = d.cls.name;
     f.width = d.width;
@@ -202,13 +202,13 @@ Result<std::vector<FillResult>> measure_fill(rtl::GatewareProfile profile, bool 
     f.blend = has_blend(d.cls);
     f.textured = has_texture(d.cls);
     f.bilinear = d.cls.bilinear;
-    f.pixels = c1.pixels - c0.pixels;
+    f.pixels = c.pixels;
     // the drain's quiet tail is not work; the work counter also holds the draw's command decode
-    f.draw_clocks = c1.work_cycles - c0.work_cycles;
-    f.core_busy_clocks = c1.core_busy_cycles - c0.core_busy_cycles;
-    f.setup_clocks = c1.setup_cycles - c0.setup_cycles;
-    f.mem_stall_clocks = c1.core_mem_stalls - c0.core_mem_stalls;
-    f.refreshes = c1.refreshes - c0.refreshes;
+    f.draw_clocks = c.work_cycles;
+    f.core_busy_clocks = c.core_busy_cycles;
+    f.setup_clocks = c.setup_cycles;
+    f.mem_stall_clocks = c.core_mem_stalls;
+    f.refreshes = c.refreshes;
     if (f.draw_clocks) f.px_per_clock = double(f.pixels) / double(f.draw_clocks);
     f.mpixel_per_s = f.px_per_clock * caps.core_hz / 1e6;
     out.push_back(f);

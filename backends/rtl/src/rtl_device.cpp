@@ -10,6 +10,26 @@
 
 namespace gpubridge::rtl {
 
+RtlCounters operator-(const RtlCounters& a, const RtlCounters& b) {
+  RtlCounters d;
+  d.cycles = a.cycles - b.cycles;
+  d.work_cycles = a.work_cycles - b.work_cycles;
+  d.commands = a.commands - b.commands;
+  d.spi_frames = a.spi_frames - b.spi_frames;
+  d.core_mem_stalls = a.core_mem_stalls - b.core_mem_stalls;
+  d.triangles = a.triangles - b.triangles;
+  d.pixels = a.pixels - b.pixels;
+  d.passed = a.passed - b.passed;
+  d.textured = a.textured - b.textured;
+  d.core_busy_cycles = a.core_busy_cycles - b.core_busy_cycles;
+  d.setup_cycles = a.setup_cycles - b.setup_cycles;
+  d.raster_cycles = a.raster_cycles - b.raster_cycles;
+  d.refreshes = a.refreshes - b.refreshes;
+  d.sdram_violations = a.sdram_violations - b.sdram_violations;
+  d.sck_edges_too_fast = a.sck_edges_too_fast - b.sck_edges_too_fast;
+  return d;
+}
+
 #if GPUBRIDGE_HAVE_RTL
 bool RtlDevice::available() { return true; }
 std::string RtlDevice::unavailable_reason() { return {}; }

@@ -54,6 +54,8 @@ struct RtlCounters {
   std::uint64_t sdram_violations = 0;  // timing violations seen by the SDRAM model (must stay 0)
   std::uint64_t sck_edges_too_fast = 0;  // SCK half periods shorter than a core clock (pins outside spec)
 };
+// The counts between two readings (later - earlier): what one frame or one draw took.
+RtlCounters operator-(const RtlCounters& later, const RtlCounters& earlier);
 
 class RtlDevice {
  public:
