@@ -126,7 +126,7 @@ DeviceCaps DeviceCaps::from(const backends::DeviceInfo& info) {
   d.max_height = info.max_height;
   if (info.caps != 0)
     d.features = static_cast<std::uint16_t>(protocol::describe(protocol::Reg::CAPS).field("FEATURES")->get(info.caps)) |
-                 (((info.id >> 16) & 0xFF) < 2 ? kTexturing : 0);  // protocol 1.0/1.1: no bit 7, every device textures
+                 (protocol::protocol_minor(info.id) < 2 ? kTexturing : 0);  // protocol 1.0/1.1: no bit 7, every device textures
   return d;
 }
 

@@ -32,9 +32,9 @@ std::vector<std::uint8_t> frames_bytes(std::initializer_list<Frame> frames) {
 BringupStep id_check(BoardBackend& b) {
   BringupStep s{"id", false, false, "", 0};
   const auto i = b.info();
-  s.ok = (i.id >> 32) == protocol::kIdMagic && ((i.id >> 24) & 0xFF) == protocol::kVersionMajor;
+  s.ok = (i.id >> 32) == protocol::kIdMagic && protocol::protocol_major(i.id) == protocol::kVersionMajor;
   s.detail = fmt::format("ID 0x{:016X} (spigpu v{}.{}, variant 0x{:04X}); CAPS: {} KiB VRAM, FIFO {}, max {}x{}", i.id,
-                         (i.id >> 24) & 0xFF, (i.id >> 16) & 0xFF, i.id & 0xFFFF, i.caps & 0xFFFFFF, (i.caps >> 46) & 0x3FF,
+                         protocol::protocol_major(i.id), protocol::protocol_minor(i.id), protocol::id_variant(i.id), i.caps & 0xFFFFFF, (i.caps >> 46) & 0x3FF,
                          i.max_width, i.max_height);
   return s;
 }

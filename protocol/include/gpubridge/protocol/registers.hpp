@@ -166,7 +166,10 @@ inline constexpr std::uint64_t kResetMagic = 0x5245534554ull;  // "RESET": RESET
 // "off!" in LINK_CTRL.CLEAR_KEY: a LINK_CTRL write with STRICT = 0 leaves strict mode only with it
 // (protocol 1.3, docs/protocol.md section 4), so no single bit error can turn strict mode off.
 inline constexpr std::uint32_t kLinkClearKey = 0x6F666621;
+// ID's fields (docs/protocol.md section 5): MAGIC [63:32], MAJOR [31:24], MINOR [23:16], VARIANT [15:0].
+constexpr unsigned protocol_major(std::uint64_t id) { return static_cast<unsigned>((id >> 24) & 0xFF); }
 constexpr unsigned protocol_minor(std::uint64_t id) { return static_cast<unsigned>((id >> 16) & 0xFF); }
+constexpr unsigned id_variant(std::uint64_t id) { return static_cast<unsigned>(id & 0xFFFF); }
 // The LINK_CTRL data that leaves strict mode on the device whose ID register reads `id`: the key
 // from 1.3 on; 0 before, where the key's bits are reserved (a 1.2 device would flag them).
 constexpr std::uint64_t link_ctrl_clear_value(std::uint64_t id) {
