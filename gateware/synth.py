@@ -81,7 +81,7 @@ def synth(profile, modules=False, abc9=False, packed=False):
         cmd += " -abc9 -device u"
     files = design_files()
     # the ecp5 profile has no SPRAM: its primitive (known to synth_ice40) is a black box there
-    lib = "read_verilog -lib sim/SB_SPRAM256KA.v; " if profile == "ecp5" else ""
+    lib = "read_verilog -lib sim/SB_SPRAM256KA.v sim/SB_MAC16.v; " if profile == "ecp5" else ""
     flat = " -noflatten" if modules else ""
     script = (f"{lib}read_verilog -sv -Irtl/soc -Irtl/core {' '.join(files)}; chparam -set PROFILE {value} spigpu_top; "
               f"{cmd}{flat} -top spigpu_top; stat")

@@ -17,14 +17,15 @@
 // Outputs form a two-stage pipeline with the steppers: `op` (stepper move), `emit` and the
 // pixel position are registered together; the steppers apply `op` in the next enabled cycle.
 module core_raster #(
-    parameter integer IDX_W = 20
+    parameter integer IDX_W = 20,
+    parameter integer DSP = 0    // 1: the edge values in three SB_MAC16 accumulators (iCE40)
 ) (
     input  wire               clk,
     input  wire               rst,
     input  wire               start,   // pulse: begin a triangle (setup outputs valid)
     input  wire [2:0]         e_we,              // setup writes the edge values at the origin
     input  wire signed [35:0] e_data,
-    output reg  signed [35:0] e0, e1, e2,        //   (and reads E20, E01 back for the planes)
+    output wire signed [35:0] e0, e1, e2,        //   (and reads E20, E01 back for the planes; not with DSP)
     input  wire signed [16:0] dx0, dx1, dx2,     // edge deltas (held by setup while drawing):
     input  wire signed [16:0] dy0, dy1, dy2,     //   E steps by -16 dy right, 16 dx down
     input  wire               flip,              //   ... negated (P1 and P2 exchanged, section 8.1)
@@ -61,20 +62,67 @@ module core_raster #(
   // one adder per edge: E - 16 dy (right), E + 16 dy (left), E + 16 dx (down)
   reg  [1:0] sel;
   wire sub = (sel != OP_LEFT && sel != OP_DOWN);
+  wire sb = sub ^ flip;
+  wire s0, s1, s2;     // E < 0 at the current pixel
+  wire ns0, ns1, ns2;  // E < 0 at the pixel the move `sel` reaches
+  wire commit;         // the move `sel` is made this cycle
   function signed [35:0] step(input signed [35:0] e, input signed [16:0] dx, input signed [16:0] dy,
-                              input [1:0] s, input sb);
+                              input [1:0] sl, input sbit);
     reg [35:0] o;
     begin
-      o = {{15{(s == OP_DOWN) ? dx[16] : dy[16]}}, (s == OP_DOWN) ? dx : dy, 4'd0};
-      step = e + $signed(o ^ {36{sb}}) + $signed({35'd0, sb});  // one adder: e +/- o
+      o = {{15{(sl == OP_DOWN) ? dx[16] : dy[16]}}, (sl == OP_DOWN) ? dx : dy, 4'd0};
+      step = e + $signed(o ^ {36{sbit}}) + $signed({35'd0, sbit});  // one adder: e +/- o
     end
   endfunction
-  wire signed [35:0] n0 = step(e0, dx0, dy0, sel, sub ^ flip);
-  wire signed [35:0] n1 = step(e1, dx1, dy1, sel, sub ^ flip);
-  wire signed [35:0] n2 = step(e2, dx2, dy2, sel, sub ^ flip);
+  genvar k;
+  generate
+    if (DSP != 0) begin : edge_dsp
+      // Only signs are read, and the steps are multiples of 16: E + 16 k < 0 exactly when
+      // floor(E / 16) + k < 0, so the accumulators hold E >> 4 (|E| < 2^35: 32 bits) and step by
+      // dx, dy themselves. The current sign is kept beside each (loaded or moved with it).
+      wire [16:0] dxs[0:2], dys[0:2];
+      wire [2:0]  ns, s;
+      assign dxs[0] = dx0; assign dxs[1] = dx1; assign dxs[2] = dx2;
+      assign dys[0] = dy0; assign dys[1] = dy1; assign dys[2] = dy2;
+      for (k = 0; k < 3; k = k + 1) begin : acc
+        wire [16:0] o = (sel == OP_DOWN) ? dxs[k] : dys[k];
+        wire [31:0] n;
+        reg         neg;
+        core_dsp_acc edge_acc (
+            .clk(clk), .en(e_we[k] || commit), .load(e_we[k]), .sub(sb), .b({{15{o[16]}}, o}),
+            .c(e_data[35:4]), .out(n));
+        always @(posedge clk) if (e_we[k] || commit) neg <= e_we[k] ? e_data[35] : n[31];
+        assign ns[k] = n[31];
+        assign s[k]  = neg;
+        wire unused_n = &{1'b0, n[30:0]};  // only the sign is read
+      end
+      assign {ns2, ns1, ns0} = ns;
+      assign {s2, s1, s0} = s;
+      assign e0 = 36'sd0;
+      assign e1 = 36'sd0;
+      assign e2 = 36'sd0;
+      wire unused_e = &{1'b0, e_data[3:0]};
+    end else begin : edge_fabric
+      reg  signed [35:0] r0, r1, r2;
+      wire signed [35:0] n0 = step(r0, dx0, dy0, sel, sb);
+      wire signed [35:0] n1 = step(r1, dx1, dy1, sel, sb);
+      wire signed [35:0] n2 = step(r2, dx2, dy2, sel, sb);
+      // edge values: setup's writes (the rasteriser is idle then) or a committed move
+      always @(posedge clk) begin
+        if (e_we[0] || commit) r0 <= e_we[0] ? e_data : n0;
+        if (e_we[1] || commit) r1 <= e_we[1] ? e_data : n1;
+        if (e_we[2] || commit) r2 <= e_we[2] ? e_data : n2;
+      end
+      assign {ns0, ns1, ns2} = {n0[35], n1[35], n2[35]};
+      assign {s0, s1, s2} = {r0[35], r1[35], r2[35]};
+      assign e0 = r0;
+      assign e1 = r1;
+      assign e2 = r2;
+    end
+  endgenerate
   reg  area;  // rect latched
-  wire ncov = area || (!n0[35] && !n1[35] && !n2[35]);
-  wire cov = area || (!e0[35] && !e1[35] && !e2[35]);
+  wire ncov = area || (!ns0 && !ns1 && !ns2);
+  wire cov = area || (!s0 && !s1 && !s2);
   // sides on which covered pixels of this row can lie, from the failing edges
   // (ex = -16 dy, or 16 dy when exchanged: a failing edge with ex > 0 grows to the right)
   function grows_r(input signed [16:0] dy, input f);  // ex > 0
@@ -83,8 +131,8 @@ module core_raster #(
   function grows_l(input signed [16:0] dy, input f);  // ex < 0
     grows_l = f ? (dy < 0) : (dy > 0);
   endfunction
-  wire right_ok = !(e0[35] && !grows_r(dy0, flip)) && !(e1[35] && !grows_r(dy1, flip)) && !(e2[35] && !grows_r(dy2, flip));
-  wire left_ok  = !(e0[35] && !grows_l(dy0, flip)) && !(e1[35] && !grows_l(dy1, flip)) && !(e2[35] && !grows_l(dy2, flip));
+  wire right_ok = !(s0 && !grows_r(dy0, flip)) && !(s1 && !grows_r(dy1, flip)) && !(s2 && !grows_r(dy2, flip));
+  wire left_ok  = !(s0 && !grows_l(dy0, flip)) && !(s1 && !grows_l(dy1, flip)) && !(s2 && !grows_l(dy2, flip));
   wire can_r = (x != xhi);
   wire can_l = (x != xlo);
   wire last_row = (y == yhi);
@@ -231,11 +279,5 @@ module core_raster #(
     end
   end
 
-  // edge values: setup's writes (the rasteriser is idle then) or a committed move
-  wire commit = !rst && !start && adv && !hold && st != R_IDLE && go;
-  always @(posedge clk) begin
-    if (e_we[0] || commit) e0 <= e_we[0] ? e_data : n0;
-    if (e_we[1] || commit) e1 <= e_we[1] ? e_data : n1;
-    if (e_we[2] || commit) e2 <= e_we[2] ? e_data : n2;
-  end
+  assign commit = !rst && !start && adv && !hold && st != R_IDLE && go;
 endmodule

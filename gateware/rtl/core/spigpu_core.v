@@ -175,7 +175,7 @@ module spigpu_core #(
   wire [IDX_W-1:0] ras_idx;
   reg         ras_go;
   wire        adv, hold;
-  core_raster #(.IDX_W(IDX_W)) raster (
+  core_raster #(.IDX_W(IDX_W), .DSP(SMALL)) raster (
       .clk(clk), .rst(rst), .start(ras_go),
       .e_we(su_e_we), .e_data(su_e_data), .e0(ras_e0), .e1(ras_e1), .e2(ras_e2),
       .dx0(su_dx0), .dx1(su_dx1), .dx2(su_dx2), .dy0(su_dy0), .dy1(su_dy1), .dy2(su_dy2),
