@@ -44,17 +44,23 @@ module core_depth #(
     zaddr = 30'(byte_addr(base, {{(22-IDX_W){1'b0}}, idx, 2'b00}) >> 2);
   endfunction
 
+  // every function from one comparator (a subtractor's borrow) and one equality
   function passes(input [2:0] f, input [23:0] z, input [23:0] d);
-    case (f)
-      3'd0: passes = 1'b0;      // NEVER
-      3'd1: passes = z < d;     // LESS
-      3'd2: passes = z == d;    // EQUAL
-      3'd3: passes = z <= d;    // LEQUAL
-      3'd4: passes = z > d;     // GREATER
-      3'd5: passes = z != d;    // NOTEQUAL
-      3'd6: passes = z >= d;    // GEQUAL
-      default: passes = 1'b1;   // ALWAYS
-    endcase
+    reg lt, eq;
+    begin
+      lt = z < d;
+      eq = z == d;
+      case (f)
+        3'd0: passes = 1'b0;      // NEVER
+        3'd1: passes = lt;        // LESS
+        3'd2: passes = eq;        // EQUAL
+        3'd3: passes = lt || eq;  // LEQUAL
+        3'd4: passes = !lt && !eq;  // GREATER
+        3'd5: passes = !eq;       // NOTEQUAL
+        3'd6: passes = !lt;       // GEQUAL
+        default: passes = 1'b1;   // ALWAYS
+      endcase
+    end
   endfunction
 
   wire active = z_test || z_write;
@@ -72,7 +78,6 @@ module core_depth #(
       .head_valid(q_head), .head_item(q_item), .head_data(q_data), .pop(z_test && take));
 
   assign rd_valid = z_test && in_valid && !q_full;
-  assign rd_addr  = zaddr(fb_z16, in_pix[IDX_W-1:0]);
 
   // the pixel being resolved: the queue head (Z_TEST) or the input
   wire [PW-1:0] cur = z_test ? q_item : in_pix;
@@ -87,7 +92,19 @@ module core_depth #(
   // a pixel is resolved when it fails, or passes with room behind and its depth write accepted
   assign take     = cur_valid && (!pass || (room && (!z_write || wr_ready)));
   assign wr_valid = active && cur_valid && pass && z_write && room;
-  assign wr_addr  = zaddr(fb_z16, cur[IDX_W-1:0]);
+  generate
+    if (AW == 0) begin : one_adder
+      // one read in flight: a read is issued only while the queue is empty and a Z_TEST write
+      // only for its head, so one address adder serves both (its input chosen by the queue's
+      // registered state)
+      wire [29:0] a = zaddr(fb_z16, (z_test && !q_empty) ? q_item[IDX_W-1:0] : in_pix[IDX_W-1:0]);
+      assign rd_addr = a;
+      assign wr_addr = a;
+    end else begin : two_adders
+      assign rd_addr = zaddr(fb_z16, in_pix[IDX_W-1:0]);
+      assign wr_addr = zaddr(fb_z16, cur[IDX_W-1:0]);
+    end
+  endgenerate
   assign wr_data  = cur_z;
   assign in_ready = !active ? out_ready : z_test ? (!q_full && rd_ready) : take;
   assign passed   = active ? (take && pass) : (in_valid && out_ready);
