@@ -41,9 +41,9 @@ module core_raster #(
     output reg  [1:0]         op,      // OP_NONE / OP_RIGHT / OP_LEFT / OP_DOWN
     output wire [1:0]         op_next, // what `op` holds after this cycle's edge
     output reg                emit,    // the pixel reached by `op` is covered: emit it
-    output reg  [1:0]         px,      // low bits of the pixel position (dither)
-    output reg  [1:0]         py,
-    output reg  [IDX_W-1:0]   pidx     // py * fb_width + px
+    output wire [1:0]         px,      // low bits of the pixel position (dither)
+    output wire [1:0]         py,
+    output wire [IDX_W-1:0]   pidx     // py * fb_width + px
 );
   localparam [1:0] OP_NONE = 2'd0, OP_RIGHT = 2'd1, OP_LEFT = 2'd2, OP_DOWN = 2'd3;
   localparam [2:0] R_IDLE = 3'd0, R_ENTRY = 3'd1, R_SEEK = 3'd2, R_TOEND = 3'd3, R_EMIT = 3'd4,
@@ -272,12 +272,15 @@ module core_raster #(
         idx  <= idx_n;
         op   <= go ? sel : OP_NONE;
         emit <= emit_n;
-        px   <= x_n[1:0];
-        py   <= y_n[1:0];
-        pidx <= idx_n;
       end
     end
   end
+
+  // the pixel reached by `op` is where the walk now is: x, y and idx move together with op and emit
+  // (after a start they differ from that pixel's only while emit is 0, when nothing reads them)
+  assign px   = x[1:0];
+  assign py   = y[1:0];
+  assign pidx = idx;
 
   assign commit = !rst && !start && adv && !hold && st != R_IDLE && go;
 endmodule
