@@ -19,7 +19,8 @@ module scanout #(
   parameter        V_TOTAL = 525,
   parameter        CRC_BYTES = 1,         // bytes folded into the CRC per clock: 1 or 4
   parameter        BUF_WORDS = 2,         // read-ahead words (2 or 4)
-  parameter        BYTES_W = 24           // bits of the largest frame's W x H x 4 (the sizes FB_FORMAT can hold)
+  parameter        BYTES_W = 24,          // bits of the largest frame's W x H x 4 (the sizes FB_FORMAT can hold)
+  parameter        DSP = 0                // 1: the display counters and FRAME_COUNT in SB_MAC16s (dsp_counter)
 ) (
   input  wire        clk,
   input  wire        rst,
@@ -36,8 +37,8 @@ module scanout #(
   // timing
   output reg         vblank,
   output wire        vsync,        // one clock at the start of vertical blanking
-  output reg  [10:0] hcount,       // clock in the line, 0 .. LINE_CLOCKS - 1 (a board's video output
-  output reg  [10:0] vcount,       // runs on these), line 0 .. V_TOTAL - 1
+  output wire [10:0] hcount,       // clock in the line, 0 .. LINE_CLOCKS - 1 (a board's video output
+  output wire [10:0] vcount,       // runs on these), line 0 .. V_TOTAL - 1
   // memory (reads, in VRAM only)
   output wire        req_valid,
   input  wire        req_ready,
@@ -50,7 +51,7 @@ module scanout #(
   output wire [VAW:0] prot_lo,
   output wire [VAW:0] prot_hi,
   // registers
-  output reg  [15:0] frame_count,
+  output wire [15:0] frame_count,
   output wire [47:0] frame_crc,
   // the frame's bytes, in order: the top frame_nbytes bytes of frame_word (combinational)
   output wire        frame_valid,
@@ -68,14 +69,18 @@ module scanout #(
   wire frame_last = vcount == V_TOTAL[10:0] - 11'd1;
   assign vsync  = line_end && vcount == V_ACTIVE[10:0] - 11'd1;
   // vblank = vcount >= V_ACTIVE, as a flag turned at the two edges (no magnitude comparator)
+  // the counters (LINE_CLOCKS and V_TOTAL are at most 2^11) count in a DSP's accumulators on up5k
+  wire [15:0] hcount16, vcount16;
+  dsp_counter #(.DSP(DSP), .WIDE(0)) u_display (
+    .clk(clk), .ld_top(rst || line_end), .d_top(16'd0), .inc_top(1'b1),
+    .ld_bot(rst || (line_end && frame_last)), .d_bot(16'd0), .inc_bot(line_end), .q_top(hcount16), .q_bot(vcount16));
+  assign hcount = hcount16[10:0];
+  assign vcount = vcount16[10:0];
+  wire unused_count = &{1'b0, hcount16[15:11], vcount16[15:11]};
   always @(posedge clk) begin
     if (rst) begin
-      hcount <= 11'd0;
-      vcount <= 11'd0;
       vblank <= 1'b0;
     end else begin
-      hcount <= line_end ? 11'd0 : hcount + 11'd1;
-      if (line_end) vcount <= frame_last ? 11'd0 : vcount + 11'd1;
       if (vsync) vblank <= 1'b1;
       else if (line_end && frame_last) vblank <= 1'b0;
     end
@@ -93,6 +98,28 @@ module scanout #(
   localparam [VAW:0] VRAM_END = {1'b1, {VAW{1'b0}}};
   reg [BYTES_W-1:0] bytes_left; // bytes still to fold
   reg [31:0] crc, crc_value;
+  wire       frame_done;       // the frame's last byte is folded: FRAME_COUNT advances
+  wire       issued;           // a read of the frame was accepted: rd_addr advances
+  // FRAME_COUNT, and rd_addr where it fits a DSP half (VAW < 16; the ecp5 profile's is logic)
+  wire [15:0] rd_addr16;
+  dsp_counter #(.DSP(DSP), .WIDE(0)) u_frame_count (
+    .clk(clk), .ld_top(rst || soft_reset), .d_top(16'd0), .inc_top(frame_done),
+    .ld_bot(swap_req), .d_bot(16'({1'b0, swap_addr[VAW-3:0], 2'b00})), .inc_bot(issued),
+    .q_top(frame_count), .q_bot(rd_addr16));
+  generate
+    if (VAW < 16) begin : g_rd_dsp
+      always @* rd_addr = rd_addr16[VAW:0];
+      wire unused_rd = &{1'b0, rd_addr16};
+    end else begin : g_rd_logic
+      reg [VAW:0] rd_next;
+      always @(posedge clk) begin
+        if (swap_req) rd_next <= {1'b0, swap_addr[VAW-3:0], 2'b00};
+        else if (issued) rd_next <= rd_next + 1'b1;
+      end
+      always @* rd_addr = rd_next;
+      wire unused_rd = &{1'b0, rd_addr16};
+    end
+  endgenerate
   assign swap_ready   = !computing && !pending && !reading;
   assign swap_pending = computing || pending || reading;
   assign frame_crc    = {frame_count, crc_value};  // the frame number is FRAME_COUNT itself
@@ -172,7 +199,7 @@ module scanout #(
   end
   wire folding = reading && have_word && bytes_left != 0;
   wire popping = folding && word_done && buf_count != 3'd0;
-  wire issued  = req_valid && req_ready;
+  assign issued = req_valid && req_ready;
   wire take    = rsp_valid && drop == 3'd0;
   wire last    = folding && bytes_left == BYTES_W'(n_fold);
   assign frame_valid  = folding;
@@ -182,6 +209,7 @@ module scanout #(
   // until reading starts, rd_addr is the frame's first word (and above says it lies beyond VRAM)
   assign frame_addr   = above ? 28'hFFFFFFF : 28'(rd_addr[VAW-1:2]);
   assign frame_end    = last;
+  assign frame_done   = folding && last;
 
   always @(posedge clk) begin
     err_range <= 1'b0;
@@ -189,7 +217,6 @@ module scanout #(
       computing <= 1'b0;
       pending <= 1'b0;
       reading <= 1'b0;
-      frame_count <= 16'd0;
       crc_value <= 32'd0;
       buf_rd <= {BAW{1'b0}};
       buf_wr <= {BAW{1'b0}};
@@ -201,7 +228,6 @@ module scanout #(
     end else begin
       if (rsp_valid && drop != 3'd0) drop <= drop - 3'd1;
       outstanding <= outstanding + {2'd0, issued} - {2'd0, take};
-      if (issued) rd_addr <= rd_addr + 1'b1;
       if (take) begin
         buf_word[buf_wr] <= rsp_rdata;
         buf_wr <= buf_wr + 1'b1;
@@ -211,7 +237,6 @@ module scanout #(
 
       if (swap_req) begin
         computing <= 1'b1;
-        rd_addr <= {1'b0, swap_addr[VAW-3:0], 2'b00};
         above <= swap_addr[27:VAW-2] != {(30 - VAW){1'b0}};
         frame_format <= swap_format;
         frame_width <= swap_width;
@@ -243,7 +268,6 @@ module scanout #(
         byte_in_word <= word_done ? 2'd0 : byte_in_word + 2'd1;
         if (last) begin
           reading <= 1'b0;
-          frame_count <= frame_count + 16'd1;
           crc_value <= ~crc_next;
         end
       end
