@@ -20,7 +20,8 @@ module scanout #(
   parameter        CRC_BYTES = 1,         // bytes folded into the CRC per clock: 1 or 4
   parameter        BUF_WORDS = 2,         // read-ahead words (2 or 4)
   parameter        BYTES_W = 24,          // bits of the largest frame's W x H x 4 (the sizes FB_FORMAT can hold)
-  parameter        DSP = 0                // 1: the display counters and FRAME_COUNT in SB_MAC16s (dsp_counter)
+  parameter        DSP = 0                // 1: the display counters, FRAME_COUNT, the read address and the
+                                          // bytes left in SB_MAC16s (dsp_counter)
 ) (
   input  wire        clk,
   input  wire        rst,
@@ -96,7 +97,7 @@ module scanout #(
   reg         above;           // the frame starts beyond VRAM
   reg [VAW:0] end_vram;        // min(first word after the frame, 2^VAW)
   localparam [VAW:0] VRAM_END = {1'b1, {VAW{1'b0}}};
-  reg [BYTES_W-1:0] bytes_left; // bytes still to fold
+  wire [BYTES_W-1:0] bytes_left; // bytes still to fold
   reg [31:0] crc, crc_value;
   wire       frame_done;       // the frame's last byte is folded: FRAME_COUNT advances
   wire       issued;           // a read of the frame was accepted: rd_addr advances
@@ -198,6 +199,30 @@ module scanout #(
     end
   end
   wire folding = reading && have_word && bytes_left != 0;
+  // bytes_left: loaded one clock before the end is computed, counted down by the bytes folded; in
+  // a DSP on up5k (one byte a clock), holding ~bytes_left and counting up, as its accumulator can
+  wire bl_load = !(rst || soft_reset) && computing && !swap_req && mul_step == 4'd10;
+  wire bl_step = !(rst || soft_reset) && !(vsync && pending) && folding;
+  generate
+    if (DSP != 0 && CRC_BYTES == 1 && BYTES_W <= 32) begin : g_left_dsp
+      wire [31:0] bytes32 = 32'(bytes);
+      wire [31:0] bytes_inv = ~bytes32;
+      wire [15:0] nb_hi, nb_lo;
+      dsp_counter #(.DSP(1), .WIDE(1)) u_bytes_left (
+        .clk(clk), .ld_top(1'b0), .d_top(bytes_inv[31:16]), .inc_top(1'b0), .ld_bot(bl_load),
+        .d_bot(bytes_inv[15:0]), .inc_bot(bl_step), .q_top(nb_hi), .q_bot(nb_lo));
+      wire [31:0] nb = {nb_hi, nb_lo};
+      assign bytes_left = ~nb[BYTES_W-1:0];
+      wire unused_nb = &{1'b0, nb};
+    end else begin : g_left_logic
+      reg [BYTES_W-1:0] left;
+      always @(posedge clk) begin
+        if (bl_load) left <= bytes;
+        else if (bl_step) left <= left - BYTES_W'(n_fold);
+      end
+      assign bytes_left = left;
+    end
+  endgenerate
   wire popping = folding && word_done && buf_count != 3'd0;
   assign issued = req_valid && req_ready;
   wire take    = rsp_valid && drop == 3'd0;
@@ -248,7 +273,6 @@ module scanout #(
         if (mul_step != 4'd11) begin
           mul_acc <= product[BYTES_W-3:0];
           mul_step <= mul_step + 4'd1;
-          if (mul_step == 4'd10) bytes_left <= bytes;
         end else begin
           computing <= 1'b0;
           pending <= 1'b1;
@@ -264,7 +288,6 @@ module scanout #(
         byte_in_word <= 2'd0;
       end else if (folding) begin
         crc <= crc_next;
-        bytes_left <= bytes_left - BYTES_W'(n_fold);
         byte_in_word <= word_done ? 2'd0 : byte_in_word + 2'd1;
         if (last) begin
           reading <= 1'b0;
