@@ -90,7 +90,9 @@ def synth(profile, modules=False, abc9=False, packed=False):
         sys.exit(f"yosys failed on profile {profile}:\n{out.stderr[-2000:]}")
     if modules:
         return per_module(out.stdout)
-    res = count(out.stdout[out.stdout.rfind("=== spigpu_top ==="):])
+    # modules kept as their own (dsp_counter_mac) make stat list the totals under "design hierarchy"
+    h = out.stdout.rfind("=== design hierarchy ===")
+    res = count(out.stdout[h if h >= 0 else out.stdout.rfind("=== spigpu_top ==="):])
     if packed and profile == "up5k":
         res["lc"] = pack(files, cmd)
     return res

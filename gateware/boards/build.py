@@ -65,7 +65,9 @@ def yosys(top_v, top, cmd, net, log_path, params=""):
         raise ToolError(f"yosys failed on {top} (log {log_path}):\n{(out.stdout + out.stderr)[-1500:]}")
     with open(log_path + ".stat") as f:
         stat = f.read()
-    return stat[stat.rfind(f"=== {top} ==="):], secs
+    # modules kept as their own (dsp_counter_mac) make stat list the totals under "design hierarchy"
+    h = stat.rfind("=== design hierarchy ===")
+    return stat[h if h >= 0 else stat.rfind(f"=== {top} ==="):], secs
 
 
 def count_cells(stat, names):
