@@ -101,7 +101,9 @@ module scanout #(
   reg [31:0] crc, crc_value;
   wire       frame_done;       // the frame's last byte is folded: FRAME_COUNT advances
   wire       issued;           // a read of the frame was accepted: rd_addr advances
-  // FRAME_COUNT, and rd_addr where it fits a DSP half (VAW < 16; the ecp5 profile's is logic)
+  // FRAME_COUNT, and rd_addr where it fits a DSP half (VAW < 16; the ecp5 profile's is logic).
+  // rd_addr loads and counts also in a reset's clock: its value matters only while a swap is
+  // computed, pending or read, each of which a later swap_req starts with a load.
   wire [15:0] rd_addr16;
   dsp_counter #(.DSP(DSP), .WIDE(0)) u_frame_count (
     .clk(clk), .ld_top(rst || soft_reset), .d_top(16'd0), .inc_top(frame_done),
