@@ -80,7 +80,7 @@ def synth(profile, modules=False, abc9=False, packed=False):
     if abc9 and profile == "up5k":
         cmd += " -abc9 -device u"
     files = design_files()
-    # the ecp5 profile has no SPRAM: its primitive (known to synth_ice40) is a black box there
+    # the ecp5 profile has no SPRAM or SB_MAC16: their primitives (known to synth_ice40) are black boxes there
     lib = "read_verilog -lib sim/SB_SPRAM256KA.v sim/SB_MAC16.v; " if profile == "ecp5" else ""
     flat = " -noflatten" if modules else ""
     script = (f"{lib}read_verilog -sv -Irtl/soc -Irtl/core {' '.join(files)}; chparam -set PROFILE {value} spigpu_top; "
@@ -90,7 +90,9 @@ def synth(profile, modules=False, abc9=False, packed=False):
         sys.exit(f"yosys failed on profile {profile}:\n{out.stderr[-2000:]}")
     if modules:
         return per_module(out.stdout)
-    res = count(out.stdout[out.stdout.rfind("=== spigpu_top ==="):])
+    # modules kept as their own (dsp_counter_mac) make stat list the totals under "design hierarchy"
+    h = out.stdout.rfind("=== design hierarchy ===")
+    res = count(out.stdout[h if h >= 0 else out.stdout.rfind("=== spigpu_top ==="):])
     if packed and profile == "up5k":
         res["lc"] = pack(files, cmd)
     return res

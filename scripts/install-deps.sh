@@ -20,6 +20,7 @@ packages=(
   umockdev libumockdev-dev                    
   xvfb xauth x11-utils                        
   verilator yosys                             # gateware: rtl backend, ctest -L rtl (lint, co-simulation, yosys read)
+  iverilog                                    # gateware: rtl.dsp_counter (the SB_MAC16 model against yosys's)
   nextpnr-ice40 fpga-icestorm                 # gateware: iCE40 place and route, icepack (docs/gateware.md)
   python3                                     # scripts/gateware.sh (gateware/boards/build.py), gateware/synth.py
   openfpgaloader                              # gpubridge flash (iceprog comes with fpga-icestorm)

@@ -53,7 +53,7 @@ def need(tool, package):
 def yosys(top_v, top, cmd, net, log_path, params=""):
     need("yosys", "yosys")
     files = " ".join(synth.design_files())
-    # the ecp5 profile has no SPRAM: its primitive (known to synth_ice40) is a black box there
+    # the ecp5 profile has no SPRAM or SB_MAC16: their primitives (known to synth_ice40) are black boxes there
     lib = "read_verilog -lib sim/SB_SPRAM256KA.v sim/SB_MAC16.v; " if "ecp5" in cmd else ""
     # the board's own modules: every .v beside its top level
     bdir = os.path.dirname(top_v)
@@ -65,7 +65,9 @@ def yosys(top_v, top, cmd, net, log_path, params=""):
         raise ToolError(f"yosys failed on {top} (log {log_path}):\n{(out.stdout + out.stderr)[-1500:]}")
     with open(log_path + ".stat") as f:
         stat = f.read()
-    return stat[stat.rfind(f"=== {top} ==="):], secs
+    # modules kept as their own (dsp_counter_mac) make stat list the totals under "design hierarchy"
+    h = stat.rfind("=== design hierarchy ===")
+    return stat[h if h >= 0 else stat.rfind(f"=== {top} ==="):], secs
 
 
 def count_cells(stat, names):

@@ -26,16 +26,19 @@ module command_fifo #(
   (* no_rw_check *) reg [70:0] mem [0:(1 << AW) - 1];   // an entry is never read in the clock it is written
   reg [70:0] q;
   reg [AW-1:0] wr, rel, rd;
-  reg [10:0]   count;     // DEPTH <= 1023
+  // entries not yet taken, 0..DEPTH (DEPTH <= 1023): in the bits DEPTH needs (7 on up5k, not 11)
+  localparam integer CW = $clog2(DEPTH + 1);
+  reg [CW-1:0] count;
 
   wire [AW-1:0] held_count = wr - rel;
   wire          rd_fire = rd != rel && (!out_valid || pop);
 
   assign out_entry   = q;
-  localparam [10:0] DEPTH11 = DEPTH[10:0];
-  assign full        = count == DEPTH11;
-  assign nearly_full = DEPTH11 - count < 11'd32;
-  assign level       = count;
+  localparam [CW-1:0] DEPTH_C = DEPTH[CW-1:0];
+  localparam [CW:0]   NEAR    = DEPTH > 31 ? DEPTH - 31 : 0;   // fewer than 32 free: count >= DEPTH - 31
+  assign full        = count == DEPTH_C;
+  assign nearly_full = {1'b0, count} >= NEAR;
+  assign level       = 11'(count);
   assign held        = held_count != {AW{1'b0}};
 
   always @(posedge clk) begin
@@ -48,7 +51,7 @@ module command_fifo #(
       wr <= {AW{1'b0}};
       rel <= {AW{1'b0}};
       rd <= {AW{1'b0}};
-      count <= 11'd0;
+      count <= {CW{1'b0}};
       out_valid <= 1'b0;
     end else begin
       if (rd_fire) rd <= rd + 1'b1;
@@ -56,7 +59,7 @@ module command_fifo #(
       else if (pop) out_valid <= 1'b0;
       if (discard_held) begin
         wr <= rel;
-        count <= count - {{(11 - AW){1'b0}}, held_count} - {10'd0, pop};
+        count <= count - CW'(held_count) - CW'(pop);
       end else begin
         if (push && !full) begin
           wr <= wr + 1'b1;
@@ -64,7 +67,7 @@ module command_fifo #(
         end else if (release_held) begin
           rel <= wr;
         end
-        count <= count + {10'd0, push && !full} - {10'd0, pop};
+        count <= count + CW'(push && !full) - CW'(pop);
       end
     end
   end

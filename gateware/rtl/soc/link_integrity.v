@@ -7,7 +7,9 @@
 // bytes arrive at most every 8 SCK periods, so the engine keeps up at any core/SCK ratio >= 1.
 // Bytes of an aborted frame are folded too; that is invisible because a group with an aborted frame
 // fails its check whatever its CRC (section 4).
-module link_integrity (
+module link_integrity #(
+  parameter DSP = 0             // 1: the LINK_STATUS counters in two SB_MAC16s (dsp_counter)
+) (
   input  wire        clk,
   input  wire        rst,          // power-on or RESET: counters 0, STRICT 0
   // MOSI bytes from the SPI slave
@@ -35,8 +37,8 @@ module link_integrity (
   reg [7:0]  byte_sh;      // byte being folded, LSB first
   reg [3:0]  fold;         // bits left to fold
   reg        skip;         // the current frame is a LINK_CHECK / LINK_CTRL frame
-  reg [23:0] frames;
-  reg [15:0] groups_ok, groups_bad;
+  wire [23:0] frames;
+  wire [15:0] groups_ok, groups_bad;
   reg        group_failed;
 
   wire first_excluded = byte_data[6:0] == 7'h13 || byte_data[6:0] == 7'h14;
@@ -45,6 +47,22 @@ module link_integrity (
   wire match = ~crc == check_crc && !group_failed;
 
   assign link_status = {groups_bad, groups_ok, 7'd0, discarding, frames};
+
+  // the counters (dsp_counter: clear wins over count): FRAMES since the last LINK_CHECK / LINK_CTRL,
+  // GROUPS_OK / GROUPS_BAD since power-on or RESET
+  wire checked   = check_strobe && !discarding && !ctrl_strobe;
+  wire restarted = rst || ctrl_strobe || checked;
+  wire [15:0] frames_hi;
+  dsp_counter #(.DSP(DSP), .WIDE(1)) u_frames (
+    .clk(clk), .ld_top(1'b0), .d_top(16'd0), .inc_top(1'b0), .ld_bot(restarted), .d_bot(16'd0),
+    .inc_bot(frame_valid && !frame_excluded),
+    .q_top(frames_hi), .q_bot(frames[15:0]));
+  assign frames[23:16] = frames_hi[7:0];
+  dsp_counter #(.DSP(DSP), .WIDE(0)) u_groups (
+    .clk(clk), .ld_top(rst), .d_top(16'd0), .inc_top(checked && !match), .ld_bot(rst), .d_bot(16'd0),
+    .inc_bot(checked && match),
+    .q_top(groups_bad), .q_bot(groups_ok));
+  wire unused_hi = &{1'b0, frames_hi[15:8]};
 
   always @(posedge clk) begin
     release_held <= 1'b0;
@@ -55,9 +73,6 @@ module link_integrity (
       fold <= 4'd0;
       byte_sh <= 8'd0;
       skip <= 1'b0;
-      frames <= 24'd0;
-      groups_ok <= 16'd0;
-      groups_bad <= 16'd0;
       group_failed <= 1'b0;
       strict <= 1'b0;
       discarding <= 1'b0;
@@ -74,7 +89,6 @@ module link_integrity (
           fold <= 4'd8;
         end
       end
-      if (frame_valid && !frame_excluded) frames <= frames + 24'd1;
       if (frame_abort || drop_overflow) group_failed <= 1'b1;
       if (ctrl_strobe) begin
         strict <= ctrl_strict;
@@ -82,14 +96,11 @@ module link_integrity (
         discard_held <= 1'b1;
         crc <= 32'hFFFFFFFF;
         fold <= 4'd0;
-        frames <= 24'd0;
         group_failed <= 1'b0;
       end else if (check_strobe && !discarding) begin
         if (match) begin
-          groups_ok <= groups_ok + 16'd1;
           release_held <= 1'b1;
         end else begin
-          groups_bad <= groups_bad + 16'd1;
           err_link_crc <= 1'b1;
           if (strict) begin
             discard_held <= 1'b1;
@@ -98,7 +109,6 @@ module link_integrity (
         end
         crc <= 32'hFFFFFFFF;
         fold <= 4'd0;
-        frames <= 24'd0;
         group_failed <= 1'b0;
       end
     end

@@ -19,7 +19,9 @@ module scanout #(
   parameter        V_TOTAL = 525,
   parameter        CRC_BYTES = 1,         // bytes folded into the CRC per clock: 1 or 4
   parameter        BUF_WORDS = 2,         // read-ahead words (2 or 4)
-  parameter        BYTES_W = 24           // bits of the largest frame's W x H x 4 (the sizes FB_FORMAT can hold)
+  parameter        BYTES_W = 24,          // bits of the largest frame's W x H x 4 (the sizes FB_FORMAT can hold)
+  parameter        DSP = 0                // 1: the display counters, FRAME_COUNT, the read address and the
+                                          // bytes left in SB_MAC16s (dsp_counter)
 ) (
   input  wire        clk,
   input  wire        rst,
@@ -36,8 +38,8 @@ module scanout #(
   // timing
   output reg         vblank,
   output wire        vsync,        // one clock at the start of vertical blanking
-  output reg  [10:0] hcount,       // clock in the line, 0 .. LINE_CLOCKS - 1 (a board's video output
-  output reg  [10:0] vcount,       // runs on these), line 0 .. V_TOTAL - 1
+  output wire [10:0] hcount,       // clock in the line, 0 .. LINE_CLOCKS - 1 (a board's video output
+  output wire [10:0] vcount,       // runs on these), line 0 .. V_TOTAL - 1
   // memory (reads, in VRAM only)
   output wire        req_valid,
   input  wire        req_ready,
@@ -50,7 +52,7 @@ module scanout #(
   output wire [VAW:0] prot_lo,
   output wire [VAW:0] prot_hi,
   // registers
-  output reg  [15:0] frame_count,
+  output wire [15:0] frame_count,
   output wire [47:0] frame_crc,
   // the frame's bytes, in order: the top frame_nbytes bytes of frame_word (combinational)
   output wire        frame_valid,
@@ -68,14 +70,18 @@ module scanout #(
   wire frame_last = vcount == V_TOTAL[10:0] - 11'd1;
   assign vsync  = line_end && vcount == V_ACTIVE[10:0] - 11'd1;
   // vblank = vcount >= V_ACTIVE, as a flag turned at the two edges (no magnitude comparator)
+  // the counters (LINE_CLOCKS and V_TOTAL are at most 2^11) count in a DSP's accumulators on up5k
+  wire [15:0] hcount16, vcount16;
+  dsp_counter #(.DSP(DSP), .WIDE(0)) u_display (
+    .clk(clk), .ld_top(rst || line_end), .d_top(16'd0), .inc_top(1'b1),
+    .ld_bot(rst || (line_end && frame_last)), .d_bot(16'd0), .inc_bot(line_end), .q_top(hcount16), .q_bot(vcount16));
+  assign hcount = hcount16[10:0];
+  assign vcount = vcount16[10:0];
+  wire unused_count = &{1'b0, hcount16[15:11], vcount16[15:11]};
   always @(posedge clk) begin
     if (rst) begin
-      hcount <= 11'd0;
-      vcount <= 11'd0;
       vblank <= 1'b0;
     end else begin
-      hcount <= line_end ? 11'd0 : hcount + 11'd1;
-      if (line_end) vcount <= frame_last ? 11'd0 : vcount + 11'd1;
       if (vsync) vblank <= 1'b1;
       else if (line_end && frame_last) vblank <= 1'b0;
     end
@@ -91,8 +97,32 @@ module scanout #(
   reg         above;           // the frame starts beyond VRAM
   reg [VAW:0] end_vram;        // min(first word after the frame, 2^VAW)
   localparam [VAW:0] VRAM_END = {1'b1, {VAW{1'b0}}};
-  reg [BYTES_W-1:0] bytes_left; // bytes still to fold
+  wire [BYTES_W-1:0] bytes_left; // bytes still to fold
   reg [31:0] crc, crc_value;
+  wire       frame_done;       // the frame's last byte is folded: FRAME_COUNT advances
+  wire       issued;           // a read of the frame was accepted: rd_addr advances
+  // FRAME_COUNT, and rd_addr where it fits a DSP half (VAW < 16; the ecp5 profile's is logic).
+  // rd_addr loads and counts also in a reset's clock: its value matters only while a swap is
+  // computed, pending or read, each of which a later swap_req starts with a load.
+  wire [15:0] rd_addr16;
+  dsp_counter #(.DSP(DSP), .WIDE(0)) u_frame_count (
+    .clk(clk), .ld_top(rst || soft_reset), .d_top(16'd0), .inc_top(frame_done),
+    .ld_bot(swap_req), .d_bot(16'({1'b0, swap_addr[VAW-3:0], 2'b00})), .inc_bot(issued),
+    .q_top(frame_count), .q_bot(rd_addr16));
+  generate
+    if (VAW < 16) begin : g_rd_dsp
+      always @* rd_addr = rd_addr16[VAW:0];
+      wire unused_rd = &{1'b0, rd_addr16};
+    end else begin : g_rd_logic
+      reg [VAW:0] rd_next;
+      always @(posedge clk) begin
+        if (swap_req) rd_next <= {1'b0, swap_addr[VAW-3:0], 2'b00};
+        else if (issued) rd_next <= rd_next + 1'b1;
+      end
+      always @* rd_addr = rd_next;
+      wire unused_rd = &{1'b0, rd_addr16};
+    end
+  endgenerate
   assign swap_ready   = !computing && !pending && !reading;
   assign swap_pending = computing || pending || reading;
   assign frame_crc    = {frame_count, crc_value};  // the frame number is FRAME_COUNT itself
@@ -171,8 +201,32 @@ module scanout #(
     end
   end
   wire folding = reading && have_word && bytes_left != 0;
+  // bytes_left: loaded one clock before the end is computed, counted down by the bytes folded; in
+  // a DSP on up5k (one byte a clock), holding ~bytes_left and counting up, as its accumulator can
+  wire bl_load = !(rst || soft_reset) && computing && !swap_req && mul_step == 4'd10;
+  wire bl_step = !(rst || soft_reset) && !(vsync && pending) && folding;
+  generate
+    if (DSP != 0 && CRC_BYTES == 1 && BYTES_W <= 32) begin : g_left_dsp
+      wire [31:0] bytes32 = 32'(bytes);
+      wire [31:0] bytes_inv = ~bytes32;
+      wire [15:0] nb_hi, nb_lo;
+      dsp_counter #(.DSP(1), .WIDE(1)) u_bytes_left (
+        .clk(clk), .ld_top(1'b0), .d_top(bytes_inv[31:16]), .inc_top(1'b0), .ld_bot(bl_load),
+        .d_bot(bytes_inv[15:0]), .inc_bot(bl_step), .q_top(nb_hi), .q_bot(nb_lo));
+      wire [31:0] nb = {nb_hi, nb_lo};
+      assign bytes_left = ~nb[BYTES_W-1:0];
+      wire unused_nb = &{1'b0, nb};
+    end else begin : g_left_logic
+      reg [BYTES_W-1:0] left;
+      always @(posedge clk) begin
+        if (bl_load) left <= bytes;
+        else if (bl_step) left <= left - BYTES_W'(n_fold);
+      end
+      assign bytes_left = left;
+    end
+  endgenerate
   wire popping = folding && word_done && buf_count != 3'd0;
-  wire issued  = req_valid && req_ready;
+  assign issued = req_valid && req_ready;
   wire take    = rsp_valid && drop == 3'd0;
   wire last    = folding && bytes_left == BYTES_W'(n_fold);
   assign frame_valid  = folding;
@@ -182,6 +236,7 @@ module scanout #(
   // until reading starts, rd_addr is the frame's first word (and above says it lies beyond VRAM)
   assign frame_addr   = above ? 28'hFFFFFFF : 28'(rd_addr[VAW-1:2]);
   assign frame_end    = last;
+  assign frame_done   = folding && last;
 
   always @(posedge clk) begin
     err_range <= 1'b0;
@@ -189,7 +244,6 @@ module scanout #(
       computing <= 1'b0;
       pending <= 1'b0;
       reading <= 1'b0;
-      frame_count <= 16'd0;
       crc_value <= 32'd0;
       buf_rd <= {BAW{1'b0}};
       buf_wr <= {BAW{1'b0}};
@@ -201,7 +255,6 @@ module scanout #(
     end else begin
       if (rsp_valid && drop != 3'd0) drop <= drop - 3'd1;
       outstanding <= outstanding + {2'd0, issued} - {2'd0, take};
-      if (issued) rd_addr <= rd_addr + 1'b1;
       if (take) begin
         buf_word[buf_wr] <= rsp_rdata;
         buf_wr <= buf_wr + 1'b1;
@@ -211,7 +264,6 @@ module scanout #(
 
       if (swap_req) begin
         computing <= 1'b1;
-        rd_addr <= {1'b0, swap_addr[VAW-3:0], 2'b00};
         above <= swap_addr[27:VAW-2] != {(30 - VAW){1'b0}};
         frame_format <= swap_format;
         frame_width <= swap_width;
@@ -223,7 +275,6 @@ module scanout #(
         if (mul_step != 4'd11) begin
           mul_acc <= product[BYTES_W-3:0];
           mul_step <= mul_step + 4'd1;
-          if (mul_step == 4'd10) bytes_left <= bytes;
         end else begin
           computing <= 1'b0;
           pending <= 1'b1;
@@ -239,11 +290,9 @@ module scanout #(
         byte_in_word <= 2'd0;
       end else if (folding) begin
         crc <= crc_next;
-        bytes_left <= bytes_left - BYTES_W'(n_fold);
         byte_in_word <= word_done ? 2'd0 : byte_in_word + 2'd1;
         if (last) begin
           reading <= 1'b0;
-          frame_count <= frame_count + 16'd1;
           crc_value <= ~crc_next;
         end
       end

@@ -163,7 +163,7 @@ module spigpu_soc #(
     .swap_pending(swap_pending_w), .frame_count(frame_count), .frame_crc(frame_crc), .mem_ready(mem_ready),
     .mem_addr(mem_addr), .prefetch(prefetch), .mem_read_strobe(mem_read_strobe), .errors(errors));
 
-  link_integrity u_link (
+  link_integrity #(.DSP(PROFILE == 0 ? 1 : 0)) u_link (
     .clk(clk), .rst(rst_any), .byte_valid(byte_valid), .byte_first(byte_first), .byte_data(byte_data),
     .frame_valid(f_valid), .frame_idx(f_idx), .frame_abort(f_abort), .drop_overflow(drop_overflow),
     .check_strobe(check_strobe), .check_crc(check_crc), .ctrl_strobe(ctrl_strobe), .ctrl_strict(ctrl_strict),
@@ -212,7 +212,11 @@ module spigpu_soc #(
     .rsp_valid(m_rsp_valid), .rsp_rdata(rsp_rdata));
 
   scanout #(.VAW(VAW), .LINE_CLOCKS(LINE_CLOCKS), .V_ACTIVE(V_ACTIVE), .V_TOTAL(V_TOTAL),
-            .CRC_BYTES(CRC_BYTES), .BUF_WORDS(SCAN_BUF), .BYTES_W(SCAN_BYTES_W)) u_scan (
+            .CRC_BYTES(CRC_BYTES), .BUF_WORDS(SCAN_BUF), .BYTES_W(SCAN_BYTES_W),
+            // the UP5K's 8 SB_MAC16s: setup, the overlap check, the swap length, the rasteriser's
+            // three edges and LINK_STATUS's counters (u_link); the scanout's counters, worth fewer
+            // cells per DSP than the edges (docs/gateware.md fit-soc3), stay in logic
+            .DSP(0)) u_scan (
     .clk(clk), .rst(rst), .soft_reset(soft_reset), .swap_req(swap_req), .swap_addr(swap_addr),
     .swap_format(cmd_fb_format), .swap_width(cmd_fb_width), .swap_height(cmd_fb_height), .swap_ready(swap_ready),
     .swap_pending(swap_pending_w), .err_range(scan_err), .vblank(vblank), .vsync(vsync),
