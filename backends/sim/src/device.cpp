@@ -115,11 +115,17 @@ struct Device::State {
     if (crc_fill >= kCrcBufferBytes) fold_crc();
     link_frames = (link_frames + 1) & 0xFFFFFF;
   }
-  // Frames [begin, end) of the caller's buffer, already counted in link_frames.
-  void feed_crc_run(const std::uint8_t* begin, const std::uint8_t* end) {
+  // A run of frames [begin, end) of the caller's buffer that write_frames() executed at once as
+  // vertex writes: their bytes join the link CRC and they are counted (frames received, FIFO
+  // entries executed, LINK_STATUS.FRAMES) as frame() and execute() count each.
+  void take_run(const std::uint8_t* begin, const std::uint8_t* end) {
     if (begin == end) return;
     fold_crc();
     link_crc = crc32_update(link_crc, std::span<const std::uint8_t>(begin, end));
+    const auto n = static_cast<std::size_t>(end - begin) / kFrameBytes;
+    stats.frames_received += n;
+    stats.queued_executed += n;
+    link_frames = static_cast<std::uint32_t>((link_frames + n) & 0xFFFFFF);
   }
   void fold_crc() {
     link_crc = crc32_update(link_crc, std::span<const std::uint8_t>(crc_buffer.data(), crc_fill));
@@ -217,9 +223,9 @@ struct Device::State {
 
   // --- queued commands ---
   // The effect of a write that arrives while the device executes queued writes at once (below)
-  // on a register facts.vertex_write names: execute() without its general validation and dispatch.
+  // on a register facts.vertex_write names: execute() without its general validation and dispatch
+  // (and without its count: take_run() counts a whole run).
   void execute_vertex_write(std::uint8_t index, std::uint64_t data) {
-    ++stats.queued_executed;
     if (data & facts.reserved[index]) {  // validate(): rule 2 is the only one these registers have
       errors |= ERR_RESERVED_BITS;
       data &= ~facts.reserved[index];
@@ -446,29 +452,30 @@ struct Device::State {
   bool executes_at_once() const { return !strict && !discarding && untimed() && fifo.empty(); }
 
   // Device::write(FrameView): the same effect as frame() on each frame in turn, with the frames
-  // facts.vertex_write names taken straight from the wire while executes_at_once(). Their bytes
-  // join the link CRC in runs, folded from the caller's buffer before the next frame that takes
-  // frame() (only LINK_CHECK reads the CRC, and it always does) and at the end of the batch.
+  // facts.vertex_write names taken straight from the wire while executes_at_once(). Their CRC and
+  // counts are taken per run (take_run), before the next frame that goes through frame() and at
+  // the end of the batch, so whatever looks at them (a LINK_CHECK, a read, a swap's scanout
+  // callback, the caller after the batch) sees them as frame-by-frame arrival leaves them. Only a
+  // pixel observer, called while a run's triangles are drawn, could see them lag; it gets pixels,
+  // not the device.
   void write_frames(FrameView frames) {
     const std::uint8_t* b = frames.bytes.data();
     const std::uint8_t* const end = b + frames.size() * kFrameBytes;
-    const std::uint8_t* run = b;  // first frame of the run not yet in the link CRC
+    const std::uint8_t* run = b;  // first frame of the current run
     bool at_once = executes_at_once();
     for (; b != end; b += kFrameBytes) {
       if (at_once && facts.vertex_write[b[0]]) {
-        ++stats.frames_received;
-        link_frames = (link_frames + 1) & 0xFFFFFF;
         execute_vertex_write(b[0], load_be64(b + 1));
         continue;
       }
-      feed_crc_run(run, b);
+      take_run(run, b);
       run = b + kFrameBytes;
       const Frame f{(b[0] & 0x80) != 0, static_cast<std::uint8_t>(b[0] & 0x7F), load_be64(b + 1)};
       if (f.read) read(f.index);
       frame(f);
       at_once = executes_at_once();
     }
-    feed_crc_run(run, end);
+    take_run(run, end);
   }
 
   void frame(const Frame& f) {
