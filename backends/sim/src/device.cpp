@@ -34,12 +34,18 @@ struct RegisterFacts {
   std::array<std::uint64_t, kRegisterCount> reserved{};
   std::array<bool, kRegisterCount> has_enum{};
   std::array<const RegisterDesc*, kRegisterCount> desc{};  // null: no register at that index
+  // By a frame's first byte (R/W̄ and index): writes to the per-vertex registers, whose whole
+  // validation is their reserved bits (no enumeration, no range rule) and whose execution only
+  // latches them (VERTEX also assembles). Most frames of a drawing stream are these.
+  std::array<bool, 256> vertex_write{};
   RegisterFacts() {
     for (const auto& r : register_table()) {
       desc[r.index] = &r;
       reserved[r.index] = r.reserved_mask();
       for (const auto& f : r.fields) has_enum[r.index] = has_enum[r.index] || f.kind == FieldKind::Enum;
     }
+    for (const Reg r : {Reg::COLOR, Reg::TEXCOORD, Reg::VERTEX})
+      vertex_write[index_of(r)] = !has_enum[index_of(r)] && desc[index_of(r)]->path == Path::Queued;
   }
 };
 
@@ -108,6 +114,18 @@ struct Device::State {
     crc_fill += kFrameBytes;
     if (crc_fill >= kCrcBufferBytes) fold_crc();
     link_frames = (link_frames + 1) & 0xFFFFFF;
+  }
+  // A run of frames [begin, end) of the caller's buffer that write_frames() executed at once as
+  // vertex writes: their bytes join the link CRC and they are counted (frames received, FIFO
+  // entries executed, LINK_STATUS.FRAMES) as frame() and execute() count each.
+  void take_run(const std::uint8_t* begin, const std::uint8_t* end) {
+    if (begin == end) return;
+    fold_crc();
+    link_crc = crc32_update(link_crc, std::span<const std::uint8_t>(begin, end));
+    const auto n = static_cast<std::size_t>(end - begin) / kFrameBytes;
+    stats.frames_received += n;
+    stats.queued_executed += n;
+    link_frames = static_cast<std::uint32_t>((link_frames + n) & 0xFFFFFF);
   }
   void fold_crc() {
     link_crc = crc32_update(link_crc, std::span<const std::uint8_t>(crc_buffer.data(), crc_fill));
@@ -204,6 +222,18 @@ struct Device::State {
   }
 
   // --- queued commands ---
+  // The effect of a write that arrives while the device executes queued writes at once (below)
+  // on a register facts.vertex_write names: execute() without its general validation and dispatch
+  // (and without its count: take_run() counts a whole run).
+  void execute_vertex_write(std::uint8_t index, std::uint64_t data) {
+    if (data & facts.reserved[index]) {  // validate(): rule 2 is the only one these registers have
+      errors |= ERR_RESERVED_BITS;
+      data &= ~facts.reserved[index];
+    }
+    regs[index] = data;
+    if (index == index_of(Reg::VERTEX)) push_vertex(data);
+  }
+
   void execute(const FifoEntry& e) {
     ++stats.queued_executed;
     const std::uint64_t data = validate(e.index, e.data);
@@ -416,6 +446,38 @@ struct Device::State {
   }
 
   // --- arrival of a complete frame ---
+  // True when a queued write arriving now would execute at once: no group is held or being
+  // discarded (not strict), the FIFO is empty and untimed. Only frames handled by frame() change
+  // any of this: executing a queued write never does.
+  bool executes_at_once() const { return !strict && !discarding && untimed() && fifo.empty(); }
+
+  // Device::write(FrameView): the same effect as frame() on each frame in turn, with the frames
+  // facts.vertex_write names taken straight from the wire while executes_at_once(). Their CRC and
+  // counts are taken per run (take_run), before the next frame that goes through frame() and at
+  // the end of the batch, so whatever looks at them (a LINK_CHECK, a read, a swap's scanout
+  // callback, the caller after the batch) sees them as frame-by-frame arrival leaves them. Only a
+  // pixel observer, called while a run's triangles are drawn, could see them lag; it gets pixels,
+  // not the device.
+  void write_frames(FrameView frames) {
+    const std::uint8_t* b = frames.bytes.data();
+    const std::uint8_t* const end = b + frames.size() * kFrameBytes;
+    const std::uint8_t* run = b;  // first frame of the current run
+    bool at_once = executes_at_once();
+    for (; b != end; b += kFrameBytes) {
+      if (at_once && facts.vertex_write[b[0]]) {
+        execute_vertex_write(b[0], load_be64(b + 1));
+        continue;
+      }
+      take_run(run, b);
+      run = b + kFrameBytes;
+      const Frame f{(b[0] & 0x80) != 0, static_cast<std::uint8_t>(b[0] & 0x7F), load_be64(b + 1)};
+      if (f.read) read(f.index);
+      frame(f);
+      at_once = executes_at_once();
+    }
+    take_run(run, end);
+  }
+
   void frame(const Frame& f) {
     ++stats.frames_received;
     const auto reg = static_cast<Reg>(f.index);
@@ -521,11 +583,7 @@ void Device::write(const protocol::Frame& frame) {
   if (frame.read) s_->read(frame.index & 0x7F);
   frame_complete(frame);
 }
-void Device::write(protocol::FrameView frames) {
-  const std::uint8_t* b = frames.bytes.data();
-  for (std::size_t i = 0; i < frames.size(); ++i, b += kFrameBytes)
-    write(Frame{(b[0] & 0x80) != 0, static_cast<std::uint8_t>(b[0] & 0x7F), load_be64(b + 1)});
-}
+void Device::write(protocol::FrameView frames) { s_->write_frames(frames); }
 std::uint64_t Device::read(std::uint8_t index) {
   const std::uint64_t v = s_->read(index & 0x7F);
   frame_complete(Frame{true, static_cast<std::uint8_t>(index & 0x7F), 0});

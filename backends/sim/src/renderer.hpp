@@ -61,7 +61,7 @@ class Renderer {
   void wait_drawing();
   void draw_bands(unsigned worker);
   void draw_pending();
-  void prefetch_rows(const Vertex& a, const Vertex& b, const Vertex& c, const DrawState& st) const;
+  void prefetch_rows(const Triangle& t, const DrawState& st) const;
 
   VideoMemory& mem_;
   AccuracyKnobs knobs_;
