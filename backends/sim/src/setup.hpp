@@ -80,17 +80,6 @@ inline std::uint64_t round_mod64(double x) {
   return x >= 0 && x < 0x1p64 ? static_cast<std::uint64_t>(x) : 0u;  // 2^64 is 0 modulo 2^64
 }
 
-// The preview's small-triangle kernel (preview_plain_kernel.inc) lanes at the box origin, set up
-// with the triangle: eight pixels of its first row, or (`pairs`, boxes at most 4 wide) four pixels
-// of each of its first two rows. Lanes outside the box hold an edge value no row step makes
-// non-negative, so they are never covered.
-struct SmallLanes {
-  std::int32_t e[3][8];  // biased edge values
-  std::uint32_t c[4][8];  // colour planes (FixedPlanes' 8.24)
-  std::uint64_t z[8];     // Z plane (32.32), when the draw has depth
-  bool pairs = false;
-};
-
 struct Triangle {
   Vertex v[3];          // after the exchange of section 8.1 (D > 0)
   std::int64_t den = 0; // 2D
@@ -103,7 +92,6 @@ struct Triangle {
   std::uint8_t small = 0;               // preview small-triangle kernel + 1 (preview_plain.hpp), 0: none
   FloatPlanes fplane;                   // preview only (the planes the state needs)
   FixedPlanes xplane;                   // preview of an untextured state: fplane in fixed point
-  SmallLanes lanes;                     // small != 0: the small-triangle kernel's lanes
 };
 
 // Returns false when the triangle draws nothing (D = 0 or an empty clipped box). Planes are set up
