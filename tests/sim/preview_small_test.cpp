@@ -163,13 +163,6 @@ TEST(SimPreviewSmall, RecognisesItsTriangles) {
   EXPECT_EQ(setup_small_preview(make(100, 130), make(140, 130), make(100, 134), st, 4, t), SmallSetup::Empty);
 }
 
-DeviceOptions preview(unsigned threads) {
-  DeviceOptions o;
-  o.threads = threads;
-  o.accuracy.preview = true;
-  return o;
-}
-
 // Small triangles around the 16-row band boundaries of the thread split, in every plain state:
 // 1, 2 and 3 threads and a second run give the same bytes; coverage is the exact path's; colour
 // and Z within 1 LSB of exact (depth ALWAYS with the write: the last triangle wins everywhere).
@@ -202,7 +195,8 @@ TEST(SimPreviewSmall, SameBytesForAnyThreadCountAcrossBands) {
       return std::pair{std::vector<std::uint8_t>(m.begin(), m.begin() + Canvas::kZBase + kW * kH * 4),
                        d.stats().pixels_covered};
     };
-    const auto one = render(preview(1)), two = render(preview(2)), three = render(preview(3)), again = render(preview(1));
+    const auto one = render(preview_options(1)), two = render(preview_options(2)), three = render(preview_options(3)),
+               again = render(preview_options(1));
     ASSERT_EQ(one.first, two.first) << "round " << round;
     ASSERT_EQ(one.first, three.first) << "round " << round;
     ASSERT_EQ(one.first, again.first) << "round " << round;
