@@ -13,13 +13,6 @@
 namespace gpubridge::sim::test {
 namespace {
 
-DeviceOptions preview_options(unsigned threads) {
-  DeviceOptions o;
-  o.threads = threads;
-  o.accuracy.preview = true;
-  return o;
-}
-
 TEST(SimPreview, SameBytesForAnyThreadCountAndRun) {
   std::mt19937 rng(20261126);
   unsigned differs_from_exact = 0;

@@ -20,6 +20,14 @@ inline std::unique_ptr<Device> make_device(DeviceOptions o = {}) {
   return std::move(d.value());
 }
 
+// `--accuracy preview` with `threads` threads (preview_test.cpp, preview_small_test.cpp).
+inline DeviceOptions preview_options(unsigned threads) {
+  DeviceOptions o;
+  o.threads = threads;
+  o.accuracy.preview = true;
+  return o;
+}
+
 inline void w(Device& d, Reg r, std::uint64_t data) { d.write(protocol::write_frame(r, data)); }
 inline std::uint64_t rd(Device& d, Reg r) { return d.read(protocol::index_of(r)); }
 inline std::uint16_t errors_of(Device& d) { return static_cast<std::uint16_t>(rd(d, Reg::STATUS) >> 48); }

@@ -2,6 +2,9 @@
 
 #include <algorithm>
 
+#include "preview_plain.hpp"
+#include "rasterizer.hpp"
+
 namespace gpubridge::sim {
 
 using namespace protocol;
@@ -83,6 +86,8 @@ DrawState decode_draw_state(const RegisterValues& r, std::uint64_t vram_bytes) {
   // gateware's setup skips them otherwise), Z for the test or the write, S/T/Q when textured.
   s.mode_class = ((s.gouraud && !all_masked) ? 1u : 0u) | ((s.z_test || s.z_write) ? 2u : 0u) |
                  ((s.textured && !all_masked) ? 4u : 0u);
+  s.preview_ok = preview_applies(s);
+  s.preview_small = s.preview_ok ? preview_small_kernel(s) : 0;
   return s;
 }
 

@@ -50,6 +50,11 @@ struct DrawState {
   bool buffers_disjoint = false; // colour and depth buffers share no byte (pixel order between them is free)
   std::uint32_t keep_bits = 0;   // the stored bits of a pixel that the write mask keeps (RGBA8888: bytes, byte c = channel c)
   unsigned mode_class = 0;       // DeviceStats::by_mode index: the planes a gateware sets up and steps (timing only)
+  // `--accuracy preview` (decided once per state, not per triangle): whether the preview routine
+  // can draw it (preview_applies) and, for its small triangles, the small-triangle kernel + 1
+  // (preview_small_kernel, preview_plain.hpp; 0: none).
+  bool preview_ok = false;
+  std::uint8_t preview_small = 0;
 };
 
 // Register indices into the device's register file.

@@ -1,5 +1,6 @@
 #include "preview_plain.hpp"
 
+#include <algorithm>
 #include <cstring>
 
 #include "setup.hpp"
@@ -22,6 +23,26 @@ bool preview_plain_applies(const DrawState& st) {
     default: return false;
   }
 }
+
+std::uint8_t preview_small_kernel(const DrawState& st) {
+  using protocol::DepthFunc;
+  if (st.textured || !preview_plain_applies(st)) return 0;
+  unsigned z = 0;  // the order of kSmallKernels (preview_plain_kernel.inc)
+  if (st.z_test) {
+    switch (st.z_func) {
+      case DepthFunc::Less: z = 1; break;
+      case DepthFunc::LessEqual: z = 2; break;
+      case DepthFunc::Greater: z = 3; break;
+      case DepthFunc::GreaterEqual: z = 4; break;
+      default: z = 5; break;  // ALWAYS (preview_plain_applies admits no other)
+    }
+  } else if (st.z_write) {
+    z = 5;  // written, not tested: ALWAYS
+  }
+  return static_cast<std::uint8_t>(1 + 2 * z + (st.blend == protocol::BlendMode::Alpha ? 1 : 0));
+}
+
+using SmallKernel = PreviewCounts (*)(const Triangle&, const SmallTarget&);
 
 // The kernel twice: for AVX2 and for the baseline, picked once per process.
 #if defined(__clang__)
@@ -47,9 +68,26 @@ namespace plain_baseline {
 #undef PREVIEW_PLAIN_AVX2
 }  // namespace plain_baseline
 
-PreviewCounts shade_preview_plain(const PreviewPlain& t) {
+namespace {
+bool has_avx2() {
   static const bool avx2 = __builtin_cpu_supports("avx2");
-  return avx2 ? plain_avx2::shade(t) : plain_baseline::shade(t);
+  return avx2;
+}
+}  // namespace
+
+PreviewCounts shade_preview_plain(const PreviewPlain& t) {
+  return has_avx2() ? plain_avx2::shade(t) : plain_baseline::shade(t);
+}
+
+SmallSetup setup_small_preview(const Vertex& a, const Vertex& b, const Vertex& c, const DrawState& st,
+                               unsigned subpixel_bits, Triangle& t) {
+  return has_avx2() ? plain_avx2::setup_small(a, b, c, st, subpixel_bits, t)
+                    : plain_baseline::setup_small(a, b, c, st, subpixel_bits, t);
+}
+
+PreviewCounts shade_preview_small(const Triangle& t, const SmallTarget& d) {
+  static const SmallKernel* const kernels = has_avx2() ? plain_avx2::kSmallKernels : plain_baseline::kSmallKernels;
+  return kernels[t.small - 1](t, d);
 }
 
 }  // namespace gpubridge::sim

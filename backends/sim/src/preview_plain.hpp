@@ -25,6 +25,8 @@ namespace gpubridge::sim {
 
 struct FixedPlanes;
 struct FloatPlanes;
+struct Triangle;
+struct Vertex;
 
 // A textured plain draw's texture: an RGBA8888 texture inside VRAM, disjoint from both buffers.
 struct PreviewTexels {
@@ -58,5 +60,37 @@ struct PreviewPlain {
 bool preview_plain_applies(const DrawState& st);
 
 PreviewCounts shade_preview_plain(const PreviewPlain& t);
+
+// --- Small triangles (docs/simulator.md "Preview", issue 24) ---
+// A triangle of an untextured plain draw whose vertices span at most 127/16 pixel in x and in y
+// (so its box is at most 8 x 8 pixels and every edge value of the box's 8-lane rows fits 16 bits)
+// and whose box leaves room for 8 words per row takes a setup and a kernel of its own: the
+// coverage setup without the vertex copies and the 64-bit generality, the colour planes in four
+// double lanes at once and no FloatPlanes, and at draw time the row kernel entered directly
+// (no PreviewPlain, no range checks, one kernel per depth function and blend picked per state).
+// The planes are the same doubles rounded the same way as setup_triangle_preview's, so the bytes
+// are the plain kernel's (SimPreviewSmall.SameBytesAsTheRowKernel).
+
+// The small-triangle kernel of a state + 1, or 0 when the small path does not apply (textured,
+// not a plain draw, or the preview routine cannot draw it at all).
+std::uint8_t preview_small_kernel(const DrawState& st);
+
+enum class SmallSetup { Empty, Drawn, NotSmall };
+// Sets up t for the small-triangle kernel (st.preview_small != 0): Empty when it draws nothing
+// (D = 0 or an empty clipped box, as setup_triangle_preview), NotSmall when it is too big (t is
+// then unspecified: set it up with setup_triangle_preview).
+SmallSetup setup_small_preview(const Vertex& a, const Vertex& b, const Vertex& c, const DrawState& st,
+                               unsigned subpixel_bits, Triangle& t);
+
+// Where a small triangle's rows [ky0, ky0 + rows) (from its box origin) are drawn.
+struct SmallTarget {
+  std::uint8_t* color = nullptr;  // box origin column, first row drawn
+  std::uint8_t* depth = nullptr;  // its depth word (when the draw tests or writes depth)
+  std::size_t pitch = 0;          // bytes per row of either buffer
+  int ky0 = 0, rows = 0;
+  std::uint32_t zmask = 0xFFFFFF;  // the Z bits compared and stored (z_bits)
+  bool z_write = false;
+};
+PreviewCounts shade_preview_small(const Triangle& t, const SmallTarget& d);
 
 }  // namespace gpubridge::sim

@@ -57,7 +57,7 @@ void Renderer::draw(const Vertex& a, const Vertex& b, const Vertex& c, const std
   Triangle& t = batching ? batch_.emplace_back() : slots_[slot];
   // Preview mode sets up float planes for the preview routine where it applies (the exact path
   // draws the rest).
-  const bool ok = knobs_.preview && preview_applies(st) ? setup_triangle_preview(a, b, c, st, knobs_.subpixel_bits, observing, t)
+  const bool ok = knobs_.preview && st.preview_ok ? setup_triangle_preview(a, b, c, st, knobs_.subpixel_bits, observing, t)
                                                         : setup_triangle(a, b, c, st, knobs_.subpixel_bits, observing, t);
   if (!ok) {
     if (batching) batch_.pop_back();

@@ -1,6 +1,7 @@
 #include "setup.hpp"
 
 #include "color_planes.hpp"
+#include "preview_plain.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -110,22 +111,6 @@ bool setup_coverage(const Vertex& va, const Vertex& vb, const Vertex& vc, const 
   f.dy[i] = (d1 * static_cast<double>(b1.ey) + d2 * static_cast<double>(b2.ey)) * inv_d;
 }
 
-// x rounded to an integer (halves up), modulo 2^64. Below 2^62 in magnitude (every value but
-// those of extreme slivers' far box corners) one conversion; beyond, x is reduced modulo 2^64
-// first (exact in double: a multiple of 2^64 subtracted from a value that is a multiple of its own
-// unit), so no conversion ever sees a value out of range (NaN becomes 0).
-std::uint64_t round_mod64(double x) {
-  if (x > -0x1p62 && x < 0x1p62) {
-    const double h = x + 0.5;
-    auto i = static_cast<std::int64_t>(h);  // truncation; floor below
-    i -= static_cast<double>(i) > h;
-    return static_cast<std::uint64_t>(i);
-  }
-  x -= 0x1p64 * std::floor(x * 0x1p-64);
-  x = std::floor(x + 0.5);
-  return x >= 0 && x < 0x1p64 ? static_cast<std::uint64_t>(x) : 0u;  // 2^64 is 0 modulo 2^64
-}
-
 // round_mod64(x) modulo 2^32 for the colour planes: below 2^50 in magnitude (all but extreme
 // slivers) one add puts round(x) (to nearest, ties to even) in the low bits of a double whose unit
 // is 1, with no conversion at all.
@@ -166,6 +151,7 @@ bool setup_triangle(const Vertex& va, const Vertex& vb, const Vertex& vc, const 
   std::int64_t D = 0;
   if (!setup_coverage(va, vb, vc, state, subpixel_bits, t, e20, e01, D)) return false;
   t.preview = false;
+  t.small = 0;
   const Vertex* v = t.v;
   const Divider div(t.den);
   const bool color = all_attributes || state.gouraud;
@@ -190,6 +176,12 @@ bool setup_triangle(const Vertex& va, const Vertex& vb, const Vertex& vc, const 
 
 bool setup_triangle_preview(const Vertex& va, const Vertex& vb, const Vertex& vc, const DrawState& state,
                             unsigned subpixel_bits, bool observing, Triangle& t) {
+  // Small triangles of a plain untextured draw: a setup of their own (preview_plain.hpp).
+  if (state.preview_small != 0 && !observing) {
+    const SmallSetup s = setup_small_preview(va, vb, vc, state, subpixel_bits, t);
+    if (s != SmallSetup::NotSmall) return s == SmallSetup::Drawn;
+  }
+  t.small = 0;
   Edge e20, e01;  // the raw weights of vertices 1 and 2 at the box origin's sample point
   if (observing) {  // the observer reports the exact interpolants: set those up too
     if (!setup_triangle(va, vb, vc, state, subpixel_bits, true, t)) return false;

@@ -7,6 +7,7 @@
 // den = 2D and steps it with additions only: q += qx; r += rx; if (r >= den) { r -= den; ++q; }.
 // That yields exactly floor((2N + D) / (2D)) of section 9 at every pixel, with no division per
 // pixel and no drift.
+#include <cmath>
 #include <cstdint>
 
 #include "draw_state.hpp"
@@ -62,6 +63,23 @@ struct FixedPlanes {
   std::uint64_t z, zdx, zdy;           // Z (+0.5: the high word is the rounded value)
 };
 
+// x rounded to an integer (halves up), modulo 2^64. Below 2^62 in magnitude (every value but
+// those of extreme slivers' far box corners) one conversion; beyond, x is reduced modulo 2^64
+// first (exact in double: a multiple of 2^64 subtracted from a value that is a multiple of its own
+// unit), so no conversion ever sees a value out of range (NaN becomes 0). The preview's Z planes
+// in 32.32 (setup.cpp and the small-triangle setup of preview_plain_kernel.inc).
+inline std::uint64_t round_mod64(double x) {
+  if (x > -0x1p62 && x < 0x1p62) {
+    const double h = x + 0.5;
+    auto i = static_cast<std::int64_t>(h);  // truncation; floor below
+    i -= static_cast<double>(i) > h;
+    return static_cast<std::uint64_t>(i);
+  }
+  x -= 0x1p64 * std::floor(x * 0x1p-64);
+  x = std::floor(x + 0.5);
+  return x >= 0 && x < 0x1p64 ? static_cast<std::uint64_t>(x) : 0u;  // 2^64 is 0 modulo 2^64
+}
+
 struct Triangle {
   Vertex v[3];          // after the exchange of section 8.1 (D > 0)
   std::int64_t den = 0; // 2D
@@ -71,6 +89,7 @@ struct Triangle {
   std::uint8_t flat[4] = {0, 0, 0, 0};  // flat colour (first vertex as listed)
   std::uint64_t index = 0;              // kicked-triangle number
   bool preview = false;                 // set up by setup_triangle_preview: drawn from fplane
+  std::uint8_t small = 0;               // preview small-triangle kernel + 1 (preview_plain.hpp), 0: none
   FloatPlanes fplane;                   // preview only (the planes the state needs)
   FixedPlanes xplane;                   // preview of an untextured state: fplane in fixed point
 };
