@@ -87,6 +87,7 @@ DrawState decode_draw_state(const RegisterValues& r, std::uint64_t vram_bytes) {
   s.mode_class = ((s.gouraud && !all_masked) ? 1u : 0u) | ((s.z_test || s.z_write) ? 2u : 0u) |
                  ((s.textured && !all_masked) ? 4u : 0u);
   s.preview_ok = preview_applies(s);
+  s.preview_plain = s.preview_ok && preview_plain_applies(s);
   s.preview_small = s.preview_ok ? preview_small_kernel(s) : 0;
   return s;
 }

@@ -51,9 +51,11 @@ struct DrawState {
   std::uint32_t keep_bits = 0;   // the stored bits of a pixel that the write mask keeps (RGBA8888: bytes, byte c = channel c)
   unsigned mode_class = 0;       // DeviceStats::by_mode index: the planes a gateware sets up and steps (timing only)
   // `--accuracy preview` (decided once per state, not per triangle): whether the preview routine
-  // can draw it (preview_applies) and, for its small triangles, the small-triangle kernel + 1
-  // (preview_small_kernel, preview_plain.hpp; 0: none).
+  // can draw it (preview_applies), whether its plain kernel can (preview_plain_applies) and, for
+  // its small triangles, the small-triangle kernel + 1 (preview_small_kernel, preview_plain.hpp;
+  // 0: none).
   bool preview_ok = false;
+  bool preview_plain = false;
   std::uint8_t preview_small = 0;
 };
 

@@ -26,7 +26,7 @@ bool preview_plain_applies(const DrawState& st) {
 
 std::uint8_t preview_small_kernel(const DrawState& st) {
   using protocol::DepthFunc;
-  if (st.textured || !preview_plain_applies(st)) return 0;
+  if (st.textured || !st.preview_plain) return 0;
   unsigned z = 0;  // the order of kSmallKernels (preview_plain_kernel.inc)
   if (st.z_test) {
     switch (st.z_func) {

@@ -567,7 +567,7 @@ void rasterize_rows(const Triangle& t, const DrawState& st, RasterContext& ctx, 
   const bool gouraud = st.gouraud && colors_differ;   // Gouraud only when colours differ
   const bool depth = st.z_test || st.z_write;
   if (t.preview) {
-    if (preview_plain_applies(st)) return draw_preview_plain(t, st, ctx, ya, yz, depth);
+    if (st.preview_plain) return draw_preview_plain(t, st, ctx, ya, yz, depth);
     return draw_preview(t, st, ctx, ya, yz, gouraud, depth);
   }
   if (ctx.vector && draw_narrow(t, st, ctx, ya, yz, gouraud, depth)) return;
