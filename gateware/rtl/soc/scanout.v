@@ -19,9 +19,7 @@ module scanout #(
   parameter        V_TOTAL = 525,
   parameter        CRC_BYTES = 1,         // bytes folded into the CRC per clock: 1 or 4
   parameter        BUF_WORDS = 2,         // read-ahead words (2 or 4)
-  parameter        BYTES_W = 24,          // bits of the largest frame's W x H x 4 (the sizes FB_FORMAT can hold)
-  parameter        DSP = 0                // 1: the display counters, FRAME_COUNT, the read address and the
-                                          // bytes left in SB_MAC16s (dsp_counter)
+  parameter        BYTES_W = 24           // bits of the largest frame's W x H x 4 (the sizes FB_FORMAT can hold)
 ) (
   input  wire        clk,
   input  wire        rst,
@@ -70,9 +68,10 @@ module scanout #(
   wire frame_last = vcount == V_TOTAL[10:0] - 11'd1;
   assign vsync  = line_end && vcount == V_ACTIVE[10:0] - 11'd1;
   // vblank = vcount >= V_ACTIVE, as a flag turned at the two edges (no magnitude comparator)
-  // the counters (LINE_CLOCKS and V_TOTAL are at most 2^11) count in a DSP's accumulators on up5k
+  // the counters (LINE_CLOCKS and V_TOTAL are at most 2^11): dsp_counter's logic form; the UP5K's
+  // SB_MAC16s hold counters worth more cells each (docs/gateware.md, fit-soc3 and the merge after it)
   wire [15:0] hcount16, vcount16;
-  dsp_counter #(.DSP(DSP), .WIDE(0)) u_display (
+  dsp_counter #(.DSP(0), .WIDE(0)) u_display (
     .clk(clk), .ld_top(rst || line_end), .d_top(16'd0), .inc_top(1'b1),
     .ld_bot(rst || (line_end && frame_last)), .d_bot(16'd0), .inc_bot(line_end), .q_top(hcount16), .q_bot(vcount16));
   assign hcount = hcount16[10:0];
@@ -97,15 +96,15 @@ module scanout #(
   reg         above;           // the frame starts beyond VRAM
   reg [VAW:0] end_vram;        // min(first word after the frame, 2^VAW)
   localparam [VAW:0] VRAM_END = {1'b1, {VAW{1'b0}}};
-  wire [BYTES_W-1:0] bytes_left; // bytes still to fold
+  reg  [BYTES_W-1:0] bytes_left; // bytes still to fold
   reg [31:0] crc, crc_value;
   wire       frame_done;       // the frame's last byte is folded: FRAME_COUNT advances
   wire       issued;           // a read of the frame was accepted: rd_addr advances
-  // FRAME_COUNT, and rd_addr where it fits a DSP half (VAW < 16; the ecp5 profile's is logic).
+  // FRAME_COUNT, and rd_addr in the bottom half (VAW < 16; the ecp5 profile's is its own register).
   // rd_addr loads and counts also in a reset's clock: its value matters only while a swap is
   // computed, pending or read, each of which a later swap_req starts with a load.
   wire [15:0] rd_addr16;
-  dsp_counter #(.DSP(DSP), .WIDE(0)) u_frame_count (
+  dsp_counter #(.DSP(0), .WIDE(0)) u_frame_count (
     .clk(clk), .ld_top(rst || soft_reset), .d_top(16'd0), .inc_top(frame_done),
     .ld_bot(swap_req), .d_bot(16'({1'b0, swap_addr[VAW-3:0], 2'b00})), .inc_bot(issued),
     .q_top(frame_count), .q_bot(rd_addr16));
@@ -201,30 +200,13 @@ module scanout #(
     end
   end
   wire folding = reading && have_word && bytes_left != 0;
-  // bytes_left: loaded one clock before the end is computed, counted down by the bytes folded; in
-  // a DSP on up5k (one byte a clock), holding ~bytes_left and counting up, as its accumulator can
+  // bytes_left: loaded one clock before the end is computed, counted down by the bytes folded
   wire bl_load = !(rst || soft_reset) && computing && !swap_req && mul_step == 4'd10;
   wire bl_step = !(rst || soft_reset) && !(vsync && pending) && folding;
-  generate
-    if (DSP != 0 && CRC_BYTES == 1 && BYTES_W <= 32) begin : g_left_dsp
-      wire [31:0] bytes32 = 32'(bytes);
-      wire [31:0] bytes_inv = ~bytes32;
-      wire [15:0] nb_hi, nb_lo;
-      dsp_counter #(.DSP(1), .WIDE(1)) u_bytes_left (
-        .clk(clk), .ld_top(1'b0), .d_top(bytes_inv[31:16]), .inc_top(1'b0), .ld_bot(bl_load),
-        .d_bot(bytes_inv[15:0]), .inc_bot(bl_step), .q_top(nb_hi), .q_bot(nb_lo));
-      wire [31:0] nb = {nb_hi, nb_lo};
-      assign bytes_left = ~nb[BYTES_W-1:0];
-      wire unused_nb = &{1'b0, nb};
-    end else begin : g_left_logic
-      reg [BYTES_W-1:0] left;
-      always @(posedge clk) begin
-        if (bl_load) left <= bytes;
-        else if (bl_step) left <= left - BYTES_W'(n_fold);
-      end
-      assign bytes_left = left;
-    end
-  endgenerate
+  always @(posedge clk) begin
+    if (bl_load) bytes_left <= bytes;
+    else if (bl_step) bytes_left <= bytes_left - BYTES_W'(n_fold);
+  end
   wire popping = folding && word_done && buf_count != 3'd0;
   assign issued = req_valid && req_ready;
   wire take    = rsp_valid && drop == 3'd0;

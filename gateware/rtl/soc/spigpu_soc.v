@@ -212,11 +212,10 @@ module spigpu_soc #(
     .rsp_valid(m_rsp_valid), .rsp_rdata(rsp_rdata));
 
   scanout #(.VAW(VAW), .LINE_CLOCKS(LINE_CLOCKS), .V_ACTIVE(V_ACTIVE), .V_TOTAL(V_TOTAL),
-            .CRC_BYTES(CRC_BYTES), .BUF_WORDS(SCAN_BUF), .BYTES_W(SCAN_BYTES_W),
-            // the UP5K's 8 SB_MAC16s: setup, the overlap check, the swap length, the rasteriser's
-            // three edges and LINK_STATUS's counters (u_link); the scanout's counters, worth fewer
-            // cells per DSP than the edges (docs/gateware.md fit-soc3), stay in logic
-            .DSP(0)) u_scan (
+            // no DSP counters here: the UP5K's 8 SB_MAC16s hold setup, the overlap check, the swap
+            // length, the rasteriser's three edges and LINK_STATUS's counters (u_link), which save
+            // more cells per DSP than the scanout's (docs/gateware.md fit-soc3 and the merge after it)
+            .CRC_BYTES(CRC_BYTES), .BUF_WORDS(SCAN_BUF), .BYTES_W(SCAN_BYTES_W)) u_scan (
     .clk(clk), .rst(rst), .soft_reset(soft_reset), .swap_req(swap_req), .swap_addr(swap_addr),
     .swap_format(cmd_fb_format), .swap_width(cmd_fb_width), .swap_height(cmd_fb_height), .swap_ready(swap_ready),
     .swap_pending(swap_pending_w), .err_range(scan_err), .vblank(vblank), .vsync(vsync),
