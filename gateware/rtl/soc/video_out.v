@@ -10,7 +10,8 @@
 // docs/protocol.md section 6 says and the top OUT_BITS bits leave (4 for the 12-bit DVI Pmod, 8 for
 // TMDS). A framebuffer is scaled by 2^SCALE_LOG2 and centred (CENTRE = 1) or placed at the top left
 // (CENTRE = 0: no placement adders, the iCEBreaker); what does not fit the screen is cropped,
-// and so are pixels beyond the 2^LINE_AW words a line buffer half holds. Words beyond VRAM show as 0.
+// and so are pixels beyond the 2^LINE_AW words a line buffer half holds. Words beyond VRAM show as 0
+// (the arbiter answers them so).
 // The timing is the scanout's (LINE_CLOCKS = H_TOTAL x PIX_DIV), so its vertical sync, where the swap is
 // latched, is the end of this stage's last visible line.
 module video_out #(
@@ -41,7 +42,7 @@ module video_out #(
   input  wire [1:0]          frame_format,
   input  wire [10:0]         frame_width,
   input  wire [10:0]         frame_height,
-  // memory-arbiter client (reads inside VRAM only, answers in order)
+  // memory-arbiter client (reads, answered in order; at or beyond 2^VAW words the arbiter answers 0)
   output wire                req_valid,
   input  wire                req_ready,
   output wire [29:0]         req_addr,
@@ -171,26 +172,23 @@ module video_out #(
   reg  [LINE_AW-1:0] wr_idx;
   reg         wr_half;
   reg  [1:0]  lead [0:1];                  // pixels before the line's first pixel in its first word
-  reg  [3:0]  outstanding;
   wire [1:0]  lead0 = ppw_l2 == 2'd2 ? byte0[1:0] : ppw_l2 == 2'd1 ? {1'b0, byte0[1]} : 2'd0;
-  wire        in_vram = !f_beyond && !f_addr[VAW];
-  assign req_valid = f_left != F_DONE && in_vram;
-  assign req_addr  = 30'(f_addr[VAW-1:0]);
+  // a word beyond VRAM is asked for at an address >= 2^VAW, which the arbiter answers with 0 in order
+  // (no zero fill here: no count of reads in flight, no multiplexer on the line buffer's data)
+  assign req_valid = f_left != F_DONE;
+  assign req_addr  = 30'({f_beyond || f_addr[VAW], f_addr[VAW-1:0]});
   wire        issued = req_valid && req_ready;
-  wire        zero_fill = f_left != F_DONE && !in_vram && outstanding == 4'd0;
   always @(posedge clk) begin
     if (rst) begin
       f_left <= F_DONE;
-      outstanding <= 4'd0;
       wr_idx <= {LINE_AW{1'b0}};
       {f_in, f_rep, f_half, n_show, n_half, l_show} <= 6'd0;
     end else begin
-      outstanding <= outstanding + {3'd0, issued} - {3'd0, rsp_valid};
-      if (rsp_valid || zero_fill) begin
-        lb[{wr_half, wr_idx}] <= rsp_valid ? rsp_rdata : 32'd0;
+      if (rsp_valid) begin
+        lb[{wr_half, wr_idx}] <= rsp_rdata;
         wr_idx <= wr_idx + 1'b1;
       end
-      if (issued || zero_fill) begin
+      if (issued) begin
         f_addr <= f_addr + 1'b1;
         f_left <= f_left - 1'b1;
       end
