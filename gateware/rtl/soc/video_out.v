@@ -61,6 +61,8 @@ module video_out #(
   localparam V_TOTAL = V_ACTIVE + V_FRONT + V_SYNC + V_BACK;
   localparam S = SCALE_LOG2;
 
+`include "const_compare.vh"
+
   // --- pixel enable and display timing: the scanout's counters (a pixel in the last clock of each
   // PIX_DIV) ---
   wire [10:0] hc, vc;
@@ -117,12 +119,12 @@ module video_out #(
       assign y0_m2 = 11'(V_TOTAL - 2);
       assign x0_new = 11'd0;
       assign y0_m2_new = 11'(V_TOTAL - 2);
-      assign x_end_new = sw > 12'(H_ACTIVE) ? 11'(H_ACTIVE) : sw[10:0];
-      assign y_end_m2_new = sh > 12'(V_ACTIVE) ? 11'(V_ACTIVE - 2) : sh_m2[11] ? 11'(V_TOTAL) + sh_m2[10:0] : sh_m2[10:0];
+      assign x_end_new = ge_const(16'(sw), H_ACTIVE + 1) ? 11'(H_ACTIVE) : sw[10:0];
+      assign y_end_m2_new = ge_const(16'(sh), V_ACTIVE + 1) ? 11'(V_ACTIVE - 2) : sh_m2[11] ? 11'(V_TOTAL) + sh_m2[10:0] : sh_m2[10:0];
     end
   endgenerate
   // only the pixels the screen shows are read: at most H_ACTIVE / 2^S of a line
-  wire [10:0] w_shown = frame_width > 11'(H_ACTIVE >> S) ? 11'(H_ACTIVE >> S) : frame_width;
+  wire [10:0] w_shown = ge_const(16'(frame_width), (H_ACTIVE >> S) + 1) ? 11'(H_ACTIVE >> S) : frame_width;
   wire [10:0] words_w = w_shown >> ppw_new;
   always @(posedge clk) begin
     if (rst) begin
@@ -135,7 +137,7 @@ module video_out #(
       x_end <= x_end_new;
       y_end_m2 <= y_end_m2_new;
       stride <= {frame_width, 2'b00} >> ppw_new;
-      n_words <= words_w > 11'((1 << LINE_AW) - 2) ? (LINE_AW+1)'((1 << LINE_AW) - 2) : words_w[LINE_AW:0];
+      n_words <= ge_const(16'(words_w), (1 << LINE_AW) - 1) ? (LINE_AW+1)'((1 << LINE_AW) - 2) : words_w[LINE_AW:0];
     end
   end
 
@@ -232,28 +234,10 @@ module video_out #(
       widx_r <= advance && word_end && !widx[LINE_AW] ? widx + 1'b1 : widx;
     end
   end
-  // visible part and sync pulses of the line and the frame, as flags for the current hc / vc that
-  // turn where the counters pass an edge (equality compares: no magnitude comparators)
-  reg         h_act, h_sync, v_act, v_sync;
-  always @(posedge clk) begin
-    if (rst) begin
-      {h_act, h_sync, v_act, v_sync} <= 4'b1010;   // hc = vc = 0
-    end else if (pix_en) begin
-      if (h_last) h_act <= 1'b1;
-      else if (hc == 11'(H_ACTIVE - 1)) h_act <= 1'b0;
-      if (hc == 11'(H_ACTIVE + H_FRONT - 1)) h_sync <= 1'b1;
-      else if (hc == 11'(H_ACTIVE + H_FRONT + H_SYNC - 1)) h_sync <= 1'b0;
-      if (h_last) begin
-        if (vc == 11'(V_TOTAL - 1)) v_act <= 1'b1;
-        else if (vc == 11'(V_ACTIVE - 1)) v_act <= 1'b0;
-        if (vc == 11'(V_ACTIVE + V_FRONT - 1)) v_sync <= 1'b1;
-        else if (vc == 11'(V_ACTIVE + V_FRONT + V_SYNC - 1)) v_sync <= 1'b0;
-      end
-    end
-  end
-  wire        active = h_act && v_act;
-  wire        hs0 = h_sync;
-  wire        vs0 = v_sync;
+  // visible part and sync pulses of the line and the frame, decoded from hc / vc (no flag registers)
+  wire        active = !ge_const(16'(hc), H_ACTIVE) && !ge_const(16'(vc), V_ACTIVE);
+  wire        hs0 = ge_const(16'(hc), H_ACTIVE + H_FRONT) && !ge_const(16'(hc), H_ACTIVE + H_FRONT + H_SYNC);
+  wire        vs0 = ge_const(16'(vc), V_ACTIVE + V_FRONT) && !ge_const(16'(vc), V_ACTIVE + V_FRONT + V_SYNC);
   reg  [31:0] word1;
   reg         on1, de1, hs1, vs1;
   reg  [1:0]  sub1;
