@@ -20,7 +20,8 @@ module spigpu_top #(
   parameter VIDEO_PIX_DIV    = 1, // core clocks per pixel
   parameter VIDEO_SCALE_LOG2 = 1, // framebuffer pixels shown 2^n x 2^n
   parameter VIDEO_LINE_AW    = 8, // line buffer: 2 x 2^n words
-  parameter VIDEO_BITS       = 4  // bits per colour channel at the pins
+  parameter VIDEO_BITS       = 4, // bits per colour channel at the pins
+  parameter VIDEO_CENTRE     = 1  // a smaller framebuffer centred (1) or at the top left (0)
 ) (
   input  wire        clk,
   input  wire        rst,
@@ -138,7 +139,7 @@ module spigpu_top #(
     if (VIDEO != 0) begin : g_video
       localparam VAW = PROFILE == 0 ? 15 : 23;
       video_out #(.VAW(VAW), .PIX_DIV(VIDEO_PIX_DIV), .SCALE_LOG2(VIDEO_SCALE_LOG2),
-                  .LINE_AW(VIDEO_LINE_AW), .OUT_BITS(VIDEO_BITS)) u_video (
+                  .LINE_AW(VIDEO_LINE_AW), .OUT_BITS(VIDEO_BITS), .CENTRE(VIDEO_CENTRE)) u_video (
         .clk(clk), .rst(rst), .hcount(disp_hcount), .vcount(disp_vcount), .frame_start(frame_start),
         .frame_addr(disp_frame_addr),
         .frame_format(frame_format), .frame_width(frame_width), .frame_height(frame_height),

@@ -10,7 +10,8 @@
 //   (iceprog's wiring); chip select is ADBUS3, which reaches the FPGA on the red LED's net through the
 //   board's AUX CS jumper, so the flash's own select (ADBUS4) stays high and the flash never answers:
 //   the FPGA drives the flash select high as well.
-// - Video: the 320 x 240 framebuffer shown 2x (640 x 480 filled), a smaller one centred; RGB444 out.
+// - Video: the 320 x 240 framebuffer shown 2x (640 x 480 filled), a smaller one at the top left (no
+//   centring adders: about 50 logic cells, docs/gateware.md "fit-soc4"); RGB444 out.
 // - Reset: until the PLL locks, and while the user button is held.
 // - VIDEO = 0 (scripts/gateware.sh --no-video) leaves the video output out, for a headless board
 //   read back over SPI (the profile's "scanout": "readback"): the DVI pins then stay low.
@@ -54,7 +55,8 @@ module icebreaker_top #(
   wire [3:0] r, g, b;
   /* verilator lint_off PINCONNECTEMPTY */
   spigpu_top #(.PROFILE(0), .CLK_MHZ(25), .LINE_CLOCKS(800), .V_ACTIVE(480), .V_TOTAL(525), .PERF(0),
-               .VIDEO(VIDEO), .VIDEO_PIX_DIV(1), .VIDEO_SCALE_LOG2(1), .VIDEO_LINE_AW(8), .VIDEO_BITS(4)) u_gpu (
+               .VIDEO(VIDEO), .VIDEO_PIX_DIV(1), .VIDEO_SCALE_LOG2(1), .VIDEO_LINE_AW(8), .VIDEO_BITS(4),
+               .VIDEO_CENTRE(0)) u_gpu (
     .clk(clk), .rst(rst), .spi_sck(spi_sck), .spi_cs_n(spi_cs_n), .spi_mosi(spi_mosi), .spi_miso(miso),
     .spi_miso_oe(miso_oe), .busy_pin(), .sd_cke(), .sd_cs_n(), .sd_ras_n(), .sd_cas_n(), .sd_we_n(), .sd_ba(),
     .sd_a(), .sd_dqm(), .sd_dq_o(), .sd_dq_oe(), .sd_dq_i(16'd0), .vblank(), .vsync(), .frame_valid(),

@@ -76,6 +76,7 @@ module command_exec #(
   output wire         executed       // one clock per FIFO entry executed (timing-model counter C)
 );
 `include "spigpu_regs.vh"
+`include "const_compare.vh"
 
   // --- validation (section 5) ---
   wire [6:0]  idx = in_entry[70:64];
@@ -87,13 +88,13 @@ module command_exec #(
   localparam [10:0] MAXH = MAX_HEIGHT[10:0];
 
   function automatic [3:0] clamp_log2(input [3:0] v);
-    clamp_log2 = v < 4'd3 ? 4'd3 : v > 4'd10 ? 4'd10 : v;
+    clamp_log2 = !ge_const(16'(v), 3) ? 4'd3 : ge_const(16'(v), 11) ? 4'd10 : v;
   endfunction
   function automatic [10:0] clamp_dim(input [10:0] v, input [10:0] max);
-    clamp_dim = v == 11'd0 ? 11'd1 : v > max ? max : v;
+    clamp_dim = v == 11'd0 ? 11'd1 : ge_const(16'(v), 32'(max) + 1) ? max : v;   // max is a constant
   endfunction
   function automatic [10:0] clamp_1024(input [10:0] v);
-    clamp_1024 = v > 11'd1024 ? 11'd1024 : v;
+    clamp_1024 = ge_const(16'(v), 1025) ? 11'd1024 : v;
   endfunction
   function automatic format_ok(input [1:0] f);
     format_ok = !((f == 2'd1 && !FEATURES[4]) || (f == 2'd2 && !FEATURES[5]));

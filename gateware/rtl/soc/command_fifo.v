@@ -29,6 +29,7 @@ module command_fifo #(
   // entries not yet taken, 0..DEPTH (DEPTH <= 1023): in the bits DEPTH needs (7 on up5k, not 11)
   localparam integer CW = $clog2(DEPTH + 1);
   reg [CW-1:0] count;
+`include "const_compare.vh"
 
   wire [AW-1:0] held_count = wr - rel;
   wire          rd_fire = rd != rel && (!out_valid || pop);
@@ -37,7 +38,7 @@ module command_fifo #(
   localparam [CW-1:0] DEPTH_C = DEPTH[CW-1:0];
   localparam [CW:0]   NEAR    = DEPTH > 31 ? DEPTH - 31 : 0;   // fewer than 32 free: count >= DEPTH - 31
   assign full        = count == DEPTH_C;
-  assign nearly_full = {1'b0, count} >= NEAR;
+  assign nearly_full = ge_const(16'(count), 32'(NEAR));
   assign level       = 11'(count);
   assign held        = held_count != {AW{1'b0}};
 

@@ -8,7 +8,9 @@
 //
 // VRAM bounds (docs/protocol.md section 6) for the core: a write beyond VRAM is dropped and a read
 // beyond returns 0, both raising ERR_MEM_RANGE. Such a read waits until no other read is in flight
-// so that its zero can be answered in order. (The other clients never ask beyond VRAM.)
+// so that its zero can be answered in order. The video output's reads beyond VRAM (a displayed buffer
+// running past its end) are answered with 0 the same way, the scanout and the core waiting meanwhile;
+// the memory-access unit and the scanout never ask beyond VRAM.
 //
 // Swap protection (docs/gateware.md "Scanout"): from the FB_DISPLAY write's execution until the
 // frame has been read, writes into the part of the display buffer the scanout has not read yet wait.
@@ -22,7 +24,7 @@ module mem_arbiter #(
 ) (
   input  wire        clk,
   input  wire        rst,
-  // video output (reads inside VRAM; constant 0 where there is none)
+  // video output (reads; beyond VRAM answered 0; constant 0 where there is none)
   input  wire        v_req_valid,
   output wire        v_req_ready,
   input  wire [29:0] v_req_addr,
@@ -69,7 +71,8 @@ module mem_arbiter #(
   reg [1:0] tag [0:(1 << TAG_AW) - 1];
   reg [TAG_AW-1:0] tag_rd, tag_wr;
   reg [TAG_AW:0] tag_count;
-  reg       zero_rsp;     // answer a core read beyond VRAM with 0 in this cycle
+  reg       zero_rsp;     // answer a core or video read beyond VRAM with 0 in this cycle
+  reg       zero_v;       // that answer is the video output's
   reg [3:0] scan_wait;
 
   wire tags_room  = tag_count != TAGS;
@@ -85,6 +88,8 @@ module mem_arbiter #(
   wire m_block = m_writes && w_prot;
   wire c_block = !m_writes && c_req_we && w_prot;
   wire c_oor   = c_req_addr[29:AW] != 0;   // beyond VRAM: an upper bit, no comparator
+  wire v_oor   = v_req_addr[29:AW] != 0;
+  wire v_hold  = v_req_valid && v_oor;       // the scanout and the core wait while it drains the reads
 
   wire m_ok  = m_req_valid && !m_block && (m_req_we || tags_room);
   wire s_ok  = s_req_valid && tags_room;
@@ -93,19 +98,19 @@ module mem_arbiter #(
 
   // choice (independent of b_req_ready)
   wire pick_m = m_ok;
-  wire pick_v = !pick_m && v_req_valid && tags_room;
-  wire pick_s = !pick_v && !pick_m && s_ok && (scan_wait == 4'd15 || !(c_ok || c_zero));
-  wire pick_c = !pick_v && !pick_m && !pick_s && c_ok;
-  wire pick_z = !pick_v && !pick_m && !pick_s && !c_ok && c_zero;
+  wire pick_v = !pick_m && v_req_valid && (v_oor ? tags_empty && !b_rsp_valid : tags_room);
+  wire pick_s = !pick_v && !v_hold && !pick_m && s_ok && (scan_wait == 4'd15 || !(c_ok || c_zero));
+  wire pick_c = !pick_v && !v_hold && !pick_m && !pick_s && c_ok;
+  wire pick_z = !pick_v && !v_hold && !pick_m && !pick_s && !c_ok && c_zero;
 
-  assign b_req_valid = pick_v || pick_m || pick_s || pick_c;
+  assign b_req_valid = (pick_v && !v_oor) || pick_m || pick_s || pick_c;
   assign b_req_we    = pick_m ? m_req_we : pick_c ? c_req_we : 1'b0;
   wire [29:0] addr   = pick_m ? m_req_addr : pick_v ? v_req_addr : pick_s ? s_req_addr : c_req_addr;
   assign b_req_addr  = addr[AW-1:0];
   assign b_req_wdata = pick_m ? m_req_wdata : c_req_wdata;
   assign b_req_be    = pick_c ? c_req_be : 4'hF;
 
-  assign v_req_ready = pick_v && b_req_ready;
+  assign v_req_ready = pick_v && (b_req_ready || v_oor);
   assign m_req_ready = pick_m && b_req_ready;
   assign s_req_ready = pick_s && b_req_ready;
   assign c_req_ready = (pick_c && b_req_ready) || pick_z;
@@ -114,22 +119,24 @@ module mem_arbiter #(
   wire [1:0] granted_client = pick_m ? 2'd0 : pick_v ? 2'd3 : pick_s ? 2'd1 : 2'd2;
   wire [1:0] head = tag[tag_rd];
 
-  assign v_rsp_valid = b_rsp_valid && head == 2'd3;
+  assign v_rsp_valid = (b_rsp_valid && head == 2'd3) || zero_v;
   assign m_rsp_valid = b_rsp_valid && head == 2'd0;
   assign s_rsp_valid = b_rsp_valid && head == 2'd1;
-  assign c_rsp_valid = (b_rsp_valid && head == 2'd2) || zero_rsp;
+  assign c_rsp_valid = (b_rsp_valid && head == 2'd2) || (zero_rsp && !zero_v);
   assign rsp_rdata   = zero_rsp ? 32'd0 : b_rsp_rdata;
   assign core_stall  = c_req_valid && !c_req_ready;
 
   always @(posedge clk) begin
     c_range_err <= pick_z;
-    zero_rsp <= pick_z && !c_req_we;
+    zero_rsp <= (pick_z && !c_req_we) || (pick_v && v_oor);
+    zero_v <= pick_v && v_oor;
     if (rst) begin
       tag_rd <= 0;
       tag_wr <= 0;
       tag_count <= 0;
       scan_wait <= 4'd0;
       zero_rsp <= 1'b0;
+      zero_v <= 1'b0;
       c_range_err <= 1'b0;
     end else begin
       if (granted_read) begin

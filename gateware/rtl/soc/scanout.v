@@ -140,8 +140,10 @@ module scanout #(
   reg  [2:0]  buf_count;
   reg  [1:0]  byte_in_word;    // CRC_BYTES = 1: next byte of the head word
 
-  // words of the frame still to read from VRAM (the rest, beyond VRAM, reads as 0)
-  wire in_frame  = !above && rd_addr < end_vram;
+  // words of the frame still to read from VRAM (the rest, beyond VRAM, reads as 0). Used only while
+  // reading, when end_vram is the frame's and rd_addr counts up from its first word (at most end_vram,
+  // both inside VRAM unless `above`) and stops there: an equality, not a magnitude comparator
+  wire in_frame  = !above && rd_addr != end_vram;
   assign req_valid   = reading && in_frame && outstanding + buf_count < BUFW;
   assign req_addr    = 30'(rd_addr[VAW-1:0]);
   assign prot_active = computing || pending || (reading && in_frame);

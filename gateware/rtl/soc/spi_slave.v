@@ -73,6 +73,7 @@ module spi_slave (
   reg  [5:0]  stat;       // status flags of this frame
   reg         ram_pend;   // the read value arrives on rd_ram this cycle
   reg         miso_q;     // MISO between falling edges
+`include "const_compare.vh"
 
   wire header_done = sck_rise && bit_cnt == 7'd7;
   wire frame_done  = sck_rise && bit_cnt == 7'd71;
@@ -87,7 +88,7 @@ module spi_slave (
   always @* begin
     if (bit_cnt == 7'd0)      miso_next = 1'b1;                  // MARKER1 of the next frame
     else if (bit_cnt == 7'd1) miso_next = 1'b0;                  // MARKER0
-    else if (bit_cnt < 7'd8)  miso_next = stat[3'd7 - bit_cnt[2:0]];
+    else if (!ge_const(16'(bit_cnt), 8)) miso_next = stat[3'd7 - bit_cnt[2:0]];
     else if (ram_pend)        miso_next = rd_ram[63];
     else                      miso_next = sh[63];
   end

@@ -8,8 +8,10 @@
 // block-RAM line buffer through its own memory-arbiter client: while one source line is shown, the
 // next is read. Pixels are expanded from RGBA8888 / RGB565 / RGBA2222 to 8 bits as
 // docs/protocol.md section 6 says and the top OUT_BITS bits leave (4 for the 12-bit DVI Pmod, 8 for
-// TMDS). A framebuffer is scaled by 2^SCALE_LOG2 and centred; what does not fit the screen is cropped,
-// and so are pixels beyond the 2^LINE_AW words a line buffer half holds. Words beyond VRAM show as 0.
+// TMDS). A framebuffer is scaled by 2^SCALE_LOG2 and centred (CENTRE = 1) or placed at the top left
+// (CENTRE = 0: no placement adders, the iCEBreaker); what does not fit the screen is cropped,
+// and so are pixels beyond the 2^LINE_AW words a line buffer half holds. Words beyond VRAM show as 0
+// (the arbiter answers them so).
 // The timing is the scanout's (LINE_CLOCKS = H_TOTAL x PIX_DIV), so its vertical sync, where the swap is
 // latched, is the end of this stage's last visible line.
 module video_out #(
@@ -26,7 +28,8 @@ module video_out #(
   parameter V_FRONT    = 10,
   parameter V_SYNC     = 2,
   parameter V_BACK     = 33,
-  parameter SYNC_NEG   = 1     // sync pulses low (640 x 480 at 60 Hz)
+  parameter SYNC_NEG   = 1,    // sync pulses low (640 x 480 at 60 Hz)
+  parameter CENTRE     = 1     // 1: a smaller picture centred; 0: at the top left (no placement adders)
 ) (
   input  wire                clk,
   input  wire                rst,
@@ -39,7 +42,7 @@ module video_out #(
   input  wire [1:0]          frame_format,
   input  wire [10:0]         frame_width,
   input  wire [10:0]         frame_height,
-  // memory-arbiter client (reads inside VRAM only, answers in order)
+  // memory-arbiter client (reads, answered in order; at or beyond 2^VAW words the arbiter answers 0)
   output wire                req_valid,
   input  wire                req_ready,
   output wire [29:0]         req_addr,
@@ -57,6 +60,8 @@ module video_out #(
   localparam H_TOTAL = H_ACTIVE + H_FRONT + H_SYNC + H_BACK;
   localparam V_TOTAL = V_ACTIVE + V_FRONT + V_SYNC + V_BACK;
   localparam S = SCALE_LOG2;
+
+`include "const_compare.vh"
 
   // --- pixel enable and display timing: the scanout's counters (a pixel in the last clock of each
   // PIX_DIV) ---
@@ -81,21 +86,46 @@ module video_out #(
   reg         beyond;                      // it starts beyond VRAM
   reg  [VAW+1:0] base;                     // its first byte
   reg  [1:0]  ppw_l2;                      // log2 pixels per word: RGBA8888 0, RGB565 1, RGBA2222 2
-  reg  [10:0] x0, x_end;
-  reg  [10:0] y0_m2, y_end_m2;             // y0 and y_end two lines earlier (mod V_TOTAL): the line
+  wire [10:0] x0, y0_m2;                   // constants at the top left (CENTRE = 0)
+  reg  [10:0] x_end, y_end_m2;             // y0 and y_end two lines earlier (mod V_TOTAL): the line
                                            // decisions are made two lines ahead, at vc
   reg  [12:0] stride;                      // bytes per framebuffer line
-  reg  [LINE_AW:0] n_words;                // words read per line: enough for any lead, at most a half
+  reg  [LINE_AW:0] n_words;                // words read per line minus 2 (the 2 any lead may add): at
+                                           // most a half
   wire [1:0]  ppw_new = frame_format == 2'd0 ? 2'd0 : frame_format == 2'd1 ? 2'd1 : 2'd2;
   wire [11:0] sw = {1'b0, frame_width} << S, sh = {1'b0, frame_height} << S;
-  wire [12:0] x_gap = 13'(H_ACTIVE) - {1'b0, sw}, x_sum = 13'(H_ACTIVE) + {1'b0, sw};
-  // y0 - 2 = (V_ACTIVE - sh - 4) / 2 and y_end - 2 = (V_ACTIVE + sh - 4) / 2: the same adders with
-  // another constant; y0 = 1 (gap -2 or -1) is V_TOTAL - 1 and y0 = 0 (cropped too) V_TOTAL - 2
-  wire [12:0] y_gap4 = 13'(V_ACTIVE - 4) - {1'b0, sh}, y_sum4 = 13'(V_ACTIVE - 4) + {1'b0, sh};
-  wire        y_crop = y_gap4[12] && !(&y_gap4[12:2]);   // sh > V_ACTIVE
+  wire [10:0] x0_new, x_end_new, y0_m2_new, y_end_m2_new;
+  generate
+    if (CENTRE != 0) begin : g_centre
+      wire [12:0] x_gap = 13'(H_ACTIVE) - {1'b0, sw}, x_sum = 13'(H_ACTIVE) + {1'b0, sw};
+      // y0 - 2 = (V_ACTIVE - sh - 4) / 2 and y_end - 2 = (V_ACTIVE + sh - 4) / 2: the same adders with
+      // another constant; y0 = 1 (gap -2 or -1) is V_TOTAL - 1 and y0 = 0 (cropped too) V_TOTAL - 2
+      wire [12:0] y_gap4 = 13'(V_ACTIVE - 4) - {1'b0, sh}, y_sum4 = 13'(V_ACTIVE - 4) + {1'b0, sh};
+      wire        y_crop = y_gap4[12] && !(&y_gap4[12:2]);   // sh > V_ACTIVE
+      reg  [10:0] x0_r, y0_m2_r;
+      always @(posedge clk) if (!rst && frame_start) {x0_r, y0_m2_r} <= {x0_new, y0_m2_new};
+      assign x0 = x0_r;
+      assign y0_m2 = y0_m2_r;
+      assign x0_new    = x_gap[12] ? 11'd0 : x_gap[11:1];
+      assign x_end_new = x_gap[12] ? 11'(H_ACTIVE) : x_sum[11:1];
+      assign y0_m2_new    = !y_gap4[12] ? y_gap4[11:1] : &y_gap4[12:1] ? 11'(V_TOTAL - 1) : 11'(V_TOTAL - 2);
+      assign y_end_m2_new = y_crop ? 11'(V_ACTIVE - 2) : y_sum4[11:1];
+      wire unused_place = &{1'b0, x_gap[0], y_gap4[0], x_sum[12], x_sum[0], y_sum4[12], y_sum4[0]};
+    end else begin : g_top_left
+      // [0, min(sw, H_ACTIVE)) x [0, min(sh, V_ACTIVE)): y0 - 2 is V_TOTAL - 2, y_end - 2 is sh - 2
+      // (mod V_TOTAL: sh = 0 or 1 gives V_TOTAL - 2 or - 1)
+      wire [11:0] sh_m2 = sh - 12'd2;
+      assign x0 = 11'd0;
+      assign y0_m2 = 11'(V_TOTAL - 2);
+      assign x0_new = 11'd0;
+      assign y0_m2_new = 11'(V_TOTAL - 2);
+      assign x_end_new = ge_const(16'(sw), H_ACTIVE + 1) ? 11'(H_ACTIVE) : sw[10:0];
+      assign y_end_m2_new = ge_const(16'(sh), V_ACTIVE + 1) ? 11'(V_ACTIVE - 2) : sh_m2[11] ? 11'(V_TOTAL) + sh_m2[10:0] : sh_m2[10:0];
+    end
+  endgenerate
   // only the pixels the screen shows are read: at most H_ACTIVE / 2^S of a line
-  wire [10:0] w_shown = frame_width > 11'(H_ACTIVE >> S) ? 11'(H_ACTIVE >> S) : frame_width;
-  wire [11:0] words_w = {1'b0, w_shown >> ppw_new} + 12'd2;
+  wire [10:0] w_shown = ge_const(16'(frame_width), (H_ACTIVE >> S) + 1) ? 11'(H_ACTIVE >> S) : frame_width;
+  wire [10:0] words_w = w_shown >> ppw_new;
   always @(posedge clk) begin
     if (rst) begin
       shown <= 1'b0;
@@ -104,12 +134,10 @@ module video_out #(
       beyond <= frame_addr[27:VAW-2] != 0;
       base <= {frame_addr[VAW-3:0], 4'd0};
       ppw_l2 <= ppw_new;
-      x0    <= x_gap[12] ? 11'd0 : x_gap[11:1];
-      x_end <= x_gap[12] ? 11'(H_ACTIVE) : x_sum[11:1];
-      y0_m2    <= !y_gap4[12] ? y_gap4[11:1] : &y_gap4[12:1] ? 11'(V_TOTAL - 1) : 11'(V_TOTAL - 2);
-      y_end_m2 <= y_crop ? 11'(V_ACTIVE - 2) : y_sum4[11:1];
+      x_end <= x_end_new;
+      y_end_m2 <= y_end_m2_new;
       stride <= {frame_width, 2'b00} >> ppw_new;
-      n_words <= words_w > 12'(1 << LINE_AW) ? (LINE_AW+1)'(1 << LINE_AW) : words_w[LINE_AW:0];
+      n_words <= ge_const(16'(words_w), (1 << LINE_AW) - 1) ? (LINE_AW+1)'((1 << LINE_AW) - 2) : words_w[LINE_AW:0];
     end
   end
 
@@ -129,7 +157,10 @@ module video_out #(
   // The reads must finish within one screen line (iCEBreaker: at most 256 SPRAM words in 800 clocks;
   // ULX3S: 642 SDRAM words at 2 clocks each in 1,600, row misses, refreshes and MEM_* beside); a fill
   // still running when the next one starts is abandoned, and its late answers would land in the new one ---
-  reg  [31:0] lb [0:(2 << LINE_AW) - 1];
+  // no_rw_check: a half is read only while the other one fills (a fill that overruns its screen line
+  // is abandoned, its words are garbage anyway), so a read never meets a write to its address and the
+  // block RAM needs no soft bypass for that collision (yosys adds about 75 flip-flops for one otherwise)
+  (* no_rw_check *) reg [31:0] lb [0:(2 << LINE_AW) - 1];
   // the next framebuffer line's first byte, and whether it (so every later line) starts beyond VRAM
   reg  [VAW+1:0] line_byte;
   reg         line_beyond;
@@ -138,30 +169,28 @@ module video_out #(
   wire [VAW+2:0] byte_next = {1'b0, byte0} + (VAW+3)'(stride);
   reg  [VAW:0] f_addr;                     // next word to read (>= 2^VAW: the line ran beyond VRAM)
   reg         f_beyond;
-  reg  [LINE_AW:0] f_left;                 // words still to read
+  reg  [LINE_AW:0] f_left;                 // words still to read, minus 2: the fill ends at F_DONE = -2
+  localparam [LINE_AW:0] F_DONE = ~(LINE_AW+1)'(1);   // (no adder for the + 2 at the latch)
   reg  [LINE_AW-1:0] wr_idx;
   reg         wr_half;
   reg  [1:0]  lead [0:1];                  // pixels before the line's first pixel in its first word
-  reg  [3:0]  outstanding;
   wire [1:0]  lead0 = ppw_l2 == 2'd2 ? byte0[1:0] : ppw_l2 == 2'd1 ? {1'b0, byte0[1]} : 2'd0;
-  wire        in_vram = !f_beyond && !f_addr[VAW];
-  assign req_valid = f_left != 0 && in_vram;
-  assign req_addr  = 30'(f_addr[VAW-1:0]);
+  // a word beyond VRAM is asked for at an address >= 2^VAW, which the arbiter answers with 0 in order
+  // (no zero fill here: no count of reads in flight, no multiplexer on the line buffer's data)
+  assign req_valid = f_left != F_DONE;
+  assign req_addr  = 30'({f_beyond || f_addr[VAW], f_addr[VAW-1:0]});
   wire        issued = req_valid && req_ready;
-  wire        zero_fill = f_left != 0 && !in_vram && outstanding == 4'd0;
   always @(posedge clk) begin
     if (rst) begin
-      f_left <= 0;
-      outstanding <= 4'd0;
+      f_left <= F_DONE;
       wr_idx <= {LINE_AW{1'b0}};
       {f_in, f_rep, f_half, n_show, n_half, l_show} <= 6'd0;
     end else begin
-      outstanding <= outstanding + {3'd0, issued} - {3'd0, rsp_valid};
-      if (rsp_valid || zero_fill) begin
-        lb[{wr_half, wr_idx}] <= rsp_valid ? rsp_rdata : 32'd0;
+      if (rsp_valid) begin
+        lb[{wr_half, wr_idx}] <= rsp_rdata;
         wr_idx <= wr_idx + 1'b1;
       end
-      if (issued || zero_fill) begin
+      if (issued) begin
         f_addr <= f_addr + 1'b1;
         f_left <= f_left - 1'b1;
       end
@@ -205,28 +234,10 @@ module video_out #(
       widx_r <= advance && word_end && !widx[LINE_AW] ? widx + 1'b1 : widx;
     end
   end
-  // visible part and sync pulses of the line and the frame, as flags for the current hc / vc that
-  // turn where the counters pass an edge (equality compares: no magnitude comparators)
-  reg         h_act, h_sync, v_act, v_sync;
-  always @(posedge clk) begin
-    if (rst) begin
-      {h_act, h_sync, v_act, v_sync} <= 4'b1010;   // hc = vc = 0
-    end else if (pix_en) begin
-      if (h_last) h_act <= 1'b1;
-      else if (hc == 11'(H_ACTIVE - 1)) h_act <= 1'b0;
-      if (hc == 11'(H_ACTIVE + H_FRONT - 1)) h_sync <= 1'b1;
-      else if (hc == 11'(H_ACTIVE + H_FRONT + H_SYNC - 1)) h_sync <= 1'b0;
-      if (h_last) begin
-        if (vc == 11'(V_TOTAL - 1)) v_act <= 1'b1;
-        else if (vc == 11'(V_ACTIVE - 1)) v_act <= 1'b0;
-        if (vc == 11'(V_ACTIVE + V_FRONT - 1)) v_sync <= 1'b1;
-        else if (vc == 11'(V_ACTIVE + V_FRONT + V_SYNC - 1)) v_sync <= 1'b0;
-      end
-    end
-  end
-  wire        active = h_act && v_act;
-  wire        hs0 = h_sync;
-  wire        vs0 = v_sync;
+  // visible part and sync pulses of the line and the frame, decoded from hc / vc (no flag registers)
+  wire        active = !ge_const(16'(hc), H_ACTIVE) && !ge_const(16'(vc), V_ACTIVE);
+  wire        hs0 = ge_const(16'(hc), H_ACTIVE + H_FRONT) && !ge_const(16'(hc), H_ACTIVE + H_FRONT + H_SYNC);
+  wire        vs0 = ge_const(16'(vc), V_ACTIVE + V_FRONT) && !ge_const(16'(vc), V_ACTIVE + V_FRONT + V_SYNC);
   reg  [31:0] word1;
   reg         on1, de1, hs1, vs1;
   reg  [1:0]  sub1;
@@ -260,7 +271,7 @@ module video_out #(
   wire [7:0] b8 = ppw_l2 == 2'd0 ? word1[15:8] : ppw_l2 == 2'd1 ? {half[4:0], half[4:2]} : {4{byte_px[3:2]}};
   // the bits below OUT_BITS and the alpha of RGBA2222 do not leave; rows past the line parity are
   // the fetch side's
-  wire unused_ok = &{1'b0, byte_px[1:0], r8, g8, b8, x_gap[0], y_gap4[0], x_sum[12], x_sum[0], y_sum4[12], y_sum4[0]};
+  wire unused_ok = &{1'b0, byte_px[1:0], r8, g8, b8, x0_new, y0_m2_new};
   always @(posedge clk) begin
     if (rst) begin
       {hsync, vsync} <= SYNC_NEG != 0 ? 2'b11 : 2'b00;

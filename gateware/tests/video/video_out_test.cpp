@@ -3,8 +3,8 @@
 // refuses requests at random, as the arbiter does when another client wins), the scanout's display
 // counters (hcount, vcount: a line of 800 x PIX_DIV clocks, 525 lines), a swap as the scanout latches
 // it (frame_start with the frame's address at the vertical sync), and two frames of output checked
-// sample by sample against VESA 640 x 480 at 60 Hz timing and the expected picture (scaled, centred,
-// expanded as docs/protocol.md section 6 says, black around it and before the first swap).
+// sample by sample against VESA 640 x 480 at 60 Hz timing and the expected picture (scaled, centred
+// or at the top left as the board's CENTRE says, expanded as docs/protocol.md section 6 says, black around it and before the first swap).
 #include <gtest/gtest.h>
 
 #include <cstdint>
@@ -20,6 +20,7 @@ constexpr int kHTotal = 800, kVTotal = 525, kHActive = 640, kVActive = 480;
 constexpr int kPixDiv = GPUBRIDGE_VIDEO_PIX_DIV;
 constexpr int kScale = 1 << GPUBRIDGE_VIDEO_SCALE_LOG2;
 constexpr int kBits = GPUBRIDGE_VIDEO_BITS;
+constexpr bool kCentre = GPUBRIDGE_VIDEO_CENTRE != 0;  // else a smaller picture is at the top left
 constexpr int kVaw = GPUBRIDGE_VIDEO_VAW;
 constexpr long kLineWords = 1L << GPUBRIDGE_VIDEO_LINE_AW;  // words of a line buffer half
 
@@ -97,6 +98,7 @@ class VideoBench {
   }
 
   long requests() const { return requests_; }
+  long beyond_requests() const { return beyond_requests_; }
 
  private:
   void tick() {
@@ -111,12 +113,15 @@ class VideoBench {
     m_.clk = 0;
     m_.eval();
     if (m_.req_valid && m_.req_ready) {
+      // a read at or beyond VRAM's end (2^VAW words) is answered with 0, in order, as the arbiter
+      // does; the video asks for such a word only where the displayed buffer runs past VRAM
       const std::uint32_t a = m_.req_addr;
-      EXPECT_LT(a, mem_.size()) << "a read beyond VRAM";
+      EXPECT_LT(a, 2 * mem_.size()) << "a read address beyond VRAM other than 2^VAW + word";
       const long latency = 1 + dist_(rng_) % 4;
       const long due = std::max(now_ + latency, inflight_.empty() ? 0 : inflight_.back().due);
       inflight_.push_back({due, a < mem_.size() ? mem_[a] : 0});
       ++requests_;
+      if (a >= mem_.size()) ++beyond_requests_;
     }
     m_.clk = 1;
     m_.eval();
@@ -132,13 +137,13 @@ class VideoBench {
   std::uniform_int_distribution<int> dist_{0, 99};
   std::vector<std::uint32_t> mem_;
   std::deque<Read> inflight_;
-  long now_ = 0, requests_ = 0;
+  long now_ = 0, requests_ = 0, beyond_requests_ = 0;
 };
 
 int top_bits(int v8) { return v8 >> (8 - kBits); }
 
 // checks two frames of samples: the first black (nothing swapped in before its vertical sync), the
-// second the framebuffer, scaled and centred; its pixels from byte vram_bytes on (beyond VRAM) black
+// second the framebuffer, scaled and centred (or at the top left); its pixels from byte vram_bytes on (beyond VRAM) black
 void check(const std::vector<Sample>& s, const Frame& f, std::size_t vram_bytes = SIZE_MAX) {
   // the pipeline's delay: the first data-enable sample is the first visible pixel
   std::size_t o = 0;
@@ -146,7 +151,7 @@ void check(const std::vector<Sample>& s, const Frame& f, std::size_t vram_bytes 
   ASSERT_LT(o, std::size_t{kHTotal}) << "no data enable in the first line";
   ASSERT_GE(s.size(), o + 2u * kHTotal * kVTotal);
   const int sw = std::min(kHActive, f.width * kScale), sh = std::min(kVActive, f.height * kScale);
-  const int x0 = (kHActive - sw) / 2, y0 = (kVActive - sh) / 2;
+  const int x0 = kCentre ? (kHActive - sw) / 2 : 0, y0 = kCentre ? (kVActive - sh) / 2 : 0;
   int mismatches = 0;
   for (std::size_t i = 0; i < 2u * kHTotal * kVTotal; ++i) {
     const Sample& v = s[o + i];
@@ -195,12 +200,26 @@ TEST(VideoOut, FullScreen) {
   check(bench.run(f, two_frames_and_a_bit()), f);
 }
 
-// a smaller RGBA2222 buffer with an odd width, so lines start inside a word: centred, black around
-TEST(VideoOut, Rgba2222OddWidthCentred) {
+// a smaller RGBA2222 buffer with an odd width, so lines start inside a word: centred (iCEBreaker: at the
+// top left), black around
+TEST(VideoOut, Rgba2222OddWidthPlaced) {
   const Frame f = pattern(2, 101, 37, 0x1230, 2);
   VideoBench bench(12);
   bench.store(f);
   check(bench.run(f, two_frames_and_a_bit()), f);
+}
+
+// the smallest buffers: one line (on the iCEBreaker two screen lines, whose last line decision wraps
+// below line 0 at the top left) and two lines
+TEST(VideoOut, OneAndTwoLines) {
+  const Frame a = pattern(2, 3, 1, 0x40, 7);
+  VideoBench ba(17);
+  ba.store(a);
+  check(ba.run(a, two_frames_and_a_bit()), a);
+  const Frame b = pattern(1, 5, 2, 0x80, 8);
+  VideoBench bb(18);
+  bb.store(b);
+  check(bb.run(b, two_frames_and_a_bit()), b);
 }
 
 // RGB565 with an odd width (lines start on half words), and RGBA8888
@@ -235,4 +254,10 @@ TEST(VideoOut, ResetSizeRgba8888BeyondVramIsBlack) {
   VideoBench bench(16);
   bench.store(f, true);
   check(bench.run(f, two_frames_and_a_bit()), f, std::size_t{4} << kVaw);
+  // where the buffer runs past VRAM (the iCEBreaker's 128 KiB), those words are asked of the arbiter,
+  // which answers 0; the ULX3S's 32 MiB hold it all
+  if (640L * 480 * 4 > (4L << kVaw))
+    EXPECT_GT(bench.beyond_requests(), 0) << "lines beyond VRAM are asked of the arbiter, which answers 0";
+  else
+    EXPECT_EQ(bench.beyond_requests(), 0);
 }
