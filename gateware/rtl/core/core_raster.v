@@ -28,7 +28,8 @@ module core_raster #(
     input  wire signed [16:0] dx0, dx1, dx2,     // edge deltas (held by setup while drawing):
     input  wire signed [16:0] dy0, dy1, dy2,     //   E steps by -16 dy right, 16 dx down
     input  wire               flip,              //   ... negated (P1 and P2 exchanged, section 8.1)
-    input  wire [10:0]        box_x0, box_y0, box_x1, box_y1,  // columns and rows to walk (held while active)
+    input  wire [10:0]        box_x0, box_xl,    // first and last column (held by setup while active)
+    input  wire [10:0]        box_y0, box_y1,    // rows to walk (box_y1 exclusive)
     input  wire [10:0]        x_start,           // first column (of row box_y0)
     input  wire               ltr,     // emit every row left to right
     input  wire               rect,    // every pixel of the box is covered (a clear)
@@ -50,7 +51,7 @@ module core_raster #(
   reg [10:0] x, y;
   // the last column and row: setup holds the box while the walk runs (a setup starts only when the
   // rasteriser is idle), so no copy of it is kept here
-  wire [10:0] xlo = box_x0, xhi = box_x1 - 11'd1, yhi = box_y1 - 11'd1;
+  wire [10:0] xlo = box_x0, xhi = box_xl, yhi = box_y1 - 11'd1;
   reg        mdir;       // direction of the current move / emission
   reg        last_dir;   // emission direction of the previous row
   reg        order;      // ltr latched

@@ -53,7 +53,7 @@ module core_setup_tm #(
     output reg          flip,
     output reg  [2:0]   e_we,         // the rasteriser loads e_data into its edge registers
     output wire signed [35:0] e_data,
-    output reg  [10:0]  box_x0, box_y0, box_x1, box_y1, x_start,
+    output reg  [10:0]  box_x0, box_y0, box_xl, box_y1, x_start,
     output reg  [IDX_W-1:0] origin_idx,
     output reg  [34:0]  den,          // |2D|
     output reg          pw_en,
@@ -213,14 +213,15 @@ module core_setup_tm #(
   // row end, rd the bottom vertex's Y), so no register holds the unclamped ones. by0 is in
   // [0, 2048]: 2048 (by0_big) lies below every clip rectangle.
   wire signed [12:0] xt = 13'(rc >>> 4);
-  wire signed [12:0] cx0 = $signed({2'b0, clip_x0}), cx1 = $signed({2'b0, clip_x1});
+  wire signed [12:0] cx0 = $signed({2'b0, clip_x0});
   wire signed [12:0] cy0 = $signed({2'b0, clip_y0}), cy1 = $signed({2'b0, clip_y1});
   wire signed [12:0] by0 = (fy > cy0) ? fy : cy0;
   wire signed [12:0] by1 = (fy < cy1) ? fy : cy1;
   reg         by0_big;
   wire        unused_by0 = by0[12];  // by0 >= 0
   wire        rows = !by0_big && $signed({2'b0, box_y0}) < by1;  // A_BOX: some row to walk
-  wire [10:0] xs = (xt < cx0) ? clip_x0 : (xt >= cx1) ? clip_x1 - 11'd1 : xt[10:0];
+  // box_xl (the last column, clip_x1 - 1, loaded at the start) is the clamp's upper bound too
+  wire [10:0] xs = (xt < cx0) ? clip_x0 : (xt > $signed({2'b0, box_xl})) ? box_xl : xt[10:0];
   wire [4:0] r_sel = (i_addr == R_YTOP) ? r_y(top) : (i_addr == R_XTOP) ? r_x(top) :
                      (i_addr == R_YBOT) ? r_y(bot) : i_addr;
 
@@ -326,7 +327,7 @@ module core_setup_tm #(
       end
       if (pc == 7'd0 && start) begin
         box_x0 <= clip_x0;
-        box_x1 <= clip_x1;
+        box_xl <= clip_x1 - 11'd1;  // clip_x1 > clip_x0 >= 0: a setup starts only then
         flip   <= 1'b0;
         if (rect) begin  // a clear: the clip rectangle
           box_y0  <= clip_y0;

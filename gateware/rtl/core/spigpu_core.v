@@ -103,7 +103,7 @@ module spigpu_core #(
   wire [2:0]  su_e_we;
   wire signed [35:0] su_e_data, ras_e0, ras_e1, ras_e2;
   wire signed [16:0] su_dx0, su_dx1, su_dx2, su_dy0, su_dy1, su_dy2;
-  wire [10:0] su_bx0, su_by0, su_bx1, su_by1, su_xs;
+  wire [10:0] su_bx0, su_by0, su_bxl, su_by1, su_xs;
   wire        su_flip;
   wire [IDX_W-1:0] su_idx;
   wire [34:0] su_den;
@@ -128,7 +128,7 @@ module spigpu_core #(
           .need(need[4:0]),
           .dx0(su_dx0), .dx1(su_dx1), .dx2(su_dx2), .dy0(su_dy0), .dy1(su_dy1), .dy2(su_dy2),
           .flip(su_flip), .e_we(su_e_we), .e_data(su_e_data),
-          .box_x0(su_bx0), .box_y0(su_by0), .box_x1(su_bx1), .box_y1(su_by1), .x_start(su_xs),
+          .box_x0(su_bx0), .box_y0(su_by0), .box_xl(su_bxl), .box_y1(su_by1), .x_start(su_xs),
           .origin_idx(su_idx),
           .den(su_den), .pw_en(pw_en), .pw_attr(pw_attr), .pw_field(pw_field), .pw_q(q24), .pw_r(pw_r));
       assign pw_q = {8'd0, q24};
@@ -142,7 +142,7 @@ module spigpu_core #(
           .need(need),
           .dx0(su_dx0), .dx1(su_dx1), .dx2(su_dx2), .dy0(su_dy0), .dy1(su_dy1), .dy2(su_dy2),
           .flip(su_flip), .e_we(su_e_we), .e_data(su_e_data), .e1(ras_e1), .e2(ras_e2),
-          .box_x0(su_bx0), .box_y0(su_by0), .box_x1(su_bx1), .box_y1(su_by1), .x_start(su_xs),
+          .box_x0(su_bx0), .box_y0(su_by0), .box_xl(su_bxl), .box_y1(su_by1), .x_start(su_xs),
           .origin_idx(su_idx),
           .den(su_den), .pw_en(pw_en), .pw_attr(pw_attr), .pw_field(pw_field), .pw_q(pw_q), .pw_r(pw_r));
     end
@@ -179,7 +179,7 @@ module spigpu_core #(
       .clk(clk), .rst(rst), .start(ras_go),
       .e_we(su_e_we), .e_data(su_e_data), .e0(ras_e0), .e1(ras_e1), .e2(ras_e2),
       .dx0(su_dx0), .dx1(su_dx1), .dx2(su_dx2), .dy0(su_dy0), .dy1(su_dy1), .dy2(su_dy2),
-      .flip(su_flip), .box_x0(su_bx0), .box_y0(su_by0), .box_x1(su_bx1), .box_y1(su_by1), .x_start(su_xs),
+      .flip(su_flip), .box_x0(su_bx0), .box_y0(su_by0), .box_xl(su_bxl), .box_y1(su_by1), .x_start(su_xs),
       .ltr(r_serial), .rect(r_rect), .adv(adv), .hold(hold), .active(ras_active), .op(ras_op),
       .op_next(ras_op_next), .emit(ras_emit), .px(ras_x), .py(ras_y));
 
