@@ -233,8 +233,11 @@ module core_setup_tm #(
   wire [31:0] dv_q;
   wire [34:0] dv_r, dv_rc;
   /* verilator lint_off PINCONNECTEMPTY */
-  core_divider #(.NW(ACC_W), .DW(35), .QW(32), .SKIP(0)) divider (
-      .clk(clk), .rst(rst), .start(dv2), .num(acc_s), .den(den), .busy(), .done(dv_done),
+  // colour numerators: |d| < 2^8, |e| < 2^33, |D| < 2^33, a0 < 2^8, so |M0| = |2(d1 e1 + d2 e2 + a0
+  // |D|) + ...| < 2^44 and the steps |32(d1 dy + d2 dy)| < 2^31: 45 numerator bits, 46 cycles a
+  // division instead of 62 (Z's need all 62)
+  core_divider #(.NW(ACC_W), .DW(35), .QW(32), .SKIP(0), .NARROW(45)) divider (
+      .clk(clk), .rst(rst), .start(dv2), .num(acc_s), .narrow(dv_attr != 3'd4), .den(den), .busy(), .done(dv_done),
       .quo(dv_q), .rem(dv_r), .rem_c(dv_rc), .neg(dv_neg));
   /* verilator lint_on PINCONNECTEMPTY */
   wire unused_q = &{1'b0, dv_q[31:24]};
