@@ -36,6 +36,13 @@ module core_color #(
     output wire        idle
 );
   localparam F_BLEND = 1, F_DITHER = 2, F_RGB565 = 4, F_RGBA2222 = 5, F_TEMPORAL = 6;
+  // Without blending and with one read in flight (up5k), a destination read only merges the
+  // masked channels of a packed pixel: the pixel is quantised and packed before it waits, so the
+  // queue holds its 16 packed bits (not its RGBA and screen position), and the response only the
+  // half word of its lane.
+  localparam integer PACKQ = (!FEATURES[F_BLEND] && AW == 0) ? 1 : 0;
+  localparam integer QIW = (PACKQ != 0) ? 48 : 68;  // queue item bits
+  localparam integer QDW = (PACKQ != 0) ? 16 : 32;  // response bits kept
 
 `include "core_addr.vh"
   // {word, lane} of pixel idx: FB_DRAW + idx * bpp
@@ -47,29 +54,48 @@ module core_color #(
   wire [67:0] in_item = {in_pix[IDX_W+35:IDX_W+32], in_addr, in_pix[31:0]};
 
   // ---- destination read queue ----
+  // PACKQ: RGBA8888 has nothing to merge (a read would only feed a blend)
+  wire        need_rd = (PACKQ != 0) ? (need_dst && fmt != 2'd0) : need_dst;
   wire        q_full, q_empty, q_head;
-  wire [67:0] q_item;
-  wire [31:0] q_data;
+  wire [QIW-1:0] q_item, push_item;
+  wire [QDW-1:0] q_data, rsp_kept;
   wire        take;
-  core_rdq #(.IW(68), .DW(32), .AW(AW)) queue (
+  wire [15:0] pk_n;     // PACKQ: the input pixel quantised and packed (below)
+  wire [67:0] cur;      // the pixel quantised here: the queue head, or (PACKQ) the input
+  generate
+    if (PACKQ != 0) begin : packed_item
+      assign push_item = {in_addr, pk_n};
+      // one read in flight: the response is the single slot's, whose lane picks the half word
+      assign rsp_kept = q_item[17] ? rsp_data[15:0] : rsp_data[31:16];
+      assign cur = in_item;
+    end else begin : full_item
+      assign push_item = in_item;
+      assign rsp_kept = rsp_data;
+      assign cur = need_rd ? q_item : in_item;
+      wire unused_pk = &{1'b0, pk_n};
+    end
+  endgenerate
+  core_rdq #(.IW(QIW), .DW(QDW), .AW(AW)) queue (
       .clk(clk), .rst(rst),
-      .push(rd_valid && rd_ready), .push_item(in_item),
+      .push(rd_valid && rd_ready), .push_item(push_item),
       .full(q_full), .empty(q_empty),
-      .rsp_valid(rsp_valid), .rsp_data(rsp_data),
-      .head_valid(q_head), .head_item(q_item), .head_data(q_data), .pop(need_dst && take));
-  assign rd_valid = need_dst && in_valid && !q_full;
+      .rsp_valid(rsp_valid), .rsp_data(rsp_kept),
+      .head_valid(q_head), .head_item(q_item), .head_data(q_data), .pop(need_rd && take));
+  assign rd_valid = need_rd && in_valid && !q_full;
   assign rd_addr  = in_addr[31:2];
 
-  wire [67:0] cur = need_dst ? q_item : in_item;
-  wire        cur_valid = need_dst ? q_head : in_valid;
-  wire [31:0] dword = q_data;
-  wire [31:0] addr = cur[63:32];
+  // the pixel being written: its address and (PACKQ) its packed value
+  wire        cur_valid = need_rd ? q_head : in_valid;
+  wire [31:0] dword = 32'(q_data);
+  wire [31:0] addr = (PACKQ != 0) ? (need_rd ? q_item[QIW-1:QIW-32] : in_addr) : cur[63:32];
+  wire [15:0] pk = need_rd ? q_item[15:0] : pk_n;
   wire [1:0]  lane = addr[1:0];
   wire [1:0]  xl = cur[65:64], yl = cur[67:66];
 
   // ---- destination pixel, expanded to 8 bits per channel ----
-  wire [15:0] d16 = lane[1] ? dword[15:0] : dword[31:16];
-  wire [7:0]  d8 = (lane == 2'd0) ? dword[31:24] : (lane == 2'd1) ? dword[23:16] :
+  wire [15:0] d16 = (PACKQ != 0 || lane[1]) ? dword[15:0] : dword[31:16];
+  wire [7:0]  d8 = (PACKQ != 0) ? (lane[0] ? d16[7:0] : d16[15:8]) :
+                   (lane == 2'd0) ? dword[31:24] : (lane == 2'd1) ? dword[23:16] :
                    (lane == 2'd2) ? dword[15:8] : dword[7:0];
   reg  [7:0]  dr, dg, db, da;
   always @(*) begin
@@ -155,13 +181,15 @@ module core_color #(
   wire [1:0] b2q = q2(cb, t2, tdith, thr), a2q = q2(ca, t2, tdith, thr);
 
   // ---- pack, write mask ----
-  wire [4:0] r5 = keep[0] ? d16[15:11] : r5q;
-  wire [5:0] g6 = keep[1] ? d16[10:5] : g6q;
-  wire [4:0] b5 = keep[2] ? d16[4:0] : b5q;
-  wire [1:0] r2 = keep[0] ? d8[7:6] : r2q;
-  wire [1:0] g2 = keep[1] ? d8[5:4] : g2q;
-  wire [1:0] b2 = keep[2] ? d8[3:2] : b2q;
-  wire [1:0] a2 = keep[3] ? d8[1:0] : a2q;
+  assign pk_n = (fmt == 2'd1) ? {r5q, g6q, b5q} : {8'd0, r2q, g2q, b2q, a2q};
+  wire [15:0] pq = (PACKQ != 0) ? pk : pk_n;  // the written pixel's packed value
+  wire [4:0] r5 = keep[0] ? d16[15:11] : pq[15:11];
+  wire [5:0] g6 = keep[1] ? d16[10:5] : pq[10:5];
+  wire [4:0] b5 = keep[2] ? d16[4:0] : pq[4:0];
+  wire [1:0] r2 = keep[0] ? d8[7:6] : pq[7:6];
+  wire [1:0] g2 = keep[1] ? d8[5:4] : pq[5:4];
+  wire [1:0] b2 = keep[2] ? d8[3:2] : pq[3:2];
+  wire [1:0] a2 = keep[3] ? d8[1:0] : pq[1:0];
   reg [31:0] data_n;
   reg [3:0]  be_n;
   always @(*) begin
@@ -180,7 +208,7 @@ module core_color #(
   // ---- write register ----
   wire wfree = !wr_valid || wr_ready;
   assign take = cur_valid && wfree;
-  assign in_ready = need_dst ? (!q_full && rd_ready) : take;
+  assign in_ready = need_rd ? (!q_full && rd_ready) : take;
   always @(posedge clk) begin
     if (rst) begin
       wr_valid <= 1'b0;

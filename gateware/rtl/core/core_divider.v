@@ -9,17 +9,23 @@
 // so one multiplexer there picks either without a second one here. With SKIP, while the partial
 // remainder is below den / 16 the next four quotient bits are known to be 0 and four numerator
 // bits are taken at once (small numerators then cost a quarter cycle per leading bit); without
-// it a division takes NW cycles.
+// it a division takes NW cycles. With NARROW > 0, a start with `narrow` says the magnitude is
+// below 2^NARROW: only its low NARROW bits are taken, read at bit NARROW - 1 of the shifting
+// register instead of its top (the bits above would give quotient bits beyond QW and leave the
+// remainder 0), so the division takes NARROW + 1 cycles; the quotient bits still enter at the
+// bottom, below what is left of the numerator.
 module core_divider #(
     parameter integer NW = 72,  // numerator width (signed)
     parameter integer DW = 35,  // divisor / remainder width (unsigned)
     parameter integer QW = 32,  // quotient bits kept
-    parameter integer SKIP = 1
+    parameter integer SKIP = 1,
+    parameter integer NARROW = 0  // 0: none; else at least QW (not with SKIP)
 ) (
     input  wire                 clk,
     input  wire                 rst,
     input  wire                 start,  // pulse while idle: latch num
     input  wire signed [NW-1:0] num,
+    input  wire                 narrow, // with NARROW: |num| < 2^NARROW (num >= -2^NARROW)
     input  wire [DW-1:0]        den,    // held by the caller until rem_c is read (not copied)
     output wire                 busy,
     output reg                  done,   // one-cycle pulse: quo / rem valid (held until next start)
@@ -37,10 +43,13 @@ module core_divider #(
   wire [DW-1:0] dv = den;
   reg [CW-1:0] left;    // numerator bits left
   reg          run;
+  localparam integer NB = (NARROW > 0) ? NARROW - 1 : MW - 1;  // the narrowed run's next bit
+  localparam [CW-1:0] NARROW_BITS = CW'(NB + 1);
+  reg          nar;     // narrowed run
 
   assign busy = run;
 
-  wire [DW:0]   trial = {pr, nq[MW-1]};
+  wire [DW:0]   trial = {pr, (NARROW > 0 && nar) ? nq[NB] : nq[MW-1]};
   wire [DW+1:0] diff = {1'b0, trial} - {2'b0, dv};
   wire          fits = !diff[DW+1];
   wire          skip = (SKIP != 0) && (pr < (dv >> 4)) && (left >= 4);
@@ -53,8 +62,9 @@ module core_divider #(
     end else if (start && !run) begin
       neg  <= num[NW-1];
       nq   <= num[NW-1] ? ~num[MW-1:0] : num[MW-1:0];
+      nar  <= (NARROW > 0) && narrow;
       pr   <= {DW{1'b0}};
-      left <= MW_BITS;
+      left <= ((NARROW > 0) && narrow) ? NARROW_BITS : MW_BITS;
       run  <= 1'b1;
     end else if (run) begin
       if (left == 0) begin

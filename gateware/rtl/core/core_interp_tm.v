@@ -19,6 +19,11 @@ module core_interp_tm #(
     input  wire [RW-1:0] wr,
     input  wire [RW-1:0] den,
     input  wire [4:0]    mask,     // attributes this draw interpolates: R G B A Z
+    // values that are not interpolated, loaded when the draw starts (the pipeline is idle): a flat
+    // draw's colour, a clear's colour or depth (the core keeps no register of its own for them)
+    input  wire          ld_rgba,
+    input  wire          ld_z,
+    input  wire [31:0]   ld_data,
     // the rasteriser's move to apply, and the one after it
     input  wire [1:0]    op,
     input  wire [1:0]    op_next,
@@ -104,6 +109,9 @@ module core_interp_tm #(
         3'd3: rgba[7:0] <= wq[7:0];
         default: z <= wq;
       endcase
+    end else begin
+      if (ld_rgba) rgba <= ld_data;
+      if (ld_z) z <= ld_data[23:0];
     end
   end
 endmodule

@@ -17,7 +17,6 @@
 // Outputs form a two-stage pipeline with the steppers: `op` (stepper move), `emit` and the
 // pixel position are registered together; the steppers apply `op` in the next enabled cycle.
 module core_raster #(
-    parameter integer IDX_W = 20,
     parameter integer DSP = 0    // 1: the edge values in three SB_MAC16 accumulators (iCE40)
 ) (
     input  wire               clk,
@@ -29,10 +28,9 @@ module core_raster #(
     input  wire signed [16:0] dx0, dx1, dx2,     // edge deltas (held by setup while drawing):
     input  wire signed [16:0] dy0, dy1, dy2,     //   E steps by -16 dy right, 16 dx down
     input  wire               flip,              //   ... negated (P1 and P2 exchanged, section 8.1)
-    input  wire [10:0]        box_x0, box_y0, box_x1, box_y1,  // columns and rows to walk
+    input  wire [10:0]        box_x0, box_xl,    // first and last column (held by setup while active)
+    input  wire [10:0]        box_y0, box_y1,    // rows to walk (box_y1 exclusive)
     input  wire [10:0]        x_start,           // first column (of row box_y0)
-    input  wire [IDX_W-1:0]   origin_idx,        // box_y0 * fb_width + x_start
-    input  wire [10:0]        fb_width,
     input  wire               ltr,     // emit every row left to right
     input  wire               rect,    // every pixel of the box is covered (a clear)
     input  wire               adv,     // the whole raster/stepper pipeline may advance
@@ -42,8 +40,7 @@ module core_raster #(
     output wire [1:0]         op_next, // what `op` holds after this cycle's edge
     output reg                emit,    // the pixel reached by `op` is covered: emit it
     output wire [1:0]         px,      // low bits of the pixel position (dither)
-    output wire [1:0]         py,
-    output wire [IDX_W-1:0]   pidx     // py * fb_width + px
+    output wire [1:0]         py       // (the pixel index follows op in the core's pixel record)
 );
   localparam [1:0] OP_NONE = 2'd0, OP_RIGHT = 2'd1, OP_LEFT = 2'd2, OP_DOWN = 2'd3;
   localparam [2:0] R_IDLE = 3'd0, R_ENTRY = 3'd1, R_SEEK = 3'd2, R_TOEND = 3'd3, R_EMIT = 3'd4,
@@ -51,8 +48,10 @@ module core_raster #(
   localparam DIR_R = 1'b0, DIR_L = 1'b1;
 
   reg [2:0] st;
-  reg [10:0] x, y, xlo, xhi, yhi;
-  reg [IDX_W-1:0] idx;   // y * fb_width + x
+  reg [10:0] x, y;
+  // the last column and row: setup holds the box while the walk runs (a setup starts only when the
+  // rasteriser is idle), so no copy of it is kept here
+  wire [10:0] xlo = box_x0, xhi = box_xl, yhi = box_y1 - 11'd1;
   reg        mdir;       // direction of the current move / emission
   reg        last_dir;   // emission direction of the previous row
   reg        order;      // ltr latched
@@ -230,13 +229,11 @@ module core_raster #(
     endcase
   end
 
-  // one adder each: x +/- 1, y + 1, idx + 1 / - 1 / + width
+  // one adder each: x +/- 1, y + 1
   wire        hmove = go && (sel == OP_RIGHT || sel == OP_LEFT);
   wire        vmove = go && (sel == OP_DOWN);
   wire [10:0] x_n = x + (hmove ? ((sel == OP_LEFT) ? 11'h7FF : 11'd1) : 11'd0);
   wire [10:0] y_n = y + {10'd0, vmove};
-  wire [IDX_W-1:0] idx_n = idx + (vmove ? {{(IDX_W-11){1'b0}}, fb_width} :
-                                  hmove ? ((sel == OP_LEFT) ? {IDX_W{1'b1}} : {{(IDX_W-1){1'b0}}, 1'b1}) : {IDX_W{1'b0}});
 
   assign op_next = (rst || start) ? OP_NONE : !adv ? op : (hold || st == R_IDLE || !go) ? OP_NONE : sel;
 
@@ -249,10 +246,6 @@ module core_raster #(
       st       <= R_ENTRY;
       x        <= x_start;
       y        <= box_y0;
-      xlo      <= box_x0;
-      xhi      <= box_x1 - 11'd1;
-      yhi      <= box_y1 - 11'd1;
-      idx      <= origin_idx;
       last_dir <= DIR_L;
       mdir     <= DIR_R;
       order    <= ltr;
@@ -269,18 +262,16 @@ module core_raster #(
         last_dir <= last_dir_n;
         x    <= x_n;
         y    <= y_n;
-        idx  <= idx_n;
         op   <= go ? sel : OP_NONE;
         emit <= emit_n;
       end
     end
   end
 
-  // the pixel reached by `op` is where the walk now is: x, y and idx move together with op and emit
+  // the pixel reached by `op` is where the walk now is: x and y move together with op and emit
   // (after a start they differ from that pixel's only while emit is 0, when nothing reads them)
   assign px   = x[1:0];
   assign py   = y[1:0];
-  assign pidx = idx;
 
   assign commit = !rst && !start && adv && !hold && st != R_IDLE && go;
 endmodule

@@ -53,7 +53,7 @@ module core_setup #(
     output wire signed [35:0] e_data,
     input  wire signed [35:0] e1,
     input  wire signed [35:0] e2,
-    output reg  [10:0]  box_x0, box_y0, box_x1, box_y1, x_start,  // walk: clip columns, rows
+    output reg  [10:0]  box_x0, box_y0, box_xl, box_y1, x_start,  // walk: clip columns, rows
     output reg  [IDX_W-1:0] origin_idx,
     output reg  [34:0]  den,          // |2D|
     // plane writes: field 0 value at the origin, 1 step right, 2 step left, 3 step down
@@ -123,7 +123,8 @@ module core_setup #(
     end
   endgenerate
   wire box_empty = (by0 >= by1) || x_out;
-  wire [10:0] xs = (xt < cx0) ? clip_x0 : (xt >= cx1) ? clip_x1 - 11'd1 : xt[10:0];
+  // box_xl (the last column, clip_x1 - 1, loaded at the start) is the clamp's upper bound too
+  wire [10:0] xs = (xt < cx0) ? clip_x0 : (xt > $signed({2'b0, box_xl})) ? box_xl : xt[10:0];
 
   // ---------------------------------------------------------------- attribute deltas
   function [AW-1:0] attr(input [151:0] v, input [2:0] k);  // v: vertex bits [183:32]
@@ -253,7 +254,7 @@ module core_setup #(
     for (gd = 0; gd < ND; gd = gd + 1) begin : dividers
       /* verilator lint_off PINCONNECTEMPTY */
       core_divider #(.NW(ACC_W), .DW(35), .QW(32), .SKIP(SKIP)) divider (
-          .clk(clk), .rst(rst), .start(dv_go[gd]), .num(acc_s), .den(den), .busy(), .done(dv_done[gd]),
+          .clk(clk), .rst(rst), .start(dv_go[gd]), .num(acc_s), .narrow(1'b0), .den(den), .busy(), .done(dv_done[gd]),
           .quo(dv_q[gd*32 +: 32]), .rem(dv_r[gd*35 +: 35]), .rem_c(dv_rc[gd*35 +: 35]),
           .neg(dv_neg[gd]));
       /* verilator lint_on PINCONNECTEMPTY */
@@ -340,7 +341,7 @@ module core_setup #(
       case (st)
         S_IDLE: if (start) begin
           box_x0 <= clip_x0;
-          box_x1 <= clip_x1;
+          box_xl <= clip_x1 - 11'd1;  // clip_x1 > clip_x0 >= 0: a setup starts only then
           flip  <= 1'b0;
           sh5   <= 1'b0;
           box2  <= 1'b0;

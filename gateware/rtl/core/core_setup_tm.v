@@ -53,7 +53,7 @@ module core_setup_tm #(
     output reg          flip,
     output reg  [2:0]   e_we,         // the rasteriser loads e_data into its edge registers
     output wire signed [35:0] e_data,
-    output reg  [10:0]  box_x0, box_y0, box_x1, box_y1, x_start,
+    output reg  [10:0]  box_x0, box_y0, box_xl, box_y1, x_start,
     output reg  [IDX_W-1:0] origin_idx,
     output reg  [34:0]  den,          // |2D|
     output reg          pw_en,
@@ -208,12 +208,20 @@ module core_setup_tm #(
   wire signed [15:0] rc = $signed(rd[15:0]);
   // samples 16p + 8 inside [min, max]: p from (min + 7) >> 4 to (max + 8) >> 4, exclusive
   wire signed [12:0] fy = 13'(($signed({rc[15], rc}) + (box2 ? 17'sd8 : 17'sd7)) >>> 4);
-  reg  signed [12:0] fy0, xt;
-  wire signed [12:0] cx0 = $signed({2'b0, clip_x0}), cx1 = $signed({2'b0, clip_x1});
+  // Each clamped value goes straight into its output register when its vertex field is read
+  // (A_FY0: the first row, rd the top vertex's Y; A_XT: the first column, rd its X; A_BOX: the
+  // row end, rd the bottom vertex's Y), so no register holds the unclamped ones. by0 is in
+  // [0, 2048]: 2048 (by0_big) lies below every clip rectangle.
+  wire signed [12:0] xt = 13'(rc >>> 4);
+  wire signed [12:0] cx0 = $signed({2'b0, clip_x0});
   wire signed [12:0] cy0 = $signed({2'b0, clip_y0}), cy1 = $signed({2'b0, clip_y1});
-  wire signed [12:0] by0 = (fy0 > cy0) ? fy0 : cy0;
+  wire signed [12:0] by0 = (fy > cy0) ? fy : cy0;
   wire signed [12:0] by1 = (fy < cy1) ? fy : cy1;
-  wire [10:0] xs = (xt < cx0) ? clip_x0 : (xt >= cx1) ? clip_x1 - 11'd1 : xt[10:0];
+  reg         by0_big;
+  wire        unused_by0 = by0[12];  // by0 >= 0
+  wire        rows = !by0_big && $signed({2'b0, box_y0}) < by1;  // A_BOX: some row to walk
+  // box_xl (the last column, clip_x1 - 1, loaded at the start) is the clamp's upper bound too
+  wire [10:0] xs = (xt < cx0) ? clip_x0 : (xt > $signed({2'b0, box_xl})) ? box_xl : xt[10:0];
   wire [4:0] r_sel = (i_addr == R_YTOP) ? r_y(top) : (i_addr == R_XTOP) ? r_x(top) :
                      (i_addr == R_YBOT) ? r_y(bot) : i_addr;
 
@@ -225,8 +233,11 @@ module core_setup_tm #(
   wire [31:0] dv_q;
   wire [34:0] dv_r, dv_rc;
   /* verilator lint_off PINCONNECTEMPTY */
-  core_divider #(.NW(ACC_W), .DW(35), .QW(32), .SKIP(0)) divider (
-      .clk(clk), .rst(rst), .start(dv2), .num(acc_s), .den(den), .busy(), .done(dv_done),
+  // colour numerators: |d| < 2^8, |e| < 2^33, |D| < 2^33, a0 < 2^8, so |M0| = |2(d1 e1 + d2 e2 + a0
+  // |D|) + ...| < 2^44 and the steps |32(d1 dy + d2 dy)| < 2^31: 45 numerator bits, 46 cycles a
+  // division instead of 62 (Z's need all 62)
+  core_divider #(.NW(ACC_W), .DW(35), .QW(32), .SKIP(0), .NARROW(45)) divider (
+      .clk(clk), .rst(rst), .start(dv2), .num(acc_s), .narrow(dv_attr != 3'd4), .den(den), .busy(), .done(dv_done),
       .quo(dv_q), .rem(dv_r), .rem_c(dv_rc), .neg(dv_neg));
   /* verilator lint_on PINCONNECTEMPTY */
   wire unused_q = &{1'b0, dv_q[31:24]};
@@ -251,7 +262,7 @@ module core_setup_tm #(
       A_JMP, A_DONE, A_NODRAW: taken = 1'b1;
       A_BRZERO: taken = (acc == {ACC_W{1'b0}});
       A_BRNNEG: taken = !acc[ACC_W-1];
-      A_BOX:    taken = (by0 >= by1);
+      A_BOX:    taken = !rows;
       A_BRRECT: taken = rect;
       A_NEXTA:  taken = (todo == 5'd0);
       default:  taken = (pc == 7'd0) && rect;
@@ -319,7 +330,7 @@ module core_setup_tm #(
       end
       if (pc == 7'd0 && start) begin
         box_x0 <= clip_x0;
-        box_x1 <= clip_x1;
+        box_xl <= clip_x1 - 11'd1;  // clip_x1 > clip_x0 >= 0: a setup starts only then
         flip   <= 1'b0;
         if (rect) begin  // a clear: the clip rectangle
           box_y0  <= clip_y0;
@@ -351,17 +362,16 @@ module core_setup_tm #(
         case (i_act)
           A_FLIP: flip <= 1'b1;
           A_FY0: begin
-            fy0  <= fy;
-            box2 <= 1'b1;
+            box_y0  <= by0[10:0];
+            by0_big <= by0[11];
+            box2    <= 1'b1;
           end
-          A_XT: xt <= 13'(rc >>> 4);
+          A_XT: x_start <= xs;
           A_BOX: begin
             box2 <= 1'b0;
-            if (by0 < by1) begin
-              box_y0  <= by0[10:0];
-              box_y1  <= by1[10:0];
-              x_start <= xs;
-              draw    <= 1'b1;
+            if (rows) begin
+              box_y1 <= by1[10:0];
+              draw   <= 1'b1;
             end
           end
           A_ORG: origin_idx <= IDX_W'(box_y0) * IDX_W'(width) + IDX_W'(x_start);

@@ -103,7 +103,7 @@ module spigpu_core #(
   wire [2:0]  su_e_we;
   wire signed [35:0] su_e_data, ras_e0, ras_e1, ras_e2;
   wire signed [16:0] su_dx0, su_dx1, su_dx2, su_dy0, su_dy1, su_dy2;
-  wire [10:0] su_bx0, su_by0, su_bx1, su_by1, su_xs;
+  wire [10:0] su_bx0, su_by0, su_bxl, su_by1, su_xs;
   wire        su_flip;
   wire [IDX_W-1:0] su_idx;
   wire [34:0] su_den;
@@ -128,7 +128,7 @@ module spigpu_core #(
           .need(need[4:0]),
           .dx0(su_dx0), .dx1(su_dx1), .dx2(su_dx2), .dy0(su_dy0), .dy1(su_dy1), .dy2(su_dy2),
           .flip(su_flip), .e_we(su_e_we), .e_data(su_e_data),
-          .box_x0(su_bx0), .box_y0(su_by0), .box_x1(su_bx1), .box_y1(su_by1), .x_start(su_xs),
+          .box_x0(su_bx0), .box_y0(su_by0), .box_xl(su_bxl), .box_y1(su_by1), .x_start(su_xs),
           .origin_idx(su_idx),
           .den(su_den), .pw_en(pw_en), .pw_attr(pw_attr), .pw_field(pw_field), .pw_q(q24), .pw_r(pw_r));
       assign pw_q = {8'd0, q24};
@@ -142,7 +142,7 @@ module spigpu_core #(
           .need(need),
           .dx0(su_dx0), .dx1(su_dx1), .dx2(su_dx2), .dy0(su_dy0), .dy1(su_dy1), .dy2(su_dy2),
           .flip(su_flip), .e_we(su_e_we), .e_data(su_e_data), .e1(ras_e1), .e2(ras_e2),
-          .box_x0(su_bx0), .box_y0(su_by0), .box_x1(su_bx1), .box_y1(su_by1), .x_start(su_xs),
+          .box_x0(su_bx0), .box_y0(su_by0), .box_xl(su_bxl), .box_y1(su_by1), .x_start(su_xs),
           .origin_idx(su_idx),
           .den(su_den), .pw_en(pw_en), .pw_attr(pw_attr), .pw_field(pw_field), .pw_q(pw_q), .pw_r(pw_r));
     end
@@ -172,17 +172,16 @@ module spigpu_core #(
   wire [1:0]  ras_op, ras_op_next;
   wire        ras_emit;
   wire [1:0]  ras_x, ras_y;
-  wire [IDX_W-1:0] ras_idx;
   reg         ras_go;
   wire        adv, hold;
-  core_raster #(.IDX_W(IDX_W), .DSP(SMALL)) raster (
+  wire        draw_go;   // the draw starts: render state copied, command accepted (sequencer below)
+  core_raster #(.DSP(SMALL)) raster (
       .clk(clk), .rst(rst), .start(ras_go),
       .e_we(su_e_we), .e_data(su_e_data), .e0(ras_e0), .e1(ras_e1), .e2(ras_e2),
       .dx0(su_dx0), .dx1(su_dx1), .dx2(su_dx2), .dy0(su_dy0), .dy1(su_dy1), .dy2(su_dy2),
-      .flip(su_flip), .box_x0(su_bx0), .box_y0(su_by0), .box_x1(su_bx1), .box_y1(su_by1), .x_start(su_xs),
-      .origin_idx(su_idx),
-      .fb_width(r_width), .ltr(r_serial), .rect(r_rect), .adv(adv), .hold(hold), .active(ras_active), .op(ras_op),
-      .op_next(ras_op_next), .emit(ras_emit), .px(ras_x), .py(ras_y), .pidx(ras_idx));
+      .flip(su_flip), .box_x0(su_bx0), .box_y0(su_by0), .box_xl(su_bxl), .box_y1(su_by1), .x_start(su_xs),
+      .ltr(r_serial), .rect(r_rect), .adv(adv), .hold(hold), .active(ras_active), .op(ras_op),
+      .op_next(ras_op_next), .emit(ras_emit), .px(ras_x), .py(ras_y));
 
   wire [7:0]  a_r, a_g, a_b, a_a;
   wire [23:0] a_z;
@@ -195,7 +194,11 @@ module spigpu_core #(
       wire [31:0] tm_rgba;
       core_interp_tm #(.RW(35)) interp (
           .clk(clk), .rst(rst), .we(pw_en), .attr(pw_attr), .field(pw_field), .wq(pw_q[23:0]),
-          .wr(pw_r), .den(su_den), .mask(r_need[4:0]), .op(ras_op), .op_next(ras_op_next),
+          .wr(pw_r), .den(su_den), .mask(r_need[4:0]),
+          // a flat draw's colour and a clear's value straight into the output registers when
+          // the draw starts (v0's COLOR, CLEAR_COLOR or CLEAR_DEPTH on the idle read port)
+          .ld_rgba(draw_go && (cmd_op != OP_TRI || !m_gouraud)), .ld_z(draw_go && cmd_op != OP_TRI),
+          .ld_data(vp_data), .op(ras_op), .op_next(ras_op_next),
           .pipe_ok(pipe_ok), .adv(adv), .rgba(tm_rgba), .z(a_z));
       assign {a_r, a_g, a_b, a_a} = tm_rgba;
     end else begin : steppers
@@ -228,29 +231,37 @@ module spigpu_core #(
   endgenerate
 
   // emitted pixel record, aligned with the steppers' values: set when the rasteriser advances,
-  // cleared when the depth stage takes it
+  // cleared when the depth stage takes it. Its pixel index takes the move `op` when the steppers
+  // do (y * width + x from the origin on), so the rasteriser keeps no index of its own.
   reg        emit2;
   reg [1:0]  x2, y2;
   reg [IDX_W-1:0] idx2;
+  localparam [1:0] OP_RIGHT = 2'd1, OP_LEFT = 2'd2, OP_DOWN = 2'd3;
+  wire [IDX_W-1:0] idx2_n = idx2 + ((ras_op == OP_DOWN) ? IDX_W'(r_width) :
+                                    (ras_op == OP_LEFT) ? {IDX_W{1'b1}} : IDX_W'(ras_op == OP_RIGHT));
   always @(posedge clk) begin
+    if (ras_go) idx2 <= su_idx;
+    else if (adv) idx2 <= idx2_n;
     if (rst) emit2 <= 1'b0;
     else if (ras_go) emit2 <= 1'b0;
     else if (adv) begin
       emit2 <= ras_emit;
       x2    <= ras_x;
       y2    <= ras_y;
-      idx2  <= ras_idx;
     end else if (d_in_ready) begin
       emit2 <= 1'b0;
     end
   end
-  wire [31:0] src_rgba = r_gouraud ? {a_r, a_g, a_b, a_a} : r_flat;
+  // up5k: the stepper's output registers hold a flat colour and a clear's depth too (loaded when
+  // the draw starts), so the record needs no choice; ecp5 keeps them in r_flat
+  wire [31:0] src_rgba = (SMALL != 0 || r_gouraud) ? {a_r, a_g, a_b, a_a} : r_flat;
+  wire [23:0] src_z = (SMALL == 0 && r_zsel) ? r_flat[23:0] : a_z;
   wire [PW-1:0] pix;
   generate
     if (TEX != 0) begin : pix_tex
-      assign pix = {a_stq, src_rgba, y2, x2, r_zsel ? r_flat[23:0] : a_z, idx2};
+      assign pix = {a_stq, src_rgba, y2, x2, src_z, idx2};
     end else begin : pix_plain
-      assign pix = {src_rgba, y2, x2, r_zsel ? r_flat[23:0] : a_z, idx2};
+      assign pix = {src_rgba, y2, x2, src_z, idx2};
     end
   endgenerate
 
@@ -372,6 +383,7 @@ module spigpu_core #(
   localparam [1:0] C_IDLE = 2'd0, C_SETUP = 2'd1, C_DRAIN = 2'd2;
   reg [1:0] cst;
   reg       accept;
+  assign draw_go = (cst == C_DRAIN) && drained;
   assign cmd_ready = accept;
 
   // clear values, truncated to the format (section 12)
@@ -528,5 +540,6 @@ module spigpu_core #(
   // what a profile does not use (the generate blocks that read it are absent) or nothing reads
   wire unused_ok = &{1'b0, ras_e0, pw_q[31:24], r_tex, r_decal, r_tex_base, r_tex_fmt, r_need, k_base,
                      k_bpp, k_pattern, k_w, k_x0, k_y0, k_x1, k_y1, a_stq, d_passed, d_out, tr_ready,
-                     tr_rsp, t_count, cmd_tri_mode[31:20], k_ready, m_pending, tc_inval};
+                     tr_rsp, t_count, cmd_tri_mode[31:20], k_ready, m_pending, tc_inval, r_flat, r_zsel,
+                     draw_go};
 endmodule

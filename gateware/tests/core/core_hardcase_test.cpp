@@ -214,6 +214,14 @@ TEST(CoreHardCases, Attributes) {
   for (auto& v : moved) v.y += 16 * 2, v.x -= 16 * 3;
   b.draw({moved});
   b.expect_same("long spans");
+  // the widest colour numerators: a triangle over the whole coordinate range with colours near
+  // 255 makes the value at the origin about 255 * 2D, above 2^41 (the up5k divider takes 45 bits
+  // of a colour numerator), in both windings
+  std::vector<Tri> huge{{V{32767, 32767, 0, 0xFFFFFFFF}, V{-32768, 32767, 0, 0xFEFDFCFF},
+                         V{32767, -32768, 0, 0xFDFEFFFE}}};  // the screen lies inside it
+  b.draw(huge);
+  b.draw({{huge[0][0], huge[0][2], huge[0][1]}});
+  b.expect_same("widest colour numerators");
 }
 
 TEST(CoreHardCases, Texturing) {

@@ -17,7 +17,7 @@ PROFILES = {
         "stages": [
             ("setup (divider included)", "core_setup_tm", {"IDX_W": "17"}, ["core_setup_prog.v", "core_divider.v"]),
             ("  of which the divider", "core_divider", {"NW": "62", "SKIP": "0"}, []),
-            ("rasteriser", "core_raster", {"IDX_W": "17"}, []),
+            ("rasteriser", "core_raster", {}, []),
             ("attribute steppers", "core_interp_tm", {"RW": "35"}, []),
             ("depth stage", "core_depth", {"PW": "77", "ZLSB": "17", "IDX_W": "17", "AW": "0", "ADDR_W": "17"}, ["core_rdq.v"]),
             ("colour stage", "core_color", {"AW": "0", "IDX_W": "17", "ADDR_W": "17", "FEATURES": "8'h3C"}, ["core_rdq.v"]),
@@ -31,7 +31,7 @@ PROFILES = {
         "stages": [
             ("setup (dividers included)", "core_setup", {"TEX": "1", "IDX_W": "20", "SKIP": "1", "XREJECT": "1", "NDIV": "3"}, ["core_divider.v"]),
             ("  of which one divider", "core_divider", {"NW": "72", "SKIP": "1"}, []),
-            ("rasteriser", "core_raster", {"IDX_W": "20"}, []),
+            ("rasteriser", "core_raster", {}, []),
             ("one attribute stepper (of 8)", "core_stepper", {"QW": "32"}, []),
             ("depth stage", "core_depth", {"PW": "176", "ZLSB": "20", "IDX_W": "20", "AW": "2", "ADDR_W": "25"}, ["core_rdq.v"]),
             ("texture unit", "core_texture", {"AW": "2", "IDX_W": "20", "ADDR_W": "25"}, ["core_recip_rom.v"]),
