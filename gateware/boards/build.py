@@ -8,8 +8,9 @@ sg48 with icebreaker.pcf at the target clock, once per seed (1..N), icepack of t
 OUT/icebreaker.bin. Reported: logic cells, block RAM, SPRAM, DSP, PLL and I/O used of the UP5K's, and
 the post-route fmax of every clock domain, the worst of the N seeds.
 ulx3s: yosys synth_ecp5 of gateware/boards/ulx3s/ulx3s_top.v (LUT4, FF, CCU2C, distributed RAM, EBR, DSP and
-the margin against the LFE5U-85F; the SDRAM controller alone beside it); nextpnr-ecp5 with ulx3s.lpf and
-ecppack to OUT/ulx3s.bit only when both are on PATH (Debian 12 ships neither: docs/gateware.md).
+the margin against the LFE5U-85F; the SDRAM controller alone beside it; the clock estimate of ecp5_timing.py,
+reported, not checked against the target); nextpnr-ecp5 with ulx3s.lpf and ecppack to OUT/ulx3s.bit only
+when both are on PATH (Debian 12 ships neither: docs/gateware.md).
 Exit status 1, naming the resource, when a design does not fit its part or misses its target clock;
 2 on a tool that is missing or fails for another reason.
 """
