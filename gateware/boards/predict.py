@@ -14,7 +14,9 @@ untextured, >= 25 bilinear-textured). --core takes build/gateware/tests/core/rtl
 
 A board runs at the clock its PLL makes (iCEBreaker 25.125 MHz, ULX3S 50 MHz), provided the routed
 design's fmax reaches it: the prediction is cycles / clock, and the report says whether the fmax was
-measured (placed and routed) or is still only the target. --doc rewrites the blocks between the
+measured (placed and routed) or is still only the target. A design that is not routed but carries a
+clock estimate below the target (the ULX3S's `clock_estimate`, gateware/boards/ecp5_timing.py) is
+predicted at the estimate. --doc rewrites the blocks between the
 "board-figures" (with --report), "fill-rates" (--fill, --core) and "predicted-fps" (--bench) markers
 of docs/gateware.md; without it they go to stdout.
 """
@@ -29,9 +31,16 @@ def board_clock(report, board):
         return None, "no report"
     target = r.get("target_mhz")
     fmax = r.get("fmax_mhz")
+    est = r.get("clock_estimate", {}).get("core_mhz")
     if fmax:
         worst = min(fmax.values())
         state = f"routed, worst fmax {worst:.2f} MHz" + ("" if worst >= target else " (below the target)")
+    elif est and est < target:
+        # not routed, and the netlist's estimate does not reach the PLL's clock: predict at the estimate
+        ce = r["clock_estimate"]
+        return est, (f"synthesised only; the PLL makes {target:g} MHz but the netlist's estimated clock is {est:g} MHz "
+                     f"({ce.get('core_mhz_cells_only', 0):g} MHz with no routing at all; docs/gateware.md "
+                     f"\"Clock estimate\"): predicted at {est:g} MHz")
     elif "error" in r:
         state = "not routed yet: " + r["error"].split(":", 1)[-1].strip().split(" (")[0]
     else:
@@ -75,6 +84,15 @@ def figures(report):
                      f"alone {sd.get('lut4', 0):,} LUT4, {sd.get('ccu2c', 0)} CCU2C, {sd.get('ff', 0):,} FF. "
                      + (sentence(ulx.get("pnr", "placed and routed")) if "fmax_mhz" not in ulx else
                         "Post-route fmax: " + ", ".join(f"`{c}` {f:.2f} MHz" for c, f in ulx["fmax_mhz"].items()) + "."))
+        ce = ulx.get("clock_estimate")
+        if ce and ce.get("core_mhz"):
+            cones = "; ".join(f"`{c['from'].replace('u_gpu.', '')}` → `{c['to'].replace('u_gpu.', '')}` {c['ns']} ns "
+                              f"({c['levels']} cells)" for c in ce.get("critical", [])[:4])
+            lines.append(f"  Clock estimate (`gateware/boards/ecp5_timing.py`: -6 cell delays, {ce['route_ns']:g} ns "
+                         f"routing per net, {ce['route_block_ns']:g} ns to a block RAM or multiplier): core "
+                         f"**{ce['core_mhz']:g} MHz**, {ce['core_mhz_cells_only']:g} MHz with no routing at all (a bound), "
+                         f"TMDS {ce.get('tmds_mhz', 0):g} MHz; target {ulx['target_mhz']:g} MHz: "
+                         + ("backed" if ce.get("meets_target") else "**not backed**") + f". Worst cones: {cones}.")
     elif ulx and "error" in ulx:
         lines.append(f"- **ULX3S** fails: {ulx['error']}")
     return "\n".join(lines)

@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """gateware.predict: predict.py judges the fill-rate goals by the whole device's figure
-(`bench rtl --fill`), never by the core alone's (ideal memory port), and shows both."""
+(`bench rtl --fill`), never by the core alone's (ideal memory port), and shows both; at the board's
+clock, or at the netlist's estimated clock when that is lower and the design is not routed."""
 import os, sys, unittest
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -55,6 +56,35 @@ class PredictFill(unittest.TestCase):
         flat = goal_line(text, "ulx3s", "RGBA8888 textured bilinear")
         self.assertIn("not judged", flat)
         self.assertNotIn(": met", text)
+
+    def test_goals_at_the_estimated_clock_when_below_the_target(self):
+        report = {"icebreaker": REPORT["icebreaker"],
+                  "ulx3s": {"target_mhz": 50, "clock_estimate": {"core_mhz": 20.0, "core_mhz_cells_only": 40.0}}}
+        text = predict.fill_rates(CORE, FILL, report)
+        # 0.55 px/clock x 20 MHz = 11.0, not the 27.5 the PLL's 50 MHz would give
+        bilinear = goal_line(text, "ulx3s", "RGBA8888 textured bilinear")
+        self.assertIn("11.0 Mpixel/s at 20 MHz", bilinear)
+        self.assertIn("**missed**", bilinear)
+        mhz, state = predict.board_clock(report, "ulx3s")
+        self.assertEqual(mhz, 20.0)
+        self.assertIn("predicted at 20 MHz", state)
+
+    def test_an_estimate_above_the_target_keeps_the_target(self):
+        report = {"ulx3s": {"target_mhz": 50, "clock_estimate": {"core_mhz": 80.0, "core_mhz_cells_only": 120.0}}}
+        self.assertEqual(predict.board_clock(report, "ulx3s")[0], 50)
+
+    def test_figures_say_whether_the_estimate_backs_the_target(self):
+        synth = {"lut4": 1, "ccu2c": 1, "dpr16x4": 1, "lut4_equivalent": 7, "ff": 1, "ebr": 1, "dsp": 1}
+        margin = {"lut4": 99.0, "ff": 99.0, "ebr": 99.0, "dsp": 99.0}
+        est = {"route_ns": 1.0, "route_block_ns": 2.0, "core_mhz": 20.5, "core_mhz_cells_only": 43.8, "tmds_mhz": 218.1,
+               "meets_target": False, "critical": [{"ns": 48.7, "from": "u_gpu.a", "to": "u_gpu.b", "levels": 59}]}
+        ulx = {"part": "LFE5U-85F-6BG381C", "target_mhz": 50, "synth": synth, "margin_pct": margin, "clock_estimate": est}
+        text = predict.figures({"ulx3s": ulx})
+        self.assertIn("core **20.5 MHz**, 43.8 MHz with no routing at all", text)
+        self.assertIn("**not backed**", text)
+        self.assertIn("`a` → `b` 48.7 ns (59 cells)", text)
+        ulx["clock_estimate"] = dict(est, core_mhz=60.0, meets_target=True)
+        self.assertIn("target 50 MHz: backed", predict.figures({"ulx3s": ulx}))
 
 
 if __name__ == "__main__":

@@ -258,6 +258,14 @@ std::vector<Example> make() {
       skip("ecppack --compress build/gateware/boards/ulx3s.config build/gateware/boards/ulx3s.bit",
            "ecppack is not in Debian 12; scripts/gateware.sh runs it when it is on PATH"),
   }});
+  all.push_back({"docs/gateware.md", "Clock estimate (ULX3S, without nextpnr-ecp5)", 0, "docs_gateware_ClockEstimate", {
+      skip("scripts/gateware.sh --board ulx3s --json build/gateware/boards/ulx3s-report.json",
+           "minutes of yosys synth_ecp5; CTest gateware.ulx3s.synth runs it"),
+      skip("gateware/boards/ecp5_timing.py build/gateware/boards/ulx3s.json --paths 5",
+           "needs the netlist the line before writes; CTest rtl.predict.ecp5_timing tests the module"),
+      skip("gateware/boards/ecp5_timing.py build/gateware/boards/ulx3s.json --route-ns 0 --route-block-ns 0",
+           "needs the netlist the line before writes; CTest rtl.predict.ecp5_timing tests the module"),
+  }});
 
   all.push_back({"docs/dmc1.md", "Quick start", 0, "docs_dmc1_QuickStart", {
       render_mixed_dmc1(),

@@ -13,13 +13,15 @@
 module sdram_ctrl #(
   parameter CLK_MHZ   = 50,
   parameter CL        = 2,
-  parameter T_RP_NS   = 18,
-  parameter T_RCD_NS  = 18,
+  // the slowest of the ULX3S's SDRAM parts checked (Alliance AS4C32M16SB-7TCN, datasheet table 16;
+  // Micron MT48LC16M16A2-6A is 18/18/42/60/12/12/60); both take CL 2 at tCK >= 10 ns (100 MHz)
+  parameter T_RP_NS   = 21,
+  parameter T_RCD_NS  = 21,
   parameter T_RAS_NS  = 42,
-  parameter T_RC_NS   = 60,
-  parameter T_RRD_NS  = 12,
-  parameter T_WR_NS   = 12,
-  parameter T_RFC_NS  = 60,
+  parameter T_RC_NS   = 63,
+  parameter T_RRD_NS  = 14,
+  parameter T_WR_NS   = 14,
+  parameter T_RFC_NS  = 63,
   parameter T_REFI_NS = 7800,
   parameter INIT_US   = 100
 ) (
