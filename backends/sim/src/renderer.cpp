@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "fixed_point.hpp"
+
 namespace gpubridge::sim {
 namespace {
 
@@ -16,6 +18,7 @@ Renderer::Renderer(VideoMemory& mem, const AccuracyKnobs& knobs, unsigned thread
   if (pool_.workers() > 1) {
     batch_.reserve(kMaxBatch);
     drawing_.reserve(kMaxBatch);
+    scratch_.resize(pool_.workers());
   }
   draw_job_ = [this](unsigned worker) { draw_bands(worker); };
 }
@@ -48,19 +51,18 @@ void Renderer::draw(const Vertex& a, const Vertex& b, const Vertex& c, const std
   if (batching) {
     draw_pending();
     if (!batch_.empty() && batch_state_ != state) submit();
-  } else if (!batch_.empty() || drawing_active_) {
-    flush();
+    // The workers set it up (draw_bands): the front end only keeps the vertices.
+    batch_.push_back(Queued{{a, b, c}, index});
+    if (batch_state_ != state) batch_state_ = state;
+    if (batch_.size() >= kMaxBatch) submit();
+    return;
   }
+  if (!batch_.empty() || drawing_active_) flush();
   // Single thread: set up into the free slot; the previous triangle is drawn after this setup so
   // the prefetched rows of this one arrive while it is drawn (order of pixel writes unchanged).
   const int slot = pending_ == 0 ? 1 : 0;
-  Triangle& t = batching ? batch_.emplace_back() : slots_[slot];
-  // Preview mode sets up float planes for the preview routine where it applies (the exact path
-  // draws the rest).
-  const bool ok = knobs_.preview && st.preview_ok ? setup_triangle_preview(a, b, c, st, knobs_.subpixel_bits, observing, t)
-                                                        : setup_triangle(a, b, c, st, knobs_.subpixel_bits, observing, t);
-  if (!ok) {
-    if (batching) batch_.pop_back();
+  Triangle& t = slots_[slot];
+  if (!setup(a, b, c, st, observing, t)) {
     ++rejected_;
     return;
   }
@@ -71,18 +73,21 @@ void Renderer::draw(const Vertex& a, const Vertex& b, const Vertex& c, const std
   mode.rows += static_cast<std::uint64_t>(t.y1 - t.y0);
   mode.columns += static_cast<std::uint64_t>(t.x1 - t.x0);
   if (observing) observe_triangle(t, st, observer_);
-  if (!batching) {
-    if (st.writes_nothing) return;
-    prefetch_rows(t, st);
-    draw_pending();
-    pending_ = slot;
-    // The state object is shared with the device: copy the pointer (an atomic count update)
-    // only when it changed, not once per triangle.
-    if (pending_state_ != state) pending_state_ = state;
-    return;
-  }
-  if (batch_state_ != state) batch_state_ = state;
-  if (batch_.size() >= kMaxBatch) submit();
+  if (st.writes_nothing) return;
+  prefetch_rows(t, st, t.y0);
+  draw_pending();
+  pending_ = slot;
+  // The state object is shared with the device: copy the pointer (an atomic count update)
+  // only when it changed, not once per triangle.
+  if (pending_state_ != state) pending_state_ = state;
+}
+
+// Preview mode sets up float planes for the preview routine where it applies (the exact path
+// draws the rest).
+bool Renderer::setup(const Vertex& a, const Vertex& b, const Vertex& c, const DrawState& st, bool observing,
+                     Triangle& t) const {
+  return knobs_.preview && st.preview_ok ? setup_triangle_preview(a, b, c, st, knobs_.subpixel_bits, observing, t)
+                                         : setup_triangle(a, b, c, st, knobs_.subpixel_bits, observing, t);
 }
 
 void Renderer::draw_pending() {
@@ -99,12 +104,12 @@ void Renderer::draw_pending() {
 // positions miss the caches): start those loads for the triangle just set up, so they overlap
 // drawing the previous one and setting up the next. Its clipped bounding box is known by now (a
 // box from the raw vertices before setup cost 60 more instructions per triangle).
-void Renderer::prefetch_rows(const Triangle& t, const DrawState& st) const {
+void Renderer::prefetch_rows(const Triangle& t, const DrawState& st, int first_row) const {
   if (!st.color_in_vram || !st.z_in_vram) return;
-  const int rows = std::min(t.y1 - t.y0, 8);
+  const int rows = std::min(t.y1 - first_row, 8);
   // The row's first 8 pixels (32 bytes at 4 bytes per pixel) may straddle two cache lines.
   const std::size_t last = static_cast<std::size_t>(std::min(7, t.x1 - 1 - t.x0));
-  const std::size_t first = static_cast<std::size_t>(t.y0) * st.fb_width + static_cast<std::size_t>(t.x0);
+  const std::size_t first = static_cast<std::size_t>(first_row) * st.fb_width + static_cast<std::size_t>(t.x0);
   const std::uint8_t* color = mem_.data() + st.fb_draw + first * st.bpp;
   for (int r = 0; r < rows; ++r, color += std::size_t{st.fb_width} * st.bpp) {
     __builtin_prefetch(color, 1);
@@ -135,8 +140,11 @@ void Renderer::submit() {
   drawing_state_ = std::move(batch_state_);
   batch_state_.reset();
   drawing_ctx_.clear();
-  for (unsigned w = 0; w < pool_.workers(); ++w)
+  for (unsigned w = 0; w < pool_.workers(); ++w) {
     drawing_ctx_.push_back(RasterContext{mem_, recip_, knobs_.z_bits, 0, {}, vector_});
+    WorkerScratch& k = scratch_[w];
+    k.rasterised = k.rejected = k.rows = k.columns = 0;
+  }
   drawing_active_ = true;
   pool_.start(draw_job_);
 }
@@ -144,26 +152,72 @@ void Renderer::submit() {
 void Renderer::wait_drawing() {
   if (!drawing_active_) return;
   pool_.wait();
-  for (const auto& c : drawing_ctx_) {
+  auto& mode = modes_[drawing_state_->mode_class];  // one state per batch
+  for (unsigned w = 0; w < pool_.workers(); ++w) {
+    const RasterContext& c = drawing_ctx_[w];
     errors_ |= c.errors;
-    add_counters(c.counters, *drawing_state_);  // one state per batch
+    add_counters(c.counters, *drawing_state_);
+    const WorkerScratch& k = scratch_[w];
+    rasterised_ += k.rasterised;
+    rejected_ += k.rejected;
+    mode.triangles += k.rasterised;
+    mode.rows += k.rows;
+    mode.columns += k.columns;
   }
   drawing_.clear();
   drawing_state_.reset();
   drawing_active_ = false;
 }
 
+// One worker's share of a batch, in submission order: the triangles whose rows touch one of its
+// bands are set up here and drawn on those bands. Their rows are found from the vertices as setup
+// finds them (the same truncation and rounding), so the worker of the band of a triangle's first
+// row always sets it up and counts it (and, for a triangle with no rows, worker 0 counts the
+// rejection), and no other worker does. Like the single-thread pipeline, a triangle is drawn after
+// the next one is set up, so the rows prefetched for that one arrive while this one is drawn.
 void Renderer::draw_bands(unsigned worker) {
   const DrawState& st = *drawing_state_;
   const unsigned n = pool_.workers();
   RasterContext& c = drawing_ctx_[worker];
-  for (const Triangle& t : drawing_) {
-    // First band of this worker at or after the triangle's first row.
-    int band = t.y0 / kBandRows;
-    band += static_cast<int>((worker + n - static_cast<unsigned>(band) % n) % n);
+  WorkerScratch& k = scratch_[worker];
+  const unsigned bits = knobs_.subpixel_bits;
+  const std::int32_t keep = bits < 4 ? ~((std::int32_t{1} << (4 - bits)) - 1) : ~std::int32_t{0};
+  int pending = -1, pending_band = 0;
+  auto draw = [&](int slot, int band) {
+    const Triangle& t = k.slot[slot];
     for (; band * kBandRows < t.y1; band += static_cast<int>(n))
       rasterize_rows(t, st, c, band * kBandRows, (band + 1) * kBandRows);
+  };
+  for (const Queued& q : drawing_) {
+    const std::int32_t y0 = q.v[0].y & keep, y1 = q.v[1].y & keep, y2 = q.v[2].y & keep;
+    const std::int64_t first = std::max<std::int64_t>(st.clip.y0, ceil_div(std::int64_t{std::min({y0, y1, y2})} - 8, 16));
+    const std::int64_t end = std::min<std::int64_t>(st.clip.y1, floor_div(std::int64_t{std::max({y0, y1, y2})} - 8, 16) + 1);
+    if (first >= end) {  // no rows: setup rejects it
+      k.rejected += worker == 0;
+      continue;
+    }
+    int band = static_cast<int>(first / kBandRows);  // first >= clip.y0 >= 0
+    const bool owner = static_cast<unsigned>(band) % n == worker;
+    band += static_cast<int>((worker + n - static_cast<unsigned>(band) % n) % n);
+    if (band * kBandRows >= end) continue;  // none of its rows is in this worker's bands
+    const int slot = pending == 0 ? 1 : 0;
+    Triangle& t = k.slot[slot];
+    if (!setup(q.v[0], q.v[1], q.v[2], st, false, t)) {
+      k.rejected += owner;
+      continue;
+    }
+    t.index = q.index;
+    if (owner) {
+      ++k.rasterised;
+      k.rows += static_cast<std::uint64_t>(t.y1 - t.y0);
+      k.columns += static_cast<std::uint64_t>(t.x1 - t.x0);
+    }
+    prefetch_rows(t, st, std::max(t.y0, band * kBandRows));
+    if (pending >= 0) draw(pending, pending_band);
+    pending = slot;
+    pending_band = band;
   }
+  if (pending >= 0) draw(pending, pending_band);
 }
 
 std::uint16_t Renderer::take_errors() {
