@@ -7,6 +7,7 @@
 #include <cstdint>
 
 #include "draw_state.hpp"
+#include "preview_plain.hpp"
 #include "gpubridge/sim/device.hpp"
 #include "reciprocal.hpp"
 #include "setup.hpp"
@@ -39,6 +40,23 @@ struct RasterContext {
 // buffers inside VRAM and disjoint, a texture inside VRAM disjoint from both, a colour stage that
 // is not fully masked. Other draws take the exact path (setup_triangle) even in preview mode.
 bool preview_applies(const DrawState& st);
+
+// What drawing a small preview triangle (Triangle::small, preview_plain.hpp) needs from its state,
+// worked out once per state (the renderer keeps it while the state lasts) instead of per triangle.
+struct SmallDraw {
+  SmallKernel kernel = nullptr;   // small_kernel(st)
+  std::uint8_t* color = nullptr;  // the colour buffer's first pixel
+  std::uint8_t* depth = nullptr;  // the depth buffer's first word (null without depth)
+  std::size_t pitch = 0;          // bytes per row of either buffer
+  unsigned width = 0;             // pixels per row
+  std::uint32_t zmask = 0xFFFFFF; // the Z bits compared and stored (z_bits)
+  bool z_write = false, blended = false;
+};
+// For a state with st.preview_small != 0 (and preview_applies).
+SmallDraw small_draw(const DrawState& st, VideoMemory& mem, unsigned z_bits);
+// Draws the rows [row_begin, row_end) of a small triangle (clipped to its box) as rasterize_rows
+// does, counting into c.
+void rasterize_small(const Triangle& t, const SmallDraw& d, RasterCounters& c, int row_begin, int row_end);
 
 // Draws the rows [row_begin, row_end) of t (a preview triangle through the preview routine) (clipped to its bounding box) with state st.
 void rasterize_rows(const Triangle& t, const DrawState& st, RasterContext& ctx, int row_begin, int row_end);

@@ -79,13 +79,22 @@ void Renderer::draw(const Vertex& a, const Vertex& b, const Vertex& c, const std
   pending_ = slot;
   // The state object is shared with the device: copy the pointer (an atomic count update)
   // only when it changed, not once per triangle.
-  if (pending_state_ != state) pending_state_ = state;
+  if (pending_state_ != state) {
+    pending_state_ = state;
+    if (knobs_.preview && st.preview_small != 0) pending_small_ = small_draw(st, mem_, knobs_.z_bits);
+  }
 }
 
 // Preview mode sets up float planes for the preview routine where it applies (the exact path
 // draws the rest).
 bool Renderer::setup(const Vertex& a, const Vertex& b, const Vertex& c, const DrawState& st, bool observing,
                      Triangle& t) const {
+  // Small triangles of a plain untextured preview draw: their own setup (setup_triangle_preview's
+  // first step), entered directly.
+  if (knobs_.preview && st.preview_small != 0 && !observing) {
+    const SmallSetup s = small_setup_(a, b, c, st, knobs_.subpixel_bits, t);
+    if (s != SmallSetup::NotSmall) return s == SmallSetup::Drawn;
+  }
   return knobs_.preview && st.preview_ok ? setup_triangle_preview(a, b, c, st, knobs_.subpixel_bits, observing, t)
                                          : setup_triangle(a, b, c, st, knobs_.subpixel_bits, observing, t);
 }
@@ -93,6 +102,13 @@ bool Renderer::setup(const Vertex& a, const Vertex& b, const Vertex& c, const Dr
 void Renderer::draw_pending() {
   if (pending_ < 0) return;
   const Triangle& t = slots_[pending_];
+  if (t.small) {  // no errors (both buffers inside memory), counters straight into the totals
+    const std::uint64_t covered = counters_.covered;
+    rasterize_small(t, pending_small_, counters_, t.y0, t.y1);
+    modes_[pending_state_->mode_class].pixels += counters_.covered - covered;
+    pending_ = -1;
+    return;
+  }
   RasterContext ctx{mem_, recip_, knobs_.z_bits, 0, {}, vector_};
   rasterize_rows(t, *pending_state_, ctx, t.y0, t.y1);
   errors_ |= ctx.errors;
@@ -111,15 +127,22 @@ void Renderer::prefetch_rows(const Triangle& t, const DrawState& st, int first_r
   const std::size_t last = static_cast<std::size_t>(std::min(7, t.x1 - 1 - t.x0));
   const std::size_t first = static_cast<std::size_t>(first_row) * st.fb_width + static_cast<std::size_t>(t.x0);
   const std::uint8_t* color = mem_.data() + st.fb_draw + first * st.bpp;
-  for (int r = 0; r < rows; ++r, color += std::size_t{st.fb_width} * st.bpp) {
-    __builtin_prefetch(color, 1);
-    __builtin_prefetch(color + last * st.bpp, 1);
+  const std::size_t cpitch = std::size_t{st.fb_width} * st.bpp, clast = last * st.bpp;
+  if (!st.z_test && !st.z_write) {
+    for (int r = 0; r < rows; ++r, color += cpitch) {
+      __builtin_prefetch(color, 1);
+      __builtin_prefetch(color + clast, 1);
+    }
+    return;
   }
-  if (!st.z_test && !st.z_write) return;
+  // Colour and depth rows in one loop (half the loop overhead of two).
   const std::uint8_t* depth = mem_.data() + st.fb_z + first * 4;
-  for (int r = 0; r < rows; ++r, depth += std::size_t{st.fb_width} * 4) {
+  const std::size_t zpitch = std::size_t{st.fb_width} * 4, zlast = last * 4;
+  for (int r = 0; r < rows; ++r, color += cpitch, depth += zpitch) {
+    __builtin_prefetch(color, 1);
+    __builtin_prefetch(color + clast, 1);
     __builtin_prefetch(depth, 1);
-    __builtin_prefetch(depth + last * 4, 1);
+    __builtin_prefetch(depth + zlast, 1);
   }
 }
 
@@ -183,10 +206,13 @@ void Renderer::draw_bands(unsigned worker) {
   const unsigned bits = knobs_.subpixel_bits;
   const std::int32_t keep = bits < 4 ? ~((std::int32_t{1} << (4 - bits)) - 1) : ~std::int32_t{0};
   int pending = -1, pending_band = 0;
+  const SmallDraw small = knobs_.preview && st.preview_small != 0 ? small_draw(st, mem_, knobs_.z_bits) : SmallDraw{};
   auto draw = [&](int slot, int band) {
     const Triangle& t = k.slot[slot];
-    for (; band * kBandRows < t.y1; band += static_cast<int>(n))
-      rasterize_rows(t, st, c, band * kBandRows, (band + 1) * kBandRows);
+    for (; band * kBandRows < t.y1; band += static_cast<int>(n)) {
+      if (t.small) rasterize_small(t, small, c.counters, band * kBandRows, (band + 1) * kBandRows);
+      else rasterize_rows(t, st, c, band * kBandRows, (band + 1) * kBandRows);
+    }
   };
   for (const Queued& q : drawing_) {
     const std::int32_t y0 = q.v[0].y & keep, y1 = q.v[1].y & keep, y2 = q.v[2].y & keep;

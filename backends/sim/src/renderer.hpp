@@ -97,6 +97,8 @@ class Renderer {
   Triangle slots_[2];
   int pending_ = -1;  // slot set up but not yet drawn (single-thread pipelining)
   std::shared_ptr<const DrawState> pending_state_;
+  SmallDraw pending_small_;  // for pending_state_ when it has small preview triangles
+  SmallSetupRoutine small_setup_ = small_setup_routine();
   std::uint16_t errors_ = 0;
   std::uint64_t rasterised_ = 0;
   std::uint64_t rejected_ = 0;
