@@ -1,10 +1,10 @@
-// Triangle setup in the band workers (backends/sim/src/renderer.hpp): with N threads each worker
-// sets up the triangles whose rows touch its own 16-row bands, so a triangle straddling the bands of
-// two workers is set up twice. The bytes, the error flags and every counter (triangles rasterised
-// and rejected, rows and columns per state class, pixels) must be those of one thread, each
-// triangle counted once: small triangles around the band edges, triangles that draw nothing (D = 0,
-// between sample rows, above the framebuffer, outside the scissor), several states and batches
-// longer than one, in the exact and the preview path, with full and truncated subpixel bits.
+// Triangle setup in the band workers (backends/sim/src/renderer.hpp): with N threads the workers
+// set up the batch (an equal run each) and then draw their own 16-row bands of every triangle. The
+// bytes, the error flags and every counter (triangles rasterised and rejected, rows and columns per
+// state class, pixels) must be those of one thread, each triangle counted once: small triangles
+// around the band edges, triangles that draw nothing (D = 0, between sample rows, above the
+// framebuffer, outside the scissor), several states and batches longer than one, in the exact and
+// the preview path, with full and truncated subpixel bits.
 #include <gtest/gtest.h>
 
 #include <cstdint>
@@ -102,7 +102,7 @@ TEST(SimBandSetup, PreviewSameBytesAndCountersForAnyThreadCount) {
   expect_same_for_any_thread_count(preview_options(1), "preview");
 }
 
-// Truncated vertex coordinates (subpixel_bits < 4) move the first row a worker must find.
+// Truncated vertex coordinates (subpixel_bits < 4) move the rows and the box.
 TEST(SimBandSetup, TruncatedSubpixelsSameBytesAndCounters) {
   DeviceOptions exact;
   exact.accuracy.subpixel_bits = 1;

@@ -2,8 +2,6 @@
 
 #include <algorithm>
 
-#include "fixed_point.hpp"
-
 namespace gpubridge::sim {
 namespace {
 
@@ -19,6 +17,8 @@ Renderer::Renderer(VideoMemory& mem, const AccuracyKnobs& knobs, unsigned thread
     batch_.reserve(kMaxBatch);
     drawing_.reserve(kMaxBatch);
     scratch_.resize(pool_.workers());
+    set_up_.resize(kMaxBatch);
+    setup_done_ = std::make_unique<std::barrier<>>(static_cast<std::ptrdiff_t>(pool_.workers()));
   }
   draw_job_ = [this](unsigned worker) { draw_bands(worker); };
 }
@@ -74,7 +74,7 @@ void Renderer::draw(const Vertex& a, const Vertex& b, const Vertex& c, const std
   mode.columns += static_cast<std::uint64_t>(t.x1 - t.x0);
   if (observing) observe_triangle(t, st, observer_);
   if (st.writes_nothing) return;
-  prefetch_rows(t, st, t.y0);
+  prefetch_rows(t, st);
   draw_pending();
   pending_ = slot;
   // The state object is shared with the device: copy the pointer (an atomic count update)
@@ -120,12 +120,12 @@ void Renderer::draw_pending() {
 // positions miss the caches): start those loads for the triangle just set up, so they overlap
 // drawing the previous one and setting up the next. Its clipped bounding box is known by now (a
 // box from the raw vertices before setup cost 60 more instructions per triangle).
-void Renderer::prefetch_rows(const Triangle& t, const DrawState& st, int first_row) const {
+void Renderer::prefetch_rows(const Triangle& t, const DrawState& st) const {
   if (!st.color_in_vram || !st.z_in_vram) return;
-  const int rows = std::min(t.y1 - first_row, 8);
+  const int rows = std::min(t.y1 - t.y0, 8);
   // The row's first 8 pixels (32 bytes at 4 bytes per pixel) may straddle two cache lines.
   const std::size_t last = static_cast<std::size_t>(std::min(7, t.x1 - 1 - t.x0));
-  const std::size_t first = static_cast<std::size_t>(first_row) * st.fb_width + static_cast<std::size_t>(t.x0);
+  const std::size_t first = static_cast<std::size_t>(t.y0) * st.fb_width + static_cast<std::size_t>(t.x0);
   const std::uint8_t* color = mem_.data() + st.fb_draw + first * st.bpp;
   const std::size_t cpitch = std::size_t{st.fb_width} * st.bpp, clast = last * st.bpp;
   if (!st.z_test && !st.z_write) {
@@ -192,58 +192,45 @@ void Renderer::wait_drawing() {
   drawing_active_ = false;
 }
 
-// One worker's share of a batch, in submission order: the triangles whose rows touch one of its
-// bands are set up here and drawn on those bands. Their rows are found from the vertices as setup
-// finds them (the same truncation and rounding), so the worker of the band of a triangle's first
-// row always sets it up and counts it (and, for a triangle with no rows, worker 0 counts the
-// rejection), and no other worker does. Like the single-thread pipeline, a triangle is drawn after
-// the next one is set up, so the rows prefetched for that one arrive while this one is drawn.
+// One worker's share of a batch. Setup first: the worker's run of the batch, counted here (a
+// rejected triangle is left with no rows). The device thread used to set up every triangle while
+// the workers drew, and on 10-px triangles that made it the busiest thread (callgrind: 1,346
+// instructions per triangle against 866 per worker, exact); setting up by bands instead (each
+// worker the triangles touching its bands, those crossing two workers' bands twice) cost a tenth
+// more instructions in all (docs/simulator.md). Then, after every worker has set up its run, the
+// rows of this worker's bands of every triangle in submission order.
 void Renderer::draw_bands(unsigned worker) {
   const DrawState& st = *drawing_state_;
   const unsigned n = pool_.workers();
   RasterContext& c = drawing_ctx_[worker];
   WorkerScratch& k = scratch_[worker];
-  const unsigned bits = knobs_.subpixel_bits;
-  const std::int32_t keep = bits < 4 ? ~((std::int32_t{1} << (4 - bits)) - 1) : ~std::int32_t{0};
-  int pending = -1, pending_band = 0;
+  // Setup: an equal run of the batch per worker, each triangle once.
+  const std::size_t size = drawing_.size(), from = size * worker / n, to = size * (worker + 1) / n;
+  for (std::size_t i = from; i < to; ++i) {
+    const Queued& q = drawing_[i];
+    Triangle& t = set_up_[i];
+    if (!setup(q.v[0], q.v[1], q.v[2], st, false, t)) {
+      ++k.rejected;
+      t.y0 = t.y1 = 0;  // draws nothing
+      continue;
+    }
+    t.index = q.index;
+    ++k.rasterised;
+    k.rows += static_cast<std::uint64_t>(t.y1 - t.y0);
+    k.columns += static_cast<std::uint64_t>(t.x1 - t.x0);
+  }
+  setup_done_->arrive_and_wait();  // the other workers' triangles are set up
+  // Drawing: every triangle in submission order, this worker's bands only.
   const SmallDraw small = knobs_.preview && st.preview_small != 0 ? small_draw(st, mem_, knobs_.z_bits) : SmallDraw{};
-  auto draw = [&](int slot, int band) {
-    const Triangle& t = k.slot[slot];
+  for (std::size_t i = 0; i < size; ++i) {
+    const Triangle& t = set_up_[i];
+    int band = t.y0 / kBandRows;
+    band += static_cast<int>((worker + n - static_cast<unsigned>(band) % n) % n);
     for (; band * kBandRows < t.y1; band += static_cast<int>(n)) {
       if (t.small) rasterize_small(t, small, c.counters, band * kBandRows, (band + 1) * kBandRows);
       else rasterize_rows(t, st, c, band * kBandRows, (band + 1) * kBandRows);
     }
-  };
-  for (const Queued& q : drawing_) {
-    const std::int32_t y0 = q.v[0].y & keep, y1 = q.v[1].y & keep, y2 = q.v[2].y & keep;
-    const std::int64_t first = std::max<std::int64_t>(st.clip.y0, ceil_div(std::int64_t{std::min({y0, y1, y2})} - 8, 16));
-    const std::int64_t end = std::min<std::int64_t>(st.clip.y1, floor_div(std::int64_t{std::max({y0, y1, y2})} - 8, 16) + 1);
-    if (first >= end) {  // no rows: setup rejects it
-      k.rejected += worker == 0;
-      continue;
-    }
-    int band = static_cast<int>(first / kBandRows);  // first >= clip.y0 >= 0
-    const bool owner = static_cast<unsigned>(band) % n == worker;
-    band += static_cast<int>((worker + n - static_cast<unsigned>(band) % n) % n);
-    if (band * kBandRows >= end) continue;  // none of its rows is in this worker's bands
-    const int slot = pending == 0 ? 1 : 0;
-    Triangle& t = k.slot[slot];
-    if (!setup(q.v[0], q.v[1], q.v[2], st, false, t)) {
-      k.rejected += owner;
-      continue;
-    }
-    t.index = q.index;
-    if (owner) {
-      ++k.rasterised;
-      k.rows += static_cast<std::uint64_t>(t.y1 - t.y0);
-      k.columns += static_cast<std::uint64_t>(t.x1 - t.x0);
-    }
-    prefetch_rows(t, st, std::max(t.y0, band * kBandRows));
-    if (pending >= 0) draw(pending, pending_band);
-    pending = slot;
-    pending_band = band;
   }
-  if (pending >= 0) draw(pending, pending_band);
 }
 
 std::uint16_t Renderer::take_errors() {

@@ -1,14 +1,14 @@
 #pragma once
 // Runs kicked triangles through setup and the rasteriser. With one thread every triangle is drawn
 // at once. With N threads triangles are batched (their vertices, not set up) while the render
-// state stays the same; a batch is drawn by N workers that each walk all triangles in submission
-// order, set up those whose rows touch one of their own 16-row bands (band i → worker i % N) and
-// draw only those bands' rows. A triangle crossing the bands of two workers is set up by both from
-// the same vertices (the same bits), so the bytes are identical for any N; its counters are kept by
-// one of them only (the worker of the band of its first row). The calling thread (the device front
-// end) only decodes and batches the next batch while the workers draw the previous one; batches are
-// drawn one after another, and flush() waits for both.
+// state stays the same; a batch is set up and drawn by N workers: first each sets up an equal run
+// of the batch (each triangle once, so each is counted once), then, when all have, each walks all
+// triangles in submission order and draws only the rows of its own 16-row bands (band i → worker
+// i % N), so the bytes are identical for any N. The calling thread (the device front end) only
+// decodes and batches the next batch while the workers set up and draw the previous one; batches
+// are drawn one after another, and flush() waits for both.
 #include <array>
+#include <barrier>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -64,7 +64,7 @@ class Renderer {
   void wait_drawing();
   void draw_bands(unsigned worker);
   void draw_pending();
-  void prefetch_rows(const Triangle& t, const DrawState& st, int first_row) const;
+  void prefetch_rows(const Triangle& t, const DrawState& st) const;
   // Sets up a triangle as the state and the accuracy want it (false: it draws nothing).
   bool setup(const Vertex& a, const Vertex& b, const Vertex& c, const DrawState& st, bool observing, Triangle& t) const;
 
@@ -73,10 +73,9 @@ class Renderer {
     Vertex v[3];
     std::uint64_t index;
   };
-  // What one worker set up and counted in the batch it draws (merged after the batch, one state
-  // per batch): each triangle counted by one worker only. Aligned apart: written while drawing.
+  // What one worker counted while setting up its run of the batch (merged after the batch, one
+  // state per batch). Aligned apart: written while the other workers write theirs.
   struct alignas(64) WorkerScratch {
-    Triangle slot[2];  // set up / drawn, as the single-thread pipeline
     std::uint64_t rasterised = 0, rejected = 0, rows = 0, columns = 0;
   };
 
@@ -92,6 +91,8 @@ class Renderer {
   std::shared_ptr<const DrawState> drawing_state_;
   std::vector<RasterContext> drawing_ctx_;  // one per worker
   std::vector<WorkerScratch> scratch_;      // one per worker
+  std::vector<Triangle> set_up_;            // drawing_ set up (by the workers, one run each)
+  std::unique_ptr<std::barrier<>> setup_done_;  // the workers meet between setup and drawing
   bool drawing_active_ = false;
   std::function<void(unsigned)> draw_job_;
   Triangle slots_[2];
