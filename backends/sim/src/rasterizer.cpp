@@ -556,26 +556,6 @@ SmallDraw small_draw(const DrawState& st, VideoMemory& mem, unsigned z_bits) {
   return d;
 }
 
-// A small triangle's rows [ya, yz) (setup_small_preview, preview_plain.hpp).
-void rasterize_small(const Triangle& t, const SmallDraw& d, RasterCounters& c, int row_begin, int row_end) {
-  const int ya = std::max(row_begin, t.y0), yz = std::min(row_end, t.y1);
-  if (ya >= yz) return;
-  SmallTarget s;
-  const std::size_t pix = static_cast<std::size_t>(ya) * d.width + static_cast<std::size_t>(t.x0);
-  s.color = d.color + pix * 4;
-  if (d.depth) s.depth = d.depth + pix * 4;
-  s.pitch = d.pitch;
-  s.ky0 = ya - t.y0;
-  s.rows = yz - ya;
-  s.zmask = d.zmask;
-  s.z_write = d.z_write;
-  const PreviewCounts n = d.kernel(t, s);
-  c.scanned += n.scanned;  // count_drawn's counts
-  c.covered += n.covered;
-  c.passed += n.passed;
-  if (d.blended) c.blended += n.passed;
-}
-
 void rasterize_rows(const Triangle& t, const DrawState& st, RasterContext& ctx, int row_begin, int row_end) {
   const int ya = std::max(row_begin, t.y0), yz = std::min(row_end, t.y1);
   if (ya >= yz) return;

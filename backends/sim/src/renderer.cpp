@@ -40,6 +40,51 @@ bool Renderer::can_batch(const DrawState& st) const {
   return true;
 }
 
+// Small triangles are bound by the latency of their first depth and colour reads (random screen
+// positions miss the caches): start those loads for the triangle just set up, so they overlap
+// drawing the previous one and setting up the next. Its clipped bounding box is known by now (a
+// box from the raw vertices before setup cost 60 more instructions per triangle).
+[[gnu::always_inline]] inline void Renderer::prefetch_rows(const Triangle& t, const DrawState& st) const {
+  if (!st.color_in_vram || !st.z_in_vram) return;
+  const int rows = std::min(t.y1 - t.y0, 8);
+  // The row's first 8 pixels (32 bytes at 4 bytes per pixel) may straddle two cache lines.
+  const std::size_t last = static_cast<std::size_t>(std::min(7, t.x1 - 1 - t.x0));
+  const std::size_t first = static_cast<std::size_t>(t.y0) * st.fb_width + static_cast<std::size_t>(t.x0);
+  const std::uint8_t* color = mem_.data() + st.fb_draw + first * st.bpp;
+  const std::size_t cpitch = std::size_t{st.fb_width} * st.bpp, clast = last * st.bpp;
+  if (!st.z_test && !st.z_write) {
+    for (int r = 0; r < rows; ++r, color += cpitch) {
+      __builtin_prefetch(color, 1);
+      __builtin_prefetch(color + clast, 1);
+    }
+    return;
+  }
+  // Colour and depth rows in one loop (half the loop overhead of two).
+  const std::uint8_t* depth = mem_.data() + st.fb_z + first * 4;
+  const std::size_t zpitch = std::size_t{st.fb_width} * 4, zlast = last * 4;
+  for (int r = 0; r < rows; ++r, color += cpitch, depth += zpitch) {
+    __builtin_prefetch(color, 1);
+    __builtin_prefetch(color + clast, 1);
+    __builtin_prefetch(depth, 1);
+    __builtin_prefetch(depth + zlast, 1);
+  }
+}
+
+// Preview mode sets up float planes for the preview routine where it applies (the exact path
+// draws the rest).
+// Inlined into both callers: a call per triangle costs more than its checks.
+[[gnu::always_inline]] inline bool Renderer::setup(const Vertex& a, const Vertex& b, const Vertex& c,
+                                                   const DrawState& st, bool observing, Triangle& t) const {
+  // Small triangles of a plain untextured preview draw: their own setup (setup_triangle_preview's
+  // first step), entered directly.
+  if (knobs_.preview && st.preview_small != 0 && !observing) {
+    const SmallSetup s = small_setup_(a, b, c, st, knobs_.subpixel_bits, t);
+    if (s != SmallSetup::NotSmall) return s == SmallSetup::Drawn;
+  }
+  return knobs_.preview && st.preview_ok ? setup_triangle_preview(a, b, c, st, knobs_.subpixel_bits, observing, t)
+                                         : setup_triangle(a, b, c, st, knobs_.subpixel_bits, observing, t);
+}
+
 void Renderer::draw(const Vertex& a, const Vertex& b, const Vertex& c, const std::shared_ptr<const DrawState>& state,
                     std::uint64_t index) {
   const DrawState& st = *state;
@@ -85,20 +130,6 @@ void Renderer::draw(const Vertex& a, const Vertex& b, const Vertex& c, const std
   }
 }
 
-// Preview mode sets up float planes for the preview routine where it applies (the exact path
-// draws the rest).
-bool Renderer::setup(const Vertex& a, const Vertex& b, const Vertex& c, const DrawState& st, bool observing,
-                     Triangle& t) const {
-  // Small triangles of a plain untextured preview draw: their own setup (setup_triangle_preview's
-  // first step), entered directly.
-  if (knobs_.preview && st.preview_small != 0 && !observing) {
-    const SmallSetup s = small_setup_(a, b, c, st, knobs_.subpixel_bits, t);
-    if (s != SmallSetup::NotSmall) return s == SmallSetup::Drawn;
-  }
-  return knobs_.preview && st.preview_ok ? setup_triangle_preview(a, b, c, st, knobs_.subpixel_bits, observing, t)
-                                         : setup_triangle(a, b, c, st, knobs_.subpixel_bits, observing, t);
-}
-
 void Renderer::draw_pending() {
   if (pending_ < 0) return;
   const Triangle& t = slots_[pending_];
@@ -114,36 +145,6 @@ void Renderer::draw_pending() {
   errors_ |= ctx.errors;
   add_counters(ctx.counters, *pending_state_);
   pending_ = -1;  // pending_state_ stays: the next triangle most likely uses it again
-}
-
-// Small triangles are bound by the latency of their first depth and colour reads (random screen
-// positions miss the caches): start those loads for the triangle just set up, so they overlap
-// drawing the previous one and setting up the next. Its clipped bounding box is known by now (a
-// box from the raw vertices before setup cost 60 more instructions per triangle).
-void Renderer::prefetch_rows(const Triangle& t, const DrawState& st) const {
-  if (!st.color_in_vram || !st.z_in_vram) return;
-  const int rows = std::min(t.y1 - t.y0, 8);
-  // The row's first 8 pixels (32 bytes at 4 bytes per pixel) may straddle two cache lines.
-  const std::size_t last = static_cast<std::size_t>(std::min(7, t.x1 - 1 - t.x0));
-  const std::size_t first = static_cast<std::size_t>(t.y0) * st.fb_width + static_cast<std::size_t>(t.x0);
-  const std::uint8_t* color = mem_.data() + st.fb_draw + first * st.bpp;
-  const std::size_t cpitch = std::size_t{st.fb_width} * st.bpp, clast = last * st.bpp;
-  if (!st.z_test && !st.z_write) {
-    for (int r = 0; r < rows; ++r, color += cpitch) {
-      __builtin_prefetch(color, 1);
-      __builtin_prefetch(color + clast, 1);
-    }
-    return;
-  }
-  // Colour and depth rows in one loop (half the loop overhead of two).
-  const std::uint8_t* depth = mem_.data() + st.fb_z + first * 4;
-  const std::size_t zpitch = std::size_t{st.fb_width} * 4, zlast = last * 4;
-  for (int r = 0; r < rows; ++r, color += cpitch, depth += zpitch) {
-    __builtin_prefetch(color, 1);
-    __builtin_prefetch(color + clast, 1);
-    __builtin_prefetch(depth, 1);
-    __builtin_prefetch(depth + zlast, 1);
-  }
 }
 
 void Renderer::flush() {
