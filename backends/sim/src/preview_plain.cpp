@@ -42,8 +42,6 @@ std::uint8_t preview_small_kernel(const DrawState& st) {
   return static_cast<std::uint8_t>(1 + 2 * z + (st.blend == protocol::BlendMode::Alpha ? 1 : 0));
 }
 
-using SmallKernel = PreviewCounts (*)(const Triangle&, const SmallTarget&);
-
 // The kernel twice: for AVX2 and for the baseline, picked once per process.
 #if defined(__clang__)
 #pragma clang attribute push(__attribute__((target("avx2"))), apply_to = function)
@@ -88,6 +86,12 @@ SmallSetup setup_small_preview(const Vertex& a, const Vertex& b, const Vertex& c
 PreviewCounts shade_preview_small(const Triangle& t, const SmallTarget& d) {
   static const SmallKernel* const kernels = has_avx2() ? plain_avx2::kSmallKernels : plain_baseline::kSmallKernels;
   return kernels[t.small - 1](t, d);
+}
+
+SmallSetupRoutine small_setup_routine() { return has_avx2() ? &plain_avx2::setup_small : &plain_baseline::setup_small; }
+
+SmallKernel small_kernel(const DrawState& st) {
+  return (has_avx2() ? plain_avx2::kSmallKernels : plain_baseline::kSmallKernels)[st.preview_small - 1];
 }
 
 }  // namespace gpubridge::sim

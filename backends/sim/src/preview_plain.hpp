@@ -93,4 +93,12 @@ struct SmallTarget {
 };
 PreviewCounts shade_preview_small(const Triangle& t, const SmallTarget& d);
 
+// The same routines of this CPU (AVX2 or the baseline), looked up once per state by the renderer
+// instead of on every call (docs/simulator.md "Preview"): same routines, same bytes.
+using SmallSetupRoutine = SmallSetup (*)(const Vertex& a, const Vertex& b, const Vertex& c, const DrawState& st,
+                                         unsigned subpixel_bits, Triangle& t);
+using SmallKernel = PreviewCounts (*)(const Triangle& t, const SmallTarget& d);
+SmallSetupRoutine small_setup_routine();
+SmallKernel small_kernel(const DrawState& st);  // st.preview_small != 0
+
 }  // namespace gpubridge::sim

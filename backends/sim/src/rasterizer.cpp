@@ -533,21 +533,6 @@ void draw_preview_plain(const Triangle& t, const DrawState& st, RasterContext& c
   count_drawn(ctx, st, c.scanned, c.covered, c.passed, st.blend != protocol::BlendMode::Off, st.textured);
 }
 
-// A small triangle's rows [ya, yz) (setup_small_preview, preview_plain.hpp).
-void draw_preview_small(const Triangle& t, const DrawState& st, RasterContext& ctx, int ya, int yz) {
-  SmallTarget d;
-  const std::size_t pix = static_cast<std::size_t>(ya) * st.fb_width + static_cast<std::size_t>(t.x0);
-  d.color = ctx.mem.data() + st.fb_draw + pix * 4;
-  if (st.z_test || st.z_write) d.depth = ctx.mem.data() + st.fb_z + pix * 4;
-  d.pitch = std::size_t{st.fb_width} * 4;
-  d.ky0 = ya - t.y0;
-  d.rows = yz - ya;
-  d.zmask = z_mask(ctx);
-  d.z_write = st.z_write;
-  const PreviewCounts c = shade_preview_small(t, d);
-  count_drawn(ctx, st, c.scanned, c.covered, c.passed, st.blend != protocol::BlendMode::Off, false);
-}
-
 }  // namespace
 
 bool preview_applies(const DrawState& st) {
@@ -558,10 +543,23 @@ bool preview_applies(const DrawState& st) {
   return !st.textured || (st.tex.in_vram && texture_disjoint(st, depth));
 }
 
+SmallDraw small_draw(const DrawState& st, VideoMemory& mem, unsigned z_bits) {
+  SmallDraw d;
+  d.kernel = small_kernel(st);
+  d.color = mem.data() + st.fb_draw;
+  if (st.z_test || st.z_write) d.depth = mem.data() + st.fb_z;
+  d.pitch = std::size_t{st.fb_width} * 4;
+  d.width = st.fb_width;
+  d.zmask = z_bits >= 24 ? 0xFFFFFFu : 0xFFFFFFu & ~((1u << (24 - z_bits)) - 1);  // z_mask
+  d.z_write = st.z_write;
+  d.blended = st.blend != protocol::BlendMode::Off;
+  return d;
+}
+
 void rasterize_rows(const Triangle& t, const DrawState& st, RasterContext& ctx, int row_begin, int row_end) {
   const int ya = std::max(row_begin, t.y0), yz = std::min(row_end, t.y1);
   if (ya >= yz) return;
-  if (t.small) return draw_preview_small(t, st, ctx, ya, yz);
+  if (t.small) return rasterize_small(t, small_draw(st, ctx.mem, ctx.z_bits), ctx.counters, ya, yz);
   bool colors_differ = false;
   for (unsigned ch = 0; ch < 4; ++ch) colors_differ |= !t.plane[kR + ch].constant;
   const bool gouraud = st.gouraud && colors_differ;   // Gouraud only when colours differ

@@ -7,6 +7,7 @@
 #include <cstdint>
 
 #include "draw_state.hpp"
+#include "preview_plain.hpp"
 #include "gpubridge/sim/device.hpp"
 #include "reciprocal.hpp"
 #include "setup.hpp"
@@ -39,6 +40,40 @@ struct RasterContext {
 // buffers inside VRAM and disjoint, a texture inside VRAM disjoint from both, a colour stage that
 // is not fully masked. Other draws take the exact path (setup_triangle) even in preview mode.
 bool preview_applies(const DrawState& st);
+
+// What drawing a small preview triangle (Triangle::small, preview_plain.hpp) needs from its state,
+// worked out once per state (the renderer keeps it while the state lasts) instead of per triangle.
+struct SmallDraw {
+  SmallKernel kernel = nullptr;   // small_kernel(st)
+  std::uint8_t* color = nullptr;  // the colour buffer's first pixel
+  std::uint8_t* depth = nullptr;  // the depth buffer's first word (null without depth)
+  std::size_t pitch = 0;          // bytes per row of either buffer
+  unsigned width = 0;             // pixels per row
+  std::uint32_t zmask = 0xFFFFFF; // the Z bits compared and stored (z_bits)
+  bool z_write = false, blended = false;
+};
+// For a state with st.preview_small != 0 (and preview_applies).
+SmallDraw small_draw(const DrawState& st, VideoMemory& mem, unsigned z_bits);
+// Draws the rows [row_begin, row_end) of a small triangle (clipped to its box) as rasterize_rows
+// does, counting into c. Inline: the renderer calls it once per small triangle.
+inline void rasterize_small(const Triangle& t, const SmallDraw& d, RasterCounters& c, int row_begin, int row_end) {
+  const int ya = row_begin > t.y0 ? row_begin : t.y0, yz = row_end < t.y1 ? row_end : t.y1;
+  if (ya >= yz) return;
+  SmallTarget s;
+  const std::size_t pix = static_cast<std::size_t>(ya) * d.width + static_cast<std::size_t>(t.x0);
+  s.color = d.color + pix * 4;
+  if (d.depth) s.depth = d.depth + pix * 4;
+  s.pitch = d.pitch;
+  s.ky0 = ya - t.y0;
+  s.rows = yz - ya;
+  s.zmask = d.zmask;
+  s.z_write = d.z_write;
+  const PreviewCounts n = d.kernel(t, s);
+  c.scanned += n.scanned;  // count_drawn's counts
+  c.covered += n.covered;
+  c.passed += n.passed;
+  if (d.blended) c.blended += n.passed;
+}
 
 // Draws the rows [row_begin, row_end) of t (a preview triangle through the preview routine) (clipped to its bounding box) with state st.
 void rasterize_rows(const Triangle& t, const DrawState& st, RasterContext& ctx, int row_begin, int row_end);
