@@ -261,7 +261,8 @@ int run_bench_rtl(const GlobalOptions& g, const RtlBenchArgs& a) {
       if (!run(name, stream, samples)) return 1;
     if (a.fit) {
       const bool texturing = gw == "ecp5";  // CAPS.FEATURES bit 7 (docs/gateware.md, the profiles' CAPS)
-      for (const auto& c : calibration_streams(texturing))
+      const bool depth = gw == "ecp5";      // CAPS2.FEATURES2 bit 0 (protocol 1.4)
+      for (const auto& c : calibration_streams(texturing, depth))
         if (!run(c.name, c.stream, calibration)) return 1;
     }
     nlohmann::json rows = nlohmann::json::array();

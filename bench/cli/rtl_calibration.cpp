@@ -33,7 +33,7 @@ constexpr Shape kShapes[] = {
 // Every rectangle here lies within 160 x 120, which scissor_word always accepts.
 std::uint64_t scissor(unsigned x0, unsigned y0, unsigned x1, unsigned y1) { return *geometry::scissor_word(x0, y0, x1, y1); }
 
-protocol::CommandStream frame(unsigned mode_class, const Shape& shape, bool bilinear, bool rgba8888, std::uint32_t seed) {
+protocol::CommandStream frame(unsigned mode_class, const Shape& shape, bool bilinear, bool rgba8888, bool depth, std::uint32_t seed) {
   protocol::CommandStream s;
   protocol::CommandStreamWriter w(s);
   std::mt19937 rng(seed);
@@ -46,12 +46,12 @@ protocol::CommandStream frame(unsigned mode_class, const Shape& shape, bool bili
   w.write(Reg::CLEAR_DEPTH, 0xFFFFFF);
   w.write(Reg::SCISSOR, scissor(0, 0, kW, kH));
   w.write(Reg::CLEAR, 0);
-  w.write(Reg::CLEAR_Z, 0);
+  if (depth) w.write(Reg::CLEAR_Z, 0);  // a device without a depth buffer refuses it (protocol 1.4)
   const unsigned strip = 4 + rng() % 8;
   w.write(Reg::SCISSOR, scissor(0, 10, kW, 10 + strip));
   w.write(Reg::CLEAR, 0);
   w.write(Reg::SCISSOR, scissor(20, 0, 20 + strip, kH));
-  w.write(Reg::CLEAR_Z, 0);
+  if (depth) w.write(Reg::CLEAR_Z, 0);
   w.write(Reg::SCISSOR, scissor(0, 0, kW, kH));
   const bool textured = mode_class & 4;
   if (textured) {
@@ -95,18 +95,19 @@ protocol::CommandStream frame(unsigned mode_class, const Shape& shape, bool bili
 
 }  // namespace
 
-std::vector<CalibrationStream> calibration_streams(bool texturing) {
+std::vector<CalibrationStream> calibration_streams(bool texturing, bool depth) {
   std::vector<CalibrationStream> out;
   std::uint32_t seed = 20261126;
   for (unsigned m = 0; m < sim::DeviceStats::kModeClasses; ++m) {
     if ((m & 4) && !texturing) continue;
+    if ((m & 2) && !depth) continue;
     for (const Shape& shape : kShapes) {
       const std::string base = std::string("calib/") + sim::mode_class_name(m) + "/" + shape.name;
-      out.push_back({base, frame(m, shape, false, false, seed++)});
+      out.push_back({base, frame(m, shape, false, false, depth, seed++)});
       if (shape.name != std::string_view("fat")) continue;
-      if (m & 4) out.push_back({base + "-bilinear", frame(m, shape, true, false, seed++)});
+      if (m & 4) out.push_back({base + "-bilinear", frame(m, shape, true, false, depth, seed++)});
       // 4 bytes a pixel (the ecp5's 16-bit SDRAM: two clocks a colour write); the up5k has no room
-      if (texturing) out.push_back({base + "-rgba8888", frame(m, shape, false, true, seed++)});
+      if (texturing) out.push_back({base + "-rgba8888", frame(m, shape, false, true, depth, seed++)});
     }
   }
   return out;

@@ -16,9 +16,9 @@ struct CalibrationStream {
   protocol::CommandStream stream;
 };
 
-// 160 × 120 RGB565 with a depth buffer (fits the up5k's 128 KiB); with `texturing` (CAPS.FEATURES
-// bit 7, the ecp5) also the textured classes, their 64 × 64 RGBA8888 texture uploaded in the frame,
-// and RGBA8888 colour buffers.
-std::vector<CalibrationStream> calibration_streams(bool texturing);
+// 160 × 120 RGB565; with `depth` (CAPS2.FEATURES2 bit 0, the ecp5) a depth buffer, its clears and
+// the depth classes; with `texturing` (CAPS.FEATURES bit 7, the ecp5) also the textured classes,
+// their 64 × 64 RGBA8888 texture uploaded in the frame, and RGBA8888 colour buffers.
+std::vector<CalibrationStream> calibration_streams(bool texturing, bool depth);
 
 }  // namespace gpubridge::cli

@@ -160,6 +160,7 @@ std::vector<FillDraw> fill_draws(const rtl::GatewareCaps& caps, bool quick) {
   std::vector<FillDraw> out;
   for (const auto& c : classes()) {
     if (!supported(c, caps.features)) continue;
+    if (has_depth(c) && !(caps.features2 & sim::FEATURE2_DEPTH)) continue;  // CAPS2 (protocol 1.4)
     if (quick) {
       out.push_back(make_draw(c, 64, 48));
       continue;

@@ -119,6 +119,7 @@ std::string Hub::device_json(const std::string& compression, const std::string& 
                    {"bridge", info_.bridge},       {"max_width", info_.max_width},
                    {"max_height", info_.max_height}, {"vram_bytes", info_.vram_bytes},
                    {"id", info_.id},               {"caps", info_.caps},
+                   {"caps2", info_.caps2},
                    {"mirror", options_.mirror},    {"accuracy", info_.accuracy},
                    {"daemon_version", kVersion},
                    {"compression", compression},   {"transport", transport}};

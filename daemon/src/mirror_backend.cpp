@@ -155,6 +155,8 @@ Result<std::unique_ptr<backends::Backend>> make_mirror(std::unique_ptr<backends:
     const auto& caps = protocol::describe(protocol::Reg::CAPS);
     o.fifo_depth = std::clamp(static_cast<unsigned>(caps.field("FIFO_DEPTH")->get(info.caps)), 64u, 1023u);
     o.features = static_cast<std::uint8_t>(caps.field("FEATURES")->get(info.caps) & sim::kAllFeatures);
+    // CAPS2 (protocol 1.4): a board without a depth buffer refuses Z, so the model must as well
+    o.features2 = protocol::has_depth_buffer(info.id, info.caps2) ? sim::FEATURE2_DEPTH : 0;
   }
   auto model = sim::SimBackend::create(o);
   if (!model) return make_error("mirror: cannot create the simulator for board \"" + info.board + "\": " + model.error().message);

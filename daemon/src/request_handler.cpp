@@ -263,15 +263,27 @@ void RequestHandler::handle_read_reg(const Message& m) {
     require_lease(m);
     return;
   }
-  if (index == protocol::index_of(Reg::ID) || index == protocol::index_of(Reg::CAPS)) {
-    const auto& info = hub_.device_info();  // constants, known since the device was attached
-    session_.reply(rid, protocol::RegValue{index, index == protocol::index_of(Reg::ID) ? info.id : info.caps});
+  // ID, CAPS and CAPS2 are constants, known since the device was attached. CAPS2 is defined from
+  // protocol 1.4 on: on an older device its index is undefined (the device would flag it).
+  const bool caps2 = index == protocol::index_of(Reg::CAPS2);
+  if (caps2 && protocol::protocol_minor(hub_.device_info().id) < 4) {
+    session_.reply_error(rid, ErrorCode::Range,
+                         "register 0x7D (CAPS2) is defined from protocol 1.4 on; this device is v1." +
+                             std::to_string(protocol::protocol_minor(hub_.device_info().id)) +
+                             " (only the lease holder may read undefined registers; the device flags ERR_BAD_REGISTER)");
+    return;
+  }
+  if (index == protocol::index_of(Reg::ID) || index == protocol::index_of(Reg::CAPS) || caps2) {
+    const auto& info = hub_.device_info();
+    session_.reply(rid, protocol::RegValue{index, index == protocol::index_of(Reg::ID) ? info.id
+                                                  : caps2                                ? info.caps2
+                                                                                         : info.caps});
     return;
   }
   if (!hub_.lease().idle()) {
     session_.reply_error(rid, ErrorCode::Busy,
                          "READ_REG " + std::string(reg->name) + ": another client holds the device lease; while it "
-                         "does, clients without the lease can read only ID and CAPS (acquire the lease, or read after "
+                         "does, clients without the lease can read only ID, CAPS and CAPS2 (acquire the lease, or read after "
                          "it is released)");
     return;
   }

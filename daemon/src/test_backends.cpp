@@ -55,6 +55,7 @@ backends::DeviceInfo FakeScanoutBackend::info() const {
   d.vram_bytes = memory_.size();
   d.id = regs_[protocol::index_of(protocol::Reg::ID)];  // the constants its registers hold
   d.caps = regs_[protocol::index_of(protocol::Reg::CAPS)];
+  d.caps2 = regs_[protocol::index_of(protocol::Reg::CAPS2)];
   return d;
 }
 

@@ -19,9 +19,13 @@ examples::DeviceCaps device_of(const usb::BoardProfile& p) {
   d.vram_bytes = std::uint64_t{p.vram_kib} * 1024;
   d.max_width = p.max_width;
   d.max_height = p.max_height;
-  // A board that names its gateware profile has exactly that profile's CAPS.FEATURES (the iCEBreaker's
-  // up5k: no texturing, bilinear or blending); the generic profiles stand for any design and keep every feature.
-  if (const auto g = rtl::parse_gateware_profile(p.gateware)) d.features = rtl::caps_of(*g).features;
+  // A board that names its gateware profile has exactly that profile's CAPS.FEATURES and CAPS2 (the
+  // iCEBreaker's up5k: no texturing, bilinear, blending or depth buffer); the generic profiles stand
+  // for any design and keep every feature.
+  if (const auto g = rtl::parse_gateware_profile(p.gateware)) {
+    const auto caps = rtl::caps_of(*g);
+    d.features = static_cast<std::uint16_t>(caps.features | ((caps.features2 & sim::FEATURE2_DEPTH) ? examples::kDepthBuffer : 0));
+  }
   return d;
 }
 

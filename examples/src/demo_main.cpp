@@ -181,7 +181,7 @@ void add_fit_options(CLI::App* sub, FitOptions& o) {
   sub->add_option("--size", o.size, "force the framebuffer size, WIDTHxHEIGHT (default: the largest that fits)");
   sub->add_option("--format", o.format, "force the framebuffer format: RGBA8888, RGB565 or RGBA2222");
   sub->add_flag("--no-depth", o.no_depth, "draw without a depth buffer (each example's painter's order)");
-  sub->add_option("--without", o.without, "do not use these device features: bilinear, blend, dither, rgb565, rgba2222, temporal, texture (comma-separated)")
+  sub->add_option("--without", o.without, "do not use these device features: bilinear, blend, dither, rgb565, rgba2222, temporal, texture, depth (comma-separated)")
       ->delimiter(',')->allow_extra_args(false);
 }
 

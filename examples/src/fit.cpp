@@ -19,7 +19,7 @@ struct FeatureName {
 };
 constexpr FeatureName kFeatureNames[] = {{kBilinear, "bilinear"}, {kBlend, "blend"},       {kDither, "dither"},
                                          {kRgb565, "rgb565"},     {kRgba2222, "rgba2222"}, {kTemporalDither, "temporal"},
-                                         {kTexturing, "texture"}};
+                                         {kTexturing, "texture"}, {kDepthBuffer, "depth"}};
 
 bool format_available(PixelFormat f, std::uint16_t features) {
   if (f == PixelFormat::RGB565) return (features & kRgb565) != 0;
@@ -126,7 +126,8 @@ DeviceCaps DeviceCaps::from(const backends::DeviceInfo& info) {
   d.max_height = info.max_height;
   if (info.caps != 0)
     d.features = static_cast<std::uint16_t>(protocol::describe(protocol::Reg::CAPS).field("FEATURES")->get(info.caps)) |
-                 (protocol::protocol_minor(info.id) < 2 ? kTexturing : 0);  // protocol 1.0/1.1: no bit 7, every device textures
+                 (protocol::protocol_minor(info.id) < 2 ? kTexturing : 0) |  // protocol 1.0/1.1: no bit 7, every device textures
+                 (protocol::has_depth_buffer(info.id, info.caps2) ? kDepthBuffer : 0);  // CAPS2 bit 0, or before 1.4
   return d;
 }
 
@@ -136,6 +137,7 @@ sim::DeviceOptions DeviceCaps::simulator_options() const {
   o.max_width = std::clamp(max_width, 1u, protocol::kMaxFramebufferDim);
   o.max_height = std::clamp(max_height, 1u, protocol::kMaxFramebufferDim);
   o.features = static_cast<std::uint8_t>(features & sim::kAllFeatures);
+  o.features2 = has(kDepthBuffer) ? sim::FEATURE2_DEPTH : 0;
   return o;
 }
 
@@ -226,7 +228,8 @@ Result<Fit> fit(const Wants& wants, const DeviceCaps& device, const FitRequest& 
   }
   std::vector<bool> doubles{wants.double_buffer};
   if (wants.double_buffer) doubles.push_back(false);
-  const bool want_depth = wants.depth && !request.no_depth;
+  // A device without a depth buffer (CAPS2, protocol 1.4) draws in painter's order, as --no-depth does.
+  const bool want_depth = wants.depth && !request.no_depth && f.has(kDepthBuffer);
   std::vector<bool> depths{want_depth};
   if (want_depth) depths.push_back(false);
   // Textures: level 0 is what the device can take; each further level gives up one step.
@@ -331,7 +334,10 @@ Result<Fit> fit(const Wants& wants, const DeviceCaps& device, const FitRequest& 
     f.gave_up.push_back("double buffering -> one buffer, drawn while it is shown (video memory)");
   if (wants.depth && !f.context.depth_buffer)
     f.gave_up.push_back(fmt::format("depth buffer -> {} ({})", wants.without_depth,
-                                    request.no_depth ? "--no-depth" : "video memory"));
+                                    request.no_depth                  ? std::string("--no-depth")
+                                    : (request.without & kDepthBuffer) ? std::string("--without depth")
+                                    : !f.has(kDepthBuffer)             ? device.name + " has no depth buffer (CAPS2)"
+                                                                       : std::string("video memory")));
   if (f.texturing())
     for (std::size_t i = 0; i < wants.textures.size(); ++i) {
       const auto& w = wants.textures[i];

@@ -43,7 +43,8 @@ const std::vector<GoldenClass>& golden_classes() {
     up5k.max_height = 240;
     DeviceCaps up5k_min = up5k;
     up5k_min.name = "up5k-min";
-    up5k_min.features = kDither | kStrictLink | kRgba2222 | kTexturing;
+    // a memory and feature class, not a gateware: it keeps the depth buffer (its goldens predate CAPS2)
+    up5k_min.features = kDither | kStrictLink | kRgba2222 | kTexturing | kDepthBuffer;
     return std::vector<GoldenClass>{
         {"large", "the default simulator: 8 MiB, 1024x1024, every feature", DeviceCaps{}},
         {"up5k", "128 KiB, 320x240, every feature (iCEBreaker and the 128 KiB board profiles)", up5k},

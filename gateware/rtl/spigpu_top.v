@@ -1,7 +1,7 @@
 // spigpu v1 device (docs/protocol.md sections 2-13), one clock domain. The profile parameter picks
 // what the device has; CAPS reports exactly that (docs/gateware.md "Profiles"):
 //   PROFILE 0 "up5k": iCE40 UP5K, 128 KiB SPRAM as VRAM, 320 x 240 at most, FIFO 64, no texturing,
-//                     bilinear or blending;
+//                     bilinear, blending or depth buffer (CAPS2, protocol 1.4);
 //   PROFILE 1 "ecp5": ECP5-85F, 32 MiB SDR SDRAM as VRAM, 1024 x 768 at most, FIFO 1023, every feature.
 // Display timing is in core clocks (LINE_CLOCKS x V_TOTAL lines, V_ACTIVE visible); the board top
 // levels set it for 640 x 480 at 60 Hz, the co-simulation uses a short frame.
@@ -81,6 +81,9 @@ module spigpu_top #(
   // beside the rest). ecp5: everything.
   localparam [7:0]  FEATURES   = PROFILE == 0 ? 8'h3C : 8'hFF;
   localparam [7:0]  CORE_FEATURES = FEATURES;
+  // CAPS2.FEATURES2 bit 0 (protocol 1.4): the depth buffer. up5k has none: it cost 458 packed logic
+  // cells and a SB_MAC16 the part has no room for (docs/gateware.md); ecp5 has it.
+  localparam        DEPTH      = PROFILE == 0 ? 0 : 1;
   localparam        MAX_WIDTH  = PROFILE == 0 ? 320 : 1024;
   localparam        MAX_HEIGHT = PROFILE == 0 ? 240 : 768;
   localparam        FIFO_DEPTH = PROFILE == 0 ? 64 : 1023;
@@ -111,7 +114,7 @@ module spigpu_top #(
   wire [29:0]  v_req_addr;
 
   spigpu_soc #(
-    .PROFILE(PROFILE), .FEATURES(FEATURES), .MAX_WIDTH(MAX_WIDTH), .MAX_HEIGHT(MAX_HEIGHT),
+    .PROFILE(PROFILE), .FEATURES(FEATURES), .DEPTH(DEPTH), .MAX_WIDTH(MAX_WIDTH), .MAX_HEIGHT(MAX_HEIGHT),
     .FIFO_DEPTH(FIFO_DEPTH), .FIFO_AW(FIFO_AW), .VRAM_KIB(VRAM_KIB), .VARIANT(VARIANT), .CLK_MHZ(CLK_MHZ),
     .LINE_CLOCKS(LINE_CLOCKS), .V_ACTIVE(V_ACTIVE), .V_TOTAL(V_TOTAL), .CRC_BYTES(CRC_BYTES),
     .SCAN_BUF(SCAN_BUF), .PERF(PERF)
@@ -156,7 +159,7 @@ module spigpu_top #(
   endgenerate
 
   spigpu_core #(.PROFILE(PROFILE), .FEATURES(CORE_FEATURES), .MAX_WIDTH(MAX_WIDTH), .MAX_HEIGHT(MAX_HEIGHT),
-                .VRAM_KIB(VRAM_KIB), .PERF(PERF)) u_core (
+                .VRAM_KIB(VRAM_KIB), .DEPTH(DEPTH), .PERF(PERF)) u_core (
     .clk(clk), .rst(rst), .cmd_valid(cmd_valid), .cmd_ready(cmd_ready), .cmd_op(cmd_op),
     .cmd_tri_mode(cmd_tri_mode), .cmd_tex_base(cmd_tex_base), .cmd_tex_fmt(cmd_tex_fmt), .cmd_scissor(cmd_scissor),
     .cmd_fb_draw(cmd_fb_draw), .cmd_fb_z(cmd_fb_z), .cmd_fb_format(cmd_fb_format), .cmd_fb_width(cmd_fb_width),

@@ -129,10 +129,13 @@ constexpr Field kCaps[] = {
     F("MAX_WIDTH", 24, 11, K::Unsigned, "largest framebuffer width"),
     F("VRAM_KIB", 0, 24, K::Unsigned, "video memory size in KiB"),
 };
+constexpr Field kCaps2[] = {
+    F("FEATURES2", 0, 8, K::Unsigned, "bit 0 depth buffer (TRI_MODE.Z_TEST/Z_WRITE, CLEAR_Z); bits 1-7 reserved, read 0"),
+};
 constexpr Field kId[] = {
     F("MAGIC", 32, 32, K::Unsigned, "0x53504755 (\"SPGU\")"),
     F("MAJOR", 24, 8, K::Unsigned, "protocol major version (1)"),
-    F("MINOR", 16, 8, K::Unsigned, "protocol minor version (3)"),
+    F("MINOR", 16, 8, K::Unsigned, "protocol minor version (4)"),
     F("VARIANT", 0, 16, K::Unsigned, "implementation: 0 simulator, others per board profile"),
 };
 
@@ -172,6 +175,8 @@ constexpr RegisterDesc kTable[] = {
     {0x70, "MEM_ADDR", A::ReadWrite, P::Queued, 0, kMemAddr, "memory access pointer (8-byte aligned)"},
     {0x71, "MEM_DATA", A::ReadWrite, P::Queued, 0, kMemData,
      "writes 8 bytes at MEM_ADDR (queued); reads return the prefetched 8 bytes (immediate); both add 8"},
+    {0x7D, "CAPS2", A::ReadOnly, P::Immediate, 0, kCaps2,
+     "more device capabilities, protocol 1.4 (value depends on the board; bits 63:8 reserved, read 0)"},
     {0x7E, "CAPS", A::ReadOnly, P::Immediate, 0, kCaps, "device capabilities (value depends on the board)"},
     {0x7F, "ID", A::ReadOnly, P::Immediate,
      (std::uint64_t{kIdMagic} << 32) | (std::uint64_t{kVersionMajor} << 24) | (std::uint64_t{kVersionMinor} << 16),

@@ -207,7 +207,7 @@ void Soak::start_hostiles() {
     auto c = client::Client::connect("unix:" + socket_, 2000ms);
     if (!c || !c->handshake("nosy", "", 2000ms)) return sleep_for(1s);
     for (int i = 0; i < 50 && !stop_; ++i) {
-      (void)c->read_register(0x7D, 2000ms);
+      (void)c->read_register(0x7C, 2000ms);  // undefined (0x7D is CAPS2 since protocol 1.4)
       (void)c->read_register(protocol::index_of(protocol::Reg::STATUS), 2000ms);
       (void)c->read_register(protocol::index_of(protocol::Reg::LINK_STATUS), 2000ms);
       (void)c->release_lease(2000ms);

@@ -214,6 +214,32 @@ TEST(Registers, LinkCtrlClearValueFollowsTheDevicesMinorVersion) {
   EXPECT_EQ(protocol_minor(describe(Reg::ID).reset), kVersionMinor);
 }
 
+TEST(Registers, Caps2AdvertisesTheDepthBufferFromVersion14) {
+  // 0x7D, next to CAPS: read-only, immediate, FEATURES2 in [7:0] (bit 0 depth buffer), the rest reserved
+  const RegisterDesc* r = find_register(0x7D);
+  ASSERT_NE(r, nullptr);
+  EXPECT_EQ(r, find_register("caps2"));
+  EXPECT_EQ(r->name, "CAPS2");
+  EXPECT_EQ(index_of(Reg::CAPS2), 0x7D);
+  EXPECT_EQ(r->access, Access::ReadOnly);
+  EXPECT_EQ(r->path, Path::Immediate);
+  const Field* f = r->field("FEATURES2");
+  ASSERT_NE(f, nullptr);
+  EXPECT_EQ(f->lsb, 0);
+  EXPECT_EQ(f->width, 8);
+  EXPECT_EQ(r->reserved_mask(), ~0xFFull);
+  EXPECT_EQ(check_write(0x7D, 1).errors, ERR_BAD_REGISTER);  // read-only
+  EXPECT_EQ(kVersionMinor, 4);
+  const std::uint64_t id13 = (std::uint64_t{kIdMagic} << 32) | (1ull << 24) | (3ull << 16);
+  const std::uint64_t id14 = describe(Reg::ID).reset;
+  EXPECT_EQ(protocol_minor(id14), 4u);
+  EXPECT_TRUE(has_depth_buffer(id13, 0)) << "1.0 ... 1.3 devices have no CAPS2 and always a depth buffer";
+  EXPECT_TRUE(has_depth_buffer(id13, 1));
+  EXPECT_FALSE(has_depth_buffer(id14, 0));
+  EXPECT_FALSE(has_depth_buffer(id14, 0xFE)) << "only bit 0 is the depth buffer";
+  EXPECT_TRUE(has_depth_buffer(id14, kFeature2Depth));
+}
+
 TEST(Crc32, CheckValue) {
   const std::string s = "123456789";
   EXPECT_EQ(crc32(std::span(reinterpret_cast<const std::uint8_t*>(s.data()), s.size())), 0xCBF43926u);

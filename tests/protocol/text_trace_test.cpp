@@ -74,6 +74,17 @@ TEST(TextTrace, Directives) {
   EXPECT_EQ(std::get<ReadbackCmd>(s->commands[6].command), (ReadbackCmd{16, 32}));
 }
 
+TEST(TextTrace, Caps2IsReadByNameAndNotWritable) {
+  // protocol 1.4's CAPS2 (0x7D) comes from the register table like every other name
+  auto s = parse(".read caps2\n.read CAPS2\n");
+  ASSERT_TRUE(s.ok()) << s.error().message;
+  ASSERT_EQ(s->commands.size(), 2u);
+  EXPECT_EQ(std::get<ReadRegCmd>(s->commands[0].command).index, 0x7D);
+  EXPECT_EQ(std::get<ReadRegCmd>(s->commands[1].command).index, index_of(Reg::CAPS2));
+  EXPECT_EQ(error_of("CAPS2 1\n"),
+            "scene.trace:1:1: CAPS2 is read-only; use `.read CAPS2` to read it (the raw form 0xIDX 0xDATA sends a write anyway)");
+}
+
 TEST(TextTrace, UploadDirectivesUseTheLoader) {
   std::vector<TraceAsset> seen;
   AssetLoader loader = [&](const TraceAsset& a) -> Result<std::vector<std::uint8_t>> {

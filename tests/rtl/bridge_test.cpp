@@ -50,6 +50,8 @@ TEST_P(Bridge, AttachesAndIdentifiesTheGateware) {
   const auto caps = rtl::caps_of(*rtl::parse_gateware_profile(GetParam().profile.gateware));
   EXPECT_EQ(info.id, caps.id_register());
   EXPECT_EQ(info.caps, caps.caps_register());
+  EXPECT_EQ(info.caps2, caps.caps2_register());  // attach reads CAPS2 on a 1.4 device
+  EXPECT_EQ(protocol::has_depth_buffer(info.id, info.caps2), caps.features2 != 0);
   // an upload, a readback, a swap
   std::vector<std::uint8_t> bytes(1000);
   for (std::size_t i = 0; i < bytes.size(); ++i) bytes[i] = static_cast<std::uint8_t>(i * 7 + 3);

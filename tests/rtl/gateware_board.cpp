@@ -86,7 +86,8 @@ Result<std::unique_ptr<GatewareBoard>> GatewareBoard::open(const usb::BoardProfi
     // registers whose value does not depend on when the read happens
     const bool timed = index == index_of(Reg::STATUS) || index == index_of(Reg::FRAME_CRC) ||
                        index == index_of(Reg::MEM_ADDR) || index == index_of(Reg::MEM_DATA);
-    const bool stable = index == index_of(Reg::ID) || index == index_of(Reg::CAPS) || index == index_of(Reg::HOST_TAG) ||
+    const bool stable = index == index_of(Reg::ID) || index == index_of(Reg::CAPS) || index == index_of(Reg::CAPS2) ||
+                        index == index_of(Reg::HOST_TAG) ||
                         index == index_of(Reg::LINK_STATUS) || (raw->compare_all_reads_ && !timed);
     if (!stable) return;
     ++raw->reads_compared_;

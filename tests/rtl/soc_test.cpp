@@ -94,6 +94,58 @@ TEST_P(SocBench, IdentityAndCapsMatchTheProfile) {
   EXPECT_EQ(r[1].data, rtl_->caps().caps_register());
 }
 
+TEST_P(SocBench, Caps2MatchesTheProfile) {
+  // protocol 1.4: CAPS2.FEATURES2 bit 0 is the depth buffer (ecp5 has it, up5k not)
+  EXPECT_EQ(protocol::protocol_minor(host_->read(Reg::ID)), 4u);
+  EXPECT_EQ(host_->read(Reg::CAPS2), rtl_->caps().caps2_register());
+  EXPECT_EQ(host_->read(Reg::CAPS2), sim_->caps2());
+  EXPECT_EQ(rtl_->caps().caps2_register(), GetParam() == rtl::GatewareProfile::Ecp5 ? 1u : 0u);
+  expect_read_equal(index_of(Reg::STATUS), kStatusCompared);  // a defined register: no ERR_BAD_REGISTER
+}
+
+// Without a depth buffer TRI_MODE.Z_TEST / Z_WRITE read back as 0 with ERR_BAD_VALUE and CLEAR_Z is
+// refused when it executes; with one they act. Both devices the same, memory and flags.
+TEST_P(SocBench, DepthWritesAreRefusedExactlyWhenTheProfileHasNoDepthBuffer) {
+  const bool depth = rtl_->caps().features2 & 1;
+  // a 16 x 8 RGBA8888 colour buffer at 0, its depth buffer at 0x1000 (filled with a pattern first)
+  std::vector<Frame> frames{Frame{false, index_of(Reg::MEM_ADDR), 0x1000}};
+  for (int i = 0; i < 64; ++i) frames.push_back(Frame{false, index_of(Reg::MEM_DATA), 0x0102030405060708ull * (i + 1)});
+  frames.push_back(Frame{false, index_of(Reg::FB_FORMAT), (8ull << 16) | 16});
+  frames.push_back(Frame{false, index_of(Reg::FB_DRAW), 0});
+  frames.push_back(Frame{false, index_of(Reg::FB_Z), 0x1000});  // ADDR [31:4]: the byte address
+  frames.push_back(Frame{false, index_of(Reg::SCISSOR), (8ull << 48) | (16ull << 32)});
+  frames.push_back(Frame{false, index_of(Reg::CLEAR_DEPTH), 0x123456});
+  burst(frames);
+  wait_idle();
+  expect_read_equal(index_of(Reg::STATUS), kStatusCompared);
+  write(Reg::ERR_CLEAR, 0x7F);
+  write(Reg::CLEAR_Z, 0);
+  wait_idle();
+  const std::uint64_t status = host_->read(Reg::STATUS);
+  sim_->read(index_of(Reg::STATUS));
+  EXPECT_EQ(((status >> 48) & protocol::ERR_BAD_VALUE) != 0, !depth) << "CLEAR_Z";
+  expect_read_equal(index_of(Reg::STATUS), kStatusCompared);
+  expect_vram_equal();
+  write(Reg::ERR_CLEAR, 0x7F);
+  // Z_TEST | Z_FUNC LESS | Z_WRITE | GOURAUD, then a triangle over the buffer
+  const std::uint64_t tri_mode = (1u << 6) | (1u << 3) | (1u << 2) | 1u;
+  write(Reg::TRI_MODE, tri_mode);
+  wait_idle();
+  EXPECT_EQ(host_->read(Reg::TRI_MODE), depth ? tri_mode : (1u << 3) | 1u);
+  expect_read_equal(index_of(Reg::TRI_MODE));
+  const std::uint64_t st = host_->read(Reg::STATUS);
+  sim_->read(index_of(Reg::STATUS));
+  EXPECT_EQ(((st >> 48) & protocol::ERR_BAD_VALUE) != 0, !depth) << "TRI_MODE";
+  const std::uint64_t verts[] = {(std::uint64_t{0x100000} << 32) | (0 << 16) | 0, (std::uint64_t{0x100000} << 32) | (0 << 16) | (16 * 16),
+                                 (std::uint64_t{0x100000} << 32) | ((8 * 16) << 16) | 0};
+  burst({Frame{false, index_of(Reg::PRIM), 0}, Frame{false, index_of(Reg::COLOR), 0xFFFFFFFF'FF8040FFull},
+         Frame{false, index_of(Reg::VERTEX), verts[0]}, Frame{false, index_of(Reg::VERTEX), verts[1]},
+         Frame{false, index_of(Reg::VERTEX), verts[2]}});
+  wait_idle();
+  expect_read_equal(index_of(Reg::STATUS), kStatusCompared);
+  expect_vram_equal();
+}
+
 TEST_P(SocBench, RegisterValidationAndReadBackMatchTheSimulator) {
   std::mt19937_64 rng(1234);
   const std::uint8_t rw[] = {0x00, 0x01, 0x02, 0x03, 0x04, 0x05, 0x06, 0x07, 0x08, 0x0A, 0x0D, 0x0E, 0x0F, 0x16, 0x18};

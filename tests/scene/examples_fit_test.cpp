@@ -175,6 +175,120 @@ TEST(DeviceCaps, FeaturesComeFromTheCapsRegister) {
   EXPECT_TRUE(DeviceCaps::from(info).has(kBlend | kRgb565 | kBilinear));
 }
 
+TEST(DeviceCaps, DepthBufferFromCaps2OrAnOlderProtocol) {
+  backends::DeviceInfo info;
+  info.caps = std::uint64_t{kDither} << 56;
+  const auto id = [](unsigned minor) { return std::uint64_t{protocol::kIdMagic} << 32 | 1ull << 24 | std::uint64_t{minor} << 16; };
+  // 1.4: CAPS2.FEATURES2 bit 0 decides.
+  info.id = id(4);
+  info.caps2 = 0;
+  EXPECT_FALSE(DeviceCaps::from(info).has(kDepthBuffer));
+  EXPECT_FALSE(DeviceCaps::from(info).simulator_options().features2 & sim::FEATURE2_DEPTH);
+  info.caps2 = protocol::kFeature2Depth;
+  EXPECT_TRUE(DeviceCaps::from(info).has(kDepthBuffer));
+  EXPECT_EQ(DeviceCaps::from(info).simulator_options().features2, sim::FEATURE2_DEPTH);
+  // 1.3 and older have no CAPS2 (the host reads none: 0) and always a depth buffer.
+  for (unsigned minor : {0u, 2u, 3u}) {
+    info.id = id(minor);
+    info.caps2 = 0;
+    EXPECT_TRUE(DeviceCaps::from(info).has(kDepthBuffer)) << "1." << minor;
+  }
+  EXPECT_TRUE(protocol::has_depth_buffer(id(3), 0));
+  EXPECT_FALSE(protocol::has_depth_buffer(id(4), 0));
+  EXPECT_TRUE(protocol::has_depth_buffer(id(4), 1));
+}
+
+TEST(Fit, ADeviceWithoutADepthBufferDrawsInPaintersOrder) {
+  DeviceCaps d;  // plenty of memory: only the missing feature can take the depth buffer away
+  d.name = "nodepth";
+  d.features = static_cast<std::uint16_t>(d.features & ~kDepthBuffer);
+  Wants w;
+  w.without_depth = "triangles sorted far to near";
+  auto f = fit(w, d);
+  ASSERT_TRUE(f) << f.error().message;
+  EXPECT_FALSE(f->context.depth_buffer);
+  EXPECT_TRUE(f->painter());
+  EXPECT_TRUE(mentions(f->gave_up, "depth buffer -> triangles sorted far to near (nodepth has no depth buffer (CAPS2))"));
+  // --without depth on a device that has one says so instead
+  FitRequest r;
+  r.without = kDepthBuffer;
+  auto g = fit(w, DeviceCaps{}, r);
+  ASSERT_TRUE(g) << g.error().message;
+  EXPECT_FALSE(g->context.depth_buffer);
+  EXPECT_TRUE(mentions(g->gave_up, "(--without depth)"));
+  EXPECT_EQ(parse_feature("depth"), kDepthBuffer);
+}
+
+TEST(Examples, WithoutADepthBufferNoExampleSendsZ) {
+  // The up5k gateware's device (no depth buffer): the simulator configured as it refuses
+  // TRI_MODE.Z_TEST / Z_WRITE and CLEAR_Z with ERR_BAD_VALUE, which render_frames reports.
+  DeviceCaps d = up5k();
+  d.features = static_cast<std::uint16_t>(d.features & ~kDepthBuffer);
+  const auto options = d.simulator_options();
+  ASSERT_EQ(options.features2, 0);
+  for (auto& ex : make_examples()) {
+    auto f = configure(*ex, d);
+    ASSERT_TRUE(f) << ex->info().name << ": " << f.error().message;
+    EXPECT_TRUE(f->painter()) << ex->info().name;
+    auto frames = render_frames(*ex, {0, 1}, options);
+    EXPECT_TRUE(frames) << (frames ? "" : frames.error().message);
+  }
+}
+
+// Two overlapping quads: depth-tested (near one drawn first) and in painter's order on a device
+// without a depth buffer give the same picture.
+TEST(Painter, TwoQuadsMatchTheDepthTestedPicture) {
+  using geometry::Vec3;
+  using geometry::Vec4;
+  const std::vector<draw::Vertex> v{
+      // near quad (z 0.25; the depth range is [0, 1]), red, left
+      {Vec3{-0.8, -0.6, 0.25}, Vec4{1, 0, 0, 1}}, {Vec3{0.3, -0.6, 0.25}, Vec4{1, 0, 0, 1}},
+      {Vec3{0.3, 0.6, 0.25}, Vec4{1, 0, 0, 1}}, {Vec3{-0.8, 0.6, 0.25}, Vec4{1, 0, 0, 1}},
+      // far quad (z 0.75), green, right, overlapping the near one
+      {Vec3{-0.2, -0.8, 0.75}, Vec4{0, 1, 0, 1}}, {Vec3{0.9, -0.8, 0.75}, Vec4{0, 1, 0, 1}},
+      {Vec3{0.9, 0.4, 0.75}, Vec4{0, 1, 0, 1}}, {Vec3{-0.2, 0.4, 0.75}, Vec4{0, 1, 0, 1}}};
+  const std::vector<std::uint32_t> near_first{0, 1, 2, 0, 2, 3, 4, 5, 6, 4, 6, 7};
+  const auto render = [&](bool depth) -> Result<Image> {
+    sim::DeviceOptions o;
+    o.features2 = depth ? sim::FEATURE2_DEPTH : 0;
+    auto sink = draw::SimulatorSink::create(o);
+    if (!sink) return sink.error();
+    auto ctx = draw::Context::create(**sink, {.width = 64, .height = 48, .depth_buffer = depth, .double_buffer = false});
+    if (!ctx) return ctx.error();
+    if (auto r = ctx->clear({0, 0, 0, 1}); !r) return r.error();
+    if (depth) {
+      if (auto r = ctx->clear_depth(1.0); !r) return r.error();
+      ctx->state().z_test = ctx->state().z_write = true;
+      if (auto r = ctx->draw_indexed(v, near_first); !r) return r.error();
+    } else {
+      const std::vector<double> distance{0.25, 0.25, 0.75, 0.75};  // per triangle: the quads' z
+      const auto order = far_to_near(near_first, distance);
+      EXPECT_EQ(order, (std::vector<std::uint32_t>{4, 5, 6, 4, 6, 7, 0, 1, 2, 0, 2, 3})) << "back to front";
+      if (auto r = ctx->draw_indexed(v, order); !r) return r.error();
+    }
+    if (auto r = ctx->swap(); !r) return r.error();
+    auto img = ctx->read_display();
+    if (!img) return img.error();
+    if (const auto e = (*sink)->backend().device().errors()) return make_error("device errors: " + protocol::describe_errors(e));
+    return img;
+  };
+  auto tested = render(true);
+  ASSERT_TRUE(tested) << tested.error().message;
+  auto painted = render(false);
+  ASSERT_TRUE(painted) << painted.error().message;
+  EXPECT_EQ(tested->rgba, painted->rgba);
+  // and the overlap is there to be decided: both colours are visible, the near one where they overlap
+  bool red = false, green = false;
+  for (unsigned y = 0; y < 48; ++y)
+    for (unsigned x = 0; x < 64; ++x) {
+      red = red || tested->pixel(x, y)[0] == 255;
+      green = green || tested->pixel(x, y)[1] == 255;
+    }
+  EXPECT_TRUE(red && green);
+  EXPECT_EQ(tested->pixel(32, 24)[0], 255) << "(32, 24) lies in both quads: the near, red one covers it";
+  EXPECT_EQ(tested->pixel(32, 24)[1], 0);
+}
+
 TEST(Context, RefusesAFramebufferLargerThanTheDevicesLargest) {
   sim::DeviceOptions small;
   small.max_width = 320;

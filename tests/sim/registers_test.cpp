@@ -19,7 +19,8 @@ TEST(SimRegisters, ResetValuesIdAndCaps) {
   o.max_width = 320;
   o.max_height = 240;
   auto d = make_device(o);
-  EXPECT_EQ(rd(*d, Reg::ID), 0x5350475501030007ull);  // protocol 1.3
+  EXPECT_EQ(rd(*d, Reg::ID), 0x5350475501040007ull);  // protocol 1.4
+  EXPECT_EQ(rd(*d, Reg::CAPS2), 1u);                  // FEATURES2: the depth buffer
   const std::uint64_t caps = rd(*d, Reg::CAPS);
   EXPECT_EQ(caps & 0xFFFFFF, 2048u);                // VRAM_KIB
   EXPECT_EQ((caps >> 24) & 0x7FF, 320u);            // MAX_WIDTH
@@ -157,6 +158,49 @@ TEST(SimRegisters, TexturingNeedsItsFeatureBit) {
   EXPECT_NE(a[4 * 17], 0);  // the triangle was drawn
 }
 
+TEST(SimRegisters, DepthNeedsCaps2Bit0) {
+  // CAPS2.FEATURES2 bit 0 (protocol 1.4): without it TRI_MODE.Z_TEST and Z_WRITE are replaced by 0
+  // with ERR_BAD_VALUE (Z_FUNC stays), and CLEAR_Z is refused when it executes, clearing nothing.
+  DeviceOptions with, without;
+  without.features2 = 0;
+  auto plain = make_device(with);
+  auto d = make_device(without);
+  EXPECT_EQ(rd(*d, Reg::CAPS2), 0u);
+  EXPECT_EQ(rd(*plain, Reg::CAPS2), 1u);
+  EXPECT_EQ(errors_of(*d), 0);  // CAPS2 is defined: reading it is no error
+  const std::uint64_t z_mode = (1u << 6) | (1u << 3) | (1u << 2) | 1u;  // Z_WRITE | LESS | Z_TEST | GOURAUD
+  w(*d, Reg::TRI_MODE, z_mode);
+  EXPECT_EQ(rd(*d, Reg::TRI_MODE), (1u << 3) | 1u);
+  EXPECT_EQ(errors_of(*d), ERR_BAD_VALUE);
+  w(*d, Reg::ERR_CLEAR, 0xFFFF);
+  w(*d, Reg::TRI_MODE, 1u << 6);  // Z_WRITE alone is refused too
+  EXPECT_EQ(rd(*d, Reg::TRI_MODE), 0u);
+  EXPECT_EQ(errors_of(*d), ERR_BAD_VALUE);
+  w(*d, Reg::ERR_CLEAR, 0xFFFF);
+  w(*plain, Reg::TRI_MODE, z_mode);
+  EXPECT_EQ(rd(*plain, Reg::TRI_MODE), z_mode);
+  EXPECT_EQ(errors_of(*plain), 0);
+  // CLEAR_Z over a 16 x 16 depth buffer at 0x1000 holding 0xAB bytes
+  for (auto* dev : {d.get(), plain.get()}) {
+    w(*dev, Reg::MEM_ADDR, 0x1000);
+    for (int i = 0; i < 16 * 16 * 4 / 8; ++i) w(*dev, Reg::MEM_DATA, 0xABABABABABABABABull);
+    w(*dev, Reg::FB_FORMAT, fb_format(16, 16, 0));
+    w(*dev, Reg::SCISSOR, scissor(0, 0, 16, 16));
+    w(*dev, Reg::FB_Z, 0x1000);
+    w(*dev, Reg::CLEAR_DEPTH, 0x123456);
+    w(*dev, Reg::CLEAR_Z, 0);
+  }
+  EXPECT_EQ(errors_of(*d), ERR_BAD_VALUE);
+  EXPECT_EQ(errors_of(*plain), 0);
+  const auto a = d->memory(), b = plain->memory();
+  EXPECT_TRUE(std::all_of(a.begin() + 0x1000, a.begin() + 0x1000 + 16 * 16 * 4, [](std::uint8_t v) { return v == 0xAB; }));
+  EXPECT_EQ(b[0x1000 + 1], 0x12);  // the depth-capable device cleared (24-bit depth in 4 bytes, big-endian)
+  EXPECT_EQ(b[0x1000 + 3], 0x56);
+  // FB_Z and CLEAR_DEPTH stay plain state registers on both
+  EXPECT_EQ(rd(*d, Reg::FB_Z), 0x1000u);
+  EXPECT_EQ(rd(*d, Reg::CLEAR_DEPTH), 0x123456u);
+}
+
 TEST(SimRegisters, ResetNeedsMagicAndKeepsMemory) {
   auto d = make_device();
   w(*d, Reg::HOST_TAG, 0x1234);
@@ -249,6 +293,11 @@ TEST(SimRegisters, OptionsAreValidated) {
   o = {};
   o.threads = 0;
   EXPECT_FALSE(Device::create(o).ok());
+  o = {};
+  o.features2 = 0x02;  // CAPS2.FEATURES2 bits 1..7 are reserved
+  EXPECT_FALSE(Device::create(o).ok());
+  o.features2 = 0;
+  EXPECT_TRUE(Device::create(o).ok());
 }
 
 TEST(SimKnobs, ParseAndErrors) {

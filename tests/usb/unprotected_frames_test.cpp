@@ -113,10 +113,11 @@ TEST(UnprotectedFrames, PrimGarbledIntoLinkCtrlLeavesStrictModeOn) {
   EXPECT_EQ((t.reg(Reg::STATUS) >> 48) & protocol::ERR_BAD_VALUE, protocol::ERR_BAD_VALUE) << "the garbled LINK_CTRL was refused";
 }
 
-// After RESET: RESET, HOST_TAG read, then attach: ID, ID, CAPS, CAPS, HOST_TAG write, HOST_TAG read.
+// After RESET: RESET, HOST_TAG read, then attach: ID, ID, CAPS, CAPS, CAPS2, CAPS2 (protocol 1.4),
+// HOST_TAG write, HOST_TAG read.
 TEST(UnprotectedFrames, GarbledIdReadAfterResetIsReadAgain) {
   auto t = open_bench();
-  t.flip(2, 6);  // ID (0x7F) -> 0x7D, undefined: reads 0
+  t.flip(2, 6);  // ID (0x7F) -> 0x7D, CAPS2 since protocol 1.4: reads 1, not the ID
   auto r = t.b().reset();
   ASSERT_TRUE(r) << r.error().message;
   ASSERT_TRUE(t.flipped());
@@ -125,7 +126,7 @@ TEST(UnprotectedFrames, GarbledIdReadAfterResetIsReadAgain) {
 
 TEST(UnprotectedFrames, GarbledHostTagEchoIsWrittenAgain) {
   auto t = open_bench();
-  t.flip(6, 40);  // a data bit of the HOST_TAG write
+  t.flip(8, 40);  // a data bit of the HOST_TAG write
   auto r = t.b().reset();
   ASSERT_TRUE(r) << r.error().message;
   ASSERT_TRUE(t.flipped());

@@ -69,16 +69,18 @@ int probe_board(const GlobalOptions& g, const ProbeArgs& a) {
   const auto i = (*board)->info();
   if (g.json) {
     nlohmann::json j{{"board", profile->name}, {"bridge", i.bridge}, {"emulated", a.emulate}, {"id", i.id}, {"caps", i.caps},
+                     {"caps2", i.caps2}, {"depth_buffer", protocol::has_depth_buffer(i.id, i.caps2)},
                      {"magic_ok", (i.id >> 32) == protocol::kIdMagic}, {"version", {protocol::protocol_major(i.id), protocol::protocol_minor(i.id)}},
                      {"variant", protocol::id_variant(i.id)}, {"vram_bytes", i.vram_bytes}, {"strict_link", (*board)->strict_link()},
                      {"spi_clock_hz", (*board)->bridge().clock_hz()}};
     std::puts(json_text(j, 2).c_str());
   } else {
-    std::printf("board %s via %s%s at %.3g MHz: ID 0x%016llX (spigpu v%u.%u, variant 0x%04X), %llu KiB VRAM, strict link %s\n",
+    std::printf("board %s via %s%s at %.3g MHz: ID 0x%016llX (spigpu v%u.%u, variant 0x%04X), %llu KiB VRAM, %s, strict link %s\n",
                 profile->name.c_str(), i.bridge.c_str(), a.emulate ? " (emulated)" : "", (*board)->bridge().clock_hz() / 1e6,
                 static_cast<unsigned long long>(i.id), protocol::protocol_major(i.id), protocol::protocol_minor(i.id),
                 protocol::id_variant(i.id),
-                static_cast<unsigned long long>(i.vram_bytes / 1024), (*board)->strict_link() ? "on" : "off");
+                static_cast<unsigned long long>(i.vram_bytes / 1024),
+                protocol::has_depth_buffer(i.id, i.caps2) ? "depth buffer" : "no depth buffer", (*board)->strict_link() ? "on" : "off");
   }
   return 0;
 }

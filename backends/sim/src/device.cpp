@@ -60,6 +60,7 @@ struct Device::State {
   explicit State(const DeviceOptions& o)
       : opt(o),
         caps(make_caps(o)),
+        caps2(o.features2),
         id((std::uint64_t{kIdMagic} << 32) | (std::uint64_t{kVersionMajor} << 24) |
            (std::uint64_t{kVersionMinor} << 16) | o.variant),
         mem(o.vram_bytes),
@@ -68,7 +69,7 @@ struct Device::State {
   }
 
   DeviceOptions opt;
-  std::uint64_t caps, id;
+  std::uint64_t caps, caps2, id;
   RegisterFacts facts;
   VideoMemory mem;
   Renderer renderer;
@@ -214,6 +215,12 @@ struct Device::State {
         need(FEATURE_BLEND, 3ull << 7);
         need(FEATURE_DITHER, 1ull << 9);
         need(FEATURE_TEMPORAL_DITHER, (1ull << 15) | (15ull << 16));  // TEMPORAL, DITHER_PHASE
+        // No depth buffer (CAPS2.FEATURES2 bit 0, protocol 1.4): Z_TEST and Z_WRITE read as 0;
+        // Z_FUNC stays as written (without Z_TEST it decides nothing).
+        if ((data & ((1ull << 2) | (1ull << 6))) && !(opt.features2 & FEATURE2_DEPTH)) {
+          data &= ~((1ull << 2) | (1ull << 6));
+          bad();
+        }
         break;
       case Reg::LINK_CTRL: need(FEATURE_STRICT_LINK, 1); break;
       default: break;
@@ -249,7 +256,12 @@ struct Device::State {
       case Reg::FB_Z:
       case Reg::FB_FORMAT: state.reset(); break;
       case Reg::CLEAR: clear_color(); break;
-      case Reg::CLEAR_Z: clear_depth(); break;
+      case Reg::CLEAR_Z:  // refused when it executes on a device without a depth buffer (section 5, rule 5)
+        if (opt.features2 & FEATURE2_DEPTH)
+          clear_depth();
+        else
+          errors |= ERR_BAD_VALUE;
+        break;
       case Reg::FB_DISPLAY: swap(data); break;
       case Reg::MEM_ADDR: load_prefetch(); break;
       case Reg::MEM_DATA: write_mem_data(data); break;
@@ -533,6 +545,7 @@ struct Device::State {
                (std::uint64_t{discarding} << 24) | link_frames;
       case Reg::HOST_TAG: return host_tag;
       case Reg::CAPS: return caps;
+      case Reg::CAPS2: return caps2;
       case Reg::ID: return id;
       case Reg::MEM_DATA: {
         const std::uint64_t v = prefetch;
@@ -611,6 +624,7 @@ void Device::set_pixel_observer(PixelObserver observer) {
 }
 const DeviceOptions& Device::options() const { return s_->opt; }
 std::uint64_t Device::caps() const { return s_->caps; }
+std::uint64_t Device::caps2() const { return s_->caps2; }
 std::uint64_t Device::id() const { return s_->id; }
 std::uint16_t Device::errors() const {
   s_->renderer.flush();

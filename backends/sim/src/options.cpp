@@ -81,6 +81,8 @@ Result<void> DeviceOptions::validate() const {
     return bad("max_height=" + std::to_string(max_height) + ": expected 1..1024");
   if (fifo_depth < 64 || fifo_depth > 1023)
     return bad("fifo_depth=" + std::to_string(fifo_depth) + ": expected 64..1023 (CAPS.FIFO_DEPTH is 10 bits)");
+  if (features2 & ~kAllFeatures2)
+    return bad("features2=" + std::to_string(features2) + ": expected only bit 0 (CAPS2.FEATURES2 bits 1..7 are reserved)");
   if (fifo_drain_interval < 1 || fifo_drain_interval > 1024)
     return bad("fifo_drain_interval=" + std::to_string(fifo_drain_interval) + ": expected 1..1024");
   if (threads < 1 || threads > kMaxThreads)

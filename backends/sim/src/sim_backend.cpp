@@ -20,6 +20,7 @@ backends::DeviceInfo SimBackend::info() const {
   i.vram_bytes = o.vram_bytes;
   i.id = device_->id();
   i.caps = device_->caps();
+  i.caps2 = device_->caps2();
   i.accuracy = accuracy_mode(o.accuracy);
   return i;
 }

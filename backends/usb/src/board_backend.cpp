@@ -45,6 +45,7 @@ backends::DeviceInfo BoardBackend::info() const {
   i.vram_bytes = vram_bytes_;
   i.id = id_;
   i.caps = caps_;
+  i.caps2 = caps2_;
   return i;
 }
 
@@ -80,6 +81,20 @@ Result<void> BoardBackend::attach_locked() {
                       backends::kDeviceProtocol);
   id_ = id;
   caps_ = (*v)[2];
+  // CAPS2 exists from protocol 1.4 on (on an older device its index is undefined and the read would
+  // raise ERR_BAD_REGISTER): read twice like ID and CAPS.
+  caps2_ = 0;
+  if (protocol::protocol_minor(id) >= 4) {
+    const std::uint8_t caps2[] = {index_of(Reg::CAPS2), index_of(Reg::CAPS2)};
+    auto c = read_frames(caps2);
+    for (unsigned attempt = 1; attempt < 3 && c && (*c)[0] != (*c)[1]; ++attempt) c = read_frames(caps2);
+    if (!c) return c.error();
+    if ((*c)[0] != (*c)[1])
+      return make_error("board '" + profile_.name + "': two CAPS2 reads differ three times (0x" + fmt::format("{:016X}", (*c)[0]) +
+                            " vs 0x" + fmt::format("{:016X}", (*c)[1]) + "): unreliable SPI link; lower bridge.spi_clock_hz",
+                        backends::kDeviceProtocol);
+    caps2_ = (*c)[0];
+  }
   const unsigned caps_depth = (caps_ >> 46) & 0x3FF;
   fifo_depth_ = caps_depth ? std::min(caps_depth, profile_.fifo_depth) : profile_.fifo_depth;
   const std::uint64_t caps_vram = (caps_ & 0xFFFFFF) * 1024;

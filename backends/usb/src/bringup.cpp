@@ -33,9 +33,10 @@ BringupStep id_check(BoardBackend& b) {
   BringupStep s{"id", false, false, "", 0};
   const auto i = b.info();
   s.ok = (i.id >> 32) == protocol::kIdMagic && protocol::protocol_major(i.id) == protocol::kVersionMajor;
-  s.detail = fmt::format("ID 0x{:016X} (spigpu v{}.{}, variant 0x{:04X}); CAPS: {} KiB VRAM, FIFO {}, max {}x{}", i.id,
+  s.detail = fmt::format("ID 0x{:016X} (spigpu v{}.{}, variant 0x{:04X}); CAPS: {} KiB VRAM, FIFO {}, max {}x{}, {}", i.id,
                          protocol::protocol_major(i.id), protocol::protocol_minor(i.id), protocol::id_variant(i.id), i.caps & 0xFFFFFF, (i.caps >> 46) & 0x3FF,
-                         i.max_width, i.max_height);
+                         i.max_width, i.max_height,
+                         protocol::has_depth_buffer(i.id, i.caps2) ? "depth buffer" : "no depth buffer (CAPS2)");
   return s;
 }
 

@@ -25,6 +25,7 @@ ClientSink::ClientSink(client::Client& c) : client_(&c) {
   number("max_width", device_.max_width, 1, protocol::kMaxFramebufferDim);
   number("max_height", device_.max_height, 1, protocol::kMaxFramebufferDim);
   number("caps", device_.caps, 0, ~std::uint64_t{0});
+  number("caps2", device_.caps2, 0, ~std::uint64_t{0});  // from daemons of protocol 1.4 on
   number("id", device_.id, 0, ~std::uint64_t{0});
   text("backend", device_.backend);
   text("board", device_.board);

@@ -15,6 +15,8 @@ module spigpu_core #(
     parameter integer MAX_WIDTH  = 1024,    // CAPS.MAX_WIDTH / MAX_HEIGHT
     parameter integer MAX_HEIGHT = 1024,
     parameter integer VRAM_KIB   = 32768,   // CAPS.VRAM_KIB
+    parameter integer DEPTH      = 1,       // CAPS2.FEATURES2 bit 0: 0 = no depth buffer (the soc
+                                            // refuses Z_TEST/Z_WRITE/CLEAR_Z; the depth stage folds away)
     parameter integer PERF       = 1        // 1: the perf_* counters count (co-simulation); 0: they
                                             // read 0 and cost nothing (boards)
 ) (
@@ -79,9 +81,9 @@ module spigpu_core #(
 
   wire       m_gouraud = cmd_tri_mode[0];
   wire       m_tex     = cmd_tri_mode[1] && FEATURES[F_TEXTURE];
-  wire       m_ztest   = cmd_tri_mode[2];
+  wire       m_ztest   = cmd_tri_mode[2] && DEPTH != 0;
   wire [2:0] m_zfunc   = cmd_tri_mode[5:3];
-  wire       m_zwrite  = cmd_tri_mode[6];
+  wire       m_zwrite  = cmd_tri_mode[6] && DEPTH != 0;
   wire [3:0] m_keep    = cmd_tri_mode[13:10];
   wire [3:0] stored    = (cmd_fb_format == 2'd1) ? 4'b0111 : 4'b1111;
   wire       all_masked  = (m_keep & stored) == stored;
@@ -482,7 +484,7 @@ module spigpu_core #(
             r_gouraud   <= 1'b0;
             r_tex       <= 1'b0;
             r_ztest     <= 1'b0;
-            r_zwrite    <= (cmd_op == OP_CLEAR_Z);
+            r_zwrite    <= (cmd_op == OP_CLEAR_Z) && DEPTH != 0;
             r_blend     <= 2'd0;
             r_dither    <= 1'b0;
             r_temporal  <= 1'b0;

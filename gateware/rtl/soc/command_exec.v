@@ -26,6 +26,7 @@ module command_exec #(
   parameter       MAX_WIDTH = 1024,
   parameter       MAX_HEIGHT = 1024,
   parameter       VRAM_KIB = 32768,
+  parameter       DEPTH = 1,          // CAPS2.FEATURES2 bit 0; 0: Z_TEST/Z_WRITE/CLEAR_Z refused (1.4)
   parameter       VPORT = 0           // 1: vertices through the read port, cmd_v0..2 are 0
 ) (
   input  wire         clk,
@@ -132,7 +133,11 @@ module command_exec #(
         if (d[9] && !FEATURES[2]) begin d[9] = 1'b0; bad = 1'b1; end
         // TEMPORAL [15] and DITHER_PHASE [19:16] (protocol 1.1)
         if (d[19:15] != 5'd0 && !FEATURES[6]) begin d[19:15] = 5'd0; bad = 1'b1; end
+        // Z_WRITE [6] and Z_TEST [2] without a depth buffer (protocol 1.4)
+        if ((d[6] || d[2]) && DEPTH == 0) begin d[6] = 1'b0; d[2] = 1'b0; bad = 1'b1; end
       end
+      // without a depth buffer CLEAR_Z is refused when it executes and clears nothing (1.4)
+      `SPIGPU_REG_CLEAR_Z: if (DEPTH == 0) bad = 1'b1;
       default: ;
     endcase
   end
@@ -182,7 +187,7 @@ module command_exec #(
 
   wire is_vertex  = idx == `SPIGPU_REG_VERTEX;
   wire is_clear   = idx == `SPIGPU_REG_CLEAR;
-  wire is_clear_z = idx == `SPIGPU_REG_CLEAR_Z;
+  wire is_clear_z = idx == `SPIGPU_REG_CLEAR_Z && DEPTH != 0;
   wire is_display = idx == `SPIGPU_REG_FB_DISPLAY;
   wire is_memaddr = idx == `SPIGPU_REG_MEM_ADDR;
   wire is_memdata = idx == `SPIGPU_REG_MEM_DATA;

@@ -4,7 +4,7 @@
 //     LINK_CTRL, LINK_CHECK, HOST_TAG, RESET) act at once after their validation; queued writes go
 //     to the command FIFO (dropped while the link is DISCARDING, ERR_OVERFLOW when full), and are
 //     validated when they execute (command_exec);
-//   - reads: live registers (STATUS, FRAME_CRC, LINK_STATUS, MEM_ADDR, MEM_DATA, CAPS, ID) from a
+//   - reads: live registers (STATUS, FRAME_CRC, LINK_STATUS, MEM_ADDR, MEM_DATA, CAPS2, CAPS, ID) from a
 //     small multiplexer in the bit-64 cycle; every other read-write register from a 32 x 64 shadow
 //     RAM that holds the last validated value (written by the executor and the immediate writes),
 //     one cycle later; write-only registers read 0;
@@ -15,6 +15,7 @@
 // starts no new core command until the core is idle again (core_drain).
 module register_file #(
   parameter [63:0] CAPS = 64'h0,
+  parameter [63:0] CAPS2 = 64'h0,
   parameter [63:0] ID = 64'h0,
   parameter [7:0]  FEATURES = 8'h3F
 ) (
@@ -161,6 +162,7 @@ module register_file #(
       `SPIGPU_REG_LINK_STATUS: rd_live = link_status;
       `SPIGPU_REG_MEM_ADDR:    rd_live = {32'd0, mem_addr, 3'd0};
       `SPIGPU_REG_MEM_DATA:    rd_live = prefetch;
+      `SPIGPU_REG_CAPS2:       rd_live = CAPS2;
       `SPIGPU_REG_CAPS:        rd_live = CAPS;
       `SPIGPU_REG_ID:          rd_live = ID;
       default:                 rd_live = 64'h0;

@@ -31,6 +31,7 @@
 `define SPIGPU_REG_FENCE 7'h18
 `define SPIGPU_REG_MEM_ADDR 7'h70
 `define SPIGPU_REG_MEM_DATA 7'h71
+`define SPIGPU_REG_CAPS2 7'h7D
 `define SPIGPU_REG_CAPS 7'h7E
 `define SPIGPU_REG_ID 7'h7F
 `endif
@@ -65,6 +66,7 @@ function automatic [1:0] reg_class(input [6:0] idx);
     `SPIGPU_REG_FENCE: reg_class = 2'd2;
     `SPIGPU_REG_MEM_ADDR: reg_class = 2'd2;
     `SPIGPU_REG_MEM_DATA: reg_class = 2'd2;
+    `SPIGPU_REG_CAPS2: reg_class = 2'd1;
     `SPIGPU_REG_CAPS: reg_class = 2'd1;
     `SPIGPU_REG_ID: reg_class = 2'd1;
     default: reg_class = 2'd0;
@@ -122,6 +124,7 @@ function automatic [63:0] reg_reserved(input [6:0] idx);
     `SPIGPU_REG_LINK_STATUS: reg_reserved = 64'hFE000000;
     `SPIGPU_REG_RESET: reg_reserved = 64'hFFFFFF0000000000;
     `SPIGPU_REG_MEM_ADDR: reg_reserved = 64'hFFFFFFFF00000007;
+    `SPIGPU_REG_CAPS2: reg_reserved = 64'hFFFFFFFFFFFFFF00;
     default: reg_reserved = 64'h0;
   endcase
 endfunction
@@ -135,7 +138,7 @@ function automatic [63:0] reg_reset(input [6:0] idx);
     `SPIGPU_REG_CLEAR_COLOR: reg_reset = 64'hFF;
     `SPIGPU_REG_CLEAR_DEPTH: reg_reset = 64'hFFFFFF;
     `SPIGPU_REG_FB_FORMAT: reg_reset = 64'h1E00280;
-    `SPIGPU_REG_ID: reg_reset = 64'h5350475501030000;
+    `SPIGPU_REG_ID: reg_reset = 64'h5350475501040000;
     default: reg_reset = 64'h0;
   endcase
 endfunction

@@ -4,6 +4,7 @@
 module spigpu_soc #(
   parameter        PROFILE     = 0,          // 0 up5k, 1 ecp5
   parameter [7:0]  FEATURES    = 8'h38,
+  parameter        DEPTH       = 1,          // CAPS2.FEATURES2 bit 0: the depth buffer (protocol 1.4)
   parameter        MAX_WIDTH   = 320,
   parameter        MAX_HEIGHT  = 240,
   parameter        FIFO_DEPTH  = 64,
@@ -101,6 +102,7 @@ module spigpu_soc #(
   localparam [10:0] MAXW11 = MAX_WIDTH, MAXH11 = MAX_HEIGHT;
   localparam [23:0] VRAM24 = VRAM_KIB;
   localparam [63:0] CAPS = {FEATURES, FIFO_D10, MAXH11, MAXW11, VRAM24};
+  localparam [63:0] CAPS2 = {63'd0, DEPTH != 0};                  // FEATURES2 [7:0]: bit 0 depth buffer
   localparam [63:0] ID_RESET = reg_reset(`SPIGPU_REG_ID);   // magic and protocol version from the table
   localparam [63:0] ID = {ID_RESET[63:16], VARIANT};
   localparam        VAW = PROFILE == 0 ? 15 : 23;      // back-end word address bits
@@ -149,7 +151,7 @@ module spigpu_soc #(
   wire [6:0]  errors;
   wire        device_busy = fifo_level != 11'd0 || !core_idle || !mem_ex_idle;
 
-  register_file #(.CAPS(CAPS), .ID(ID), .FEATURES(FEATURES)) u_regs (
+  register_file #(.CAPS(CAPS), .CAPS2(CAPS2), .ID(ID), .FEATURES(FEATURES)) u_regs (
     .clk(clk), .rst(rst), .frame_valid(f_valid), .frame_rw(f_rw), .frame_idx(f_idx), .frame_data(f_data),
     .frame_abort(f_abort), .rd_strobe(rd_strobe), .rd_idx(rd_idx), .rd_live(rd_live), .rd_from_ram(rd_from_ram),
     .rd_ram(rd_ram), .status_flags(status_flags), .fifo_push(fifo_push), .fifo_push_held(fifo_push_held),
@@ -181,7 +183,7 @@ module spigpu_soc #(
   wire [63:0] mem_op_data;
   wire        swap_req, swap_ready, waiting_vsync;
   wire [27:0] swap_addr;
-  command_exec #(.FEATURES(FEATURES), .MAX_WIDTH(MAX_WIDTH), .MAX_HEIGHT(MAX_HEIGHT), .VRAM_KIB(VRAM_KIB),
+  command_exec #(.FEATURES(FEATURES), .MAX_WIDTH(MAX_WIDTH), .MAX_HEIGHT(MAX_HEIGHT), .VRAM_KIB(VRAM_KIB), .DEPTH(DEPTH),
                  .VPORT(PROFILE == 0 ? 1 : 0)) u_exec (
     .clk(clk), .rst(rst_any), .in_valid(fifo_out_valid), .in_entry(fifo_out), .in_pop(fifo_pop),
     .sh_wr_req(sh_wr_req), .sh_wr_idx(sh_wr_idx), .sh_wr_data(sh_wr_data), .sh_wr_ack(sh_wr_ack),

@@ -45,6 +45,8 @@ struct DeviceInfo {
   std::uint64_t vram_bytes = 0;
   std::uint64_t id = 0;    // ID register
   std::uint64_t caps = 0;  // CAPS register
+  // CAPS2 register (protocol 1.4; 0 for an older device, which has no CAPS2): protocol::has_depth_buffer.
+  std::uint64_t caps2 = 0;
   // Where the scanned-out frames come from when not from the device itself ("" = the device's own):
   // a board that sends no frames back shows the simulator's, and says so here.
   std::string frames_note;

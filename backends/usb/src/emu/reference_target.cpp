@@ -70,6 +70,9 @@ std::uint64_t ReferenceTarget::read_register(std::uint8_t index) {
       return std::uint64_t{0x38} << 56 | std::uint64_t{cfg_.fifo_depth & 0x3FF} << 46 |
              std::uint64_t{cfg_.max_height & 0x7FF} << 35 | std::uint64_t{cfg_.max_width & 0x7FF} << 24 |
              (cfg_.vram_kib & 0xFFFFFF);
+    // CAPS2.FEATURES2 bit 0: depth buffer. The target renders nothing and refuses no Z bits, which is
+    // what a device with a depth buffer does at the link level.
+    case index_of(Reg::CAPS2): return protocol::kFeature2Depth;
     case index_of(Reg::ID): return protocol::describe(Reg::ID).reset | cfg_.variant;
     case index_of(Reg::MEM_DATA): {
       if (!mem_ready_ || !fifo_.empty()) return 0;

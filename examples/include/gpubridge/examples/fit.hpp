@@ -38,7 +38,11 @@ inline constexpr std::uint16_t kRgba2222 = sim::FEATURE_RGBA2222;
 inline constexpr std::uint16_t kTemporalDither = sim::FEATURE_TEMPORAL_DITHER;
 // texturing is CAPS.FEATURES bit 7 since protocol 1.2; every 1.0 and 1.1 device (ID.MINOR < 2) textures
 inline constexpr std::uint16_t kTexturing = sim::FEATURE_TEXTURE;
-// "bilinear", "blend", "dither", "rgb565", "rgba2222", "temporal", "texture".
+// The depth buffer is CAPS2.FEATURES2 bit 0 since protocol 1.4 (protocol::has_depth_buffer: every
+// 1.0 ... 1.3 device has one); here bit 8, above the CAPS.FEATURES byte. Without it the examples
+// draw in painter's order, as they do when video memory is short.
+inline constexpr std::uint16_t kDepthBuffer = static_cast<std::uint16_t>(sim::FEATURE2_DEPTH << 8);
+// "bilinear", "blend", "dither", "rgb565", "rgba2222", "temporal", "texture", "depth".
 std::string_view feature_name(std::uint16_t bit);
 std::optional<std::uint16_t> parse_feature(std::string_view name);
 // "bilinear blend ..." for a mask (the known bits only).
@@ -49,11 +53,12 @@ struct DeviceCaps {
   std::string name = "simulator";  // board profile name, or "simulator"
   std::uint64_t vram_bytes = 8u << 20;
   unsigned max_width = protocol::kMaxFramebufferDim, max_height = protocol::kMaxFramebufferDim;
-  std::uint16_t features = sim::kAllFeatures | kTexturing;
+  std::uint16_t features = sim::kAllFeatures | kTexturing | kDepthBuffer;
   bool has(std::uint16_t bit) const { return (features & bit) == bit; }
 
-  // From a device description (a backend's info(), a daemon's WELCOME): limits and the CAPS
-  // register's FEATURES; a description without CAPS (0) is taken to have every feature.
+  // From a device description (a backend's info(), a daemon's WELCOME): limits, the CAPS
+  // register's FEATURES and CAPS2's depth buffer; a description without CAPS (0) is taken to have
+  // every feature.
   static DeviceCaps from(const backends::DeviceInfo& info);
   // The simulator options of a device with these CAPS (to render it in-process).
   sim::DeviceOptions simulator_options() const;

@@ -42,6 +42,7 @@ enum class Reg : std::uint8_t {
   FENCE = 0x18,
   MEM_ADDR = 0x70,
   MEM_DATA = 0x71,
+  CAPS2 = 0x7D,  // protocol 1.4: more capabilities (FEATURES2); undefined before
   CAPS = 0x7E,
   ID = 0x7F,
 };
@@ -160,8 +161,9 @@ constexpr bool miso_status_valid(std::uint8_t b) { return (b & MISO_MARKER_MASK)
 // Fixed identification values.
 inline constexpr std::uint32_t kIdMagic = 0x53504755;  // "SPGU" in ID[63:32]
 inline constexpr std::uint8_t kVersionMajor = 1;
-// 1.1: TRI_MODE.TEMPORAL / DITHER_PHASE; 1.2: CAPS.FEATURES bit 7 (texturing); 1.3: LINK_CTRL.CLEAR_KEY.
-inline constexpr std::uint8_t kVersionMinor = 3;
+// 1.1: TRI_MODE.TEMPORAL / DITHER_PHASE; 1.2: CAPS.FEATURES bit 7 (texturing); 1.3: LINK_CTRL.CLEAR_KEY;
+// 1.4: CAPS2 (0x7D), FEATURES2 bit 0 = depth buffer.
+inline constexpr std::uint8_t kVersionMinor = 4;
 inline constexpr std::uint64_t kResetMagic = 0x5245534554ull;  // "RESET": RESET's required data
 // "off!" in LINK_CTRL.CLEAR_KEY: a LINK_CTRL write with STRICT = 0 leaves strict mode only with it
 // (protocol 1.3, docs/protocol.md section 4), so no single bit error can turn strict mode off.
@@ -174,6 +176,14 @@ constexpr unsigned id_variant(std::uint64_t id) { return static_cast<unsigned>(i
 // from 1.3 on; 0 before, where the key's bits are reserved (a 1.2 device would flag them).
 constexpr std::uint64_t link_ctrl_clear_value(std::uint64_t id) {
   return protocol_minor(id) >= 3 ? std::uint64_t{kLinkClearKey} << 32 : 0;
+}
+// CAPS2.FEATURES2 bits (protocol 1.4, docs/protocol.md section 5, CAPS2).
+inline constexpr std::uint8_t kFeature2Depth = 1u << 0;  // depth buffer: TRI_MODE.Z_TEST/Z_WRITE, CLEAR_Z
+// Whether the device whose ID reads `id` and CAPS2 reads `caps2` has a depth buffer. CAPS2 exists
+// from 1.4 on; every 1.0 ... 1.3 device has one (its CAPS2 index is undefined: a host does not read
+// it there, and passes 0).
+constexpr bool has_depth_buffer(std::uint64_t id, std::uint64_t caps2) {
+  return protocol_minor(id) < 4 || (caps2 & kFeature2Depth) != 0;
 }
 inline constexpr unsigned kMaxFramebufferDim = 1024;
 inline constexpr unsigned kMinTextureLog2 = 3;

@@ -14,6 +14,7 @@ inline sim::DeviceOptions simulator_options(const GatewareCaps& c) {
   o.max_height = c.max_height;
   o.fifo_depth = c.fifo_depth;
   o.features = c.features;
+  o.features2 = c.features2;
   o.variant = c.variant;
   return o;
 }

@@ -114,6 +114,7 @@ class Device final : public backends::SpiTarget {
 
   const DeviceOptions& options() const;
   std::uint64_t caps() const;  // CAPS register value
+  std::uint64_t caps2() const;  // CAPS2 register value (protocol 1.4)
   std::uint64_t id() const;    // ID register value
   std::uint16_t errors() const;  // STATUS.ERRORS
   const DeviceStats& stats() const;

@@ -55,6 +55,11 @@ enum Feature : std::uint8_t {
   FEATURE_TEXTURE = 1u << 7,          // TRI_MODE.TEXTURED: the texture unit (protocol 1.2)
 };
 inline constexpr std::uint8_t kAllFeatures = 0xFF;
+// CAPS2.FEATURES2 bits (protocol 1.4, docs/protocol.md, CAPS2); the other bits are reserved.
+enum Feature2 : std::uint8_t {
+  FEATURE2_DEPTH = 1u << 0,  // the depth buffer: TRI_MODE.Z_TEST / Z_WRITE and CLEAR_Z
+};
+inline constexpr std::uint8_t kAllFeatures2 = FEATURE2_DEPTH;
 
 inline constexpr std::uint64_t kMaxVramBytes = 1ull << 32;  // addresses are 32-bit
 inline constexpr unsigned kMaxThreads = 64;
@@ -66,6 +71,7 @@ struct DeviceOptions {
   unsigned fifo_depth = 512;                           // CAPS.FIFO_DEPTH, 64..1023
   std::uint16_t variant = 0;                           // ID.VARIANT (0 = simulator)
   std::uint8_t features = kAllFeatures;                // CAPS.FEATURES
+  std::uint8_t features2 = kAllFeatures2;              // CAPS2.FEATURES2 (only kAllFeatures2's bits)
   // 0 = untimed: queued writes execute as soon as they are released (the default).
   // N > 0: each received frame lets at most N FIFO entries execute (a device slower than the
   // link, for flow-control tests); Device::drain() executes the rest.

@@ -97,7 +97,7 @@ class BoardBackend final : public backends::Backend {
   mutable std::mutex mu_;
   backends::ScanoutCallback scanout_cb_;
   const std::atomic<bool>* cancel_ = nullptr;
-  std::uint64_t id_ = 0, caps_ = 0;
+  std::uint64_t id_ = 0, caps_ = 0, caps2_ = 0;  // caps2_: 0 on a device before protocol 1.4 (no CAPS2)
   unsigned fifo_depth_ = 0;
   std::uint32_t vram_bytes_ = 0;
   bool strict_ = false, gone_ = false;

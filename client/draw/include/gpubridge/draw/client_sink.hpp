@@ -31,7 +31,7 @@ class ClientSink final : public CommandSink {
   }
   Result<void> flush() override { return client_->fence(); }
   // From the daemon's WELCOME device description (backend, board, limits, "vram_bytes", "caps",
-  // "id"); what it does not say keeps DeviceInfo's defaults, and 8 MiB of video memory.
+  // "caps2", "id"); what it does not say keeps DeviceInfo's defaults, and 8 MiB of video memory.
   backends::DeviceInfo device() const override { return device_; }
   Result<void> end_frame(unsigned max_in_flight) override {
     if (auto h = client_->fence_async(); !h) return h.error();
