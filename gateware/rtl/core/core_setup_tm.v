@@ -31,7 +31,8 @@
 // only when edge 0-2's bias is -1; act div: the plane field), [17:14] act, [24:18] tgt (branch
 // target; m2 of a multiply; the field select of wf), [26:25] multiply pair, [28:27] its sign.
 module core_setup_tm #(
-    parameter integer IDX_W = 17
+    parameter integer IDX_W = 17,
+    parameter integer DEPTH = 1   // 0: no depth buffer (CAPS2): no Z plane, colour numerators only
 ) (
     input  wire         clk,
     input  wire         rst,
@@ -64,7 +65,11 @@ module core_setup_tm #(
 );
   // Without S, T, Q: |M0| < 2^60 (see core_setup), and a0 2D < 2^58 is added to it (below),
   // so 62 bits; RAM words are 36 bits (the biased edge values), a operands at most 25 (Z).
-  localparam integer ACC_W = 62;
+  // Without a depth buffer the widest value is a colour numerator, |M0| < 2^44 (the divider
+  // below), so 46 bits. The accumulator only adds, subtracts and shifts left (a multiply is
+  // MSB-first), so a wider intermediate sum wraps and still ends exact; its sign and zero tests
+  // are of D and the edges (below 2^36).
+  localparam integer ACC_W = (DEPTH != 0) ? 62 : 46;
   localparam integer MW = 36;
   localparam integer AW = 25;
 
@@ -235,8 +240,9 @@ module core_setup_tm #(
   /* verilator lint_off PINCONNECTEMPTY */
   // colour numerators: |d| < 2^8, |e| < 2^33, |D| < 2^33, a0 < 2^8, so |M0| = |2(d1 e1 + d2 e2 + a0
   // |D|) + ...| < 2^44 and the steps |32(d1 dy + d2 dy)| < 2^31: 45 numerator bits, 46 cycles a
-  // division instead of 62 (Z's need all 62)
-  core_divider #(.NW(ACC_W), .DW(35), .QW(32), .SKIP(0), .NARROW(45)) divider (
+  // division instead of 62 (Z's need all 62). Without a depth buffer every numerator is a
+  // colour's: the divider is 46 bits wide and always takes 46 cycles.
+  core_divider #(.NW(ACC_W), .DW(35), .QW(32), .SKIP(0), .NARROW((DEPTH != 0) ? 45 : 0)) divider (
       .clk(clk), .rst(rst), .start(dv2), .num(acc_s), .narrow(dv_attr != 3'd4), .den(den), .busy(), .done(dv_done),
       .quo(dv_q), .rem(dv_r), .rem_c(dv_rc), .neg(dv_neg));
   /* verilator lint_on PINCONNECTEMPTY */

@@ -122,7 +122,7 @@ module spigpu_core #(
       // edge values are not read back
       wire [23:0] q24;
       wire unused_e = &{1'b0, ras_e1, ras_e2, need[7:5], cmd_v0, cmd_v1, cmd_v2, cmd_clear_color, cmd_clear_depth};
-      core_setup_tm #(.IDX_W(IDX_W)) setup (
+      core_setup_tm #(.IDX_W(IDX_W), .DEPTH(DEPTH)) setup (
           .clk(clk), .rst(rst), .start(su_go), .rect(su_rect), .busy(su_busy), .done(su_done),
           .draw(su_draw), .vp_addr(vp_addr), .vp_data(vp_data),
           .vp_idle((cmd_op == OP_TRI) ? 4'b0010 : {3'b110, cmd_op == OP_CLEAR_Z}),
