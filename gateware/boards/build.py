@@ -99,7 +99,10 @@ def icebreaker(out_dir, seeds, abc9, video):
         rep = os.path.join(out_dir, f"icebreaker.seed{seed}.report.json")
         log_path = os.path.join(out_dir, f"icebreaker.seed{seed}.nextpnr.log")
         cmd = ["nextpnr-ice40", "--up5k", "--package", "sg48", "--pcf", os.path.join(BOARDS_DIR, "icebreaker", "icebreaker.pcf"),
-               "--freq", str(ICEBREAKER["target_mhz"]), "--json", net, "--asc", asc, "--seed", str(seed), "--report", rep]
+               "--freq", str(ICEBREAKER["target_mhz"]), "--json", net, "--asc", asc, "--seed", str(seed), "--report", rep,
+               # a routed design below the target clock still gets its report and bitstream: the
+               # fmax check below names the clock it misses (exit 1), not a tool failure (exit 2)
+               "--timing-allow-fail"]
         out, secs = run(cmd, "nextpnr-ice40", log_path)
         log = out.stdout + out.stderr
         used = utilisation(log)
