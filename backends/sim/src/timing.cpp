@@ -102,28 +102,30 @@ Result<BoardTiming> timing_preset(std::string_view name) {
   }
   if (name == "up5k") {
     // iCEBreaker: 25.125 MHz core (its PLL), 128 KiB SPRAM (one 32-bit access per clock), SPI 7.5 MHz,
-    // no BUSY pin. The setup is a bit-serial program (gen_setup_prog.py: 220 cycles flat .. 1,289 Gouraud + Z on
+    // no BUSY pin. The setup is a bit-serial program (gen_setup_prog.py: 227 cycles flat .. 883 Gouraud, 1,126 Gouraud + Z on
     // the core bench); the one time-shared stepper costs a cycle per interpolated attribute per
     // rasteriser move (rows, boundary columns and pixels); clears are drawn as rectangles.
     b.clock_mhz = 25.125;
     b.spi_clock_mhz = 7.5;
     b.memory_bytes_per_cycle = 4.0;
-    // Flat and Gouraud refitted for protocol 1.4 (`gpubridge bench rtl --fit --profile up5k`, worst
-    // error 0.6 % on the scenes). The profile has no depth buffer since 1.4 (Z refused): the z classes
-    // keep the earlier fit of the core with its depth stage (the core bench still builds it), unused.
-    b.setup_cycles = {228.1, 1077.0, 510.1, 1292.0, 0.0, 0.0, 0.0, 0.0};  // no texture unit
-    b.row_cycles = {2.029, 2.753, 0.7314, 3.853, 0.0, 0.0, 0.0, 0.0};
-    b.column_cycles = {0.6602, 2.528, 1.257, 3.189, 0.0, 0.0, 0.0, 0.0};
-    b.pixel_cycles = {1.013, 4.0, 4.077, 5.271, 0.0, 0.0, 0.0, 0.0};
-    b.cycles_per_command = 0.4231;
-    b.cycles_per_triangle = 5.916;
+    // Flat and Gouraud refitted after the fifth-session gateware rounds (fit-core4's 45-bit colour
+    // divisions, protocol 1.4 without a depth buffer, the 46-bit setup of DEPTH = 0): `gpubridge bench
+    // rtl --fit --profile up5k`, worst error 0.6 % on the scenes, 0.4 % on the calibration frames.
+    // The z classes keep the earlier fit of the core with its depth stage (the core bench still
+    // builds it); the up5k profile refuses Z, so they are unused.
+    b.setup_cycles = {228.1, 884.6, 510.1, 1292.0, 0.0, 0.0, 0.0, 0.0};  // no texture unit
+    b.row_cycles = {2.029, 2.752, 0.7314, 3.853, 0.0, 0.0, 0.0, 0.0};
+    b.column_cycles = {0.6607, 2.528, 1.257, 3.189, 0.0, 0.0, 0.0, 0.0};
+    b.pixel_cycles = {1.013, 4.001, 4.077, 5.271, 0.0, 0.0, 0.0, 0.0};
+    b.cycles_per_command = 0.6937;
+    b.cycles_per_triangle = 4.126;
     b.cycles_per_blended_pixel = 0.0;  // no blending
-    b.cycles_per_rejected_triangle = 93.28;
+    b.cycles_per_rejected_triangle = 88.59;
     b.cycles_per_clear = 888.1;
     b.cycles_per_clear_row = 0.0;
     b.cycles_per_clear_pixel = 1.001;  // colour clears only (1.4 with CLEAR_Z's 4-byte writes)
-    b.cycles_per_mem_write = 5.24;
-    b.cycles_per_color_byte = 0.001352;
+    b.cycles_per_mem_write = 4.8;
+    b.cycles_per_color_byte = 0.001284;
     b.clear_bytes_per_cycle = 1e9;  // a clear costs by pixel (one SPRAM write each), not by byte
     return b;
   }
