@@ -234,14 +234,14 @@ std::vector<Example> make() {
       skip("build/tools/gpubridge bench rtl --fit", "the full calibration run, an hour of co-simulation, by hand"),
       skip("build/tools/gpubridge bench rtl --fill",
            "framebuffer-sized rectangles, minutes of co-simulation; CTest rtl.cli.bench_fill runs the --quick form"),
-      skip("gateware/synth.py --pack --check", "yosys synthesis of both profiles and nextpnr packing take many minutes (and up5k does not fit yet: exit 1), by hand"),
+      skip("gateware/synth.py --pack --check", "yosys synthesis of both profiles and nextpnr packing take many minutes, by hand"),
       skip("gateware/tests/core/synth_core.py", "yosys synthesis per stage takes many minutes, by hand"),
       skip("build/gateware/tests/core/rtl_core_ecp5_bench", "a measurement, by hand; the core's tests run in ctest -L rtl"),
   }});
 
   all.push_back({"docs/gateware.md", "Building the bitstreams", 0, "docs_gateware_BuildingTheBitstreams", {
       skip("scripts/gateware.sh --board icebreaker --seeds 4 --json build/gateware/boards/icebreaker-report.json",
-           "yosys and four place-and-route runs take many minutes, and the up5k profile does not fit yet (exit 1); "
+           "yosys and four place-and-route runs take many minutes, and the routed up5k design misses its 25.125 MHz clock (exit 1); "
            "CTest gateware.icebreaker.pnr runs it with one seed under -DGPUBRIDGE_GATEWARE_PNR=ON"),
       skip("scripts/gateware.sh --board ulx3s --json build/gateware/boards/ulx3s-report.json",
            "minutes of yosys synth_ecp5; CTest gateware.ulx3s.synth runs it"),
