@@ -34,7 +34,12 @@ def board_clock(report, board):
     est = r.get("clock_estimate", {}).get("core_mhz")
     if fmax:
         worst = min(fmax.values())
-        state = f"routed, worst fmax {worst:.2f} MHz" + ("" if worst >= target else " (below the target)")
+        if worst < target:
+            # routed below the PLL's clock: the board is not usable at the target, and at the fmax
+            # (a slower PLL setting) it would run this fast at best
+            return worst, (f"routed, worst fmax {worst:.2f} MHz, below the {target:g} MHz target: "
+                           f"predicted at {worst:.2f} MHz")
+        state = f"routed, worst fmax {worst:.2f} MHz"
     elif est and est < target:
         # not routed, and the netlist's estimate does not reach the PLL's clock: predict at the estimate
         ce = r["clock_estimate"]
