@@ -73,6 +73,14 @@ class PredictFill(unittest.TestCase):
         report = {"ulx3s": {"target_mhz": 50, "clock_estimate": {"core_mhz": 80.0, "core_mhz_cells_only": 120.0}}}
         self.assertEqual(predict.board_clock(report, "ulx3s")[0], 50)
 
+    def test_a_routed_design_below_its_target_is_predicted_at_its_fmax(self):
+        slow = {"icebreaker": {"target_mhz": 25.125, "fmax_mhz": {"clk": 16.86}}}
+        mhz, state = predict.board_clock(slow, "icebreaker")
+        self.assertEqual(mhz, 16.86)
+        self.assertIn("predicted at 16.86 MHz", state)
+        fast = {"icebreaker": {"target_mhz": 25.125, "fmax_mhz": {"clk": 31.0}}}
+        self.assertEqual(predict.board_clock(fast, "icebreaker")[0], 25.125)
+
     def test_figures_say_whether_the_estimate_backs_the_target(self):
         synth = {"lut4": 1, "ccu2c": 1, "dpr16x4": 1, "lut4_equivalent": 7, "ff": 1, "ebr": 1, "dsp": 1}
         margin = {"lut4": 99.0, "ff": 99.0, "ebr": 99.0, "dsp": 99.0}
