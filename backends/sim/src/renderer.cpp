@@ -16,9 +16,6 @@ Renderer::Renderer(VideoMemory& mem, const AccuracyKnobs& knobs, unsigned thread
   if (pool_.workers() > 1) {
     batch_.reserve(kMaxBatch);
     drawing_.reserve(kMaxBatch);
-    scratch_.resize(pool_.workers());
-    set_up_.resize(kMaxBatch);
-    setup_done_ = std::make_unique<std::barrier<>>(static_cast<std::ptrdiff_t>(pool_.workers()));
   }
   draw_job_ = [this](unsigned worker) { draw_bands(worker); };
 }
@@ -96,8 +93,18 @@ void Renderer::draw(const Vertex& a, const Vertex& b, const Vertex& c, const std
   if (batching) {
     draw_pending();
     if (!batch_.empty() && batch_state_ != state) submit();
-    // The workers set it up (draw_bands): the front end only keeps the vertices.
-    batch_.push_back(Queued{{a, b, c}, index});
+    // The front end sets the triangle up while the workers draw the previous batch. Setting up in
+    // the workers instead (an equal run each, then a barrier, then the bands) took the front end's
+    // setup off the busiest thread but lost this overlap: on two cores it was slower at 2 threads
+    // (10-px triangles, exact 7.8 -> 6.9, preview 15.5 -> 10.2 Mtri/s; docs/simulator.md, "Threads").
+    Triangle& t = batch_.emplace_back();
+    if (!setup(a, b, c, st, false, t)) {
+      batch_.pop_back();
+      ++rejected_;
+      return;
+    }
+    t.index = index;
+    count_rasterised(t, st);
     if (batch_state_ != state) batch_state_ = state;
     if (batch_.size() >= kMaxBatch) submit();
     return;
@@ -112,11 +119,7 @@ void Renderer::draw(const Vertex& a, const Vertex& b, const Vertex& c, const std
     return;
   }
   t.index = index;
-  ++rasterised_;
-  auto& mode = modes_[st.mode_class];
-  ++mode.triangles;
-  mode.rows += static_cast<std::uint64_t>(t.y1 - t.y0);
-  mode.columns += static_cast<std::uint64_t>(t.x1 - t.x0);
+  count_rasterised(t, st);
   if (observing) observe_triangle(t, st, observer_);
   if (st.writes_nothing) return;
   prefetch_rows(t, st);
@@ -128,6 +131,14 @@ void Renderer::draw(const Vertex& a, const Vertex& b, const Vertex& c, const std
     pending_state_ = state;
     if (knobs_.preview && st.preview_small != 0) pending_small_ = small_draw(st, mem_, knobs_.z_bits);
   }
+}
+
+void Renderer::count_rasterised(const Triangle& t, const DrawState& st) {
+  ++rasterised_;
+  auto& mode = modes_[st.mode_class];
+  ++mode.triangles;
+  mode.rows += static_cast<std::uint64_t>(t.y1 - t.y0);
+  mode.columns += static_cast<std::uint64_t>(t.x1 - t.x0);
 }
 
 void Renderer::draw_pending() {
@@ -164,11 +175,8 @@ void Renderer::submit() {
   drawing_state_ = std::move(batch_state_);
   batch_state_.reset();
   drawing_ctx_.clear();
-  for (unsigned w = 0; w < pool_.workers(); ++w) {
+  for (unsigned w = 0; w < pool_.workers(); ++w)
     drawing_ctx_.push_back(RasterContext{mem_, recip_, knobs_.z_bits, 0, {}, vector_});
-    WorkerScratch& k = scratch_[w];
-    k.rasterised = k.rejected = k.rows = k.columns = 0;
-  }
   drawing_active_ = true;
   pool_.start(draw_job_);
 }
@@ -176,55 +184,22 @@ void Renderer::submit() {
 void Renderer::wait_drawing() {
   if (!drawing_active_) return;
   pool_.wait();
-  auto& mode = modes_[drawing_state_->mode_class];  // one state per batch
-  for (unsigned w = 0; w < pool_.workers(); ++w) {
-    const RasterContext& c = drawing_ctx_[w];
+  for (const auto& c : drawing_ctx_) {
     errors_ |= c.errors;
-    add_counters(c.counters, *drawing_state_);
-    const WorkerScratch& k = scratch_[w];
-    rasterised_ += k.rasterised;
-    rejected_ += k.rejected;
-    mode.triangles += k.rasterised;
-    mode.rows += k.rows;
-    mode.columns += k.columns;
+    add_counters(c.counters, *drawing_state_);  // one state per batch
   }
   drawing_.clear();
   drawing_state_.reset();
   drawing_active_ = false;
 }
 
-// One worker's share of a batch. Setup first: the worker's run of the batch, counted here (a
-// rejected triangle is left with no rows). The device thread used to set up every triangle while
-// the workers drew, and on 10-px triangles that made it the busiest thread (callgrind: 1,346
-// instructions per triangle against 866 per worker, exact); setting up by bands instead (each
-// worker the triangles touching its bands, those crossing two workers' bands twice) cost a tenth
-// more instructions in all (docs/simulator.md). Then, after every worker has set up its run, the
-// rows of this worker's bands of every triangle in submission order.
+// One worker's share of a batch: the rows of its bands of every triangle, in submission order.
 void Renderer::draw_bands(unsigned worker) {
   const DrawState& st = *drawing_state_;
   const unsigned n = pool_.workers();
   RasterContext& c = drawing_ctx_[worker];
-  WorkerScratch& k = scratch_[worker];
-  // Setup: an equal run of the batch per worker, each triangle once.
-  const std::size_t size = drawing_.size(), from = size * worker / n, to = size * (worker + 1) / n;
-  for (std::size_t i = from; i < to; ++i) {
-    const Queued& q = drawing_[i];
-    Triangle& t = set_up_[i];
-    if (!setup(q.v[0], q.v[1], q.v[2], st, false, t)) {
-      ++k.rejected;
-      t.y0 = t.y1 = 0;  // draws nothing
-      continue;
-    }
-    t.index = q.index;
-    ++k.rasterised;
-    k.rows += static_cast<std::uint64_t>(t.y1 - t.y0);
-    k.columns += static_cast<std::uint64_t>(t.x1 - t.x0);
-  }
-  setup_done_->arrive_and_wait();  // the other workers' triangles are set up
-  // Drawing: every triangle in submission order, this worker's bands only.
   const SmallDraw small = knobs_.preview && st.preview_small != 0 ? small_draw(st, mem_, knobs_.z_bits) : SmallDraw{};
-  for (std::size_t i = 0; i < size; ++i) {
-    const Triangle& t = set_up_[i];
+  for (const Triangle& t : drawing_) {
     int band = t.y0 / kBandRows;
     band += static_cast<int>((worker + n - static_cast<unsigned>(band) % n) % n);
     for (; band * kBandRows < t.y1; band += static_cast<int>(n)) {

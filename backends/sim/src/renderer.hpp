@@ -1,14 +1,11 @@
 #pragma once
 // Runs kicked triangles through setup and the rasteriser. With one thread every triangle is drawn
-// at once. With N threads triangles are batched (their vertices, not set up) while the render
-// state stays the same; a batch is set up and drawn by N workers: first each sets up an equal run
-// of the batch (each triangle once, so each is counted once), then, when all have, each walks all
-// triangles in submission order and draws only the rows of its own 16-row bands (band i → worker
-// i % N), so the bytes are identical for any N. The calling thread (the device front end) only
-// decodes and batches the next batch while the workers set up and draw the previous one; batches
-// are drawn one after another, and flush() waits for both.
+// at once. With N threads triangles are batched while the render state stays the same; a batch is
+// drawn by N workers that each walk all triangles in submission order and draw only the rows of
+// their own 16-row bands (band i → worker i % N), so the bytes are identical for any N. The
+// calling thread (the device front end) decodes and sets up the next batch while the workers draw
+// the previous one; batches are drawn one after another, and flush() waits for both.
 #include <array>
-#include <barrier>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -67,17 +64,9 @@ class Renderer {
   void prefetch_rows(const Triangle& t, const DrawState& st) const;
   // Sets up a triangle as the state and the accuracy want it (false: it draws nothing).
   bool setup(const Vertex& a, const Vertex& b, const Vertex& c, const DrawState& st, bool observing, Triangle& t) const;
+  // Counts a triangle that was set up (rasterised, and its state class's triangles, rows, columns).
+  void count_rasterised(const Triangle& t, const DrawState& st);
 
-  // A kicked triangle waiting in a batch: set up by the workers that draw it.
-  struct Queued {
-    Vertex v[3];
-    std::uint64_t index;
-  };
-  // What one worker counted while setting up its run of the batch (merged after the batch, one
-  // state per batch). Aligned apart: written while the other workers write theirs.
-  struct alignas(64) WorkerScratch {
-    std::uint64_t rasterised = 0, rejected = 0, rows = 0, columns = 0;
-  };
 
   VideoMemory& mem_;
   AccuracyKnobs knobs_;
@@ -85,14 +74,11 @@ class Renderer {
   ReciprocalUnit recip_;
   BandPool pool_;
   PixelObserver observer_;
-  std::vector<Queued> batch_;  // being filled by the front end
+  std::vector<Triangle> batch_;  // being filled by the front end
   std::shared_ptr<const DrawState> batch_state_;
-  std::vector<Queued> drawing_;  // being set up and drawn by the workers
+  std::vector<Triangle> drawing_;  // being drawn by the workers
   std::shared_ptr<const DrawState> drawing_state_;
   std::vector<RasterContext> drawing_ctx_;  // one per worker
-  std::vector<WorkerScratch> scratch_;      // one per worker
-  std::vector<Triangle> set_up_;            // drawing_ set up (by the workers, one run each)
-  std::unique_ptr<std::barrier<>> setup_done_;  // the workers meet between setup and drawing
   bool drawing_active_ = false;
   std::function<void(unsigned)> draw_job_;
   Triangle slots_[2];
