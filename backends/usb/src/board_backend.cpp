@@ -59,18 +59,33 @@ void BoardBackend::track(const Frame& f) {
   if (f.index == index_of(Reg::FB_DISPLAY)) fb_display_ = f.data;
 }
 
+// A bit error on MOSI turns a read into a read of another register, one on MISO garbles the
+// value: so each constant is read twice, and the burst again while a pair differs.
+Result<std::vector<std::uint64_t>> BoardBackend::read_constants(std::initializer_list<Reg> regs) {
+  std::vector<std::uint8_t> indices;
+  for (const Reg r : regs) indices.insert(indices.end(), 2, index_of(r));
+  const auto differing = [](const std::vector<std::uint64_t>& v) {
+    for (std::size_t i = 0; i < v.size(); i += 2)
+      if (v[i] != v[i + 1]) return i;
+    return v.size();
+  };
+  auto v = read_frames(indices);
+  for (unsigned attempt = 1; attempt < 3 && v && differing(*v) != v->size(); ++attempt) v = read_frames(indices);
+  if (!v) return v.error();
+  if (const std::size_t i = differing(*v); i != v->size())
+    return make_error("board '" + profile_.name + "': two " + std::string(protocol::find_register(indices[i])->name) +
+                          " reads differ three times (0x" + fmt::format("{:016X}", (*v)[i]) + " vs 0x" +
+                          fmt::format("{:016X}", (*v)[i + 1]) + "): unreliable SPI link; lower bridge.spi_clock_hz",
+                      backends::kDeviceProtocol);
+  std::vector<std::uint64_t> values;
+  for (std::size_t i = 0; i < v->size(); i += 2) values.push_back((*v)[i]);
+  return values;
+}
+
 Result<void> BoardBackend::attach_locked() {
-  // ID and CAPS each read twice; pairs that disagree are read again (a bit error on MOSI turns a
-  // read into a read of another register, one on MISO garbles the value).
-  const std::uint8_t id_caps[] = {index_of(Reg::ID), index_of(Reg::ID), index_of(Reg::CAPS), index_of(Reg::CAPS)};
-  auto v = read_frames(id_caps);
-  for (unsigned attempt = 1; attempt < 3 && v && ((*v)[0] != (*v)[1] || (*v)[2] != (*v)[3]); ++attempt) v = read_frames(id_caps);
+  auto v = read_constants({Reg::ID, Reg::CAPS});
   if (!v) return v.error();
   const std::uint64_t id = (*v)[0];
-  if (id != (*v)[1] || (*v)[2] != (*v)[3])
-    return make_error("board '" + profile_.name + "': two ID or CAPS reads differ three times (ID 0x" + fmt::format("{:016X}", id) +
-                          " vs 0x" + fmt::format("{:016X}", (*v)[1]) + "): unreliable SPI link; lower bridge.spi_clock_hz",
-                      backends::kDeviceProtocol);
   if ((id >> 32) != protocol::kIdMagic)
     return make_error("board '" + profile_.name + "': ID register reads 0x" + fmt::format("{:016X}", id) +
                           ", not a spigpu design (magic 0x53504755); load the gpubridge bitstream",
@@ -80,19 +95,13 @@ Result<void> BoardBackend::attach_locked() {
                           " is not supported (this host speaks v1)",
                       backends::kDeviceProtocol);
   id_ = id;
-  caps_ = (*v)[2];
+  caps_ = (*v)[1];
   // CAPS2 exists from protocol 1.4 on (on an older device its index is undefined and the read would
-  // raise ERR_BAD_REGISTER): read twice like ID and CAPS.
+  // raise ERR_BAD_REGISTER).
   caps2_ = 0;
   if (protocol::protocol_minor(id) >= 4) {
-    const std::uint8_t caps2[] = {index_of(Reg::CAPS2), index_of(Reg::CAPS2)};
-    auto c = read_frames(caps2);
-    for (unsigned attempt = 1; attempt < 3 && c && (*c)[0] != (*c)[1]; ++attempt) c = read_frames(caps2);
+    auto c = read_constants({Reg::CAPS2});
     if (!c) return c.error();
-    if ((*c)[0] != (*c)[1])
-      return make_error("board '" + profile_.name + "': two CAPS2 reads differ three times (0x" + fmt::format("{:016X}", (*c)[0]) +
-                            " vs 0x" + fmt::format("{:016X}", (*c)[1]) + "): unreliable SPI link; lower bridge.spi_clock_hz",
-                        backends::kDeviceProtocol);
     caps2_ = (*c)[0];
   }
   const unsigned caps_depth = (caps_ >> 46) & 0x3FF;

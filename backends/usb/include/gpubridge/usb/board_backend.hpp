@@ -3,6 +3,7 @@
 // under one chip select, FIFO flow control, strict link integrity with go-back-N resend,
 // STATUS/ID/memory reads, upload/readback through MEM_ADDR/MEM_DATA and scanout frames.
 #include <cstdint>
+#include <initializer_list>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -67,6 +68,9 @@ class BoardBackend final : public backends::Backend {
   Result<void> account_batch(const Batch& b, BatchStatus s, bool transfer_ok, std::span<const protocol::Frame> frames,
                              SendProgress& p);
   Result<std::vector<std::uint64_t>> read_frames(std::span<const std::uint8_t> indices);
+  // The values of constant registers (ID, CAPS, CAPS2), each read twice per burst; a burst whose
+  // pairs disagree is read again, three bursts at most.
+  Result<std::vector<std::uint64_t>> read_constants(std::initializer_list<protocol::Reg> regs);
   Result<std::vector<std::uint8_t>> exchange(std::span<const SpiWindow> windows,
                                              std::span<const protocol::Frame> sent_in_order);
   Result<void> on_fault(const Error& e);
