@@ -55,7 +55,9 @@ def pack(files, cmd):
         top, net = os.path.join(tmp, "pack_top.v"), os.path.join(tmp, "pack.json")
         with open(top, "w") as f:
             f.write(PACK_TOP)
-        script = f"read_verilog -sv -Irtl/soc -Irtl/core {' '.join(files)} {top}; {cmd} -top pack_top -json {net}"
+        # dsp_counter_mac's SB_MAC16 passes synth_ice40 under another name (rtl/soc/dsp_counter_mac.v)
+        script = (f"read_verilog -sv -Irtl/soc -Irtl/core {' '.join(files)} {top}; {cmd} -top pack_top; "
+                  f"chtype -map SB_MAC16_KEPT SB_MAC16; write_json {net}")
         out = subprocess.run(["yosys", "-q", "-p", script], cwd=GW, capture_output=True, text=True)
         if out.returncode != 0:
             sys.exit(f"yosys failed on the pack wrapper:\n{out.stderr[-2000:]}")
@@ -84,7 +86,7 @@ def synth(profile, modules=False, abc9=False, packed=False):
     lib = "read_verilog -lib sim/SB_SPRAM256KA.v sim/SB_MAC16.v; " if profile == "ecp5" else ""
     flat = " -noflatten" if modules else ""
     script = (f"{lib}read_verilog -sv -Irtl/soc -Irtl/core {' '.join(files)}; chparam -set PROFILE {value} spigpu_top; "
-              f"{cmd}{flat} -top spigpu_top; stat")
+              f"{cmd}{flat} -top spigpu_top; {'chtype -map SB_MAC16_KEPT SB_MAC16; ' if 'ice40' in cmd else ''}stat")
     out = subprocess.run(["yosys", "-q", "-p", script, "-l", "/dev/stdout"], cwd=GW, capture_output=True, text=True)
     if out.returncode != 0:
         sys.exit(f"yosys failed on profile {profile}:\n{out.stderr[-2000:]}")

@@ -59,8 +59,11 @@ def yosys(top_v, top, cmd, net, log_path, params=""):
     # the board's own modules: every .v beside its top level
     bdir = os.path.dirname(top_v)
     board_files = " ".join(os.path.relpath(os.path.join(bdir, f), GW) for f in sorted(os.listdir(bdir)) if f.endswith(".v"))
+    # dsp_counter_mac's SB_MAC16 goes through synth_ice40 as a black box of another name (ice40_dsp
+    # would rewrite it, rtl/soc/dsp_counter_mac.v) and gets its own name back here
+    keep = "chtype -map SB_MAC16_KEPT SB_MAC16; " if "ice40" in cmd else ""
     script = (f"{lib}read_verilog -sv -Irtl/soc -Irtl/core {files} {board_files}; "
-              f"{params}{cmd} -top {top} -json {net}; stat")
+              f"{params}{cmd} -top {top}; {keep}write_json {net}; stat")
     out, secs = run(["yosys", "-q", "-p", script, "-l", log_path + ".stat"], "yosys", log_path, cwd=GW)
     if out.returncode != 0:
         raise ToolError(f"yosys failed on {top} (log {log_path}):\n{(out.stdout + out.stderr)[-1500:]}")

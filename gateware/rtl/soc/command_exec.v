@@ -40,6 +40,9 @@ module command_exec #(
   output wire [4:0]   sh_wr_idx,
   output wire [63:0]  sh_wr_data,
   input  wire         sh_wr_ack,
+  output wire [4:0]   sh_rd_idx,     // VPORT: COLOR, read from the shadow RAM (no copy here)
+  input  wire [63:0]  sh_rd_data,
+  input  wire         sh_rd_valid,
   output reg  [6:0]   err_set,       // {.., BAD_VALUE (bit 4), RESERVED_BITS (bit 3), ..}
   input  wire         core_drain,
   // render core command port (docs: soc <-> core interface)
@@ -218,7 +221,10 @@ module command_exec #(
   assign cmd_tex_fmt = tex_fmt;
   assign cmd_scissor = scissor;
   assign cmd_fb_draw = base_out(fb_draw);
-  assign cmd_fb_z = base_out(fb_z);
+  // without a depth buffer (DEPTH = 0) the core never reads or writes Z (TRI_MODE's Z_TEST and Z_WRITE
+  // and CLEAR_Z are refused here), so FB_Z need not reach it: a constant 0 lets synthesis drop this
+  // copy and the core's snapshot of it (FB_Z still reads back from the register file's shadow RAM)
+  assign cmd_fb_z = DEPTH != 0 ? base_out(fb_z) : 28'd0;
   assign cmd_fb_format = fb_format;
   assign cmd_fb_width = 11'(fb_width);
   assign cmd_fb_height = 11'(fb_height);
@@ -239,13 +245,16 @@ module command_exec #(
       wire [1:0] rslot = (vp_addr[3:2] == 2'd0) ? sl0 : (vp_addr[3:2] == 2'd1) ? sl1 : sl2;
       wire       rslot3 = vp_addr[3:2] == 2'd3;
       reg  [1:0] cinit;   // 0, 1: writing CLEAR_COLOR's, CLEAR_DEPTH's reset value; 2: done
-      wire       vwrite = in_valid && is_vertex && wc != 2'd3 && cinit[1];
+      // the third word is COLOR, from the register file's shadow RAM, which holds the validated
+      // value of the last executed COLOR (or its reset value): no 32 flip-flops of its own here. An
+      // SPI read of a shadowed register takes the RAM's read port for a clock; the word then waits
+      wire       vwrite = in_valid && is_vertex && wc != 2'd3 && cinit[1] && (wc != 2'd2 || sh_rd_valid);
       wire       is_cd  = idx == `SPIGPU_REG_CLEAR_DEPTH;
       wire       cwrite = go && (idx == `SPIGPU_REG_CLEAR_COLOR || is_cd);
       wire       iwrite = !cinit[1];
       // CLEAR_COLOR and CLEAR_DEPTH are d[31:0] (validation clears the bits above CLEAR_DEPTH's 24)
       wire [31:0] wdata = iwrite ? (cinit[0] ? RESET_CLEAR_DEPTH[31:0] : RESET_CLEAR_COLOR[31:0])
-                        : (vwrite && wc == 2'd1) ? {8'd0, d[55:32]} : (vwrite && wc == 2'd2) ? color[31:0] : d[31:0];
+                        : (vwrite && wc == 2'd1) ? {8'd0, d[55:32]} : (vwrite && wc == 2'd2) ? sh_rd_data[31:0] : d[31:0];
       wire [3:0]  waddr = vwrite ? {wslot, wc} : iwrite ? {3'b110, cinit[0]} : {3'b110, is_cd};
       assign vert_ok = (!is_vertex || wc == 2'd3) && !iwrite;
       always @(posedge clk) begin
@@ -271,11 +280,14 @@ module command_exec #(
           end
         end
       end
-      wire unused_vp = &{1'b0, color[63:32], texcoord, stored0, stored1, clear_color, clear_depth};
+      localparam [6:0] COLOR_IDX = `SPIGPU_REG_COLOR;
+      assign sh_rd_idx = COLOR_IDX[4:0];
+      wire unused_vp = &{1'b0, color, texcoord, stored0, stored1, clear_color, clear_depth, sh_rd_data[63:32]};
     end else begin : g_vflat
       assign vert_ok = 1'b1;
       always @(*) vp_data = 32'd0;
-      wire unused_vp = &{1'b0, vp_addr};
+      assign sh_rd_idx = 5'd0;
+      wire unused_vp = &{1'b0, vp_addr, sh_rd_data, sh_rd_valid};
     end
   endgenerate
 

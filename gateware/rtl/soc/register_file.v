@@ -17,7 +17,8 @@ module register_file #(
   parameter [63:0] CAPS = 64'h0,
   parameter [63:0] CAPS2 = 64'h0,
   parameter [63:0] ID = 64'h0,
-  parameter [7:0]  FEATURES = 8'h3F
+  parameter [7:0]  FEATURES = 8'h3F,
+  parameter        EX_READ = 0        // 1: the executor reads the shadow RAM while SPI reads do not (up5k)
 ) (
   input  wire        clk,
   input  wire        rst,
@@ -58,6 +59,12 @@ module register_file #(
   input  wire [4:0]  ex_wr_idx,
   input  wire [63:0] ex_wr_data,
   output wire        ex_wr_ack,
+  // executor reads (EX_READ = 1): the shadow RAM's read port is the SPI side's only in the bit-64
+  // cycle of a read of a shadowed register; in every other clock it reads ex_rd_idx, and
+  // ex_rd_valid says the clock before was such a clock (ex_rd_data is then that entry)
+  input  wire [4:0]  ex_rd_idx,
+  output wire [63:0] ex_rd_data,
+  output wire        ex_rd_valid,
   input  wire [6:0]  err_set,        // flags raised elsewhere (executor, memory, scanout)
   input  wire        core_range_err, // the core's access fell beyond VRAM
   input  wire        core_idle,
@@ -133,10 +140,15 @@ module register_file #(
                      : imm_wr ? (is_link_ctrl ? {63'd0, link_ctrl_strict} : imm_data) : ex_wr_data;
   assign ex_wr_ack = ex_wr_req && !seq_active && !imm_wr;
 
+  wire        spi_reads = !EX_READ || (rd_strobe && rd_from_ram);
+  reg         ex_rd_q;
   always @(posedge clk) begin
     if (sh_we) shadow[sh_wa] <= sh_wd;
-    shadow_q <= shadow[rd_idx[4:0]];
+    shadow_q <= shadow[spi_reads ? rd_idx[4:0] : ex_rd_idx];
+    ex_rd_q <= !spi_reads;
   end
+  assign ex_rd_data  = shadow_q;
+  assign ex_rd_valid = ex_rd_q;
   always @(posedge clk) begin
     if (rst || reset_ok) begin
       seq_active <= 1'b1;

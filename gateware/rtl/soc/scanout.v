@@ -19,7 +19,8 @@ module scanout #(
   parameter        V_TOTAL = 525,
   parameter        CRC_BYTES = 1,         // bytes folded into the CRC per clock: 1 or 4
   parameter        BUF_WORDS = 2,         // read-ahead words (2 or 4)
-  parameter        BYTES_W = 24           // bits of the largest frame's W x H x 4 (the sizes FB_FORMAT can hold)
+  parameter        BYTES_W = 24,          // bits of the largest frame's W x H x 4 (the sizes FB_FORMAT can hold)
+  parameter        DSP = 0                // 1: FRAME_COUNT and the read address in an SB_MAC16 (up5k)
 ) (
   input  wire        clk,
   input  wire        rst,
@@ -104,7 +105,7 @@ module scanout #(
   // rd_addr loads and counts also in a reset's clock: its value matters only while a swap is
   // computed, pending or read, each of which a later swap_req starts with a load.
   wire [15:0] rd_addr16;
-  dsp_counter #(.DSP(0), .WIDE(0)) u_frame_count (
+  dsp_counter #(.DSP(DSP), .WIDE(0)) u_frame_count (
     .clk(clk), .ld_top(rst || soft_reset), .d_top(16'd0), .inc_top(frame_done),
     .ld_bot(swap_req), .d_bot(16'({1'b0, swap_addr[VAW-3:0], 2'b00})), .inc_bot(issued),
     .q_top(frame_count), .q_bot(rd_addr16));
@@ -146,10 +147,12 @@ module scanout #(
   wire in_frame  = !above && rd_addr != end_vram;
   assign req_valid   = reading && in_frame && outstanding + buf_count < BUFW;
   assign req_addr    = 30'(rd_addr[VAW-1:0]);
-  assign prot_active = computing || pending || (reading && in_frame);
-  assign prot_lo     = above ? VRAM_END : rd_addr;
-  // while the end is being computed, everything from the frame's start up is protected
-  assign prot_hi     = computing ? VRAM_END : end_vram;
+  // a frame starting beyond VRAM protects nothing (no multiplexer on prot_lo for it); while the end
+  // is being computed, everything from the frame's start up is protected: end_vram is VRAM_END from
+  // the swap request until the end is known (no multiplexer on prot_hi)
+  assign prot_active = !above && (computing || pending || (reading && in_frame));
+  assign prot_lo     = rd_addr;
+  assign prot_hi     = end_vram;
   // the frame's end in words, rd_addr + ceil(bytes / 4), from its start inside VRAM (beyond it:
   // above): one adder, the rounding as its carry in (bit 0 of the doubled operands)
   localparam integer EW = (VAW + 2 > BYTES_W - 1) ? VAW + 2 : BYTES_W - 1;
@@ -248,6 +251,7 @@ module scanout #(
 
       if (swap_req) begin
         computing <= 1'b1;
+        end_vram <= VRAM_END;
         above <= swap_addr[27:VAW-2] != {(30 - VAW){1'b0}};
         frame_format <= swap_format;
         frame_width <= swap_width;

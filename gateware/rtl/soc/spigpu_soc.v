@@ -151,7 +151,10 @@ module spigpu_soc #(
   wire [6:0]  errors;
   wire        device_busy = fifo_level != 11'd0 || !core_idle || !mem_ex_idle;
 
-  register_file #(.CAPS(CAPS), .CAPS2(CAPS2), .ID(ID), .FEATURES(FEATURES)) u_regs (
+  wire [4:0]  sh_rd_idx;
+  wire [63:0] sh_rd_data;
+  wire        sh_rd_valid;
+  register_file #(.CAPS(CAPS), .CAPS2(CAPS2), .ID(ID), .FEATURES(FEATURES), .EX_READ(PROFILE == 0 ? 1 : 0)) u_regs (
     .clk(clk), .rst(rst), .frame_valid(f_valid), .frame_rw(f_rw), .frame_idx(f_idx), .frame_data(f_data),
     .frame_abort(f_abort), .rd_strobe(rd_strobe), .rd_idx(rd_idx), .rd_live(rd_live), .rd_from_ram(rd_from_ram),
     .rd_ram(rd_ram), .status_flags(status_flags), .fifo_push(fifo_push), .fifo_push_held(fifo_push_held),
@@ -160,7 +163,8 @@ module spigpu_soc #(
     .err_link_crc(err_link_crc), .drop_overflow(drop_overflow), .link_check_strobe(check_strobe),
     .link_check_crc(check_crc), .link_ctrl_strobe(ctrl_strobe), .link_ctrl_strict(ctrl_strict),
     .soft_reset(soft_reset), .ex_wr_req(sh_wr_req), .ex_wr_idx(sh_wr_idx), .ex_wr_data(sh_wr_data),
-    .ex_wr_ack(sh_wr_ack), .err_set(ex_err | {mem_err || scan_err, 6'd0}), .core_range_err(core_range_err),
+    .ex_wr_ack(sh_wr_ack), .ex_rd_idx(sh_rd_idx), .ex_rd_data(sh_rd_data), .ex_rd_valid(sh_rd_valid),
+    .err_set(ex_err | {mem_err || scan_err, 6'd0}), .core_range_err(core_range_err),
     .core_idle(core_idle), .core_drain(core_drain), .busy(device_busy), .vblank(vblank),
     .swap_pending(swap_pending_w), .frame_count(frame_count), .frame_crc(frame_crc), .mem_ready(mem_ready),
     .mem_addr(mem_addr), .prefetch(prefetch), .mem_read_strobe(mem_read_strobe), .errors(errors));
@@ -187,6 +191,7 @@ module spigpu_soc #(
                  .VPORT(PROFILE == 0 ? 1 : 0)) u_exec (
     .clk(clk), .rst(rst_any), .in_valid(fifo_out_valid), .in_entry(fifo_out), .in_pop(fifo_pop),
     .sh_wr_req(sh_wr_req), .sh_wr_idx(sh_wr_idx), .sh_wr_data(sh_wr_data), .sh_wr_ack(sh_wr_ack),
+    .sh_rd_idx(sh_rd_idx), .sh_rd_data(sh_rd_data), .sh_rd_valid(sh_rd_valid),
     .err_set(ex_err), .core_drain(core_drain), .cmd_valid(cmd_valid), .cmd_ready(cmd_ready), .cmd_op(cmd_op),
     .cmd_tri_mode(cmd_tri_mode), .cmd_tex_base(cmd_tex_base), .cmd_tex_fmt(cmd_tex_fmt), .cmd_scissor(cmd_scissor),
     .cmd_fb_draw(cmd_fb_draw), .cmd_fb_z(cmd_fb_z), .cmd_fb_format(cmd_fb_format), .cmd_fb_width(cmd_fb_width),
@@ -214,10 +219,12 @@ module spigpu_soc #(
     .rsp_valid(m_rsp_valid), .rsp_rdata(rsp_rdata));
 
   scanout #(.VAW(VAW), .LINE_CLOCKS(LINE_CLOCKS), .V_ACTIVE(V_ACTIVE), .V_TOTAL(V_TOTAL),
-            // no DSP counters here: the UP5K's 8 SB_MAC16s hold setup, the overlap check, the swap
-            // length, the rasteriser's three edges and LINK_STATUS's counters (u_link), which save
-            // more cells per DSP than the scanout's (docs/gateware.md fit-soc3 and the merge after it)
-            .CRC_BYTES(CRC_BYTES), .BUF_WORDS(SCAN_BUF), .BYTES_W(SCAN_BYTES_W)) u_scan (
+            // the UP5K's SB_MAC16s hold setup, the swap length, the rasteriser's three edges and
+            // LINK_STATUS's counters (u_link); the one the depth buffer's overlap check took is free
+            // without it (DEPTH = 0) and holds FRAME_COUNT and the frame's read address (the counter
+            // with a load costs the most cells of the scanout's; docs/gateware.md fit-soc5)
+            .CRC_BYTES(CRC_BYTES), .BUF_WORDS(SCAN_BUF), .BYTES_W(SCAN_BYTES_W),
+            .DSP(PROFILE == 0 && DEPTH == 0 ? 1 : 0)) u_scan (
     .clk(clk), .rst(rst), .soft_reset(soft_reset), .swap_req(swap_req), .swap_addr(swap_addr),
     .swap_format(cmd_fb_format), .swap_width(cmd_fb_width), .swap_height(cmd_fb_height), .swap_ready(swap_ready),
     .swap_pending(swap_pending_w), .err_range(scan_err), .vblank(vblank), .vsync(vsync),
