@@ -75,7 +75,7 @@ TEST(SimPreviewSmall, SameBytesAsTheRowKernel) {
   std::mt19937 rng(2411);
   const std::vector<std::uint8_t> before = random_bytes(77);
   VideoMemory m1(kVram), m2(kVram);
-  unsigned drawn = 0, empty = 0, not_small = 0, covered = 0;
+  unsigned drawn = 0, empty = 0, not_small = 0, covered = 0, wide = 0;
   for (int i = 0; i < 4000; ++i) {
     const unsigned z_bits = i % 5 == 0 ? 16 : 24;
     const DrawState st = random_state(rng, true);
@@ -102,6 +102,7 @@ TEST(SimPreviewSmall, SameBytesAsTheRowKernel) {
       continue;
     }
     ++drawn;
+    wide += small.x1 - small.x0 > 8 ? 1u : 0u;
     ASSERT_NE(small.small, 0);
     ASSERT_EQ(ref.small, 0);
     ASSERT_EQ(small.x0, ref.x0);
@@ -125,6 +126,7 @@ TEST(SimPreviewSmall, SameBytesAsTheRowKernel) {
   EXPECT_GT(empty, 50u);
   EXPECT_GT(not_small, 200u);
   EXPECT_GT(covered, 5000u);
+  EXPECT_GT(wide, 100u);  // boxes 9 to 16 wide: two groups of lanes per row
 }
 
 // Tall slivers up to the 255-subpixel span (box 8 wide, up to 16 rows): the steepest colour and Z
@@ -187,10 +189,15 @@ TEST(SimPreviewSmall, RecognisesItsTriangles) {
   EXPECT_EQ(setup_small_preview(make(160, 160), make(287, 160), make(160, 287), st, 4, t), SmallSetup::Drawn);
   EXPECT_EQ(t.x1 - t.x0, 8);
   EXPECT_EQ(t.y1 - t.y0, 8);
-  // Sample points 16x + 8 from 168 to 280 and 296: 8 and 9 columns.
+  // Sample points 16x + 8 from 168 to 280 and 296: 8 and 9 columns (9 to 16: two groups of lanes).
   EXPECT_EQ(setup_small_preview(make(160, 160), make(295, 160), make(160, 287), st, 4, t), SmallSetup::Drawn);
   EXPECT_EQ(t.x1 - t.x0, 8);
-  EXPECT_EQ(setup_small_preview(make(160, 160), make(296, 160), make(160, 287), st, 4, t), SmallSetup::NotSmall);
+  EXPECT_EQ(setup_small_preview(make(160, 160), make(296, 160), make(160, 287), st, 4, t), SmallSetup::Drawn);
+  EXPECT_EQ(t.x1 - t.x0, 9);
+  // Wide: 255 subpixels (16 columns) is small, 256 is not.
+  EXPECT_EQ(setup_small_preview(make(160, 160), make(415, 160), make(160, 287), st, 4, t), SmallSetup::Drawn);
+  EXPECT_EQ(t.x1 - t.x0, 16);
+  EXPECT_EQ(setup_small_preview(make(160, 160), make(416, 160), make(160, 287), st, 4, t), SmallSetup::NotSmall);
   // Tall: 255 subpixels (16 rows) is small, 256 is not.
   EXPECT_EQ(setup_small_preview(make(160, 160), make(287, 160), make(160, 415), st, 4, t), SmallSetup::Drawn);
   EXPECT_EQ(t.x1 - t.x0, 8);
@@ -211,6 +218,12 @@ TEST(SimPreviewSmall, RecognisesItsTriangles) {
   EXPECT_EQ(setup_small_preview(make(right, 16), make(right + 40, 16), make(right, 56), st, 4, t), SmallSetup::NotSmall);
   EXPECT_EQ(setup_small_preview(make(right - 16, 16), make(right + 20, 16), make(right - 16, 56), st, 4, t),
             SmallSetup::Drawn);
+  // A box 9 wide needs room for 16 words: 16 pixels from the right edge, not 15.
+  const int right16 = 16 * static_cast<int>(kFbW - 16);
+  EXPECT_EQ(setup_small_preview(make(right16, 16), make(right16 + 140, 16), make(right16, 56), st, 4, t), SmallSetup::Drawn);
+  EXPECT_EQ(t.x1 - t.x0, 9);
+  EXPECT_EQ(setup_small_preview(make(right16 + 16, 16), make(right16 + 156, 16), make(right16 + 16, 56), st, 4, t),
+            SmallSetup::NotSmall);
   // Degenerate (collinear) and off the framebuffer.
   EXPECT_EQ(setup_small_preview(make(100, 100), make(150, 150), make(200, 200), st, 4, t), SmallSetup::Empty);
   EXPECT_EQ(setup_small_preview(make(-32768, -32768), make(-32700, -32768), make(-32768, -32700), st, 4, t),
@@ -221,9 +234,10 @@ TEST(SimPreviewSmall, RecognisesItsTriangles) {
   EXPECT_EQ(setup_small_preview(make(100, 130), make(140, 130), make(100, 134), st, 4, t), SmallSetup::Empty);
 }
 
-// Small triangles (up to 15 pixels tall) around the 16-row band boundaries of the thread split, in every plain state:
-// 1, 2 and 3 threads and a second run give the same bytes; coverage is the exact path's; colour
-// and Z within 1 LSB of exact (depth ALWAYS with the write: the last triangle wins everywhere).
+// Small triangles (up to 15 pixels wide and tall) around the 16-row band boundaries of the thread
+// split, in every plain state: 1, 2 and 3 threads and a second run give the same bytes; coverage
+// is the exact path's; colour and Z within 1 LSB of exact (depth ALWAYS with the write: the last
+// triangle wins everywhere).
 TEST(SimPreviewSmall, SameBytesForAnyThreadCountAcrossBands) {
   std::mt19937 rng(16);
   constexpr unsigned kW = 96, kH = 80;
@@ -244,7 +258,7 @@ TEST(SimPreviewSmall, SameBytesForAnyThreadCountAcrossBands) {
         const int cx = static_cast<int>(r() % (16 * kW)), cy = 16 * band + static_cast<int>(r() % 160) - 80;
         for (int k = 0; k < 3; ++k) {
           w(d, Reg::COLOR, color(static_cast<std::uint32_t>(r())));
-          w(d, Reg::VERTEX, vtx(cx + static_cast<int>(r() % 121) - 60, cy + static_cast<int>(r() % 241) - 120,
+          w(d, Reg::VERTEX, vtx(cx + static_cast<int>(r() % 241) - 120, cy + static_cast<int>(r() % 241) - 120,
                                 static_cast<std::uint32_t>(r())));
         }
       }
