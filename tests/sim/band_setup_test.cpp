@@ -11,6 +11,7 @@
 #include <random>
 #include <vector>
 
+#include "draw_state.hpp"
 #include "sim_test_util.hpp"
 
 namespace gpubridge::sim::test {
@@ -110,6 +111,29 @@ TEST(SimBandSetup, TruncatedSubpixelsSameBytesAndCounters) {
   DeviceOptions preview = preview_options(1);
   preview.accuracy.subpixel_bits = 2;
   expect_same_for_any_thread_count(preview, "preview, subpixel_bits=2");
+}
+
+// Whether a state's bands may be drawn by different workers (DrawState::bands_independent, decided
+// once per state): not when the colour and depth buffers share a byte (with depth on), nor when
+// the texture shares a byte with a buffer the draw writes.
+TEST(SimBandSetup, BandsIndependentOnlyWithoutAliasing) {
+  constexpr unsigned w = 64, h = 48;
+  constexpr std::uint32_t buffer = w * h * 4;  // bytes of either buffer (RGBA8888)
+  constexpr std::uint64_t vram = 1u << 20;
+  constexpr std::uint64_t depth_less = 4u | (1u << 3) | (1u << 6), textured = 2u;
+  const std::uint64_t tex_16x16 = 4u | (4u << 4);  // 1 KiB of RGBA8888
+  auto state = [&](std::uint64_t mode, std::uint32_t z_at, std::uint32_t tex_at) {
+    return decode_draw_state(RegisterValues{mode, tex_at, tex_16x16, scissor(0, 0, 2047, 2047), 0, z_at, fb_format(w, h)},
+                             vram);
+  };
+  EXPECT_TRUE(state(depth_less, buffer, 0x80000).bands_independent);        // depth right after colour
+  EXPECT_FALSE(state(depth_less, buffer - 16, 0x80000).bands_independent);  // their last and first 16 bytes shared
+  EXPECT_TRUE(state(1u, buffer - 16, 0x80000).bands_independent);           // no depth: the Z address is unused
+  EXPECT_TRUE(state(depth_less | textured, buffer, 2 * buffer).bands_independent);
+  EXPECT_FALSE(state(depth_less | textured, buffer, buffer - 1024 + 16).bands_independent);  // texture over colour's end
+  EXPECT_FALSE(state(depth_less | textured, buffer, 2 * buffer - 16).bands_independent);     // texture over depth's end
+  EXPECT_TRUE(state(textured, buffer, 2 * buffer - 16).bands_independent);                  // no depth
+  EXPECT_FALSE(state(textured, buffer, 0).bands_independent);                               // texture over colour
 }
 
 }  // namespace

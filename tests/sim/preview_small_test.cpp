@@ -75,16 +75,17 @@ TEST(SimPreviewSmall, SameBytesAsTheRowKernel) {
   std::mt19937 rng(2411);
   const std::vector<std::uint8_t> before = random_bytes(77);
   VideoMemory m1(kVram), m2(kVram);
-  unsigned drawn = 0, empty = 0, not_small = 0, covered = 0;
+  unsigned drawn = 0, empty = 0, not_small = 0, covered = 0, wide = 0;
   for (int i = 0; i < 4000; ++i) {
     const unsigned z_bits = i % 5 == 0 ? 16 : 24;
     const DrawState st = random_state(rng, true);
     ASSERT_NE(st.preview_small, 0) << "a plain untextured state takes the small path";
     DrawState general = st;
     general.preview_small = 0;  // the general preview path: setup_triangle_preview, the row kernel
-    // Centres anywhere on (and a little off) the framebuffer; spreads around the 127-subpixel limit.
+    // Centres anywhere on (and a little off) the framebuffer; spreads around the box-width limit
+    // (8 pixels: about 128 subpixels), the 255-subpixel span limit and the former 127 one.
     const int cx = static_cast<int>(rng() % ((kFbW + 8) * 16)) - 64, cy = static_cast<int>(rng() % ((kFbH + 8) * 16)) - 64;
-    const int spread = i % 4 == 0 ? 70 : i % 4 == 1 ? 40 : i % 4 == 2 ? 12 : 63;
+    const int spread = i % 6 == 0 ? 70 : i % 6 == 1 ? 40 : i % 6 == 2 ? 12 : i % 6 == 3 ? 63 : i % 6 == 4 ? 130 : 100;
     const Vertex a = random_vertex(rng, cx, cy, spread), b = random_vertex(rng, cx, cy, spread),
                  c = random_vertex(rng, cx, cy, spread);
     const unsigned subpixel_bits = i % 7 == 0 ? 2 : 4;
@@ -101,6 +102,7 @@ TEST(SimPreviewSmall, SameBytesAsTheRowKernel) {
       continue;
     }
     ++drawn;
+    wide += small.x1 - small.x0 > 8 ? 1u : 0u;
     ASSERT_NE(small.small, 0);
     ASSERT_EQ(ref.small, 0);
     ASSERT_EQ(small.x0, ref.x0);
@@ -124,11 +126,55 @@ TEST(SimPreviewSmall, SameBytesAsTheRowKernel) {
   EXPECT_GT(empty, 50u);
   EXPECT_GT(not_small, 200u);
   EXPECT_GT(covered, 5000u);
+  EXPECT_GT(wide, 100u);  // boxes 9 to 16 wide: two groups of lanes per row
 }
 
-// The limits: 127 subpixels each way is small, 128 is not; a box with no room for 8-word rows
-// (at the right edge) is not; a degenerate triangle and one off the framebuffer draw nothing;
-// coordinates at the ends of the s12.4 range stay defined.
+// Tall slivers up to the 255-subpixel span (box 8 wide, up to 16 rows): the steepest colour and Z
+// planes the small setup takes, with the smallest areas, must still be the general path's bytes.
+TEST(SimPreviewSmall, TallSliversSameBytesAsTheRowKernel) {
+  std::mt19937 rng(2412);
+  const std::vector<std::uint8_t> before = random_bytes(78);
+  VideoMemory m1(kVram), m2(kVram);
+  unsigned drawn = 0, tall = 0, thin = 0;
+  for (int i = 0; i < 6000; ++i) {
+    const DrawState st = random_state(rng, false);
+    DrawState general = st;
+    general.preview_small = 0;
+    // a and b up to 255 subpixels apart vertically, c close to the line between them (D small).
+    const int x = 16 + static_cast<int>(rng() % ((kFbW - 24) * 16)), y = static_cast<int>(rng() % ((kFbH - 17) * 16));
+    const int h = 200 + static_cast<int>(rng() % 56), dx = static_cast<int>(rng() % 9) - 4;
+    Vertex a = random_vertex(rng, x, y, 0), b = random_vertex(rng, x + dx, y + h, 0), c = random_vertex(rng, x, y, 0);
+    const int t = static_cast<int>(rng() % static_cast<unsigned>(h + 1));
+    c.x = x + dx * t / h + static_cast<int>(rng() % 5) - 2;
+    c.y = y + t;
+    Triangle small, ref;
+    const SmallSetup s = setup_small_preview(a, b, c, st, 4, small);
+    const bool ref_ok = setup_triangle_preview(a, b, c, general, 4, false, ref);
+    if (s == SmallSetup::NotSmall) continue;
+    ASSERT_EQ(s == SmallSetup::Drawn, ref_ok) << "case " << i;
+    if (s == SmallSetup::Empty) continue;
+    ++drawn;
+    tall += small.y1 - small.y0 > 8 ? 1u : 0u;
+    thin += small.den < 2 * 128 ? 1u : 0u;  // D below 128: planes steeper than 2 per subpixel
+    std::copy(before.begin(), before.end(), m1.data());
+    std::copy(before.begin(), before.end(), m2.data());
+    const int split = small.y0 + static_cast<int>(rng() % static_cast<unsigned>(small.y1 - small.y0 + 1));
+    const Drawn d1 = draw(small, st, m1, 24, split);
+    const Drawn d2 = draw(ref, general, m2, 24, ref.y1);
+    ASSERT_TRUE(std::equal(m1.data(), m1.data() + m1.size(), m2.data())) << "case " << i;
+    EXPECT_EQ(d1.counters.covered, d2.counters.covered) << i;
+    EXPECT_EQ(d1.counters.passed, d2.counters.passed) << i;
+  }
+  EXPECT_GT(drawn, 1000u);
+  EXPECT_GT(tall, 500u);
+  EXPECT_GT(thin, 100u);
+  std::printf("tall slivers: %u drawn, %u taller than 8 rows, %u of D < 128\n", drawn, tall, thin);
+}
+
+// The limits: a span of 255 subpixels each way with a box at most 8 wide is small, a span of 256 or
+// a box 9 wide is not, nor a triangle of D = 1 spanning more than 127; a box with no room for
+// 8-word rows (at the right edge) is not; a degenerate triangle and one off the framebuffer draw
+// nothing; coordinates at the ends of the s12.4 range stay defined.
 TEST(SimPreviewSmall, RecognisesItsTriangles) {
   std::mt19937 rng(5);
   const DrawState st = random_state(rng, false);
@@ -142,8 +188,27 @@ TEST(SimPreviewSmall, RecognisesItsTriangles) {
   Triangle t;
   EXPECT_EQ(setup_small_preview(make(160, 160), make(287, 160), make(160, 287), st, 4, t), SmallSetup::Drawn);
   EXPECT_EQ(t.x1 - t.x0, 8);
-  EXPECT_EQ(setup_small_preview(make(160, 160), make(288, 160), make(160, 287), st, 4, t), SmallSetup::NotSmall);
-  EXPECT_EQ(setup_small_preview(make(160, 160), make(287, 160), make(160, 288), st, 4, t), SmallSetup::NotSmall);
+  EXPECT_EQ(t.y1 - t.y0, 8);
+  // Sample points 16x + 8 from 168 to 280 and 296: 8 and 9 columns (9 to 16: two groups of lanes).
+  EXPECT_EQ(setup_small_preview(make(160, 160), make(295, 160), make(160, 287), st, 4, t), SmallSetup::Drawn);
+  EXPECT_EQ(t.x1 - t.x0, 8);
+  EXPECT_EQ(setup_small_preview(make(160, 160), make(296, 160), make(160, 287), st, 4, t), SmallSetup::Drawn);
+  EXPECT_EQ(t.x1 - t.x0, 9);
+  // Wide: 255 subpixels (16 columns) is small, 256 is not.
+  EXPECT_EQ(setup_small_preview(make(160, 160), make(415, 160), make(160, 287), st, 4, t), SmallSetup::Drawn);
+  EXPECT_EQ(t.x1 - t.x0, 16);
+  EXPECT_EQ(setup_small_preview(make(160, 160), make(416, 160), make(160, 287), st, 4, t), SmallSetup::NotSmall);
+  // Tall: 255 subpixels (16 rows) is small, 256 is not.
+  EXPECT_EQ(setup_small_preview(make(160, 160), make(287, 160), make(160, 415), st, 4, t), SmallSetup::Drawn);
+  EXPECT_EQ(t.x1 - t.x0, 8);
+  EXPECT_EQ(t.y1 - t.y0, 16);
+  EXPECT_EQ(setup_small_preview(make(160, 160), make(287, 160), make(160, 416), st, 4, t), SmallSetup::NotSmall);
+  // D = 1: small up to a span of 127, not beyond.
+  EXPECT_NE(setup_small_preview(make(168, 160), make(169, 287), make(168, 161), st, 4, t), SmallSetup::NotSmall);
+  EXPECT_EQ(setup_small_preview(make(168, 160), make(169, 360), make(168, 161), st, 4, t), SmallSetup::NotSmall);
+  EXPECT_EQ(setup_small_preview(make(168, 160), make(169, 360), make(168, 159), st, 4, t), SmallSetup::NotSmall);  // D = −1
+  // D = 2 at that span is small again.
+  EXPECT_NE(setup_small_preview(make(168, 160), make(170, 360), make(168, 161), st, 4, t), SmallSetup::NotSmall);
   // One pixel: its sample point (16·10 + 8) inside, the neighbours' outside.
   EXPECT_EQ(setup_small_preview(make(164, 164), make(174, 164), make(164, 174), st, 4, t), SmallSetup::Drawn);
   EXPECT_EQ(t.x1 - t.x0, 1);
@@ -153,6 +218,12 @@ TEST(SimPreviewSmall, RecognisesItsTriangles) {
   EXPECT_EQ(setup_small_preview(make(right, 16), make(right + 40, 16), make(right, 56), st, 4, t), SmallSetup::NotSmall);
   EXPECT_EQ(setup_small_preview(make(right - 16, 16), make(right + 20, 16), make(right - 16, 56), st, 4, t),
             SmallSetup::Drawn);
+  // A box 9 wide needs room for 16 words: 16 pixels from the right edge, not 15.
+  const int right16 = 16 * static_cast<int>(kFbW - 16);
+  EXPECT_EQ(setup_small_preview(make(right16, 16), make(right16 + 140, 16), make(right16, 56), st, 4, t), SmallSetup::Drawn);
+  EXPECT_EQ(t.x1 - t.x0, 9);
+  EXPECT_EQ(setup_small_preview(make(right16 + 16, 16), make(right16 + 156, 16), make(right16 + 16, 56), st, 4, t),
+            SmallSetup::NotSmall);
   // Degenerate (collinear) and off the framebuffer.
   EXPECT_EQ(setup_small_preview(make(100, 100), make(150, 150), make(200, 200), st, 4, t), SmallSetup::Empty);
   EXPECT_EQ(setup_small_preview(make(-32768, -32768), make(-32700, -32768), make(-32768, -32700), st, 4, t),
@@ -163,9 +234,10 @@ TEST(SimPreviewSmall, RecognisesItsTriangles) {
   EXPECT_EQ(setup_small_preview(make(100, 130), make(140, 130), make(100, 134), st, 4, t), SmallSetup::Empty);
 }
 
-// Small triangles around the 16-row band boundaries of the thread split, in every plain state:
-// 1, 2 and 3 threads and a second run give the same bytes; coverage is the exact path's; colour
-// and Z within 1 LSB of exact (depth ALWAYS with the write: the last triangle wins everywhere).
+// Small triangles (up to 15 pixels wide and tall) around the 16-row band boundaries of the thread
+// split, in every plain state: 1, 2 and 3 threads and a second run give the same bytes; coverage
+// is the exact path's; colour and Z within 1 LSB of exact (depth ALWAYS with the write: the last
+// triangle wins everywhere).
 TEST(SimPreviewSmall, SameBytesForAnyThreadCountAcrossBands) {
   std::mt19937 rng(16);
   constexpr unsigned kW = 96, kH = 80;
@@ -186,7 +258,7 @@ TEST(SimPreviewSmall, SameBytesForAnyThreadCountAcrossBands) {
         const int cx = static_cast<int>(r() % (16 * kW)), cy = 16 * band + static_cast<int>(r() % 160) - 80;
         for (int k = 0; k < 3; ++k) {
           w(d, Reg::COLOR, color(static_cast<std::uint32_t>(r())));
-          w(d, Reg::VERTEX, vtx(cx + static_cast<int>(r() % 121) - 60, cy + static_cast<int>(r() % 121) - 60,
+          w(d, Reg::VERTEX, vtx(cx + static_cast<int>(r() % 241) - 120, cy + static_cast<int>(r() % 241) - 120,
                                 static_cast<std::uint32_t>(r())));
         }
       }

@@ -29,6 +29,10 @@ std::uint32_t keep_bits_of(PixelFormat f, std::uint8_t keep_mask) {
   return bits;
 }
 
+bool overlaps(std::uint64_t a, std::uint64_t alen, std::uint64_t b, std::uint64_t blen) {
+  return a < b + blen && b < a + alen;
+}
+
 }  // namespace
 
 DrawState decode_draw_state(const RegisterValues& r, std::uint64_t vram_bytes) {
@@ -86,6 +90,11 @@ DrawState decode_draw_state(const RegisterValues& r, std::uint64_t vram_bytes) {
   // gateware's setup skips them otherwise), Z for the test or the write, S/T/Q when textured.
   s.mode_class = ((s.gouraud && !all_masked) ? 1u : 0u) | ((s.z_test || s.z_write) ? 2u : 0u) |
                  ((s.textured && !all_masked) ? 4u : 0u);
+  const bool depth = s.z_test || s.z_write;
+  const std::uint64_t tlen = (std::uint64_t{1} << (s.tex.wl + s.tex.hl)) * bytes_per_pixel(s.tex.format);
+  s.bands_independent = (!depth || !overlaps(s.fb_draw, clen, s.fb_z, zlen)) &&
+                        (!s.textured || (!overlaps(s.tex.base, tlen, s.fb_draw, clen) &&
+                                         (!depth || !overlaps(s.tex.base, tlen, s.fb_z, zlen))));
   s.preview_ok = preview_applies(s);
   s.preview_plain = s.preview_ok && preview_plain_applies(s);
   s.preview_small = s.preview_ok ? preview_small_kernel(s) : 0;

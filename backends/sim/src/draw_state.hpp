@@ -50,6 +50,10 @@ struct DrawState {
   bool buffers_disjoint = false; // colour and depth buffers share no byte (pixel order between them is free)
   std::uint32_t keep_bits = 0;   // the stored bits of a pixel that the write mask keeps (RGBA8888: bytes, byte c = channel c)
   unsigned mode_class = 0;       // DeviceStats::by_mode index: the planes a gateware sets up and steps (timing only)
+  // Bands can be drawn independently (the renderer's batches across threads): no buffer the draw
+  // reads overlaps one it writes in another band (colour, depth and texture ranges do not alias).
+  // Decided here once per state rather than per triangle.
+  bool bands_independent = false;
   // `--accuracy preview` (decided once per state, not per triangle): whether the preview routine
   // can draw it (preview_applies), whether its plain kernel can (preview_plain_applies) and, for
   // its small triangles, the small-triangle kernel + 1 (preview_small_kernel, preview_plain.hpp;

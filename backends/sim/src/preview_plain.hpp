@@ -62,9 +62,10 @@ bool preview_plain_applies(const DrawState& st);
 PreviewCounts shade_preview_plain(const PreviewPlain& t);
 
 // --- Small triangles (docs/simulator.md "Preview", issue 24) ---
-// A triangle of an untextured plain draw whose vertices span at most 127/16 pixel in x and in y
-// (so its box is at most 8 x 8 pixels and every edge value of the box's 8-lane rows fits 16 bits)
-// and whose box leaves room for 8 words per row takes a setup and a kernel of its own: the
+// A triangle of an untextured plain draw whose vertices span at most 255/16 pixel in x and in y
+// (so its box is at most 16 x 16 pixels and every edge value at a box pixel is below 2^17) and
+// whose box leaves room for 8 words per row (16 for boxes 9 to 16 wide: two groups of 8 lanes)
+// takes a setup and a kernel of its own (a sliver of D = 1 spanning more than 127 does not): the
 // coverage setup without the vertex copies and the 64-bit generality, the colour planes in four
 // double lanes at once and no FloatPlanes, and at draw time the row kernel entered directly
 // (no PreviewPlain, no range checks, one kernel per depth function and blend picked per state).

@@ -3,39 +3,18 @@
 #include <algorithm>
 
 namespace gpubridge::sim {
-namespace {
-
-bool overlaps(std::uint64_t a, std::uint64_t alen, std::uint64_t b, std::uint64_t blen) {
-  return a < b + blen && b < a + alen;
-}
-
-}  // namespace
 
 Renderer::Renderer(VideoMemory& mem, const AccuracyKnobs& knobs, unsigned threads, bool vector_routines)
     : mem_(mem), knobs_(knobs), vector_(vector_routines), recip_(knobs.recip_bits, knobs.nr_steps), pool_(threads) {
   if (pool_.workers() > 1) {
-    batch_.reserve(kMaxBatch);
-    drawing_.reserve(kMaxBatch);
+    // Constructed once: a batch's triangles are set up in place (no triangle constructed per draw).
+    batch_.resize(kMaxBatch);
+    drawing_.resize(kMaxBatch);
   }
   draw_job_ = [this](unsigned worker) { draw_bands(worker); };
 }
 
 Renderer::~Renderer() { wait_drawing(); }  // the workers read drawing_: stop them before it goes
-
-// Bands can only be drawn independently when no buffer the draw reads overlaps one it writes in
-// another band: colour, depth and texture ranges must not alias.
-bool Renderer::can_batch(const DrawState& st) const {
-  const std::uint64_t pixels = std::uint64_t{st.fb_width} * st.fb_height;
-  const std::uint64_t clen = pixels * st.bpp, zlen = pixels * 4;
-  const bool depth = st.z_test || st.z_write;
-  if (depth && overlaps(st.fb_draw, clen, st.fb_z, zlen)) return false;
-  if (st.textured) {
-    const std::uint64_t tlen = (std::uint64_t{1} << (st.tex.wl + st.tex.hl)) * protocol::bytes_per_pixel(st.tex.format);
-    if (overlaps(st.tex.base, tlen, st.fb_draw, clen)) return false;
-    if (depth && overlaps(st.tex.base, tlen, st.fb_z, zlen)) return false;
-  }
-  return true;
-}
 
 // Small triangles are bound by the latency of their first depth and colour reads (random screen
 // positions miss the caches): start those loads for the triangle just set up, so they overlap
@@ -89,27 +68,26 @@ void Renderer::draw(const Vertex& a, const Vertex& b, const Vertex& c, const std
   const bool observing = static_cast<bool>(observer_);
   // No work when nothing is written (unless someone watches the attributes).
   if (st.writes_nothing && !observing) return;
-  const bool batching = pool_.workers() > 1 && !observing && can_batch(st);
+  const bool batching = pool_.workers() > 1 && !observing && st.bands_independent;
   if (batching) {
     draw_pending();
-    if (!batch_.empty() && batch_state_ != state) submit();
+    if (batch_n_ != 0 && batch_state_ != state) submit();
     // The front end sets the triangle up while the workers draw the previous batch. Setting up in
     // the workers instead (an equal run each, then a barrier, then the bands) took the front end's
     // setup off the busiest thread but lost this overlap: on two cores it was slower at 2 threads
     // (10-px triangles, exact 7.8 -> 6.9, preview 15.5 -> 10.2 Mtri/s; docs/simulator.md, "Threads").
-    Triangle& t = batch_.emplace_back();
+    Triangle& t = batch_[batch_n_];
     if (!setup(a, b, c, st, false, t)) {
-      batch_.pop_back();
       ++rejected_;
       return;
     }
     t.index = index;
     count_rasterised(t, st);
     if (batch_state_ != state) batch_state_ = state;
-    if (batch_.size() >= kMaxBatch) submit();
+    if (++batch_n_ >= kMaxBatch) submit();
     return;
   }
-  if (!batch_.empty() || drawing_active_) flush();
+  if (batch_n_ != 0 || drawing_active_) flush();
   // Single thread: set up into the free slot; the previous triangle is drawn after this setup so
   // the prefetched rows of this one arrive while it is drawn (order of pixel writes unchanged).
   const int slot = pending_ == 0 ? 1 : 0;
@@ -166,12 +144,13 @@ void Renderer::flush() {
 
 void Renderer::submit() {
   wait_drawing();
-  if (batch_.empty()) {
+  if (batch_n_ == 0) {
     batch_state_.reset();
     return;
   }
   std::swap(batch_, drawing_);
-  batch_.clear();
+  drawing_n_ = batch_n_;
+  batch_n_ = 0;
   drawing_state_ = std::move(batch_state_);
   batch_state_.reset();
   drawing_ctx_.clear();
@@ -188,7 +167,7 @@ void Renderer::wait_drawing() {
     errors_ |= c.errors;
     add_counters(c.counters, *drawing_state_);  // one state per batch
   }
-  drawing_.clear();
+  drawing_n_ = 0;
   drawing_state_.reset();
   drawing_active_ = false;
 }
@@ -199,7 +178,8 @@ void Renderer::draw_bands(unsigned worker) {
   const unsigned n = pool_.workers();
   RasterContext& c = drawing_ctx_[worker];
   const SmallDraw small = knobs_.preview && st.preview_small != 0 ? small_draw(st, mem_, knobs_.z_bits) : SmallDraw{};
-  for (const Triangle& t : drawing_) {
+  for (std::size_t i = 0; i < drawing_n_; ++i) {
+    const Triangle& t = drawing_[i];
     int band = t.y0 / kBandRows;
     band += static_cast<int>((worker + n - static_cast<unsigned>(band) % n) % n);
     for (; band * kBandRows < t.y1; band += static_cast<int>(n)) {

@@ -54,7 +54,6 @@ class Renderer {
   static constexpr std::size_t kMaxBatch = 4096;
 
  private:
-  bool can_batch(const DrawState& st) const;
   // Hands the filling batch to the workers (after the one they are drawing) and returns.
   void submit();
   // Waits for the batch the workers are drawing and collects its errors and counters.
@@ -74,9 +73,11 @@ class Renderer {
   ReciprocalUnit recip_;
   BandPool pool_;
   PixelObserver observer_;
-  std::vector<Triangle> batch_;  // being filled by the front end
+  std::vector<Triangle> batch_;  // being filled by the front end: its first batch_n_
+  std::size_t batch_n_ = 0;
   std::shared_ptr<const DrawState> batch_state_;
-  std::vector<Triangle> drawing_;  // being drawn by the workers
+  std::vector<Triangle> drawing_;  // being drawn by the workers: its first drawing_n_
+  std::size_t drawing_n_ = 0;
   std::shared_ptr<const DrawState> drawing_state_;
   std::vector<RasterContext> drawing_ctx_;  // one per worker
   bool drawing_active_ = false;
