@@ -52,6 +52,10 @@ module core_raster #(
   // the last column and row: setup holds the box while the walk runs (a setup starts only when the
   // rasteriser is idle), so no copy of it is kept here
   wire [10:0] xlo = box_x0, xhi = box_xl, yhi = box_y1 - 11'd1;
+  // x != xhi, x != xlo, y == yhi, registered: compared when x or y is loaded or moves (the
+  // comparison of the position the move reaches, which does not wait for the step decision), so
+  // the decision reads one flip-flop each instead of an 11-bit comparison
+  reg        can_r, can_l, last_row;
   reg        mdir;       // direction of the current move / emission
   reg        last_dir;   // emission direction of the previous row
   reg        order;      // ltr latched
@@ -124,17 +128,23 @@ module core_raster #(
   wire cov = area || (!s0 && !s1 && !s2);
   // sides on which covered pixels of this row can lie, from the failing edges
   // (ex = -16 dy, or 16 dy when exchanged: a failing edge with ex > 0 grows to the right)
+  // The sides are fixed for the draw (setup holds dy and flip): latched at the start as "edge k,
+  // failing, rules out the right (nr) / the left (nl)", so no 17-bit comparison of dy lies on
+  // the walk's paths. dy > 0 as sign and non-zero bits (no carry chain).
   function grows_r(input signed [16:0] dy, input f);  // ex > 0
-    grows_r = f ? (dy > 0) : (dy < 0);
+    grows_r = f ? (!dy[16] && |dy[15:0]) : dy[16];
   endfunction
   function grows_l(input signed [16:0] dy, input f);  // ex < 0
-    grows_l = f ? (dy < 0) : (dy > 0);
+    grows_l = f ? dy[16] : (!dy[16] && |dy[15:0]);
   endfunction
-  wire right_ok = !(s0 && !grows_r(dy0, flip)) && !(s1 && !grows_r(dy1, flip)) && !(s2 && !grows_r(dy2, flip));
-  wire left_ok  = !(s0 && !grows_l(dy0, flip)) && !(s1 && !grows_l(dy1, flip)) && !(s2 && !grows_l(dy2, flip));
-  wire can_r = (x != xhi);
-  wire can_l = (x != xlo);
-  wire last_row = (y == yhi);
+  reg  [2:0] nr, nl;
+  always @(posedge clk)
+    if (start) begin
+      nr <= ~{grows_r(dy2, flip), grows_r(dy1, flip), grows_r(dy0, flip)};
+      nl <= ~{grows_l(dy2, flip), grows_l(dy1, flip), grows_l(dy0, flip)};
+    end
+  wire right_ok = !(s0 && nr[0]) && !(s1 && nr[1]) && !(s2 && nr[2]);
+  wire left_ok  = !(s0 && nl[0]) && !(s1 && nl[1]) && !(s2 && nl[2]);
 
   // ---- decision for this cycle ----
   reg       go;         // commit the move `sel`
@@ -229,11 +239,23 @@ module core_raster #(
     endcase
   end
 
-  // one adder each: x +/- 1, y + 1
-  wire        hmove = go && (sel == OP_RIGHT || sel == OP_LEFT);
-  wire        vmove = go && (sel == OP_DOWN);
-  wire [10:0] x_n = x + (hmove ? ((sel == OP_LEFT) ? 11'h7FF : 11'd1) : 11'd0);
-  wire [10:0] y_n = y + {10'd0, vmove};
+  // one adder each: the position a move of `sel` reaches (or the start), x +/- 1, y + 1, and its
+  // bound flags; the decision only enables the registers
+  wire [10:0] x_mv = (start ? x_start : x) + (start ? 11'd0 : (sel == OP_LEFT) ? 11'h7FF : 11'd1);
+  wire [10:0] y_mv = start ? box_y0 : y + 11'd1;
+  wire        hmove = commit && (sel == OP_RIGHT || sel == OP_LEFT);
+  wire        vmove = commit && (sel == OP_DOWN);
+  always @(posedge clk) begin
+    if (start || hmove) begin
+      x     <= x_mv;
+      can_r <= (x_mv != xhi);
+      can_l <= (x_mv != xlo);
+    end
+    if (start || vmove) begin
+      y        <= y_mv;
+      last_row <= (y_mv == yhi);
+    end
+  end
 
   assign op_next = (rst || start) ? OP_NONE : !adv ? op : (hold || st == R_IDLE || !go) ? OP_NONE : sel;
 
@@ -244,8 +266,6 @@ module core_raster #(
       emit <= 1'b0;
     end else if (start) begin
       st       <= R_ENTRY;
-      x        <= x_start;
-      y        <= box_y0;
       last_dir <= DIR_L;
       mdir     <= DIR_R;
       order    <= ltr;
@@ -260,8 +280,6 @@ module core_raster #(
         st       <= st_n;
         mdir     <= mdir_n;
         last_dir <= last_dir_n;
-        x    <= x_n;
-        y    <= y_n;
         op   <= go ? sel : OP_NONE;
         emit <= emit_n;
       end

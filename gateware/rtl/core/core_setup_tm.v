@@ -224,7 +224,13 @@ module core_setup_tm #(
   wire signed [12:0] by1 = (fy < cy1) ? fy : cy1;
   reg         by0_big;
   wire        unused_by0 = by0[12];  // by0 >= 0
-  wire        rows = !by0_big && $signed({2'b0, box_y0}) < by1;  // A_BOX: some row to walk
+  wire        unused_by1 = &{1'b0, by1[12:11]};  // stored only when box_y0 < by1 <= cy1 < 2048
+  // A_BOX: some row to walk, box_y0 < min(fy, cy1). The clip half is compared a clock ahead
+  // (box_y0 is loaded at A_FY0, two instructions before A_BOX; the clip rectangle is the
+  // command's), so the branch does not wait for the scissor's clamp and the fy clamp in series.
+  reg         y0_in_clip;
+  always @(posedge clk) y0_in_clip <= $signed({2'b0, box_y0}) < cy1;
+  wire        rows = !by0_big && y0_in_clip && $signed({2'b0, box_y0}) < fy;
   // box_xl (the last column, clip_x1 - 1, loaded at the start) is the clamp's upper bound too
   wire [10:0] xs = (xt < cx0) ? clip_x0 : (xt > $signed({2'b0, box_xl})) ? box_xl : xt[10:0];
   wire [4:0] r_sel = (i_addr == R_YTOP) ? r_y(top) : (i_addr == R_XTOP) ? r_x(top) :
