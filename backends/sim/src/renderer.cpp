@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "sdram_spans.hpp"
+
 namespace gpubridge::sim {
 namespace {
 
@@ -139,6 +141,7 @@ void Renderer::count_rasterised(const Triangle& t, const DrawState& st) {
   ++mode.triangles;
   mode.rows += static_cast<std::uint64_t>(t.y1 - t.y0);
   mode.columns += static_cast<std::uint64_t>(t.x1 - t.x0);
+  if (!t.small && !st.writes_nothing) access_triangle_rows(sdram_, t, st);
 }
 
 void Renderer::draw_pending() {

@@ -14,6 +14,7 @@
 #include "gpubridge/common/band_pool.hpp"
 #include "draw_state.hpp"
 #include "gpubridge/sim/device.hpp"
+#include "gpubridge/sim/timing.hpp"
 #include "rasterizer.hpp"
 #include "reciprocal.hpp"
 #include "setup.hpp"
@@ -43,7 +44,10 @@ class Renderer {
   // Triangles, box rows and covered pixels per render-state class; triangles set up for nothing.
   const std::array<DeviceStats::ModeWork, DeviceStats::kModeClasses>& mode_work() const { return modes_; }
   std::uint64_t triangles_rejected() const { return rejected_; }
+  // The SDRAM rows the drawn triangles' spans open (the timing model's row counts); clears touch it.
+  SdramRows& sdram_rows() { return sdram_; }
   void reset_counters() {
+    sdram_.reset_counts();
     counters_ = {};
     rasterised_ = 0;
     rejected_ = 0;
@@ -91,6 +95,7 @@ class Renderer {
   std::uint64_t rejected_ = 0;
   RasterCounters counters_;
   std::array<DeviceStats::ModeWork, DeviceStats::kModeClasses> modes_{};
+  SdramRows sdram_;
   void add_counters(const RasterCounters& c, const DrawState& st) {
     counters_.add(c);
     modes_[st.mode_class].pixels += c.covered;

@@ -56,6 +56,11 @@ struct DeviceStats {
   std::uint64_t clears = 0;               // CLEAR / CLEAR_Z with a non-empty clipping rectangle
   std::uint64_t clear_rows = 0;           // rows they filled
   std::uint64_t clear_pixels = 0;         // pixels they filled
+  // The SDRAM rows the drawn pixels' depth and colour accesses open (timing.hpp SdramRows, the
+  // ULX3S controller's geometry, in drawing order): ACTIVEs on an idle bank and row misses
+  // (another row of the bank open). Clears leave their rows open but are not counted here.
+  std::uint64_t row_opens = 0;
+  std::uint64_t row_misses = 0;
   bool operator==(const DeviceStats&) const = default;
 };
 // The class index of DeviceStats::by_mode as a name: "flat", "gouraud", "z", "gouraud_z", "tex",
