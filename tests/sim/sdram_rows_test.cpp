@@ -148,6 +148,8 @@ TEST(SimSdramRows, DeviceCountsTheDrawnSpans) {
       }
     }
     ASSERT_EQ(st.pixels_covered, covered);
+    EXPECT_EQ(st.sdram_accesses, r.hits() + r.opens() + r.misses());
+    EXPECT_EQ(st.sdram_accesses, 3 * covered);
     EXPECT_EQ(st.row_opens, r.opens()) << std::hex << zbase;
     EXPECT_EQ(st.row_misses, r.misses()) << std::hex << zbase;
     if (zbase == 0x100000u) EXPECT_GT(st.row_misses, covered) << "same bank: misses at every switch";
@@ -157,20 +159,22 @@ TEST(SimSdramRows, DeviceCountsTheDrawnSpans) {
 
 TEST(SimSdramRows, RowAndRefreshTermsInTheEstimate) {
   DeviceStats w;
+  w.sdram_accesses = 1000;
   w.row_opens = 10;
   w.row_misses = 100;
   BoardTiming b;
   b.memory_bound = false;
   b.cycles_per_command = 0;
   const double base = estimate_timing(w, b, 4).pipeline_cycles;
+  b.cycles_per_sdram_access = 2;
   b.cycles_per_row_open = 2;
   b.cycles_per_row_miss = 5;
-  EXPECT_DOUBLE_EQ(estimate_timing(w, b, 4).pipeline_cycles, base + 10 * 2 + 100 * 5);
+  EXPECT_DOUBLE_EQ(estimate_timing(w, b, 4).pipeline_cycles, base + 1000 * 2 + 10 * 2 + 100 * 5);
   // a refresh of 8 clocks every 400: the work is 98 % of the board's time
   b.refresh_interval_cycles = 400;
   b.cycles_per_refresh = 8;
   EXPECT_DOUBLE_EQ(refresh_stretch(b), 1.0 / (1.0 - 8.0 / 400.0));
-  EXPECT_DOUBLE_EQ(estimate_timing(w, b, 4).pipeline_cycles, (base + 520) / 0.98);
+  EXPECT_DOUBLE_EQ(estimate_timing(w, b, 4).pipeline_cycles, (base + 2520) / 0.98);
   // the keys of the settings
   ASSERT_TRUE(apply_timing_setting(b, "cycles_per_row_miss=6.5"));
   ASSERT_TRUE(apply_timing_setting(b, "refresh_interval_cycles=0"));

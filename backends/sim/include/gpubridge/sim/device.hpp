@@ -59,6 +59,7 @@ struct DeviceStats {
   // The SDRAM rows the drawn pixels' depth and colour accesses open (timing.hpp SdramRows, the
   // ULX3S controller's geometry, in drawing order): ACTIVEs on an idle bank and row misses
   // (another row of the bank open). Clears leave their rows open but are not counted here.
+  std::uint64_t sdram_accesses = 0;  // every access of that stream (a 32-bit word each)
   std::uint64_t row_opens = 0;
   std::uint64_t row_misses = 0;
   bool operator==(const DeviceStats&) const = default;

@@ -43,12 +43,14 @@ struct BoardTiming {
   double cycles_per_mem_write = 0;          // MEM_DATA write (8 bytes through the arbiter)
   double cycles_per_texel_byte = 0;         // texture bytes fetched (bilinear: four texels a sample)
   double cycles_per_color_byte = 0;         // colour bytes written (bpp per passed pixel)
-  // The SDRAM's rows (the ecp5 preset; 0 elsewhere): cycles per ACTIVE on an idle bank
+  // The SDRAM's rows (the ecp5 preset; 0 elsewhere): cycles per access of the row model's stream
+  // (DeviceStats::sdram_accesses: a 32-bit word, a burst of 2), per ACTIVE on an idle bank
   // (DeviceStats::row_opens: tRCD), per row miss (row_misses: PRECHARGE + ACTIVE, tRP + tRCD and
   // the bank's tRAS / tWR / tRC waits), and the auto refresh: every refresh_interval_cycles (tREFI
   // in core clocks; 0 = none) the controller spends cycles_per_refresh (precharge all, tRFC, the
   // rows opened again after it), which stretches the rest by 1 / (1 − cycles_per_refresh /
   // refresh_interval_cycles).
+  double cycles_per_sdram_access = 0;
   double cycles_per_row_open = 0;
   double cycles_per_row_miss = 0;
   double refresh_interval_cycles = 0;
