@@ -291,7 +291,9 @@ int run_bench_rtl(const GlobalOptions& g, const RtlBenchArgs& a) {
       std::vector<FitSample> fs;
       for (const auto* set : {&samples, &calibration})
         for (const auto& s : *set) fs.push_back({s.work, s.rtl, s.bpp});
-      const TimingFit fit = fit_timing(fs, *preset);
+      // the fit starts from the board's structure: on the ULX3S its SDRAM (refresh, row terms)
+      auto base = gw == "ecp5" ? sim::timing_preset("ecp5-rows") : preset;
+      const TimingFit fit = fit_timing(fs, base ? *base : *preset);
       nlohmann::json params = nlohmann::json::object(), errors = nlohmann::json::array();
       for (const auto& [k, v] : fit.parameters) params[k] = v;
       double worst_fit = 0, worst_calibration = 0;

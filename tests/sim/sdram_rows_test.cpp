@@ -180,11 +180,18 @@ TEST(SimSdramRows, RowAndRefreshTermsInTheEstimate) {
   ASSERT_TRUE(apply_timing_setting(b, "refresh_interval_cycles=0"));
   EXPECT_EQ(b.cycles_per_row_miss, 6.5);
   EXPECT_EQ(refresh_stretch(b), 1.0);
-  // the ecp5 preset refreshes every 7.8 us at 50 MHz, 2 + 4 + 2 clocks (tRP, tRFC, tRCD)
-  auto e = timing_preset("ecp5");
+  // the row model's ecp5 preset refreshes every 7.8 us at 50 MHz, 2 + 4 + 2 clocks (tRP, tRFC, tRCD)
+  auto e = timing_preset("ecp5-rows");
   ASSERT_TRUE(e);
   EXPECT_EQ(e->refresh_interval_cycles, 390);
   EXPECT_EQ(e->cycles_per_refresh, 8);
+  EXPECT_GT(e->cycles_per_row_miss, 0);
+  EXPECT_EQ(e->clock_mhz, 50);
+  EXPECT_FALSE(e->memory_bound);
+  auto plain = timing_preset("ecp5");  // the tested preset: no row terms yet
+  ASSERT_TRUE(plain);
+  EXPECT_EQ(plain->cycles_per_row_miss, 0);
+  EXPECT_EQ(refresh_stretch(*plain), 1.0);
   auto u = timing_preset("up5k");
   ASSERT_TRUE(u);
   EXPECT_EQ(u->cycles_per_row_miss, 0);
