@@ -73,7 +73,7 @@ nlohmann::json counters_json(const sim::DeviceStats& w, const rtl::RtlCounters& 
             {"pixels_textured", w.pixels_textured}, {"pixels_blended", w.pixels_blended}, {"texel_bytes", w.texel_bytes},
             {"clears", w.clears}, {"clear_rows", w.clear_rows}, {"clear_pixels", w.clear_pixels},
             {"clear_bytes", w.clear_bytes}, {"mem_data_writes", w.mem_data_writes}, {"swaps", w.swaps},
-            {"sdram_accesses", w.sdram_accesses}, {"row_opens", w.row_opens}, {"row_misses", w.row_misses}, {"by_mode", modes}}},
+            {"texel_footprint_bytes", w.texel_footprint_bytes}, {"sdram_accesses", w.sdram_accesses}, {"row_opens", w.row_opens}, {"row_misses", w.row_misses}, {"by_mode", modes}}},
           {"rtl",
            {{"work_cycles", r.work_cycles}, {"commands", r.commands}, {"core_busy_cycles", r.core_busy_cycles},
             {"setup_cycles", r.setup_cycles}, {"raster_cycles", r.raster_cycles}, {"core_mem_stalls", r.core_mem_stalls},
@@ -291,9 +291,7 @@ int run_bench_rtl(const GlobalOptions& g, const RtlBenchArgs& a) {
       std::vector<FitSample> fs;
       for (const auto* set : {&samples, &calibration})
         for (const auto& s : *set) fs.push_back({s.work, s.rtl, s.bpp});
-      // the fit starts from the board's structure: on the ULX3S its SDRAM (refresh, row terms)
-      auto base = gw == "ecp5" ? sim::timing_preset("ecp5-rows") : preset;
-      const TimingFit fit = fit_timing(fs, base ? *base : *preset);
+      const TimingFit fit = fit_timing(fs, *preset);
       nlohmann::json params = nlohmann::json::object(), errors = nlohmann::json::array();
       for (const auto& [k, v] : fit.parameters) params[k] = v;
       double worst_fit = 0, worst_calibration = 0;

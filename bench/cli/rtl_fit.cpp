@@ -59,6 +59,8 @@ std::vector<Term> stage_terms(Stage stage, double& clear_byte_cycles, bool sdram
       t.push_back({"cycles_per_color_byte", [](const FitSample& s) { return double(s.work.pixels_depth_passed) * s.bpp; },
                    [](BoardTiming& b) -> double& { return b.cycles_per_color_byte; }});
       if (sdram) {
+        t.push_back({"cycles_per_texel_footprint_byte", [](const FitSample& s) { return double(s.work.texel_footprint_bytes); },
+                     [](BoardTiming& b) -> double& { return b.cycles_per_texel_footprint_byte; }});
         t.push_back({"cycles_per_sdram_access", [](const FitSample& s) { return double(s.work.sdram_accesses); },
                      [](BoardTiming& b) -> double& { return b.cycles_per_sdram_access; }});
         t.push_back({"cycles_per_row_open", [](const FitSample& s) { return double(s.work.row_opens); },
@@ -139,6 +141,7 @@ TimingFit fit_timing(const std::vector<FitSample>& samples, const BoardTiming& b
   b.setup_cycles = b.row_cycles = b.column_cycles = b.pixel_cycles = {};
   b.cycles_per_rejected_triangle = b.cycles_per_clear = b.cycles_per_clear_row = b.cycles_per_clear_pixel = 0;
   b.cycles_per_mem_write = b.cycles_per_texel_byte = b.cycles_per_color_byte = 0;
+  b.cycles_per_texel_footprint_byte = 0;
   b.cycles_per_sdram_access = b.cycles_per_row_open = b.cycles_per_row_miss = 0;
   // The refresh terms are the controller's (tREFI, and tRP + tRFC + tRCD per refresh), kept from
   // `base`: the fit sees each stage's clocks without the refresh's share.

@@ -4,10 +4,12 @@
 // what the row and refresh terms add to an estimate.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 
 #include "gpubridge/sim/timing.hpp"
 #include "reference.hpp"
+#include "sdram_spans.hpp"
 #include "sim_test_util.hpp"
 
 namespace gpubridge::sim::test {
@@ -157,6 +159,28 @@ TEST(SimSdramRows, DeviceCountsTheDrawnSpans) {
   }
 }
 
+// A triangle's texture footprint: vertices at texel (0, 0), (16, 0), (0, 16) of a 16 x 16 RGB565
+// texture (S = 0.5, Q = 0.5: one texture width) cover 128 texels.
+TEST(SimSdramRows, TexelFootprintIsTheTextureSpaceAreaCappedBySamples) {
+  Triangle t;
+  const std::int32_t half = 1 << 23;  // s8.24: 0.5
+  t.v[0].s = 0, t.v[0].t = 0;
+  t.v[1].s = half, t.v[1].t = 0;
+  t.v[2].s = 0, t.v[2].t = half;
+  for (auto& v : t.v) v.q = 0x80000000u;  // u0.32: 0.5
+  DrawState st;
+  st.tex.wl = st.tex.hl = 4;
+  st.tex.format = protocol::PixelFormat::RGB565;
+  st.tex.bilinear = false;
+  EXPECT_EQ(texel_footprint_bytes(t, st, 1000), (128u + 1u) * 2u);  // the area, plus one texel
+  EXPECT_EQ(texel_footprint_bytes(t, st, 100), 100u * 2u);          // no more than the samples
+  st.tex.bilinear = true;  // a border: 128 + 2·sqrt(128) + 1 texels
+  EXPECT_EQ(texel_footprint_bytes(t, st, 1000), static_cast<std::uint64_t>(std::llround((128 + 2 * std::sqrt(128.0) + 1) * 2)));
+  EXPECT_EQ(texel_footprint_bytes(t, st, 10), 10u * 4u * 2u);
+  t.v[1].q = 0;  // no reciprocal: every sample's bytes
+  EXPECT_EQ(texel_footprint_bytes(t, st, 1000), 1000u * 4u * 2u);
+}
+
 TEST(SimSdramRows, RowAndRefreshTermsInTheEstimate) {
   DeviceStats w;
   w.sdram_accesses = 1000;
@@ -180,18 +204,14 @@ TEST(SimSdramRows, RowAndRefreshTermsInTheEstimate) {
   ASSERT_TRUE(apply_timing_setting(b, "refresh_interval_cycles=0"));
   EXPECT_EQ(b.cycles_per_row_miss, 6.5);
   EXPECT_EQ(refresh_stretch(b), 1.0);
-  // the row model's ecp5 preset refreshes every 7.8 us at 50 MHz, 2 + 4 + 2 clocks (tRP, tRFC, tRCD)
-  auto e = timing_preset("ecp5-rows");
+  // the ecp5 preset refreshes every 7.8 us at 50 MHz, 2 + 4 + 2 clocks (tRP, tRFC, tRCD)
+  auto e = timing_preset("ecp5");
   ASSERT_TRUE(e);
   EXPECT_EQ(e->refresh_interval_cycles, 390);
   EXPECT_EQ(e->cycles_per_refresh, 8);
   EXPECT_GT(e->cycles_per_row_miss, 0);
   EXPECT_EQ(e->clock_mhz, 50);
   EXPECT_FALSE(e->memory_bound);
-  auto plain = timing_preset("ecp5");  // the tested preset: no row terms yet
-  ASSERT_TRUE(plain);
-  EXPECT_EQ(plain->cycles_per_row_miss, 0);
-  EXPECT_EQ(refresh_stretch(*plain), 1.0);
   auto u = timing_preset("up5k");
   ASSERT_TRUE(u);
   EXPECT_EQ(u->cycles_per_row_miss, 0);

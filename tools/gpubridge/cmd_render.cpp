@@ -245,7 +245,7 @@ GPUBRIDGE_COMMAND("render", 10, [](CLI::App& app, GlobalOptions& g, auto& runner
   sub->add_flag("--timing", a->timing,
                 "predict board time per frame with the timing model (docs/protocol.md section 19; DMC-1: docs/dmc1.md)");
   sub->add_option("--board-timing", a->timing_params,
-                  "timing model settings KEY=VALUE (profile=up5k|ecp5|ecp5-rows|ecp5-50mhz, clock_mhz, spi_clock_mhz, "
+                  "timing model settings KEY=VALUE (profile=up5k|ecp5|ecp5-50mhz, clock_mhz, spi_clock_mhz, "
                   "setup_cycles_CLASS, ...: docs/protocol.md section 19; DMC-1: clock_mhz, screen_cycles_per_word, ...)")
       ->expected(1, 32);
   sub->add_option("--dump-attributes", a->dump_attributes,

@@ -644,6 +644,7 @@ const DeviceStats& Device::stats() const {
   st.texel_bytes = c.texel_bytes;
   st.by_mode = s_->renderer.mode_work();
   st.triangles_rejected = s_->renderer.triangles_rejected();
+  st.texel_footprint_bytes = s_->renderer.texel_footprint();
   st.sdram_accesses = s_->renderer.sdram_rows().hits() + s_->renderer.sdram_rows().opens() + s_->renderer.sdram_rows().misses();
   st.row_opens = s_->renderer.sdram_rows().opens();
   st.row_misses = s_->renderer.sdram_rows().misses();

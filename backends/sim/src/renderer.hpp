@@ -46,8 +46,11 @@ class Renderer {
   std::uint64_t triangles_rejected() const { return rejected_; }
   // The SDRAM rows the drawn triangles' spans open (the timing model's row counts); clears touch it.
   SdramRows& sdram_rows() { return sdram_; }
+  // Texture bytes the textured triangles' footprints hold (texel_footprint_bytes).
+  std::uint64_t texel_footprint() const { return texel_footprint_; }
   void reset_counters() {
     sdram_.reset_counts();
+    texel_footprint_ = 0;
     counters_ = {};
     rasterised_ = 0;
     rejected_ = 0;
@@ -96,6 +99,7 @@ class Renderer {
   RasterCounters counters_;
   std::array<DeviceStats::ModeWork, DeviceStats::kModeClasses> modes_{};
   SdramRows sdram_;
+  std::uint64_t texel_footprint_ = 0;
   void add_counters(const RasterCounters& c, const DrawState& st) {
     counters_.add(c);
     modes_[st.mode_class].pixels += c.covered;

@@ -147,6 +147,7 @@ TimingEstimate estimate_timing(const DeviceStats& w, const BoardTiming& b, unsig
                       double(w.pixels_textured) * b.cycles_per_textured_pixel +
                       double(w.pixels_blended) * b.cycles_per_blended_pixel +
                       double(w.clear_bytes) / b.clear_bytes_per_cycle + structure_cycles(w, b, color_bpp) +
+                      double(w.texel_footprint_bytes) * b.cycles_per_texel_footprint_byte +
                       double(w.sdram_accesses) * b.cycles_per_sdram_access + double(w.row_opens) * b.cycles_per_row_open +
                       double(w.row_misses) * b.cycles_per_row_miss;
   e.pipeline_cycles *= refresh_stretch(b);
@@ -195,6 +196,7 @@ DeviceStats stats_difference(const DeviceStats& a, const DeviceStats& b) {
   d.clears = a.clears - b.clears;
   d.clear_rows = a.clear_rows - b.clear_rows;
   d.clear_pixels = a.clear_pixels - b.clear_pixels;
+  d.texel_footprint_bytes = a.texel_footprint_bytes - b.texel_footprint_bytes;
   d.sdram_accesses = a.sdram_accesses - b.sdram_accesses;
   d.row_opens = a.row_opens - b.row_opens;
   d.row_misses = a.row_misses - b.row_misses;
@@ -204,7 +206,7 @@ DeviceStats stats_difference(const DeviceStats& a, const DeviceStats& b) {
 Result<BoardTiming> timing_preset(std::string_view name) {
   BoardTiming b;
   if (name == "ecp5-50mhz") return b;
-  if (name == "up5k" || name == "ecp5" || name == "ecp5-rows") {
+  if (name == "up5k" || name == "ecp5") {
     // The gateware profiles (gateware/rtl/spigpu_top.v) at their co-simulated clocks; every cycle
     // term from `gpubridge bench rtl --fit` (docs/gateware.md "Timing model", 2026-11-26): the
     // staged least-squares fit on the RTL's setup, rasteriser and remaining clocks of every example,
@@ -243,68 +245,46 @@ Result<BoardTiming> timing_preset(std::string_view name) {
     b.clear_bytes_per_cycle = 1e9;  // a clear costs by pixel (one SPRAM write each), not by byte
     return b;
   }
-  if (name == "ecp5" || name == "ecp5-rows") {
+  if (name == "ecp5") {
     // ULX3S: 50 MHz core, 16-bit SDR SDRAM (a 32-bit word per 2 clocks at best), SPI 15 MHz. Parallel
     // setup (38 cycles flat .. 336 textured Gouraud + Z on the core bench), one pixel a clock on
-    // spans, memory stalls per depth read, colour byte and texel fetch (texel cache), clears a word
+    // spans, memory stalls per depth read, colour byte, texel fetch and SDRAM row miss, clears a word
     // per 2 clocks beside the rasteriser.
     b.clock_mhz = 50.0;
     b.spi_clock_mhz = 15.0;
     b.memory_bytes_per_cycle = 2.0;
-  }
-  if (name == "ecp5") {
-    // The fit before the SDRAM row model (row misses averaged into the per-pixel terms); kept as the
-    // profile's preset because the row model's fit ("ecp5-rows") puts textured-floor 12 % high,
-    // beyond the 10 % of rtl.bridge's scene test (docs/gateware.md "Timing model").
-    b.setup_cycles = {42.54, 173.0, 98.98, 203.8, 166.5, 280.1, 205.6, 315.4};
-    b.row_cycles = {1.725, 0.7712, 2.873, 2.361, 1.996, 1.617, 5.105, 2.512};
-    b.column_cycles = {0.379, 0.0, 1.117, 0.3836, 0.7652, 1.507, 2.744, 0.3189};
-    b.pixel_cycles = {0.3477, 0.5947, 4.491, 4.86, 1.992, 1.746, 5.244, 6.739};
-    b.cycles_per_command = 2.33;
-    b.cycles_per_triangle = 0.0;
-    b.cycles_per_blended_pixel = 3.198;
-    b.cycles_per_rejected_triangle = 0.0;
-    b.cycles_per_clear = 9.541;
-    b.cycles_per_clear_row = 0.0;
-    b.cycles_per_clear_pixel = 0.01171;
-    b.cycles_per_mem_write = 11.98;
-    b.cycles_per_texel_byte = 0.1716;
-    b.cycles_per_color_byte = 0.3643;
-    b.clear_bytes_per_cycle = 1.983;
-    return b;
-  }
-  if (name == "ecp5-rows") {
-    // The SDRAM row model (docs/protocol.md section 19) fitted by `gpubridge bench rtl --fit
-    // --profile ecp5` (2026-11-26, 14 scenes and 48 calibration frames; docs/gateware.md "Timing
-    // model"): a row miss costs 1.83 clocks beyond the per-pixel terms, a row open and the access
-    // itself nothing beyond them.
+    // Fitted with the SDRAM row model and the texel footprint (`gpubridge bench rtl --fit --profile
+    // ecp5`, 2026-11-26, 14 scenes and 48 calibration frames; docs/gateware.md "Timing model"): a row
+    // miss costs 1.92 clocks beyond the per-pixel terms, a byte of texture footprint (texel cache
+    // fills) 0.57, a byte sampled 0.073; a row open and the access itself nothing beyond them.
     b.setup_cycles = {41.71, 169.5, 97.0, 199.8, 163.2, 274.5, 201.5, 309.0};
-    b.row_cycles = {1.252, 0.515, 2.611, 2.295, 2.128, 1.624, 6.54, 4.413};
-    b.column_cycles = {0.2573, 0.0, 0.5919, 0.0328, 0.8244, 1.779, 3.316, 1.205};
-    b.pixel_cycles = {0.4383, 0.6195, 4.724, 4.965, 2.447, 2.117, 5.45, 6.424};
+    b.row_cycles = {1.418, 0.4192, 2.721, 2.36, 0.5689, 0.6137, 6.116, 4.173};
+    b.column_cycles = {0.4139, 0.0, 0.7694, 0.1205, 0.0, 0.474, 2.862, 1.223};
+    b.pixel_cycles = {0.3255, 0.5814, 4.594, 4.878, 1.582, 1.226, 4.108, 5.107};
     b.cycles_per_command = 2.552;
     b.cycles_per_triangle = 0.0;
-    b.cycles_per_blended_pixel = 3.199;
+    b.cycles_per_blended_pixel = 3.182;
     b.cycles_per_rejected_triangle = 0.0;
     b.cycles_per_clear = 8.387;
     b.cycles_per_clear_row = 0.0;
-    b.cycles_per_clear_pixel = 0.0159;
+    b.cycles_per_clear_pixel = 0.005953;
     b.cycles_per_mem_write = 11.67;
-    b.cycles_per_texel_byte = 0.1876;
-    b.cycles_per_color_byte = 0.3264;
+    b.cycles_per_texel_byte = 0.07261;
+    b.cycles_per_color_byte = 0.3689;
+    b.cycles_per_texel_footprint_byte = 0.5707;
     b.cycles_per_sdram_access = 0.0;
     b.cycles_per_row_open = 0.0;
-    b.cycles_per_row_miss = 1.825;
+    b.cycles_per_row_miss = 1.919;
     b.clear_bytes_per_cycle = 2.004;
     // The SDRAM (sdram_ctrl.v with the Alliance AS4C32M16SB-7's timing): an auto refresh every
     // tREFI = 7.8 us costs precharge all (tRP 21 ns), tRFC (63 ns) and the first row opened again
-    // (tRCD 21 ns), in whole clocks; the fit keeps these and fits the row opens and misses.
+    // (tRCD 21 ns), in whole clocks; the fit keeps these and fits the rest.
     const auto clocks = [&](double ns) { return std::ceil(ns * b.clock_mhz / 1000.0); };
     b.refresh_interval_cycles = clocks(7800);
     b.cycles_per_refresh = clocks(21) + clocks(63) + clocks(21);
     return b;
   }
-  return make_error("unknown timing profile '" + std::string(name) + "' (ecp5-50mhz, up5k, ecp5, ecp5-rows)");
+  return make_error("unknown timing profile '" + std::string(name) + "' (ecp5-50mhz, up5k, ecp5)");
 }
 
 Result<void> apply_timing_setting(BoardTiming& b, std::string_view setting) {
@@ -332,6 +312,7 @@ Result<void> apply_timing_setting(BoardTiming& b, std::string_view setting) {
       {"cycles_per_texel_byte", &BoardTiming::cycles_per_texel_byte},
       {"cycles_per_color_byte", &BoardTiming::cycles_per_color_byte},
       {"cycles_per_sdram_access", &BoardTiming::cycles_per_sdram_access},
+      {"cycles_per_texel_footprint_byte", &BoardTiming::cycles_per_texel_footprint_byte},
       {"cycles_per_row_open", &BoardTiming::cycles_per_row_open},
       {"cycles_per_row_miss", &BoardTiming::cycles_per_row_miss},
       {"refresh_interval_cycles", &BoardTiming::refresh_interval_cycles},

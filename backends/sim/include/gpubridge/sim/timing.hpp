@@ -51,6 +51,7 @@ struct BoardTiming {
   // rows opened again after it), which stretches the rest by 1 / (1 − cycles_per_refresh /
   // refresh_interval_cycles).
   double cycles_per_sdram_access = 0;
+  double cycles_per_texel_footprint_byte = 0;  // DeviceStats::texel_footprint_bytes: texel cache fills
   double cycles_per_row_open = 0;
   double cycles_per_row_miss = 0;
   double refresh_interval_cycles = 0;
