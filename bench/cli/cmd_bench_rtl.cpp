@@ -73,7 +73,7 @@ nlohmann::json counters_json(const sim::DeviceStats& w, const rtl::RtlCounters& 
             {"pixels_textured", w.pixels_textured}, {"pixels_blended", w.pixels_blended}, {"texel_bytes", w.texel_bytes},
             {"clears", w.clears}, {"clear_rows", w.clear_rows}, {"clear_pixels", w.clear_pixels},
             {"clear_bytes", w.clear_bytes}, {"mem_data_writes", w.mem_data_writes}, {"swaps", w.swaps},
-            {"by_mode", modes}}},
+            {"texel_footprint_bytes", w.texel_footprint_bytes}, {"sdram_accesses", w.sdram_accesses}, {"row_opens", w.row_opens}, {"row_misses", w.row_misses}, {"by_mode", modes}}},
           {"rtl",
            {{"work_cycles", r.work_cycles}, {"commands", r.commands}, {"core_busy_cycles", r.core_busy_cycles},
             {"setup_cycles", r.setup_cycles}, {"raster_cycles", r.raster_cycles}, {"core_mem_stalls", r.core_mem_stalls},

@@ -19,6 +19,13 @@ constexpr unsigned kW = 160, kH = 120;
 constexpr std::uint32_t kColor = 0, kDepth565 = kW * kH * 2, kDepth8888 = kW * kH * 4;  // 16-byte aligned
 constexpr std::uint32_t kTexture = kDepth8888 + kW * kH * 4;
 constexpr unsigned kTexLog2 = 6;
+// A depth buffer in the colour buffer's SDRAM banks (ecp5): RGBA8888 colour and depth share the
+// stride, so at a 4 KiB multiple apart (4 banks of 1 KiB rows) every depth access and colour write
+// of a pixel go to one bank's two rows; at kDepth8888 (75 KiB) they are always a bank apart. The
+// pair separates the row-miss cost from the pixel cost (docs/protocol.md section 19).
+constexpr std::uint32_t kDepthSameBank = 42u << 12;  // past the texture
+static_assert(kDepthSameBank >= kTexture + (4u << (2 * kTexLog2)));
+static_assert(kDepth8888 % 4096 != 0);
 
 struct Shape {
   const char* name;
@@ -33,14 +40,15 @@ constexpr Shape kShapes[] = {
 // Every rectangle here lies within 160 x 120, which scissor_word always accepts.
 std::uint64_t scissor(unsigned x0, unsigned y0, unsigned x1, unsigned y1) { return *geometry::scissor_word(x0, y0, x1, y1); }
 
-protocol::CommandStream frame(unsigned mode_class, const Shape& shape, bool bilinear, bool rgba8888, bool depth, std::uint32_t seed) {
+protocol::CommandStream frame(unsigned mode_class, const Shape& shape, bool bilinear, bool rgba8888, bool depth, std::uint32_t seed,
+                              bool same_bank = false) {
   protocol::CommandStream s;
   protocol::CommandStreamWriter w(s);
   std::mt19937 rng(seed);
   w.write(Reg::FB_FORMAT, *geometry::fb_format_word(kW, kH, rgba8888 ? protocol::PixelFormat::RGBA8888
                                                                      : protocol::PixelFormat::RGB565));
   w.write(Reg::FB_DRAW, kColor);
-  w.write(Reg::FB_Z, rgba8888 ? kDepth8888 : kDepth565);
+  w.write(Reg::FB_Z, same_bank ? kDepthSameBank : rgba8888 ? kDepth8888 : kDepth565);
   // clears: the whole buffer, a wide strip and a tall one (rows and pixels vary apart)
   w.write(Reg::CLEAR_COLOR, rng());
   w.write(Reg::CLEAR_DEPTH, 0xFFFFFF);
@@ -108,6 +116,9 @@ std::vector<CalibrationStream> calibration_streams(bool texturing, bool depth) {
       if (m & 4) out.push_back({base + "-bilinear", frame(m, shape, true, false, depth, seed++)});
       // 4 bytes a pixel (the ecp5's 16-bit SDRAM: two clocks a colour write); the up5k has no room
       if (texturing) out.push_back({base + "-rgba8888", frame(m, shape, false, true, depth, seed++)});
+      // a seed of their own: the frames above stay as they were
+      if (texturing && (m & 2))
+        out.push_back({base + "-rgba8888-same-bank", frame(m, shape, false, true, depth, 0x5A3EBA00u + m, true)});
     }
   }
   return out;

@@ -20,7 +20,8 @@ struct Term {
 enum Stage { kSetup, kRaster, kRest };
 
 // The terms that can cost in each stage (docs/protocol.md section 19, docs/gateware.md).
-std::vector<Term> stage_terms(Stage stage, double& clear_byte_cycles) {
+// sdram: the board has an SDRAM (its preset refreshes), so its row opens and misses can cost.
+std::vector<Term> stage_terms(Stage stage, double& clear_byte_cycles, bool sdram) {
   std::vector<Term> t;
   auto clears = [&] {
     // up5k draws a clear as a rectangle (setup + rasteriser); ecp5 fills it beside them
@@ -57,6 +58,16 @@ std::vector<Term> stage_terms(Stage stage, double& clear_byte_cycles) {
                    [](BoardTiming& b) -> double& { return b.cycles_per_texel_byte; }});
       t.push_back({"cycles_per_color_byte", [](const FitSample& s) { return double(s.work.pixels_depth_passed) * s.bpp; },
                    [](BoardTiming& b) -> double& { return b.cycles_per_color_byte; }});
+      if (sdram) {
+        t.push_back({"cycles_per_texel_footprint_byte", [](const FitSample& s) { return double(s.work.texel_footprint_bytes); },
+                     [](BoardTiming& b) -> double& { return b.cycles_per_texel_footprint_byte; }});
+        t.push_back({"cycles_per_sdram_access", [](const FitSample& s) { return double(s.work.sdram_accesses); },
+                     [](BoardTiming& b) -> double& { return b.cycles_per_sdram_access; }});
+        t.push_back({"cycles_per_row_open", [](const FitSample& s) { return double(s.work.row_opens); },
+                     [](BoardTiming& b) -> double& { return b.cycles_per_row_open; }});
+        t.push_back({"cycles_per_row_miss", [](const FitSample& s) { return double(s.work.row_misses); },
+                     [](BoardTiming& b) -> double& { return b.cycles_per_row_miss; }});
+      }
       clears();
       break;
     case kRest:
@@ -130,19 +141,25 @@ TimingFit fit_timing(const std::vector<FitSample>& samples, const BoardTiming& b
   b.setup_cycles = b.row_cycles = b.column_cycles = b.pixel_cycles = {};
   b.cycles_per_rejected_triangle = b.cycles_per_clear = b.cycles_per_clear_row = b.cycles_per_clear_pixel = 0;
   b.cycles_per_mem_write = b.cycles_per_texel_byte = b.cycles_per_color_byte = 0;
+  b.cycles_per_texel_footprint_byte = 0;
+  b.cycles_per_sdram_access = b.cycles_per_row_open = b.cycles_per_row_miss = 0;
+  // The refresh terms are the controller's (tREFI, and tRP + tRFC + tRCD per refresh), kept from
+  // `base`: the fit sees each stage's clocks without the refresh's share.
+  const bool sdram = b.refresh_interval_cycles > 0;
+  const double stretch = sim::refresh_stretch(b);
   b.memory_bound = false;  // the terms are fitted on cycles that include the memory's
   double clear_byte_cycles = 0;
   std::vector<double> weight;  // relative error of the whole frame
   for (const auto& s : samples) weight.push_back(1.0 / std::max(1.0, double(s.rtl.work_cycles)));
   for (Stage stage : {kSetup, kRaster, kRest}) {
-    const auto terms = stage_terms(stage, clear_byte_cycles);
+    const auto terms = stage_terms(stage, clear_byte_cycles, sdram);
     std::vector<std::vector<double>> x;
     std::vector<double> y;
     for (const auto& s : samples) {
       std::vector<double> row;
       for (const auto& t : terms) row.push_back(t.count(s));
       x.push_back(std::move(row));
-      y.push_back(stage_target(stage, s.rtl));
+      y.push_back(stage_target(stage, s.rtl) / stretch);
     }
     const auto p = nnls(x, y, weight);
     for (std::size_t j = 0; j < terms.size(); ++j) terms[j].param(b) += p[j];
@@ -151,7 +168,7 @@ TimingFit fit_timing(const std::vector<FitSample>& samples, const BoardTiming& b
   // the listing: every non-zero parameter as a setting
   double unused = 0;
   for (Stage stage : {kSetup, kRaster, kRest})
-    for (const auto& t : stage_terms(stage, unused)) {
+    for (const auto& t : stage_terms(stage, unused, sdram)) {
       const double v = t.key == "clear_bytes_per_cycle" ? b.clear_bytes_per_cycle : t.param(b);
       const bool listed = std::any_of(f.parameters.begin(), f.parameters.end(), [&](const auto& kv) { return kv.first == t.key; });
       if (!listed && v != 0 && !(t.key == "clear_bytes_per_cycle" && v >= 1e9)) f.parameters.emplace_back(t.key, v);

@@ -329,6 +329,7 @@ struct Device::State {
       const std::uint64_t at = base + (std::uint64_t(y) * st.fb_width + st.clip.x0) * bpp;
       dropped |= !mem.write(at, row.data(), row.size());
       stats.clear_bytes += row.size();
+      renderer.sdram_rows().touch_range(at, row.size());
     }
     if (dropped) errors |= ERR_MEM_RANGE;
   }
@@ -643,6 +644,10 @@ const DeviceStats& Device::stats() const {
   st.texel_bytes = c.texel_bytes;
   st.by_mode = s_->renderer.mode_work();
   st.triangles_rejected = s_->renderer.triangles_rejected();
+  st.texel_footprint_bytes = s_->renderer.texel_footprint();
+  st.sdram_accesses = s_->renderer.sdram_rows().hits() + s_->renderer.sdram_rows().opens() + s_->renderer.sdram_rows().misses();
+  st.row_opens = s_->renderer.sdram_rows().opens();
+  st.row_misses = s_->renderer.sdram_rows().misses();
   return st;
 }
 void Device::reset_stats() {

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "sdram_spans.hpp"
+
 namespace gpubridge::sim {
 
 Renderer::Renderer(VideoMemory& mem, const AccuracyKnobs& knobs, unsigned threads, bool vector_routines)
@@ -117,6 +119,9 @@ void Renderer::count_rasterised(const Triangle& t, const DrawState& st) {
   ++mode.triangles;
   mode.rows += static_cast<std::uint64_t>(t.y1 - t.y0);
   mode.columns += static_cast<std::uint64_t>(t.x1 - t.x0);
+  if (t.small || st.writes_nothing) return;
+  const std::uint64_t covered = access_triangle_rows(sdram_, t, st);
+  if (st.mode_class & 4) texel_footprint_ += texel_footprint_bytes(t, st, covered);
 }
 
 void Renderer::draw_pending() {

@@ -14,6 +14,7 @@
 #include "gpubridge/common/band_pool.hpp"
 #include "draw_state.hpp"
 #include "gpubridge/sim/device.hpp"
+#include "gpubridge/sim/timing.hpp"
 #include "rasterizer.hpp"
 #include "reciprocal.hpp"
 #include "setup.hpp"
@@ -43,7 +44,13 @@ class Renderer {
   // Triangles, box rows and covered pixels per render-state class; triangles set up for nothing.
   const std::array<DeviceStats::ModeWork, DeviceStats::kModeClasses>& mode_work() const { return modes_; }
   std::uint64_t triangles_rejected() const { return rejected_; }
+  // The SDRAM rows the drawn triangles' spans open (the timing model's row counts); clears touch it.
+  SdramRows& sdram_rows() { return sdram_; }
+  // Texture bytes the textured triangles' footprints hold (texel_footprint_bytes).
+  std::uint64_t texel_footprint() const { return texel_footprint_; }
   void reset_counters() {
+    sdram_.reset_counts();
+    texel_footprint_ = 0;
     counters_ = {};
     rasterised_ = 0;
     rejected_ = 0;
@@ -92,6 +99,8 @@ class Renderer {
   std::uint64_t rejected_ = 0;
   RasterCounters counters_;
   std::array<DeviceStats::ModeWork, DeviceStats::kModeClasses> modes_{};
+  SdramRows sdram_;
+  std::uint64_t texel_footprint_ = 0;
   void add_counters(const RasterCounters& c, const DrawState& st) {
     counters_.add(c);
     modes_[st.mode_class].pixels += c.covered;

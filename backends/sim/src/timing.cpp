@@ -22,7 +22,115 @@ double structure_cycles(const DeviceStats& w, const BoardTiming& b, unsigned col
   return c;
 }
 
+// Accesses of a span gathered into runs of one row (SdramRows::access(address, count)).
+class RunEmitter {
+ public:
+  RunEmitter(SdramRows& rows, unsigned row_bits) : rows_(rows), row_bits_(row_bits) {}
+  ~RunEmitter() { flush(); }
+  RunEmitter(const RunEmitter&) = delete;
+  RunEmitter& operator=(const RunEmitter&) = delete;
+  void emit(std::uint64_t address, std::uint64_t count) {
+    if (count == 0) return;
+    if (count_ != 0 && (address >> row_bits_) == (address_ >> row_bits_)) {
+      count_ += count;
+      return;
+    }
+    flush();
+    address_ = address;
+    count_ = count;
+  }
+  void flush() {
+    if (count_ != 0) rows_.access(address_, count_);
+    count_ = 0;
+  }
+
+ private:
+  SdramRows& rows_;
+  unsigned row_bits_;
+  std::uint64_t address_ = 0, count_ = 0;
+};
+
 }  // namespace
+
+double refresh_stretch(const BoardTiming& b) {
+  if (b.refresh_interval_cycles <= 0 || b.cycles_per_refresh <= 0) return 1.0;
+  // a refresh every interval of the board's time, the work in the rest: t = work + t·cost/interval
+  const double share = std::min(b.cycles_per_refresh / b.refresh_interval_cycles, 0.9);
+  return 1.0 / (1.0 - share);
+}
+
+SdramRows::Outcome SdramRows::access(std::uint64_t address, std::uint64_t count) {
+  const std::uint64_t row = address >> g_.row_bits;
+  const std::size_t bank = static_cast<std::size_t>(row & ((std::uint64_t{1} << g_.bank_bits) - 1));
+  const std::uint64_t held = open_[bank];
+  open_[bank] = row;
+  if (count > 1) hits_ += count - 1;
+  if (held == row) {
+    ++hits_;
+    return Outcome::Hit;
+  }
+  if (held == kClosed) {
+    ++opens_;
+    return Outcome::Open;
+  }
+  ++misses_;
+  return Outcome::Miss;
+}
+
+void SdramRows::touch(std::uint64_t address) {
+  const std::uint64_t row = address >> g_.row_bits;
+  open_[static_cast<std::size_t>(row & ((std::uint64_t{1} << g_.bank_bits) - 1))] = row;
+}
+
+void SdramRows::touch_range(std::uint64_t address, std::uint64_t bytes) {
+  const std::uint64_t end = address + bytes;
+  for (std::uint64_t a = address; a < end; a = ((a >> g_.row_bits) + 1) << g_.row_bits) touch(a);
+}
+
+void SdramRows::refresh() { std::fill(open_.begin(), open_.end(), kClosed); }
+
+void access_span(SdramRows& rows, const SpanAccess& span) {
+  const SdramGeometry& g = rows.geometry();
+  const std::uint64_t zn = (span.z_read ? 1u : 0u) + (span.z_write ? 1u : 0u);  // per pixel
+  const std::uint64_t cn = (span.color_read ? 1u : 0u) + (span.color_write ? 1u : 0u);  // per word
+  const std::uint64_t n = span.pixels, bpp = span.bpp;
+  if (n == 0 || bpp == 0 || (zn == 0 && cn == 0)) return;
+  const std::uint64_t row_bytes = std::uint64_t{1} << g.row_bits;
+  const std::uint64_t bank_mask = (std::uint64_t{1} << g.bank_bits) - 1;
+  auto word = [&](std::uint64_t i) { return (span.color + bpp * i) >> 2; };
+  // the last pixel of the span in colour word w: the combiner sends the word after it
+  auto last_pixel = [&](std::uint64_t w) { return std::min(n, ((w + 1) * 4 - span.color + bpp - 1) / bpp) - 1; };
+  RunEmitter out(rows, g.row_bits);
+  std::uint64_t a = 0;  // first pixel of the segment
+  while (a < n) {
+    // a segment [a, b): both streams stay in one row each
+    const std::uint64_t za = span.depth + 4 * a, ca = span.color + bpp * a;
+    std::uint64_t b = n;
+    if (zn != 0) b = std::min(b, a + ((za | (row_bytes - 1)) + 1 - za + 3) / 4);
+    if (cn != 0) b = std::min(b, a + ((ca | (row_bytes - 1)) + 1 - ca + bpp - 1) / bpp);
+    // the colour words sent in the segment: those whose last pixel lies in it
+    const std::uint64_t w0 = word(a);
+    const std::uint64_t w1 = last_pixel(word(b - 1)) == b - 1 ? word(b - 1) + 1 : word(b - 1);
+    const std::uint64_t zrow = za >> g.row_bits, crow = ca >> g.row_bits;
+    const bool conflict = zn != 0 && cn != 0 && zrow != crow && (zrow & bank_mask) == (crow & bank_mask);
+    if (!conflict) {
+      // different banks, one row or one stream: each bank keeps its row through the segment
+      out.emit(za, zn * (b - a));
+      if (w1 > w0) out.emit(w0 * 4, cn * (w1 - w0));
+    } else {
+      // one bank, two rows: the depth accesses up to a colour word's last pixel, then the word
+      std::uint64_t p = a;
+      for (std::uint64_t w = w0; w < w1; ++w) {
+        const std::uint64_t end = last_pixel(w) + 1;
+        out.emit(span.depth + 4 * p, zn * (end - p));
+        out.emit(w * 4, cn);
+        p = end;
+      }
+      out.emit(span.depth + 4 * p, zn * (b - p));
+    }
+    a = b;
+  }
+}
 
 const char* mode_class_name(unsigned index) {
   static constexpr const char* kNames[DeviceStats::kModeClasses] = {"flat", "gouraud",     "z",     "gouraud_z",
@@ -38,7 +146,11 @@ TimingEstimate estimate_timing(const DeviceStats& w, const BoardTiming& b, unsig
                       double(w.pixels_depth_passed) * b.cycles_per_pixel +
                       double(w.pixels_textured) * b.cycles_per_textured_pixel +
                       double(w.pixels_blended) * b.cycles_per_blended_pixel +
-                      double(w.clear_bytes) / b.clear_bytes_per_cycle + structure_cycles(w, b, color_bpp);
+                      double(w.clear_bytes) / b.clear_bytes_per_cycle + structure_cycles(w, b, color_bpp) +
+                      double(w.texel_footprint_bytes) * b.cycles_per_texel_footprint_byte +
+                      double(w.sdram_accesses) * b.cycles_per_sdram_access + double(w.row_opens) * b.cycles_per_row_open +
+                      double(w.row_misses) * b.cycles_per_row_miss;
+  e.pipeline_cycles *= refresh_stretch(b);
   // Memory: depth read + write (4 + 4) for every covered pixel (an upper bound: not every draw
   // tests or writes Z), colour write, destination read when blending, texels fetched, clears,
   // uploads (8 bytes per MEM_DATA). No depth buffer, no depth traffic.
@@ -84,6 +196,10 @@ DeviceStats stats_difference(const DeviceStats& a, const DeviceStats& b) {
   d.clears = a.clears - b.clears;
   d.clear_rows = a.clear_rows - b.clear_rows;
   d.clear_pixels = a.clear_pixels - b.clear_pixels;
+  d.texel_footprint_bytes = a.texel_footprint_bytes - b.texel_footprint_bytes;
+  d.sdram_accesses = a.sdram_accesses - b.sdram_accesses;
+  d.row_opens = a.row_opens - b.row_opens;
+  d.row_misses = a.row_misses - b.row_misses;
   return d;
 }
 
@@ -132,26 +248,40 @@ Result<BoardTiming> timing_preset(std::string_view name) {
   if (name == "ecp5") {
     // ULX3S: 50 MHz core, 16-bit SDR SDRAM (a 32-bit word per 2 clocks at best), SPI 15 MHz. Parallel
     // setup (38 cycles flat .. 336 textured Gouraud + Z on the core bench), one pixel a clock on
-    // spans, memory stalls per depth read, colour byte and texel fetch (texel cache), clears a word
+    // spans, memory stalls per depth read, colour byte, texel fetch and SDRAM row miss, clears a word
     // per 2 clocks beside the rasteriser.
     b.clock_mhz = 50.0;
     b.spi_clock_mhz = 15.0;
     b.memory_bytes_per_cycle = 2.0;
-    b.setup_cycles = {42.54, 173.0, 98.98, 203.8, 166.5, 280.1, 205.6, 315.4};
-    b.row_cycles = {1.725, 0.7712, 2.873, 2.361, 1.996, 1.617, 5.105, 2.512};
-    b.column_cycles = {0.379, 0.0, 1.117, 0.3836, 0.7652, 1.507, 2.744, 0.3189};
-    b.pixel_cycles = {0.3477, 0.5947, 4.491, 4.86, 1.992, 1.746, 5.244, 6.739};
-    b.cycles_per_command = 2.33;
+    // Fitted with the SDRAM row model and the texel footprint (`gpubridge bench rtl --fit --profile
+    // ecp5`, 2026-11-26, 14 scenes and 48 calibration frames; docs/gateware.md "Timing model"): a row
+    // miss costs 1.92 clocks beyond the per-pixel terms, a byte of texture footprint (texel cache
+    // fills) 0.57, a byte sampled 0.073; a row open and the access itself nothing beyond them.
+    b.setup_cycles = {41.71, 169.5, 97.0, 199.8, 163.2, 274.5, 201.5, 309.0};
+    b.row_cycles = {1.418, 0.4192, 2.721, 2.36, 0.5689, 0.6137, 6.116, 4.173};
+    b.column_cycles = {0.4139, 0.0, 0.7694, 0.1205, 0.0, 0.474, 2.862, 1.223};
+    b.pixel_cycles = {0.3255, 0.5814, 4.594, 4.878, 1.582, 1.226, 4.108, 5.107};
+    b.cycles_per_command = 2.552;
     b.cycles_per_triangle = 0.0;
-    b.cycles_per_blended_pixel = 3.198;
+    b.cycles_per_blended_pixel = 3.182;
     b.cycles_per_rejected_triangle = 0.0;
-    b.cycles_per_clear = 9.541;
+    b.cycles_per_clear = 8.387;
     b.cycles_per_clear_row = 0.0;
-    b.cycles_per_clear_pixel = 0.01171;
-    b.cycles_per_mem_write = 11.98;
-    b.cycles_per_texel_byte = 0.1716;
-    b.cycles_per_color_byte = 0.3643;
-    b.clear_bytes_per_cycle = 1.983;
+    b.cycles_per_clear_pixel = 0.005953;
+    b.cycles_per_mem_write = 11.67;
+    b.cycles_per_texel_byte = 0.07261;
+    b.cycles_per_color_byte = 0.3689;
+    b.cycles_per_texel_footprint_byte = 0.5707;
+    b.cycles_per_sdram_access = 0.0;
+    b.cycles_per_row_open = 0.0;
+    b.cycles_per_row_miss = 1.919;
+    b.clear_bytes_per_cycle = 2.004;
+    // The SDRAM (sdram_ctrl.v with the Alliance AS4C32M16SB-7's timing): an auto refresh every
+    // tREFI = 7.8 us costs precharge all (tRP 21 ns), tRFC (63 ns) and the first row opened again
+    // (tRCD 21 ns), in whole clocks; the fit keeps these and fits the rest.
+    const auto clocks = [&](double ns) { return std::ceil(ns * b.clock_mhz / 1000.0); };
+    b.refresh_interval_cycles = clocks(7800);
+    b.cycles_per_refresh = clocks(21) + clocks(63) + clocks(21);
     return b;
   }
   return make_error("unknown timing profile '" + std::string(name) + "' (ecp5-50mhz, up5k, ecp5)");
@@ -181,6 +311,12 @@ Result<void> apply_timing_setting(BoardTiming& b, std::string_view setting) {
       {"cycles_per_mem_write", &BoardTiming::cycles_per_mem_write},
       {"cycles_per_texel_byte", &BoardTiming::cycles_per_texel_byte},
       {"cycles_per_color_byte", &BoardTiming::cycles_per_color_byte},
+      {"cycles_per_sdram_access", &BoardTiming::cycles_per_sdram_access},
+      {"cycles_per_texel_footprint_byte", &BoardTiming::cycles_per_texel_footprint_byte},
+      {"cycles_per_row_open", &BoardTiming::cycles_per_row_open},
+      {"cycles_per_row_miss", &BoardTiming::cycles_per_row_miss},
+      {"refresh_interval_cycles", &BoardTiming::refresh_interval_cycles},
+      {"cycles_per_refresh", &BoardTiming::cycles_per_refresh},
   };
   const auto eq = setting.find('=');
   if (eq == std::string_view::npos) return make_error("timing setting '" + std::string(setting) + "' is not KEY=VALUE");
@@ -227,7 +363,7 @@ Result<void> apply_timing_setting(BoardTiming& b, std::string_view setting) {
   }
   for (const auto& k : kKeys) {
     if (k.name != name) continue;
-    const bool positive_needed = name != "cs_gap_us" && name.substr(0, 7) != "cycles_";
+    const bool positive_needed = name != "cs_gap_us" && name.substr(0, 7) != "cycles_" && name != "refresh_interval_cycles";
     if (!ok || (positive_needed && v <= 0))
       return make_error("timing " + std::string(name) + "=" + text + ": expected a finite number" +
                         (positive_needed ? " > 0" : " >= 0"));

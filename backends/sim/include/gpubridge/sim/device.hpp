@@ -56,6 +56,15 @@ struct DeviceStats {
   std::uint64_t clears = 0;               // CLEAR / CLEAR_Z with a non-empty clipping rectangle
   std::uint64_t clear_rows = 0;           // rows they filled
   std::uint64_t clear_pixels = 0;         // pixels they filled
+  // The SDRAM rows the drawn pixels' depth and colour accesses open (timing.hpp SdramRows, the
+  // ULX3S controller's geometry, in drawing order): ACTIVEs on an idle bank and row misses
+  // (another row of the bank open). Clears leave their rows open but are not counted here.
+  // Texture bytes inside the textured triangles' texture-space footprints (at most their samples'
+  // bytes): what a texel cache fetches from memory at most, without wrapping.
+  std::uint64_t texel_footprint_bytes = 0;
+  std::uint64_t sdram_accesses = 0;  // every access of that stream (a 32-bit word each)
+  std::uint64_t row_opens = 0;
+  std::uint64_t row_misses = 0;
   bool operator==(const DeviceStats&) const = default;
 };
 // The class index of DeviceStats::by_mode as a name: "flat", "gouraud", "z", "gouraud_z", "tex",

@@ -4,7 +4,9 @@
 // time of the frames that carried it. Not part of the device contract; the simulator never
 // sleeps or stalls because of it.
 #include <array>
+#include <cstdint>
 #include <string>
+#include <vector>
 
 #include "gpubridge/common/result.hpp"
 #include "gpubridge/sim/device.hpp"
@@ -41,11 +43,76 @@ struct BoardTiming {
   double cycles_per_mem_write = 0;          // MEM_DATA write (8 bytes through the arbiter)
   double cycles_per_texel_byte = 0;         // texture bytes fetched (bilinear: four texels a sample)
   double cycles_per_color_byte = 0;         // colour bytes written (bpp per passed pixel)
+  // The SDRAM's rows (the ecp5 preset; 0 elsewhere): cycles per access of the row model's stream
+  // (DeviceStats::sdram_accesses: a 32-bit word, a burst of 2), per ACTIVE on an idle bank
+  // (DeviceStats::row_opens: tRCD), per row miss (row_misses: PRECHARGE + ACTIVE, tRP + tRCD and
+  // the bank's tRAS / tWR / tRC waits), and the auto refresh: every refresh_interval_cycles (tREFI
+  // in core clocks; 0 = none) the controller spends cycles_per_refresh (precharge all, tRFC, the
+  // rows opened again after it), which stretches the rest by 1 / (1 − cycles_per_refresh /
+  // refresh_interval_cycles).
+  double cycles_per_sdram_access = 0;
+  double cycles_per_texel_footprint_byte = 0;  // DeviceStats::texel_footprint_bytes: texel cache fills
+  double cycles_per_row_open = 0;
+  double cycles_per_row_miss = 0;
+  double refresh_interval_cycles = 0;
+  double cycles_per_refresh = 0;
   // true: cycles = max(pipeline, bytes / memory_bytes_per_cycle). false: the pipeline terms
   // already hold the memory's time (the gateware presets, fitted on the RTL with its SDRAM and
   // texel cache, which the byte count does not see); memory_cycles is then only reported.
   bool memory_bound = true;
 };
+
+// Which row each bank of an SDR SDRAM holds, as a controller that keeps every bank's row open
+// until another row of that bank (or a refresh) needs it: the gateware's sdram_ctrl.v. A byte
+// address maps to its row like the controller's word address does: the low row_bits of the address
+// inside a row (1 KiB: 256 words of 4 bytes), then bank_bits of bank, then the row, so consecutive
+// rows rotate through the banks. Each access is a hit (the bank holds its row), an open (the bank
+// is idle: ACTIVE) or a miss (the bank holds another row: PRECHARGE + ACTIVE).
+struct SdramGeometry {
+  unsigned row_bits = 10;  // log2 of the bytes a row holds (ULX3S: 512 columns x 16 bits)
+  unsigned bank_bits = 2;  // log2 of the banks (4)
+};
+
+class SdramRows {
+ public:
+  enum class Outcome { Hit, Open, Miss };
+  explicit SdramRows(SdramGeometry g = {}) : g_(g), open_(std::size_t{1} << g.bank_bits, kClosed) {}
+  // `count` accesses in a row to the row holding byte `address`: the first one's outcome (the
+  // others hit), counted.
+  Outcome access(std::uint64_t address, std::uint64_t count = 1);
+  // The row holding `address` opened without counting (traffic the model does not charge here,
+  // e.g. a clear, which has terms of its own, still leaves its rows open).
+  void touch(std::uint64_t address);
+  // Every row of [address, address + bytes) touched in address order.
+  void touch_range(std::uint64_t address, std::uint64_t bytes);
+  // An auto refresh: every bank precharged.
+  void refresh();
+  std::uint64_t hits() const { return hits_; }
+  std::uint64_t opens() const { return opens_; }
+  std::uint64_t misses() const { return misses_; }
+  void reset_counts() { hits_ = opens_ = misses_ = 0; }
+  const SdramGeometry& geometry() const { return g_; }
+
+ private:
+  static constexpr std::uint64_t kClosed = ~std::uint64_t{0};
+  SdramGeometry g_;
+  std::vector<std::uint64_t> open_;  // row per bank, kClosed when precharged
+  std::uint64_t hits_ = 0, opens_ = 0, misses_ = 0;
+};
+
+// One span of covered pixels as the ecp5 core's memory port sends it (core_memport.v): per pixel a
+// depth read (Z test) and write (Z write) of its 4-byte word, a colour read (blend, partial write
+// mask) and write per 32-bit colour word (the write combiner merges the pixels of a word), in pixel
+// order: the rows are visited in runs, so a depth and a colour buffer in one bank but different
+// rows miss at every switch, and in different banks hit.
+struct SpanAccess {
+  std::uint64_t color = 0;  // byte address of the first pixel's colour
+  std::uint64_t depth = 0;  // byte address of the first pixel's Z word
+  unsigned bpp = 4;
+  unsigned pixels = 0;
+  bool z_read = false, z_write = false, color_read = false, color_write = true;
+};
+void access_span(SdramRows& rows, const SpanAccess& span);
 
 struct TimingEstimate {
   double pipeline_cycles = 0;  // setup + rasterisation + pixel stages + clears
@@ -66,6 +133,8 @@ TimingEstimate estimate_timing(const DeviceStats& work, const BoardTiming& board
 // Link time (ms) of `frames` 72-bit SPI frames under `board`: the bits at its SPI clock plus the
 // chip-select gap between bursts of frames_per_burst (docs/protocol.md section 19).
 double spi_link_ms(double frames, const BoardTiming& board);
+// The factor the auto refresh stretches a board's work by (1 without refresh terms).
+double refresh_stretch(const BoardTiming& board);
 // a − b, field by field.
 DeviceStats stats_difference(const DeviceStats& a, const DeviceStats& b);
 // "clock_mhz=25 spi_clock_mhz=10 ..." settings applied to a profile (errors name the key);
