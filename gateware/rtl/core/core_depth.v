@@ -90,9 +90,8 @@ module core_depth #(
   reg [PW-1:0]  o_pix;
   wire          room = !o_valid;
   // a pixel is resolved when it fails, or passes with room behind and its depth write accepted
-  wire          z_free;    // the depth write can be taken this cycle
-  wire          z_idle;    // no depth write waiting
-  assign take     = cur_valid && (!pass || (room && (!z_write || z_free)));
+  assign take     = cur_valid && (!pass || (room && (!z_write || wr_ready)));
+  assign wr_valid = active && cur_valid && pass && z_write && room;
   generate
     if (AW == 0) begin : one_adder
       // one read in flight: a read is issued only while the queue is empty and a Z_TEST write
@@ -101,41 +100,12 @@ module core_depth #(
       wire [29:0] a = zaddr(fb_z16, (z_test && !q_empty) ? q_item[IDX_W-1:0] : in_pix[IDX_W-1:0]);
       assign rd_addr = a;
       assign wr_addr = a;
-      assign wr_data = cur_z;
-      assign wr_valid = active && cur_valid && pass && z_write && room;
-      assign z_free = wr_ready;
-      assign z_idle = 1'b1;
     end else begin : two_adders
       assign rd_addr = zaddr(fb_z16, in_pix[IDX_W-1:0]);
-      // The depth write goes three registers behind the pixel's resolution (stages that close
-      // up when the one ahead is empty), so that it reaches the memory port next to the pixel's
-      // colour write, which the colour stage's PIPE steps delay: on the SDRAM the two writes
-      // share one read-to-write turnaround, as before those steps (Z test + write 0.129 px/clock
-      // with the write at resolution, 0.143 before the colour steps).
-      reg [2:0]  zv;
-      reg [53:0] zq0, zq1, zq2;    // {word address, depth}
-      wire z2_free = !zv[2] || wr_ready;
-      wire z1_free = !zv[1] || z2_free;
-      assign z_free = !zv[0] || z1_free;
-      wire z_push = active && cur_valid && pass && z_write && room && z_free;
-      always @(posedge clk) begin
-        if (rst) begin
-          zv <= 3'd0;
-        end else begin
-          if (z2_free) zv[2] <= zv[1];
-          if (z1_free) zv[1] <= zv[0];
-          if (z_free)  zv[0] <= z_push;
-        end
-        if (z2_free) zq2 <= zq1;
-        if (z1_free) zq1 <= zq0;
-        if (z_free)  zq0 <= {zaddr(fb_z16, cur[IDX_W-1:0]), cur_z};
-      end
-      assign wr_valid = zv[2];
-      assign wr_addr  = zq2[53:24];
-      assign wr_data  = zq2[23:0];
-      assign z_idle   = (zv == 3'd0);
+      assign wr_addr = zaddr(fb_z16, cur[IDX_W-1:0]);
     end
   endgenerate
+  assign wr_data  = cur_z;
   assign in_ready = !active ? out_ready : z_test ? (!q_full && rd_ready) : take;
   assign passed   = active ? (take && pass) : (in_valid && out_ready);
 
@@ -152,5 +122,5 @@ module core_depth #(
   assign out_valid = active ? o_valid : in_valid;
   assign out_pix   = active ? o_pix : in_pix;
 
-  assign idle = q_empty && !o_valid && z_idle;
+  assign idle = q_empty && !o_valid;
 endmodule

@@ -128,7 +128,10 @@ module core_setup #(
       assign x_out = 1'b0;
     end
   endgenerate
-  wire box_empty = (by0 >= by1) || x_out;
+  // x_out is registered in S_BOX (its operands are the edges and vertices, there since S_AREA), so
+  // S_BOX2's decision does not carry the column arithmetic too (the ULX3S clock)
+  reg  x_out_r;
+  wire box_empty = (by0 >= by1) || x_out_r;
   // box_xl (the last column, clip_x1 - 1, loaded at the start) is the clamp's upper bound too
   wire [10:0] xs = (xt < cx0) ? r_clip_x0 : (xt > $signed({2'b0, box_xl})) ? box_xl : xt[10:0];
 
@@ -415,6 +418,7 @@ module core_setup #(
           end
         end
         S_BOX: begin
+          x_out_r <= x_out;
           fy0  <= fy;
           xt   <= 13'(xa >>> 4);
           pv   <= argmax(dy2, dy0, dy1);   // the bottom vertex
