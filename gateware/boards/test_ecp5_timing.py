@@ -9,6 +9,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import ecp5_timing  # noqa: E402
 
 CLK_TO_Q, LUT, CARRY_IN_TO_OUT, A_TO_COUT, CIN_TO_S, MULT = 0.525, 0.236, 0.071, 0.447, 0.474, 3.927
+MULT_OUTREG_CLK_TO_P, MULT_OUTREG_SETUP = 0.735, 3.486   # MULT18X18D with its output register
 
 
 class Netlist:
@@ -67,6 +68,19 @@ class Ecp5Timing(unittest.TestCase):
         n.ff("b", "d_b", "q_b")
         # the nets to and from a block take the block allowance (2 ns)
         self.assertAlmostEqual(worst(n), round(CLK_TO_Q + 2.0 + MULT + 2.0, 2))
+
+    def test_multiplier_output_register_splits_the_path(self):
+        # a register absorbed into the MULT18X18D (REG_OUTPUT_CLK) ends the path into it and starts
+        # the one out of it: FF -> A (setup through the array) and P (clock to out) -> FF
+        n = Netlist()
+        n.ff("a", "d_a", "q_a")
+        n.cell("m", "MULT18X18D", {"P0": "d_b"}, {"A0": "q_a", "CLK0": "clk"},
+               {"REG_INPUTA_CLK": "NONE", "REG_INPUTB_CLK": "NONE", "REG_OUTPUT_CLK": "CLK0"})
+        n.ff("b", "d_b", "q_b")
+        into = round(CLK_TO_Q + 2.0 + MULT_OUTREG_SETUP, 2)
+        out_of = round(MULT_OUTREG_CLK_TO_P + 2.0, 2)
+        self.assertAlmostEqual(worst(n), max(into, out_of))
+        self.assertLess(worst(n), round(CLK_TO_Q + 2.0 + MULT + 2.0, 2))  # shorter than unregistered
 
     def test_paths_between_clock_domains_are_left_out(self):
         n = Netlist()

@@ -6,7 +6,9 @@ module core_color #(
     parameter integer AW = 2,            // log2 of destination reads in flight
     parameter integer IDX_W = 20,
     parameter integer ADDR_W = 32,
-    parameter [7:0]   FEATURES = 8'hFF   // CAPS.FEATURES: blend, dither, RGB565, RGBA2222 logic
+    parameter [7:0]   FEATURES = 8'hFF,  // CAPS.FEATURES: blend, dither, RGB565, RGBA2222 logic
+    parameter integer PIPE = 0           // 1 (ecp5): three registered steps between the queue
+                                         // head and the write register (below)
 ) (
     input  wire        clk,
     input  wire        rst,
@@ -87,34 +89,54 @@ module core_color #(
   // the pixel being written: its address and (PACKQ) its packed value
   wire        cur_valid = need_rd ? q_head : in_valid;
   wire [31:0] dword = 32'(q_data);
-  wire [31:0] addr = (PACKQ != 0) ? (need_rd ? q_item[QIW-1:QIW-32] : in_addr) : cur[63:32];
+  wire [31:0] addr = (PACKQ != 0) ? (need_rd ? q_item[QIW-1:QIW-32] : in_addr) : wcur[63:32];
   wire [15:0] pk = need_rd ? q_item[15:0] : pk_n;
   wire [1:0]  lane = addr[1:0];
-  wire [1:0]  xl = cur[65:64], yl = cur[67:66];
+  wire [1:0]  xl, yl;
+
+  // ---- PIPE: the pixel, its destination word and its blend over three registered steps ----
+  // (the ULX3S clock, docs/gateware.md "Clock estimate"): p1 the queue head (or input) and its
+  // word, p2 the blend before its division by 255 (the products), p3 the blended channels; the
+  // write register quantises, packs and masks p3. One enable (the write register free) moves
+  // them all, so a pixel a clock still leaves. PIPE = 0: every step is the pixel of this clock.
+  localparam integer PP = (PIPE != 0 && PACKQ == 0) ? 1 : 0;
+  wire        pen = !wr_valid || wr_ready;
+  reg         p1v, p2v, p3v;
+  reg [67:0]  p1c, p2c, p3c;
+  reg [31:0]  p1d, p2d, p3d;
+  reg [31:0]  p1x;                               // p1's destination, 8 bits a channel
+  wire [67:0] bcur = (PP != 0) ? p1c : cur;      // the pixel blended
+  wire [67:0] wcur = (PP != 0) ? p3c : cur;      // the pixel written
+  wire [31:0] wdword = (PP != 0) ? p3d : dword;
 
   // ---- destination pixel, expanded to 8 bits per channel ----
-  wire [15:0] d16 = (PACKQ != 0 || lane[1]) ? dword[15:0] : dword[31:16];
-  wire [7:0]  d8 = (PACKQ != 0) ? (lane[0] ? d16[7:0] : d16[15:8]) :
-                   (lane == 2'd0) ? dword[31:24] : (lane == 2'd1) ? dword[23:16] :
-                   (lane == 2'd2) ? dword[15:8] : dword[7:0];
-  reg  [7:0]  dr, dg, db, da;
-  always @(*) begin
-    case (fmt)
-      2'd1: begin
-        dr = {d16[15:11], d16[15:13]};
-        dg = {d16[10:5], d16[10:9]};
-        db = {d16[4:0], d16[4:2]};
-        da = 8'hFF;
-      end
-      2'd2: begin
-        dr = {4{d8[7:6]}};
-        dg = {4{d8[5:4]}};
-        db = {4{d8[3:2]}};
-        da = {4{d8[1:0]}};
-      end
-      default: {dr, dg, db, da} = dword;
+  function [15:0] dst16(input [31:0] w, input ln1);  // ln1: lane bit 1
+    dst16 = (PACKQ != 0 || ln1) ? w[15:0] : w[31:16];
+  endfunction
+  function [7:0] dst8(input [31:0] w, input [1:0] ln);
+    reg [15:0] h;
+    begin
+      h = dst16(w, ln[1]);
+      dst8 = (PACKQ != 0) ? (ln[0] ? h[7:0] : h[15:8]) :
+             (ln == 2'd0) ? w[31:24] : (ln == 2'd1) ? w[23:16] : (ln == 2'd2) ? w[15:8] : w[7:0];
+    end
+  endfunction
+  assign xl = wcur[65:64];
+  assign yl = wcur[67:66];
+  wire [15:0] d16 = dst16(wdword, lane[1]);
+  wire [7:0]  d8 = dst8(wdword, lane);
+  function [31:0] expand(input [1:0] f, input [15:0] h, input [7:0] b, input [31:0] w);
+    case (f)
+      2'd1: expand = {h[15:11], h[15:13], h[10:5], h[10:9], h[4:0], h[4:2], 8'hFF};
+      2'd2: expand = {{4{b[7:6]}}, {4{b[5:4]}}, {4{b[3:2]}}, {4{b[1:0]}}};
+      default: expand = w;
     endcase
-  end
+  endfunction
+  // PP: expanded before p1 (its lane from the pixel entering p1), so p1 holds it ready for the blend
+  wire [31:0] dexp = (PP != 0) ? p1x : expand(fmt, d16, d8, dword);
+  wire [7:0]  dr = dexp[31:24], dg = dexp[23:16], db = dexp[15:8], da = dexp[7:0];
+  wire [31:0] dexp_in = expand(fmt, dst16(dword, cur[33]), dst8(dword, cur[33:32]), dword);
+  wire unused_pp = &{1'b0, bcur[67:32], wcur[31:0], dexp_in};  // blended: the colour; written: the rest
 
   // ---- blend ----
   function [7:0] div255(input [16:0] x);
@@ -124,22 +146,47 @@ module core_color #(
       div255 = 8'((y + {8'd0, y[16:8]}) >> 8);
     end
   endfunction
-  wire [7:0] sa = cur[7:0];
-  function [7:0] blend_ch(input [1:0] m, input [7:0] s, input [7:0] d, input [7:0] a);
+  wire [7:0] sa = bcur[7:0];
+  // the blend before its division by 255 (ALPHA, MULTIPLY), or its result (OFF, ADD)
+  function [16:0] blend_pre(input [1:0] m, input [7:0] s, input [7:0] d, input [7:0] a);
     case (m)
       // ALPHA: s*a + d*(255-a) = d*255 + a*(s-d), in [0, 65025]
-      2'd1: blend_ch = div255(17'($signed({1'b0, d, 8'd0}) - $signed({10'd0, d}) +
-                                 $signed({10'd0, a}) * ($signed({10'd0, s}) - $signed({10'd0, d}))));
-      2'd2: blend_ch = ({1'b0, s} + {1'b0, d} > 9'd255) ? 8'hFF : s + d;  // ADD
-      2'd3: blend_ch = div255({1'b0, 16'(s) * 16'(d)});                     // MULTIPLY
-      default: blend_ch = s;
+      2'd1: blend_pre = 17'($signed({1'b0, d, 8'd0}) - $signed({10'd0, d}) +
+                            $signed({10'd0, a}) * ($signed({10'd0, s}) - $signed({10'd0, d})));
+      2'd2: blend_pre = {9'd0, ({1'b0, s} + {1'b0, d} > 9'd255) ? 8'hFF : s + d};  // ADD
+      2'd3: blend_pre = {1'b0, 16'(s) * 16'(d)};                                  // MULTIPLY
+      default: blend_pre = {9'd0, s};
     endcase
   endfunction
+  function [7:0] blend_post(input [1:0] m, input [16:0] x);
+    blend_post = (m == 2'd1 || m == 2'd3) ? div255(x) : x[7:0];
+  endfunction
   wire [1:0] bm = FEATURES[F_BLEND] ? blend : 2'd0;
-  wire [7:0] cr = blend_ch(bm, cur[31:24], dr, sa);
-  wire [7:0] cg = blend_ch(bm, cur[23:16], dg, sa);
-  wire [7:0] cb = blend_ch(bm, cur[15:8], db, sa);
-  wire [7:0] ca = blend_ch(bm, cur[7:0], da, sa);
+  wire [16:0] xr = blend_pre(bm, bcur[31:24], dr, sa);
+  wire [16:0] xg = blend_pre(bm, bcur[23:16], dg, sa);
+  wire [16:0] xb = blend_pre(bm, bcur[15:8], db, sa);
+  wire [16:0] xa = blend_pre(bm, bcur[7:0], da, sa);
+  reg  [16:0] p2r, p2g, p2b, p2a;
+  reg  [7:0]  p3r, p3g, p3b, p3a;
+  wire [7:0] cr = (PP != 0) ? p3r : blend_post(bm, xr);
+  wire [7:0] cg = (PP != 0) ? p3g : blend_post(bm, xg);
+  wire [7:0] cb = (PP != 0) ? p3b : blend_post(bm, xb);
+  wire [7:0] ca = (PP != 0) ? p3a : blend_post(bm, xa);
+  always @(posedge clk) begin
+    if (rst || PP == 0) begin
+      p1v <= 1'b0; p2v <= 1'b0; p3v <= 1'b0;
+    end else if (pen) begin
+      p1v <= cur_valid; p2v <= p1v; p3v <= p2v;
+    end
+    if (pen) begin
+      p1c <= cur; p1d <= dword; p1x <= dexp_in;
+      p2c <= p1c; p2d <= p1d;
+      p2r <= xr; p2g <= xg; p2b <= xb; p2a <= xa;
+      p3c <= p2c; p3d <= p2d;
+      p3r <= blend_post(bm, p2r); p3g <= blend_post(bm, p2g);
+      p3b <= blend_post(bm, p2b); p3a <= blend_post(bm, p2a);
+    end
+  end
 
   // ---- quantise and dither (4x4 Bayer at screen position) ----
   reg [3:0] bayer;
@@ -206,20 +253,21 @@ module core_color #(
   end
 
   // ---- write register ----
-  wire wfree = !wr_valid || wr_ready;
+  wire wfree = pen;
+  wire wv = (PP != 0) ? p3v : cur_valid;  // the written pixel is there
   assign take = cur_valid && wfree;
   assign in_ready = need_rd ? (!q_full && rd_ready) : take;
   always @(posedge clk) begin
     if (rst) begin
       wr_valid <= 1'b0;
     end else if (wfree) begin
-      wr_valid <= cur_valid;
-      if (cur_valid) begin
+      wr_valid <= wv;
+      if (wv) begin
         wr_addr <= addr[31:2];
         wr_data <= data_n;
         wr_be   <= be_n;
       end
     end
   end
-  assign idle = q_empty && !wr_valid;
+  assign idle = q_empty && !wr_valid && !p1v && !p2v && !p3v;
 endmodule

@@ -18,7 +18,8 @@
 //   4. per interpolated attribute: the three numerators divided by 2D into (quotient,
 //      remainder) plane fields; the step left is written as (~qx, 2D - 1 - rx), which the steppers
 //      add with a carry in. A clear (rect) sets up only the clip rectangle and its first index.
-// Multiplies are a1*m1 +/- a2*m2, both products at once. A multiply overlaps the previous
+// Multiplies are a1*m1 +/- a2*m2, both products at once, over three registered clocks (operands,
+// products, sum). A multiply overlaps the previous
 // division. The vertex inputs are read while the command waits on
 // the port (held stable by the soc).
 module core_setup #(
@@ -40,9 +41,9 @@ module core_setup #(
     input  wire [183:0] v2,
     input  wire [10:0]  clip_x0,
     input  wire [10:0]  clip_y0,
-    input  wire [10:0]  clip_x1,      // exclusive, already min(SCISSOR.X1, WIDTH)
+    input  wire [10:0]  clip_x1,   // exclusive, already min(SCISSOR.X1, WIDTH)
     input  wire [10:0]  clip_y1,
-    input  wire [10:0]  width,        // FB_FORMAT.WIDTH
+    input  wire [10:0]  width,     // FB_FORMAT.WIDTH
     input  wire [7:0]   need,         // planes to set up: R G B A Z S T Q (bit 0 = R)
     // held for the rasteriser: kick-order edges 1->2, 2->0, 0->1 and the exchange
     output reg  signed [16:0] dx0, dx1, dx2, dy0, dy1, dy2,
@@ -70,9 +71,14 @@ module core_setup #(
   localparam integer ACC_W = (TEX != 0) ? 72 : 61;
 
   // ---------------------------------------------------------------- vertices (kick order)
-  wire signed [15:0] x0 = v0[15:0], y0 = v0[31:16];
-  wire signed [15:0] x1 = v1[15:0], y1 = v1[31:16];
-  wire signed [15:0] x2 = v2[15:0], y2 = v2[31:16];
+  // Copied when a triangle starts (S_DELTA takes the edges a clock later): the command port's
+  // words come through the soc's command FIFO and executor, which leave no time in the same
+  // clock for the arithmetic behind them (the ULX3S clock, docs/gateware.md "Clock estimate").
+  reg  [183:0] r_v0, r_v1, r_v2;
+  reg  [10:0]  r_clip_x0, r_clip_y0, r_clip_x1, r_clip_y1, r_width;
+  wire signed [15:0] x0 = r_v0[15:0], y0 = r_v0[31:16];
+  wire signed [15:0] x1 = r_v1[15:0], y1 = r_v1[31:16];
+  wire signed [15:0] x2 = r_v2[15:0], y2 = r_v2[31:16];
   function signed [16:0] sub16(input signed [15:0] b, input signed [15:0] a);
     sub16 = $signed({b[15], b}) - $signed({a[15], a});
   endfunction
@@ -104,8 +110,8 @@ module core_setup #(
   wire signed [12:0] fy = 13'(($signed({ya[15], ya}) + (box2 ? 17'sd8 : 17'sd7)) >>> 4);
   reg  signed [12:0] fy0, xt;  // the top vertex's first row and column (S_BOX)
   wire signed [12:0] fy1 = fy;
-  wire signed [12:0] cx0 = $signed({2'b0, clip_x0}), cx1 = $signed({2'b0, clip_x1});
-  wire signed [12:0] cy0 = $signed({2'b0, clip_y0}), cy1 = $signed({2'b0, clip_y1});
+  wire signed [12:0] cx0 = $signed({2'b0, r_clip_x0}), cx1 = $signed({2'b0, r_clip_x1});
+  wire signed [12:0] cy0 = $signed({2'b0, r_clip_y0}), cy1 = $signed({2'b0, r_clip_y1});
   wire signed [12:0] by0 = (fy0 > cy0) ? fy0 : cy0;
   wire signed [12:0] by1 = (fy1 < cy1) ? fy1 : cy1;
   // Columns: with XREJECT a triangle wholly beside the clip rectangle is dropped here; without
@@ -122,9 +128,12 @@ module core_setup #(
       assign x_out = 1'b0;
     end
   endgenerate
-  wire box_empty = (by0 >= by1) || x_out;
+  // x_out is registered in S_BOX (its operands are the edges and vertices, there since S_AREA), so
+  // S_BOX2's decision does not carry the column arithmetic too (the ULX3S clock)
+  reg  x_out_r;
+  wire box_empty = (by0 >= by1) || x_out_r;
   // box_xl (the last column, clip_x1 - 1, loaded at the start) is the clamp's upper bound too
-  wire [10:0] xs = (xt < cx0) ? clip_x0 : (xt > $signed({2'b0, box_xl})) ? box_xl : xt[10:0];
+  wire [10:0] xs = (xt < cx0) ? r_clip_x0 : (xt > $signed({2'b0, box_xl})) ? box_xl : xt[10:0];
 
   // ---------------------------------------------------------------- attribute deltas
   function [AW-1:0] attr(input [151:0] v, input [2:0] k);  // v: vertex bits [183:32]
@@ -141,30 +150,42 @@ module core_setup #(
   endfunction
   reg  [2:0] ak;  // attribute being set up
   wire [2:0] akv = (TEX != 0 || ak < 3'd5) ? ak : 3'd4;
-  wire signed [AW-1:0] a0 = attr(v0[183:32], akv);
-  wire signed [AW-1:0] d1 = attr(v1[183:32], akv) - a0, d2 = attr(v2[183:32], akv) - a0;  // |d| < 2^(AW-1)
+  wire signed [AW-1:0] a0 = attr(r_v0[183:32], akv);
+  wire signed [AW-1:0] d1c = attr(r_v1[183:32], akv) - a0, d2c = attr(r_v2[183:32], akv) - a0;  // |d| < 2^(AW-1)
+  // registered (a clock after `ak` moves: S_ANEXT is at least two clocks before their first use)
+  // so that the vertex multiplexer and the subtraction end here, not in the multiply's operands
+  reg  signed [AW-1:0] d1, d2;
+  always @(posedge clk) begin
+    d1 <= d1c;
+    d2 <= d2c;
+  end
 
   // ---------------------------------------------------------------- operands
-  // m operand (one bus): selected by `osel`, alternating between osel1 and osel2 in a multiply
   localparam [3:0] O_DX0 = 4'd0, O_DY0 = 4'd1, O_DX1 = 4'd2, O_DY1 = 4'd3, O_DX2 = 4'd4,
                    O_DY2 = 4'd5, O_W = 4'd6, O_XS = 4'd7, O_E1 = 4'd8, O_E2 = 4'd9, O_D1 = 4'd10,
                    O_D2 = 4'd11, O_D = 4'd12, O_ONE = 4'd13;
+  // Two m operand buses: `osel` (the first product's, or a single addition's) and `osel2` (the
+  // second product's), so that a multiply registers all its operands in one clock.
   reg  [3:0] osel;
   reg        sh5;   // the delta operands times 32
-  reg signed [16:0] nop;
-  always @(*) begin
-    case (osel)
-      O_DX0: nop = dx0;  O_DY0: nop = dy0;
-      O_DX1: nop = dx1;  O_DY1: nop = dy1;
-      O_DX2: nop = dx2;  O_DY2: nop = dy2;
-      O_W:   nop = {6'd0, width};
-      O_XS:  nop = {6'd0, x_start};
-      default: nop = 17'sd1;
-    endcase
-  end
-  wire signed [35:0] mop = (osel == O_E1) ? e1 : (osel == O_E2) ? e2 :
-                           (osel == O_D1) ? 36'(d1) : (osel == O_D2) ? 36'(d2) :
-                           (osel == O_D) ? {2'b0, den[34:1]} : sh5 ? (36'(nop) <<< 5) : 36'(nop);
+  function signed [35:0] moper(input [3:0] k, input s5, input signed [35:0] ea, input signed [35:0] eb,
+                               input signed [AW-1:0] da, input signed [AW-1:0] db);
+    reg signed [16:0] n;
+    begin
+      case (k)
+        O_DX0: n = dx0;  O_DY0: n = dy0;
+        O_DX1: n = dx1;  O_DY1: n = dy1;
+        O_DX2: n = dx2;  O_DY2: n = dy2;
+        O_W:   n = {6'd0, r_width};
+        O_XS:  n = {6'd0, x_start};
+        default: n = 17'sd1;
+      endcase
+      moper = (k == O_E1) ? ea : (k == O_E2) ? eb : (k == O_D1) ? 36'(da) : (k == O_D2) ? 36'(db) :
+              (k == O_D) ? {2'b0, den[34:1]} : s5 ? (36'(n) <<< 5) : 36'(n);
+    end
+  endfunction
+  wire signed [35:0] mop = moper(osel, sh5, e1, e2, d1, d2);
+  wire signed [35:0] mop2 = moper(osel2, sh5, e1, e2, d1, d2);
 
   // a operands (multiplier bits), by `asel`
   localparam [1:0] A_AREA = 2'd0, A_ORIGIN = 2'd1, A_EDGE = 2'd2, A_ATTR = 2'd3;
@@ -201,13 +222,16 @@ module core_setup #(
   reg        add_go, add_dbl, add_neg;
   reg  [3:0] add_osel;
 
-  // both products at once; the m operands are taken in two cycles (one bus)
-  reg signed [35:0] m1;
-  wire signed [ACC_W-1:0] p1 = ACC_W'(ma1) * ACC_W'(m1);   // |a| < 2^(AW-1), |m| < 2^35
-  wire signed [ACC_W-1:0] p2 = ACC_W'(ma2) * ACC_W'(mop);
+  // A multiply in three clocks, each ending in registers (the ULX3S clock, docs/gateware.md
+  // "Clock estimate"): the mac_go clock takes the operands (the sequencer set their selects with
+  // mac_go), ph 0 the two products (MULT18X18D and the adders of their partial products), ph 1
+  // their sum, negated when asked, into the accumulator.
+  reg signed [32:0] ma1_r, ma2_r;
+  reg signed [35:0] m1, m2;
+  reg signed [ACC_W-1:0] p1, p2;   // |a| < 2^(AW-1), |m| < 2^35
   wire signed [ACC_W-1:0] s12 = p1 + (msub ? -p2 : p2);
   always @(*) begin
-    osel  = mac_run ? (ph ? osel2 : osel1) : add_osel;
+    osel  = mac_go ? osel1 : add_osel;
     c_en  = add_go && !mac_run;
     c_dbl = add_dbl;
     c_neg = add_neg;
@@ -218,9 +242,14 @@ module core_setup #(
     end else if (mac_go) begin
       mac_run <= 1'b1;
       ph      <= 1'b0;
+      m1      <= mop;
+      m2      <= mop2;
+      ma1_r   <= ma1;
+      ma2_r   <= ma2;
     end else if (mac_run) begin
       if (!ph) begin
-        m1 <= mop;
+        p1 <= ACC_W'(ma1_r) * ACC_W'(m1);
+        p2 <= ACC_W'(ma2_r) * ACC_W'(m2);
         ph <= 1'b1;
       end else begin
         acc     <= mneg ? -s12 : s12;
@@ -289,7 +318,7 @@ module core_setup #(
   localparam [4:0] S_IDLE = 5'd0, S_AREA = 5'd1, S_FLIP = 5'd2, S_BOX = 5'd3, S_ORIGIN = 5'd4,
                    S_EDGE = 5'd5, S_BIAS = 5'd6, S_ANEXT = 5'd7, S_GX = 5'd8, S_GY = 5'd9,
                    S_M0 = 5'd10, S_M0_C = 5'd11, S_M0_D = 5'd12, S_DRAIN = 5'd13, S_END = 5'd14,
-                   S_WAIT = 5'd15, S_GX_W = 5'd16, S_BOX2 = 5'd17;
+                   S_WAIT = 5'd15, S_GX_W = 5'd16, S_BOX2 = 5'd17, S_DELTA = 5'd18;
   reg [4:0]  st, ret;   // S_WAIT: until the multiply is done, then ret
   reg [1:0]  cstep;     // M0 corrections
   reg [7:0]  todo;
@@ -346,6 +375,10 @@ module core_setup #(
           sh5   <= 1'b0;
           box2  <= 1'b0;
           cstep <= 2'd0;
+          r_v0 <= v0; r_v1 <= v1; r_v2 <= v2;
+          r_clip_x0 <= clip_x0; r_clip_y0 <= clip_y0;
+          r_clip_x1 <= clip_x1; r_clip_y1 <= clip_y1;
+          r_width <= width;
           if (rect) begin
             box_y0  <= clip_y0;
             box_y1  <= clip_y1;
@@ -353,11 +386,14 @@ module core_setup #(
             draw    <= 1'b1;
             st      <= S_ORIGIN;
           end else begin
-            dx0 <= sub16(x2, x1); dy0 <= sub16(y2, y1);
-            dx1 <= sub16(x0, x2); dy1 <= sub16(y0, y2);
-            dx2 <= sub16(x1, x0); dy2 <= sub16(y1, y0);
-            st  <= S_AREA;
+            st  <= S_DELTA;
           end
+        end
+        S_DELTA: begin
+          dx0 <= sub16(x2, x1); dy0 <= sub16(y2, y1);
+          dx1 <= sub16(x0, x2); dy1 <= sub16(y0, y2);
+          dx2 <= sub16(x1, x0); dy2 <= sub16(y1, y0);
+          st  <= S_AREA;
         end
         S_AREA: begin  // D = dx20*dy01 - dx01*dy20
           asel <= A_AREA; osel1 <= O_DY2; osel2 <= O_DY1; msub <= 1'b1; mneg <= 1'b0;
@@ -382,6 +418,7 @@ module core_setup #(
           end
         end
         S_BOX: begin
+          x_out_r <= x_out;
           fy0  <= fy;
           xt   <= 13'(xa >>> 4);
           pv   <= argmax(dy2, dy0, dy1);   // the bottom vertex

@@ -45,11 +45,11 @@ module core_texture #(
 
 `include "core_addr.vh"
   localparam integer PAY = IDX_W + 36;  // {yl, xl, idx, rgba}
-  wire [31:0] in_q = in_pix[IDX_W+155:IDX_W+124];
-  wire [31:0] in_t = in_pix[IDX_W+123:IDX_W+92];
-  wire [31:0] in_s = in_pix[IDX_W+91:IDX_W+60];
-  wire [PAY-1:0] in_pay = {in_pix[IDX_W+27:IDX_W+24], in_pix[IDX_W-1:0], in_pix[IDX_W+59:IDX_W+28]};
-
+  // Pixels enter through a two-entry FIFO whose room is registered state: the unit's readiness
+  // (stage 5's cache hits, a block RAM read) reaches back into the depth stage and the rasteriser
+  // no more (the ULX3S clock, docs/gateware.md "Clock estimate").
+  // The FIFO also holds q's leading zeros (counted on the way in), so that the count and the
+  // normalising shift in front of the reciprocal table are not one clock's work.
   function [5:0] clz32(input [31:0] v);
     integer k;
     begin
@@ -58,8 +58,19 @@ module core_texture #(
         if (v[k]) clz32 = 6'(31 - k);
     end
   endfunction
-  wire [5:0]  in_n = clz32(in_q);
-  wire [31:0] in_m = in_q << in_n[4:0];
+  wire [5:0]        in_n_in = clz32(in_pix[IDX_W+155:IDX_W+124]);
+  wire              f_valid;
+  wire [IDX_W+155:0] f_pix;
+  wire [4:0]        in_n;
+  core_fifo2 #(.W(IDX_W + 161)) in_fifo (
+      .clk(clk), .rst(rst), .push(in_valid && in_ready), .din({in_n_in[4:0], in_pix}), .room(in_ready),
+      .valid(f_valid), .dout({in_n, f_pix}), .pop(en));
+  wire [31:0] in_q = f_pix[IDX_W+155:IDX_W+124];
+  wire [31:0] in_t = f_pix[IDX_W+123:IDX_W+92];
+  wire [31:0] in_s = f_pix[IDX_W+91:IDX_W+60];
+  wire [PAY-1:0] in_pay = {f_pix[IDX_W+27:IDX_W+24], f_pix[IDX_W-1:0], f_pix[IDX_W+59:IDX_W+28]};
+
+  wire [31:0] in_m = in_q << in_n;
 
   wire [31:0] y0;
   core_recip_rom rom (.clk(clk), .en(en), .addr(in_m[30:21]), .y(y0));
@@ -91,13 +102,13 @@ module core_texture #(
   wire [31:0] tnr = negp[63:32];                            // 2 - M y as u1.31
   wire [32:0] ysh = yt3[63:31];
   wire [31:0] ynr = ysh[32] ? 32'hFFFFFFFF : ysh[31:0];   // min(2^32 - 1, (y t) >> 31)
-  wire unused_low = &{1'b0, yt3[30:0], negp[31:0], in_n[5], in_pix[IDX_W+23:IDX_W]};  // depth: not here
+  wire unused_low = &{1'b0, yt3[30:0], negp[31:0], in_n_in[5], f_pix[IDX_W+23:IDX_W]};  // depth: not here
 
   always @(posedge clk) begin
     if (rst) begin
       v1 <= 1'b0; v2 <= 1'b0; v3 <= 1'b0; v4 <= 1'b0;
     end else if (en) begin
-      v1 <= in_valid; qz1 <= (in_q == 32'd0); n1 <= in_n[4:0]; m1 <= in_m; s1 <= in_s; t1 <= in_t;
+      v1 <= f_valid; qz1 <= (in_q == 32'd0); n1 <= in_n; m1 <= in_m; s1 <= in_s; t1 <= in_t;
       pay1 <= in_pay;
       v2 <= v1; qz2 <= qz1; n2 <= n1; p2 <= {32'd0, m1} * {32'd0, y0}; y02 <= y0; s2 <= s1; t2 <= t1;
       pay2 <= pay1;
@@ -115,10 +126,20 @@ module core_texture #(
   wire signed [63:0] tv = qz4 ? 64'sd0 : (tv4 >>> shv);
   wire signed [63:0] up = bilinear ? tu - 64'sd2048 : tu;
   wire signed [63:0] vp = bilinear ? tv - 64'sd2048 : tv;
-  wire signed [51:0] i0 = 52'(up >>> 12), j0 = 52'(vp >>> 12);
-  wire signed [51:0] i1 = i0 + 52'sd1, j1 = j0 + 52'sd1;
-  wire [7:0] fu = bilinear ? up[11:4] : 8'd0;
-  wire [7:0] fv = bilinear ? vp[11:4] : 8'd0;
+  // i1 = i0 + 1 from its own adder ((up + 4096) >>> 12), beside i0's rather than after it
+  wire signed [63:0] up1 = bilinear ? tu + 64'sd2048 : tu + 64'sd4096;
+  wire signed [63:0] vp1 = bilinear ? tv + 64'sd2048 : tv + 64'sd4096;
+
+  // Two stages between the products and the addresses (the ULX3S clock, docs/gateware.md "Clock
+  // estimate"): stage 4a holds the integer texel coordinates (the shifts and adders end there),
+  // stage 4w the wrapped ones; stage 5 adds the addresses and looks the texels up in the cache.
+  reg        v4a, v4w;
+  reg signed [51:0] i0a, i1a, j0a, j1a;
+  reg [7:0]  fua, fva, fuw, fvw;
+  reg [9:0]  iaw, ibw, jaw, jbw;
+  reg [PAY-1:0] pay4a, pay4w;
+  wire [7:0] fu = fuw;
+  wire [7:0] fv = fvw;
 
   function [9:0] wrap(input signed [51:0] i, input [1:0] mode, input [3:0] lg);
     reg [10:0] size, k;
@@ -136,8 +157,26 @@ module core_texture #(
       endcase
     end
   endfunction
-  wire [9:0] ia = wrap(i0, wrap_s, wl), ib = wrap(i1, wrap_s, wl);
-  wire [9:0] ja = wrap(j0, wrap_t, hl), jb = wrap(j1, wrap_t, hl);
+  wire [9:0] ia_n = wrap(i0a, wrap_s, wl), ib_n = wrap(i1a, wrap_s, wl);  // stage 4w's, next
+  wire [9:0] ja_n = wrap(j0a, wrap_t, hl), jb_n = wrap(j1a, wrap_t, hl);
+  always @(posedge clk) begin
+    if (rst) begin
+      v4a <= 1'b0; v4w <= 1'b0;
+    end else if (en) begin
+      v4a <= v4; v4w <= v4a;
+    end
+    if (en) begin
+      i0a <= 52'(up >>> 12); i1a <= 52'(up1 >>> 12);
+      j0a <= 52'(vp >>> 12); j1a <= 52'(vp1 >>> 12);
+      fua <= bilinear ? up[11:4] : 8'd0;
+      fva <= bilinear ? vp[11:4] : 8'd0;
+      pay4a <= pay4;
+      iaw <= ia_n; ibw <= ib_n;
+      jaw <= ja_n; jbw <= jb_n;
+      fuw <= fua; fvw <= fva; pay4w <= pay4a;
+    end
+  end
+  wire [9:0] ia = iaw, ib = ibw, ja = jaw, jb = jbw;
 
   function [31:0] taddr(input [27:0] base, input [9:0] i, input [9:0] j, input [3:0] lg, input [1:0] f);
     reg [19:0] off;
@@ -193,9 +232,11 @@ module core_texture #(
       reg [11:0]  sweep;                // bit 11: sweeping; [10:0] the entry
       assign sweeping = sweep[11];
       // lookup: bank {jp, ip} reads the pixel's texel with those parities
-      wire [9:0] li0 = (ia[0] == 1'b0) ? ia : ib, lj0 = (ja[0] == 1'b0) ? ja : jb;  // bank 0: jp 0, ip 0
-      wire [9:0] li1 = (ia[0] == 1'b1) ? ia : ib;                                  // bank 1: jp 0, ip 1
-      wire [9:0] lj2 = (ja[0] == 1'b1) ? ja : jb;                                  // bank 2: jp 1, ip 0
+      // (read as the pixel enters stage 4w; the hits and words are registered into stage 5, so
+      // the block RAM's read time ends there, not in the enable of the whole pipeline)
+      wire [9:0] li0 = (ia_n[0] == 1'b0) ? ia_n : ib_n, lj0 = (ja_n[0] == 1'b0) ? ja_n : jb_n;  // bank 0: jp 0, ip 0
+      wire [9:0] li1 = (ia_n[0] == 1'b1) ? ia_n : ib_n;                                        // bank 1: jp 0, ip 1
+      wire [9:0] lj2 = (ja_n[0] == 1'b1) ? ja_n : jb_n;                                        // bank 2: jp 1, ip 0
       // entry of texel (i, j) in its bank: {j[2:1], i[9:1]}
       wire [10:0] x0 = {lj0[2:1], li0[9:1]}, x1 = {lj0[2:1], li1[9:1]};
       wire [10:0] x2 = {lj2[2:1], li0[9:1]}, x3 = {lj2[2:1], li1[9:1]};
@@ -222,6 +263,30 @@ module core_texture #(
           tg3 <= lj2[9:3];
         end
       end
+      // The read is a clock before the pixel's stage 5 (where the old design read), so the fills
+      // that land between the read and stage 5 (the responses of the pixel ahead, the texels it
+      // shares with this one) are caught here, or it would miss them (bilinear, 0.636 -> 0.566
+      // px/clk on the core bench without this).
+      reg [10:0]  xr0, xr1, xr2, xr3;   // the entries read
+      reg [3:0]   snv;                  // entry k filled since its read: sn_k holds it
+      reg [46:0]  sn0, sn1, sn2, sn3;
+      // (compared with the entries read, registered: a fill in the clock of the read itself is
+      // not caught, as before)
+      wire [3:0]  snp = {4{fill && !sweeping}} & {fbank == 2'd3 && fidx == xr3, fbank == 2'd2 && fidx == xr2,
+                                                 fbank == 2'd1 && fidx == xr1, fbank == 2'd0 && fidx == xr0};
+      always @(posedge clk) begin
+        if (en) begin
+          xr0 <= x0; xr1 <= x1; xr2 <= x2; xr3 <= x3;
+        end
+        if (rst || en) snv <= 4'd0;
+        else snv <= snv | snp;
+        if (snp[0]) sn0 <= fword;
+        if (snp[1]) sn1 <= fword;
+        if (snp[2]) sn2 <= fword;
+        if (snp[3]) sn3 <= fword;
+      end
+      wire [46:0] e0 = snv[0] ? sn0 : rd0, e1 = snv[1] ? sn1 : rd1;
+      wire [46:0] e2 = snv[2] ? sn2 : rd2, e3 = snv[3] ? sn3 : rd3;
       always @(posedge clk) begin
         if (rst) begin
           epoch <= 8'd1;
@@ -233,19 +298,29 @@ module core_texture #(
           if (epoch == 8'hFF) sweep <= {1'b1, 11'd0};  // epoch 0 next: forget every older one
         end
       end
-      wire [3:0] bhit = {rd3[46:39] == epoch && rd3[38:32] == tg3, rd2[46:39] == epoch && rd2[38:32] == tg2,
-                         rd1[46:39] == epoch && rd1[38:32] == tg1, rd0[46:39] == epoch && rd0[38:32] == tg0} &
+      wire [3:0] bhit = {e3[46:39] == epoch && e3[38:32] == tg3, e2[46:39] == epoch && e2[38:32] == tg2,
+                         e1[46:39] == epoch && e1[38:32] == tg1, e0[46:39] == epoch && e0[38:32] == tg0} &
                         {4{cache_en}};
       // slot k's bank: {j parity, i parity} of its texel
-      wire [1:0] sb00 = {ja5[0], ia5[0]}, sb10 = {ja5[0], ib5[0]}, sb01 = {jb5[0], ia5[0]}, sb11 = {jb5[0], ib5[0]};
+      wire [1:0] sb00 = {ja[0], ia[0]}, sb10 = {ja[0], ib[0]}, sb01 = {jb[0], ia[0]}, sb11 = {jb[0], ib[0]};
       function [31:0] bw(input [1:0] b, input [31:0] d0, input [31:0] d1, input [31:0] d2, input [31:0] d3);
         bw = (b == 2'd0) ? d0 : (b == 2'd1) ? d1 : (b == 2'd2) ? d2 : d3;
       endfunction
-      assign hit5 = {bhit[sb00], bhit[sb10], bhit[sb01], bhit[sb11]};
-      assign hdata5 = {bw(sb00, rd0[31:0], rd1[31:0], rd2[31:0], rd3[31:0]),
-                       bw(sb10, rd0[31:0], rd1[31:0], rd2[31:0], rd3[31:0]),
-                       bw(sb01, rd0[31:0], rd1[31:0], rd2[31:0], rd3[31:0]),
-                       bw(sb11, rd0[31:0], rd1[31:0], rd2[31:0], rd3[31:0])};
+      wire [3:0] hit_n = {bhit[sb00], bhit[sb10], bhit[sb01], bhit[sb11]};
+      wire [127:0] hdata_n = {bw(sb00, e0[31:0], e1[31:0], e2[31:0], e3[31:0]),
+                       bw(sb10, e0[31:0], e1[31:0], e2[31:0], e3[31:0]),
+                       bw(sb01, e0[31:0], e1[31:0], e2[31:0], e3[31:0]),
+                       bw(sb11, e0[31:0], e1[31:0], e2[31:0], e3[31:0])};
+      reg [3:0]   hit_r;
+      reg [127:0] hdata_r;
+      always @(posedge clk) begin
+        if (en) begin
+          hit_r   <= hit_n;
+          hdata_r <= hdata_n;
+        end
+      end
+      assign hit5 = hit_r;
+      assign hdata5 = hdata_r;
     end else begin : no_cache
       assign hit5 = 4'd0;
       assign hdata5 = 128'd0;
@@ -270,7 +345,6 @@ module core_texture #(
   wire [3:0]  rem_after = rem & ~((rd_valid && rd_ready) ? slot_bit : 4'd0);
   wire        done5 = can && (rem_after == 4'd0);
   assign en = (!v5 || done5) && !sweeping;
-  assign in_ready = en;
 
   always @(posedge clk) begin
     if (rst) begin
@@ -279,7 +353,7 @@ module core_texture #(
       pushed <= 1'b0;
     end else begin
       if (en) begin
-        v5     <= v4;
+        v5     <= v4w;
         asked  <= 4'd0;
         pushed <= 1'b0;
         bil5   <= bilinear;
@@ -294,7 +368,7 @@ module core_texture #(
         ib5    <= ib;
         ja5    <= ja;
         jb5    <= jb;
-        pay5   <= pay4;
+        pay5   <= pay4w;
       end else begin
         if (push) pushed <= 1'b1;
         if (rd_valid && rd_ready) asked <= asked | slot_bit;
@@ -374,15 +448,25 @@ module core_texture #(
   wire [31:0] c01 = hbil ? texel(hword[63:32], hl00[3:2], tfmt) : c00;
   wire [31:0] c11 = hbil ? texel(hword[31:0], hl00[1:0], tfmt) : c00;
 
-  // (c00 (256-fu) + c10 fu) (256-fv) + (c01 (256-fu) + c11 fu) fv, rounded: section 10.4 exactly
-  function [7:0] bilerp(input [7:0] p00, input [7:0] p10, input [7:0] p01, input [7:0] p11,
-                        input [7:0] u, input [7:0] v);
-    reg [16:0] a, b;
-    begin
-      a = 17'(p00) * (17'd256 - 17'(u)) + 17'(p10) * 17'(u);
-      b = 17'(p01) * (17'd256 - 17'(u)) + 17'(p11) * 17'(u);
-      bilerp = 8'((34'(a) * (34'd256 - 34'(v)) + 34'(b) * 34'(v) + 34'd32768) >> 16);
-    end
+  // The filter is three registered steps behind the queue head (the ULX3S clock, docs/gateware.md
+  // "Clock estimate"), all moved by one enable, so a pixel a clock still leaves when the colour
+  // stage takes one a clock:
+  //   f1: the four texels, expanded;  f2: the step along u, (p00 (256-u) + p10 u) per row;
+  //   f3: the step along v, rounded (section 10.4 exactly);  out: MODULATE or DECAL.
+  wire fen = !out_valid || out_ready;
+  assign pop = hvalid && fen;
+  reg         f1v, f2v, f3v;
+  reg [31:0]  f1c00, f1c10, f1c01, f1c11;
+  reg [7:0]   f1u, f1v8, f2v8;
+  reg [PAY-1:0] f1pay, f2pay, f3pay;
+  reg [16:0]  f2a[0:3], f2b[0:3];   // per channel (0 R .. 3 A): the rows' steps along u
+  reg [7:0]   f3t[0:3];             // the filtered texel
+  // (c00 (256-fu) + c10 fu) (256-fv) + (c01 (256-fu) + c11 fu) fv, rounded
+  function [16:0] lerp_u(input [7:0] p0, input [7:0] p1, input [7:0] u);
+    lerp_u = 17'(p0) * (17'd256 - 17'(u)) + 17'(p1) * 17'(u);
+  endfunction
+  function [7:0] lerp_v(input [16:0] a, input [16:0] b, input [7:0] v);
+    lerp_v = 8'((34'(a) * (34'd256 - 34'(v)) + 34'(b) * 34'(v) + 34'd32768) >> 16);
   endfunction
   function [7:0] div255(input [15:0] x);
     reg [16:0] y;
@@ -391,25 +475,39 @@ module core_texture #(
       div255 = 8'((y + {8'd0, y[16:8]}) >> 8);
     end
   endfunction
-  wire [7:0] tr = bilerp(c00[31:24], c10[31:24], c01[31:24], c11[31:24], hfu, hfv);
-  wire [7:0] tg = bilerp(c00[23:16], c10[23:16], c01[23:16], c11[23:16], hfu, hfv);
-  wire [7:0] tb = bilerp(c00[15:8], c10[15:8], c01[15:8], c11[15:8], hfu, hfv);
-  wire [7:0] ta = bilerp(c00[7:0], c10[7:0], c01[7:0], c11[7:0], hfu, hfv);
-  wire [31:0] col = hpay[31:0];
-  wire [31:0] comb = decal ? {tr, tg, tb, ta} :
-                     {div255(16'(tr) * 16'(col[31:24])), div255(16'(tg) * 16'(col[23:16])),
-                      div255(16'(tb) * 16'(col[15:8])), div255(16'(ta) * 16'(col[7:0]))};
+  integer ch;
+  always @(posedge clk) begin
+    if (rst) begin
+      f1v <= 1'b0; f2v <= 1'b0; f3v <= 1'b0;
+    end else if (fen) begin
+      f1v <= hvalid; f2v <= f1v; f3v <= f2v;
+    end
+    if (fen) begin
+      f1c00 <= c00; f1c10 <= c10; f1c01 <= c01; f1c11 <= c11;
+      f1u <= hfu; f1v8 <= hfv; f1pay <= hpay;
+      for (ch = 0; ch < 4; ch = ch + 1) begin
+        f2a[ch] <= lerp_u(f1c00[ch*8 +: 8], f1c10[ch*8 +: 8], f1u);
+        f2b[ch] <= lerp_u(f1c01[ch*8 +: 8], f1c11[ch*8 +: 8], f1u);
+        f3t[ch] <= lerp_v(f2a[ch], f2b[ch], f2v8);
+      end
+      f2v8 <= f1v8; f2pay <= f1pay;
+      f3pay <= f2pay;
+    end
+  end
+  wire [31:0] col = f3pay[31:0];
+  wire [31:0] tex = {f3t[3], f3t[2], f3t[1], f3t[0]};
+  wire [31:0] comb = decal ? tex :
+                     {div255(16'(f3t[3]) * 16'(col[31:24])), div255(16'(f3t[2]) * 16'(col[23:16])),
+                      div255(16'(f3t[1]) * 16'(col[15:8])), div255(16'(f3t[0]) * 16'(col[7:0]))};
 
-  wire ofree = !out_valid || out_ready;
-  assign pop = hvalid && ofree;
   always @(posedge clk) begin
     if (rst) begin
       out_valid <= 1'b0;
-    end else if (ofree) begin
-      out_valid <= hvalid;
-      if (hvalid) out_pix <= {hpay[PAY-1:32], comb};
+    end else if (fen) begin
+      out_valid <= f3v;
+      if (f3v) out_pix <= {f3pay[PAY-1:32], comb};
     end
   end
   assign textured = pop;
-  assign idle = !v1 && !v2 && !v3 && !v4 && !v5 && (wp == rp) && !out_valid;
+  assign idle = !f_valid && !v1 && !v2 && !v3 && !v4 && !v4a && !v4w && !v5 && (wp == rp) && !f1v && !f2v && !f3v && !out_valid;
 endmodule

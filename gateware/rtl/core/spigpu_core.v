@@ -328,7 +328,7 @@ module spigpu_core #(
   wire [29:0] cr_addr, cw_addr;
   wire [31:0] cw_data;
   wire [3:0]  cw_be;
-  core_color #(.AW(Q_AW), .IDX_W(IDX_W), .ADDR_W(ADDR_W), .FEATURES(FEATURES)) colour (
+  core_color #(.AW(Q_AW), .IDX_W(IDX_W), .ADDR_W(ADDR_W), .FEATURES(FEATURES), .PIPE(1 - SMALL)) colour (
       .clk(clk), .rst(rst), .fmt(r_fmt), .fb_draw16(r_fb_draw), .blend(r_blend), .dither(r_dither),
       .temporal(r_temporal), .phase(r_phase),
       .keep(r_keep), .need_dst(r_need_dst),
