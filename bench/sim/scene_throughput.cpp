@@ -1,6 +1,6 @@
 // scene_throughput: one scene of `gpubridge bench accuracy` (bench/src/scenes.cpp) written to the
-// simulator device exactly as its throughput rows write it (bench/src/sim_runner.cpp: the same
-// device set-up and the same frame: CLEAR + CLEAR_Z + the whole scene), without the rest of the
+// simulator device exactly as its throughput rows write it (the same device set-up and the same
+// frame, CLEAR + CLEAR_Z + the whole scene: gpubridge/bench/sim_scene.hpp), without the rest of the
 // report. For instruction counts (valgrind --tool=callgrind) and alternating timings of one row,
 // where sim_throughput's triangles (equilateral, one size) are not the scene's (random shapes).
 //
@@ -15,15 +15,14 @@
 #include <string>
 #include <vector>
 
-#include "gpubridge/accuracy/texel_probe.hpp"
 #include "gpubridge/bench/scenes.hpp"
+#include "gpubridge/bench/sim_scene.hpp"
 #include "gpubridge/protocol/crc32.hpp"
 #include "gpubridge/protocol/frame.hpp"
 #include "gpubridge/sim/device.hpp"
 #include "gpubridge/sim/options.hpp"
 
 using namespace gpubridge;
-using protocol::Reg;
 
 namespace {
 
@@ -33,64 +32,10 @@ double cpu_seconds() {
   return double(ts.tv_sec) + double(ts.tv_nsec) * 1e-9;
 }
 
-std::vector<std::uint8_t> to_bytes(const std::vector<protocol::Frame>& frames) {
-  std::vector<std::uint8_t> bytes;
-  bytes.reserve(frames.size() * protocol::kFrameBytes);
-  for (const auto& f : frames) protocol::append(bytes, f);
-  return bytes;
-}
-
-// sim_runner.cpp's layout: colour at 0, depth after it, the texture after that (16-byte aligned).
-struct Layout {
-  std::uint32_t color = 0, depth = 0, texture = 0;
-};
-Layout layout_of(const bench::Scene& s) {
-  Layout l;
-  l.depth = (s.width * s.height * 4 + 15) & ~15u;
-  l.texture = l.depth + ((s.width * s.height * 4 + 15) & ~15u);
-  return l;
-}
-
-// sim_runner.cpp's make_device set-up frames (the probe texture is copied in by the caller).
-Result<std::vector<std::uint8_t>> setup_bytes(const bench::Scene& s) {
-  const Layout l = layout_of(s);
-  std::vector<protocol::Frame> f;
-  auto word = [&](Reg r, Result<std::uint64_t> w) -> Result<void> {
-    if (!w) return w.error();
-    f.push_back(protocol::write_frame(r, *w));
-    return {};
-  };
-  if (auto r = word(Reg::FB_FORMAT, geometry::fb_format_word(s.width, s.height, protocol::PixelFormat::RGBA8888)); !r) return r.error();
-  if (auto r = word(Reg::FB_DRAW, geometry::address16_word(l.color)); !r) return r.error();
-  if (auto r = word(Reg::FB_Z, geometry::address16_word(l.depth)); !r) return r.error();
-  if (auto r = word(Reg::SCISSOR, geometry::scissor_word(0, 0, 1024, 1024)); !r) return r.error();
-  if (s.textured) {
-    if (auto r = word(Reg::TEX_BASE, geometry::address16_word(l.texture)); !r) return r.error();
-    geometry::TextureFormat tf{.width = 1u << bench::kTextureLog2, .height = 1u << bench::kTextureLog2, .bilinear = true};
-    if (auto r = word(Reg::TEX_FMT, geometry::tex_fmt_word(tf)); !r) return r.error();
-  }
-  return to_bytes(f);
-}
-
-// sim_runner.cpp's scene_frame: clear + state + every triangle.
-std::vector<std::uint8_t> scene_bytes(const bench::Scene& s) {
-  std::vector<protocol::Frame> f;
-  f.reserve(s.triangles.size() * 9 + 8);
-  f.push_back(protocol::write_frame(Reg::CLEAR_COLOR, 0x000000FF));
-  f.push_back(protocol::write_frame(Reg::CLEAR, 0));
-  f.push_back(protocol::write_frame(Reg::CLEAR_DEPTH, 0xFFFFFF));
-  f.push_back(protocol::write_frame(Reg::CLEAR_Z, 0));
-  f.push_back(protocol::write_frame(Reg::TRI_MODE, geometry::tri_mode_word(s.state)));
-  f.push_back(protocol::write_frame(Reg::PRIM, static_cast<std::uint64_t>(protocol::PrimType::List)));
-  for (const auto& t : s.triangles) geometry::encode_triangle(t, s.textured, f);
-  return to_bytes(f);
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
-  sim::DeviceOptions opt;
-  opt.vram_bytes = 16u << 20;  // as sim_runner.cpp
+  sim::DeviceOptions opt;  // threads and accuracy; the device is the bench's (sim_scene.hpp)
   unsigned repeat = 3;
   std::string name;
   for (int i = 1; i < argc; ++i) {
@@ -102,6 +47,11 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "scene_throughput: %s\n", r.error().message.c_str());
         return 2;
       }
+    } else if (!std::strcmp(argv[i], "--help")) {
+      std::printf("usage: scene_throughput --scene NAME [--threads N] [--repeat R] [--accuracy KNOB=VALUE]...\n"
+                  "One scene of `gpubridge bench accuracy` written to the simulator as its throughput rows write\n"
+                  "it; prints the best frame's wall and CPU time and the CRC of video memory.\n");
+      return 0;
     } else {
       std::fprintf(stderr, "usage: scene_throughput --scene NAME [--threads N] [--repeat R] [--accuracy KNOB=VALUE]...\n");
       return 2;
@@ -117,17 +67,9 @@ int main(int argc, char** argv) {
     return 2;
   }
   const bench::Scene& scene = *it;
-  auto dev = sim::Device::create(opt);
+  auto dev = bench::make_scene_device(scene, opt.accuracy, opt.threads);
   if (!dev) return std::fprintf(stderr, "scene_throughput: %s\n", dev.error().message.c_str()), 1;
-  if (scene.textured) {
-    const auto tex = accuracy::make_probe_texture(bench::kTextureLog2, bench::kTextureLog2);
-    auto mem = (*dev)->memory();
-    std::copy(tex.begin(), tex.end(), mem.begin() + layout_of(scene).texture);
-  }
-  const auto setup = setup_bytes(scene);
-  if (!setup) return std::fprintf(stderr, "scene_throughput: %s\n", setup.error().message.c_str()), 1;
-  (*dev)->write(protocol::FrameView{*setup});
-  const auto bytes = scene_bytes(scene);
+  const auto bytes = bench::scene_frame_bytes(scene, scene.state, scene.triangles.size());
   double best = 1e30, best_cpu = 1e30;
   for (unsigned r = 0; r <= repeat; ++r) {
     (*dev)->reset_stats();

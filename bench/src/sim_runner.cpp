@@ -4,6 +4,7 @@
 #include <chrono>
 
 #include "gpubridge/accuracy/texel_probe.hpp"
+#include "gpubridge/bench/sim_scene.hpp"
 #include "gpubridge/protocol/frame.hpp"
 #include "gpubridge/sim/device.hpp"
 
@@ -29,7 +30,9 @@ std::vector<std::uint8_t> frames_to_bytes(const std::vector<protocol::Frame>& fr
   return bytes;
 }
 
-Result<std::unique_ptr<sim::Device>> make_device(const Scene& s, const sim::AccuracyKnobs& knobs, unsigned threads) {
+}  // namespace
+
+Result<std::unique_ptr<sim::Device>> make_scene_device(const Scene& s, const sim::AccuracyKnobs& knobs, unsigned threads) {
   sim::DeviceOptions opt;
   opt.vram_bytes = 16u << 20;
   opt.threads = threads;
@@ -61,8 +64,7 @@ Result<std::unique_ptr<sim::Device>> make_device(const Scene& s, const sim::Accu
   return dev;
 }
 
-// Clear + state + triangles [0, count) as one batch of wire frames.
-std::vector<std::uint8_t> scene_frame(const Scene& s, const geometry::RenderState& st, std::size_t count) {
+std::vector<std::uint8_t> scene_frame_bytes(const Scene& s, const geometry::RenderState& st, std::size_t count) {
   std::vector<protocol::Frame> f;
   f.reserve(count * 9 + 8);
   f.push_back(protocol::write_frame(Reg::CLEAR_COLOR, 0x000000FF));
@@ -75,12 +77,11 @@ std::vector<std::uint8_t> scene_frame(const Scene& s, const geometry::RenderStat
   return frames_to_bytes(f);
 }
 
-}  // namespace
 
 Result<Timing> time_sim(const Scene& scene, const sim::AccuracyKnobs& knobs, unsigned threads, unsigned runs) {
-  auto dev = make_device(scene, knobs, threads);
+  auto dev = make_scene_device(scene, knobs, threads);
   if (!dev) return dev.error();
-  const auto bytes = scene_frame(scene, scene.state, scene.triangles.size());
+  const auto bytes = scene_frame_bytes(scene, scene.state, scene.triangles.size());
   Timing t;
   t.best_seconds = 1e30;
   for (unsigned r = 0; r <= runs; ++r) {
@@ -97,7 +98,7 @@ Result<Timing> time_sim(const Scene& scene, const sim::AccuracyKnobs& knobs, uns
 }
 
 Result<RenderedFrame> render_sim_error_pass(const Scene& scene, const sim::AccuracyKnobs& knobs) {
-  auto dev_r = make_device(scene, knobs, 1);
+  auto dev_r = make_scene_device(scene, knobs, 1);
   if (!dev_r) return dev_r.error();
   auto& dev = **dev_r;
   const std::size_t n = std::size_t{scene.width} * scene.height;
@@ -117,7 +118,7 @@ Result<RenderedFrame> render_sim_error_pass(const Scene& scene, const sim::Accur
   st.z_write = true;
   st.textured = scene.textured;
   st.tex_decal = scene.textured;
-  const auto bytes = scene_frame(scene, st, scene.error_subset);
+  const auto bytes = scene_frame_bytes(scene, st, scene.error_subset);
   dev.write(protocol::FrameView{bytes});
   dev.drain();
   dev.set_pixel_observer(nullptr);
