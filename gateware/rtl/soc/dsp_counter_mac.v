@@ -4,6 +4,11 @@
 // pass, which rewrites it as an unclocked 16 x 16 multiply (A x B = 1 x 1): for yosys (SYNTHESIS) the
 // cell is SB_MAC16_KEPT, a black box the pass does not know, renamed SB_MAC16 after synthesis
 // (boards/build.py, synth.py: `chtype -map SB_MAC16_KEPT SB_MAC16`); simulators see SB_MAC16.
+`ifdef SYNTHESIS
+`define DSP_COUNTER_MAC_CELL SB_MAC16_KEPT
+`else
+`define DSP_COUNTER_MAC_CELL SB_MAC16
+`endif
 (* keep_hierarchy *)
 module dsp_counter_mac #(
   parameter WIDE = 0
@@ -18,8 +23,7 @@ module dsp_counter_mac #(
   output wire [31:0] o
 );
   wire co, accum_co, signext;
-`ifdef SYNTHESIS
-  SB_MAC16_KEPT #(
+  `DSP_COUNTER_MAC_CELL #(
     .TOPOUTPUT_SELECT(2'd1), .TOPADDSUB_UPPERINPUT(1'b0), .TOPADDSUB_LOWERINPUT(2'd0),
     .TOPADDSUB_CARRYSELECT(WIDE != 0 ? 2'd3 : 2'd0),
     .BOTOUTPUT_SELECT(2'd1), .BOTADDSUB_UPPERINPUT(1'b0), .BOTADDSUB_LOWERINPUT(2'd0),
@@ -30,19 +34,6 @@ module dsp_counter_mac #(
     .ORSTTOP(1'b0), .ORSTBOT(1'b0), .OLOADTOP(load_top), .OLOADBOT(load_bot), .ADDSUBTOP(1'b0),
     .ADDSUBBOT(1'b0), .OHOLDTOP(hold_top), .OHOLDBOT(hold_bot), .CI(1'b0), .ACCUMCI(1'b0),
     .SIGNEXTIN(1'b0), .O(o), .CO(co), .ACCUMCO(accum_co), .SIGNEXTOUT(signext));
-`else
-  SB_MAC16 #(
-    .TOPOUTPUT_SELECT(2'd1), .TOPADDSUB_UPPERINPUT(1'b0), .TOPADDSUB_LOWERINPUT(2'd0),
-    .TOPADDSUB_CARRYSELECT(WIDE != 0 ? 2'd3 : 2'd0),
-    .BOTOUTPUT_SELECT(2'd1), .BOTADDSUB_UPPERINPUT(1'b0), .BOTADDSUB_LOWERINPUT(2'd0),
-    .BOTADDSUB_CARRYSELECT(2'd0), .MODE_8x8(1'b1)
-  ) u_mac (
-    .CLK(clk), .CE(1'b1), .C(d_top), .A(WIDE != 0 ? 16'd0 : 16'd1), .B(16'd1), .D(d_bot),
-    .AHOLD(1'b1), .BHOLD(1'b1), .CHOLD(1'b1), .DHOLD(1'b1), .IRSTTOP(1'b0), .IRSTBOT(1'b0),
-    .ORSTTOP(1'b0), .ORSTBOT(1'b0), .OLOADTOP(load_top), .OLOADBOT(load_bot), .ADDSUBTOP(1'b0),
-    .ADDSUBBOT(1'b0), .OHOLDTOP(hold_top), .OHOLDBOT(hold_bot), .CI(1'b0), .ACCUMCI(1'b0),
-    .SIGNEXTIN(1'b0), .O(o), .CO(co), .ACCUMCO(accum_co), .SIGNEXTOUT(signext));
-`endif
   wire unused = &{1'b0, co, accum_co, signext};
 endmodule
 
