@@ -45,7 +45,9 @@ Result<FramePrediction> predict_frame(Example& ex, const DeviceCaps& device, con
   auto fitted = configure(ex, device, request);
   if (!fitted) return fitted.error();
   p.fit = *fitted;
-  auto sink = draw::SimulatorSink::create(device.simulator_options());
+  auto options = device.simulator_options();
+  options.sdram_rows = true;  // the row and footprint terms of the estimate
+  auto sink = draw::SimulatorSink::create(options);
   if (!sink) return sink.error();
   UploadCountingSink counting(**sink);
   auto ctx = draw::Context::create(counting, ex.options());

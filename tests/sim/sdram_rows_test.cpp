@@ -4,6 +4,7 @@
 // what the row and refresh terms add to an estimate.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -121,7 +122,9 @@ constexpr unsigned kLess = 1 << 3;
 TEST(SimSdramRows, DeviceCountsTheDrawnSpans) {
   const ref::P a{2 * 16, 3 * 16}, b{60 * 16, 5 * 16}, c{9 * 16, 40 * 16};
   for (std::uint32_t zbase : {0x100000u, 0x100400u}) {
-    Canvas cv(64, 48);
+    DeviceOptions counting;
+    counting.sdram_rows = true;
+    Canvas cv(64, 48, 0, counting);
     w(*cv.dev, Reg::FB_Z, zbase);
     w(*cv.dev, Reg::TRI_MODE, kZTest | kLess | kZWrite);
     cv.dev->reset_stats();
@@ -157,6 +160,25 @@ TEST(SimSdramRows, DeviceCountsTheDrawnSpans) {
     if (zbase == 0x100000u) EXPECT_GT(st.row_misses, covered) << "same bank: misses at every switch";
     else EXPECT_LT(st.row_misses, covered / 8) << "other bank: misses only where rows change";
   }
+}
+
+// The count costs a span replay per triangle: a device not asked for it (the default) leaves the
+// counters at 0 and draws the same bytes.
+TEST(SimSdramRows, CountedOnlyWhenAskedFor) {
+  DeviceOptions counting;
+  counting.sdram_rows = true;
+  Canvas plain(64, 48), counted(64, 48, 0, counting);
+  for (Canvas* cv : {&plain, &counted}) {
+    w(*cv->dev, Reg::TRI_MODE, kZTest | kLess | kZWrite);
+    cv->dev->reset_stats();
+    cv->tri(2 * 16, 3 * 16, 60 * 16, 5 * 16, 9 * 16, 40 * 16, 0xFFFFFFFF, 0xFFFFFFFF, 0xFFFFFFFF, 100, 100, 100);
+  }
+  EXPECT_EQ(plain.dev->stats().sdram_accesses, 0u);
+  EXPECT_EQ(plain.dev->stats().row_misses, 0u);
+  EXPECT_GT(counted.dev->stats().sdram_accesses, 0u);
+  EXPECT_EQ(plain.dev->stats().pixels_covered, counted.dev->stats().pixels_covered);
+  const auto a = plain.dev->memory(), b = counted.dev->memory();
+  EXPECT_TRUE(std::equal(a.begin(), a.end(), b.begin(), b.end()));
 }
 
 // A triangle's texture footprint: vertices at texel (0, 0), (16, 0), (0, 16) of a 16 x 16 RGB565

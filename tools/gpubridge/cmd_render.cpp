@@ -73,6 +73,7 @@ int run_render(const GlobalOptions& g, const RenderArgs& a) {
   const std::uint64_t vram_mib = a.vram_mib.value_or(8);
   if (vram_mib < 1 || vram_mib > 4096) return fail("--vram-mib " + std::to_string(vram_mib) + ": expected 1..4096", 2);
   opt.vram_bytes = vram_mib << 20;
+  opt.sdram_rows = a.timing;  // the timing model's row terms (section 19); a cost only --timing pays
   sim::BoardTiming board;
   for (const auto& s : a.timing_params)
     if (auto r = sim::apply_timing_setting(board, s); !r) return fail(r.error().message, 2);

@@ -64,7 +64,7 @@ struct Device::State {
         id((std::uint64_t{kIdMagic} << 32) | (std::uint64_t{kVersionMajor} << 24) |
            (std::uint64_t{kVersionMinor} << 16) | o.variant),
         mem(o.vram_bytes),
-        renderer(mem, o.accuracy, o.threads, o.vector_routines) {
+        renderer(mem, o.accuracy, o.threads, o.vector_routines, o.sdram_rows) {
     reset_registers();
   }
 
@@ -329,7 +329,7 @@ struct Device::State {
       const std::uint64_t at = base + (std::uint64_t(y) * st.fb_width + st.clip.x0) * bpp;
       dropped |= !mem.write(at, row.data(), row.size());
       stats.clear_bytes += row.size();
-      renderer.sdram_rows().touch_range(at, row.size());
+      if (renderer.counts_sdram_rows()) renderer.sdram_rows().touch_range(at, row.size());
     }
     if (dropped) errors |= ERR_MEM_RANGE;
   }

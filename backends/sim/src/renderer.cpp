@@ -6,8 +6,9 @@
 
 namespace gpubridge::sim {
 
-Renderer::Renderer(VideoMemory& mem, const AccuracyKnobs& knobs, unsigned threads, bool vector_routines)
-    : mem_(mem), knobs_(knobs), vector_(vector_routines), recip_(knobs.recip_bits, knobs.nr_steps), pool_(threads) {
+Renderer::Renderer(VideoMemory& mem, const AccuracyKnobs& knobs, unsigned threads, bool vector_routines, bool sdram_rows)
+    : mem_(mem), knobs_(knobs), vector_(vector_routines), count_rows_(sdram_rows), recip_(knobs.recip_bits, knobs.nr_steps),
+      pool_(threads) {
   if (pool_.workers() > 1) {
     // Constructed once: a batch's triangles are set up in place (no triangle constructed per draw).
     batch_.resize(kMaxBatch);
@@ -119,7 +120,7 @@ void Renderer::count_rasterised(const Triangle& t, const DrawState& st) {
   ++mode.triangles;
   mode.rows += static_cast<std::uint64_t>(t.y1 - t.y0);
   mode.columns += static_cast<std::uint64_t>(t.x1 - t.x0);
-  if (t.small || st.writes_nothing) return;
+  if (!count_rows_ || t.small || st.writes_nothing) return;
   const std::uint64_t covered = access_triangle_rows(sdram_, t, st);
   if (st.mode_class & 4) texel_footprint_ += texel_footprint_bytes(t, st, covered);
 }

@@ -24,7 +24,8 @@ namespace gpubridge::sim {
 
 class Renderer {
  public:
-  Renderer(VideoMemory& mem, const AccuracyKnobs& knobs, unsigned threads, bool vector_routines);
+  // sdram_rows: count the SDRAM rows the drawn spans open (DeviceOptions::sdram_rows).
+  Renderer(VideoMemory& mem, const AccuracyKnobs& knobs, unsigned threads, bool vector_routines, bool sdram_rows = false);
   ~Renderer();
   Renderer(const Renderer&) = delete;
   Renderer& operator=(const Renderer&) = delete;
@@ -45,7 +46,9 @@ class Renderer {
   const std::array<DeviceStats::ModeWork, DeviceStats::kModeClasses>& mode_work() const { return modes_; }
   std::uint64_t triangles_rejected() const { return rejected_; }
   // The SDRAM rows the drawn triangles' spans open (the timing model's row counts); clears touch it.
+  // Counted only when asked for at construction (counts_sdram_rows()).
   SdramRows& sdram_rows() { return sdram_; }
+  bool counts_sdram_rows() const { return count_rows_; }
   // Texture bytes the textured triangles' footprints hold (texel_footprint_bytes).
   std::uint64_t texel_footprint() const { return texel_footprint_; }
   void reset_counters() {
@@ -77,6 +80,7 @@ class Renderer {
   VideoMemory& mem_;
   AccuracyKnobs knobs_;
   bool vector_;
+  bool count_rows_;
   ReciprocalUnit recip_;
   BandPool pool_;
   PixelObserver observer_;

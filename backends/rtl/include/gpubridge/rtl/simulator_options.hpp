@@ -16,6 +16,7 @@ inline sim::DeviceOptions simulator_options(const GatewareCaps& c) {
   o.features = c.features;
   o.features2 = c.features2;
   o.variant = c.variant;
+  o.sdram_rows = true;  // its counters feed the timing model checked against the gateware's cycles
   return o;
 }
 

@@ -83,6 +83,12 @@ struct DeviceOptions {
   // false: every pixel goes through the scalar routines instead of the vector ones. The output is
   // identical by design; tests render both ways and compare bytes.
   bool vector_routines = true;
+  // Count the SDRAM rows the draws open (DeviceStats sdram_accesses, row_opens, row_misses,
+  // texel_footprint_bytes: the timing model's row and footprint terms, section 19). The count
+  // replays every drawn triangle's spans (about as costly as drawing an untextured one), so only
+  // what estimates timing turns it on: `gpubridge render --timing`, the frame predictions, the
+  // simulator beside the gateware (rtl::simulator_options); otherwise those counters stay 0.
+  bool sdram_rows = false;
   AccuracyKnobs accuracy;
 
   // Empty when valid, otherwise what is wrong and the accepted range.
