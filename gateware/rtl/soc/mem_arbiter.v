@@ -77,16 +77,20 @@ module mem_arbiter #(
 
   wire tags_room  = tag_count != TAGS;
   wire tags_empty = tag_count == 0;
-  // One comparator pair: the memory-access unit writes only while the core is idle (the executor
-  // starts MEM_* after the core finished and no core command during them).
+  // A comparator pair per writer, each on its own address register: one pair on the address the
+  // memory-access unit's phase chose (m_writes ? m : c) put that choice, 16 multiplexers driven by
+  // one net, in front of the compare on the arbiter's one-clock decision (issue 19, 25.125 MHz).
+  // The memory-access unit writes only while the core is idle (the executor starts MEM_* after the
+  // core finished and no core command during them), so both never block at once.
   wire        m_writes = m_req_valid && m_req_we;
-  wire [29:0] w_addr   = m_writes ? m_req_addr : c_req_addr;
   // only writes inside VRAM meet the compare (the core's beyond it are dropped, MEM_DATA's are
   // never issued), so AW + 1 bits are enough
-  wire [AW:0] w_vram   = {1'b0, w_addr[AW-1:0]};
-  wire        w_prot   = prot_active && w_vram >= prot_lo && w_vram < prot_hi;
-  wire m_block = m_writes && w_prot;
-  wire c_block = !m_writes && c_req_we && w_prot;
+  wire [AW:0] m_vram   = {1'b0, m_req_addr[AW-1:0]};
+  wire [AW:0] c_vram   = {1'b0, c_req_addr[AW-1:0]};
+  wire        m_prot   = prot_active && m_vram >= prot_lo && m_vram < prot_hi;
+  wire        c_prot   = prot_active && c_vram >= prot_lo && c_vram < prot_hi;
+  wire m_block = m_writes && m_prot;
+  wire c_block = !m_writes && c_req_we && c_prot;
   wire c_oor   = c_req_addr[29:AW] != 0;   // beyond VRAM: an upper bit, no comparator
   wire v_oor   = v_req_addr[29:AW] != 0;
   wire v_hold  = v_req_valid && v_oor;       // the scanout and the core wait while it drains the reads
@@ -150,5 +154,5 @@ module mem_arbiter #(
     end
   end
 
-  wire unused_ok = &{1'b0, addr[29:AW], w_addr[29:AW]};
+  wire unused_ok = &{1'b0, addr[29:AW]};
 endmodule
