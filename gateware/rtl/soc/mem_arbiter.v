@@ -90,7 +90,7 @@ module mem_arbiter #(
   wire        m_prot   = prot_active && m_vram >= prot_lo && m_vram < prot_hi;
   wire        c_prot   = prot_active && c_vram >= prot_lo && c_vram < prot_hi;
   wire m_block = m_writes && m_prot;
-  wire c_block = !m_writes && c_req_we && c_prot;
+  wire c_block = c_req_we && c_prot;   // (no core request while the unit writes: see pick_c)
   wire c_oor   = c_req_addr[29:AW] != 0;   // beyond VRAM: an upper bit, no comparator
   wire v_oor   = v_req_addr[29:AW] != 0;
   wire v_hold  = v_req_valid && v_oor;       // the scanout and the core wait while it drains the reads
@@ -104,8 +104,15 @@ module mem_arbiter #(
   wire pick_m = m_ok;
   wire pick_v = !pick_m && v_req_valid && (v_oor ? tags_empty && !b_rsp_valid : tags_room);
   wire pick_s = !pick_v && !v_hold && !pick_m && s_ok && (scan_wait == 4'd15 || !(c_ok || c_zero));
-  wire pick_c = !pick_v && !v_hold && !pick_m && !pick_s && c_ok;
-  wire pick_z = !pick_v && !v_hold && !pick_m && !pick_s && !c_ok && c_zero;
+  // The core's grant as if no write of the memory-access unit were blocked: the unit writes only
+  // while the core is idle (no core request), so whenever m_block can be 1, c_req_valid is 0 and
+  // pick_c is 0 either way. This takes the unit's address compare off c_req_ready, which reaches
+  // deep into the core's stall logic (issue 19, 25.125 MHz).
+  wire mc_ok  = m_req_valid && (m_req_we || tags_room);
+  wire vc_pick = !mc_ok && v_req_valid && (v_oor ? tags_empty && !b_rsp_valid : tags_room);
+  wire sc_pick = !vc_pick && !v_hold && !mc_ok && s_ok && (scan_wait == 4'd15 || !(c_ok || c_zero));
+  wire pick_c = !vc_pick && !v_hold && !mc_ok && !sc_pick && c_ok;
+  wire pick_z = !vc_pick && !v_hold && !mc_ok && !sc_pick && !c_ok && c_zero;
 
   assign b_req_valid = (pick_v && !v_oor) || pick_m || pick_s || pick_c;
   assign b_req_we    = pick_m ? m_req_we : pick_c ? c_req_we : 1'b0;
@@ -153,6 +160,16 @@ module mem_arbiter #(
       else scan_wait <= 4'd0;
     end
   end
+
+`ifndef SYNTHESIS
+  // the invariant pick_c, pick_z and c_block rely on, checked in every co-simulation
+  always @(posedge clk) begin
+    if (!rst && m_writes && c_req_valid) begin
+      $display("mem_arbiter: a write of the memory-access unit while the core requests");
+      $stop;
+    end
+  end
+`endif
 
   wire unused_ok = &{1'b0, addr[29:AW]};
 endmodule
