@@ -43,7 +43,7 @@ module spigpu_core #(
     output wire [3:0]   vp_addr,          // PROFILE 0: the vertices through the soc's read port
     input  wire [31:0]  vp_data,          // ({vertex, word} in, the word a clock later), not cmd_v*;
                                           // {3, 0} CLEAR_COLOR, {3, 1} CLEAR_DEPTH (not cmd_clear_*)
-    output wire         core_idle,
+    output reg          core_idle,
     // memory port
     output wire         mem_req_valid,
     input  wire         mem_req_ready,
@@ -364,6 +364,7 @@ module spigpu_core #(
   wire pipe_idle = !ras_active && ras_op == 2'd0 && !ras_emit && !emit2;
   wire stages_idle = d_idle && t_idle && c_idle;
   wire drained = pipe_idle && stages_idle && m_idle && !k_busy;
+  wire idle_now;  // the pipeline-empty test; the port core_idle is it a clock late
   core_memport #(.TAGS_AW((SMALL != 0) ? 1 : 3), .COMBINE(1 - SMALL)) memport (
       .clk(clk), .rst(rst), .flush(!ras_active || r_serial),
       .clr_valid(k_valid), .clr_ready(k_ready), .clr_addr(k_addr), .clr_data(k_data), .clr_be(k_be),
@@ -400,7 +401,7 @@ module spigpu_core #(
     ras_go   <= 1'b0;
     k_go     <= 1'b0;
     tc_inval <= 1'b0;
-    if (rst || core_idle) tc_keep <= 1'b0;
+    if (rst || idle_now) tc_keep <= 1'b0;
     if (rst) begin
       cst <= C_IDLE;
       colour_on_r <= 1'b1;
@@ -503,7 +504,17 @@ module spigpu_core #(
     end
   end
 
-  assign core_idle = (cst == C_IDLE) && !cmd_valid && !accept && !su_busy && drained && !k_go && !ras_go;
+  assign idle_now = (cst == C_IDLE) && !cmd_valid && !accept && !su_busy && drained && !k_go && !ras_go;
+
+  // The soc sees the pipeline-empty test a clock late (issue 19, 25.125 MHz on the UP5K): the
+  // test (the rasteriser's emit and state, the memory port, setup) reached the soc's command FIFO
+  // pop through command_exec in one clock. Registered it can be late, never early: the core leaves
+  // idle only on a command the soc presents (cmd_valid, in the test), so the clock after that the
+  // flip-flop already says busy, and in the clock itself the soc's users that act on it see no
+  // core command at the FIFO's head (command_exec waits on it only for FENCE, FB_DISPLAY and the
+  // MEM_* registers; the RESET drain and STATUS.BUSY also look at cmd_valid / the FIFO's level).
+  // Becoming idle is a clock late: a command waiting on it starts a clock later.
+  always @(posedge clk) core_idle <= !rst && idle_now;
 
   // ---------------------------------------------------------------- counters
   generate
@@ -522,7 +533,7 @@ module spigpu_core #(
           if (emit2 && d_in_ready && !r_rect) perf_pixels <= perf_pixels + 32'd1;
           if (d_passed && !r_rect) perf_passed <= perf_passed + 32'd1;
           if (t_count) perf_textured <= perf_textured + 32'd1;
-          if (!core_idle) perf_busy <= perf_busy + 32'd1;
+          if (!idle_now) perf_busy <= perf_busy + 32'd1;
           if (su_busy) perf_setup <= perf_setup + 32'd1;
           if (ras_active) perf_raster <= perf_raster + 32'd1;
         end

@@ -77,16 +77,20 @@ module mem_arbiter #(
 
   wire tags_room  = tag_count != TAGS;
   wire tags_empty = tag_count == 0;
-  // One comparator pair: the memory-access unit writes only while the core is idle (the executor
-  // starts MEM_* after the core finished and no core command during them).
+  // A comparator pair per writer, each on its own address register: one pair on the address the
+  // memory-access unit's phase chose (m_writes ? m : c) put that choice, 16 multiplexers driven by
+  // one net, in front of the compare on the arbiter's one-clock decision (issue 19, 25.125 MHz).
+  // The memory-access unit writes only while the core is idle (the executor starts MEM_* after the
+  // core finished and no core command during them), so both never block at once.
   wire        m_writes = m_req_valid && m_req_we;
-  wire [29:0] w_addr   = m_writes ? m_req_addr : c_req_addr;
   // only writes inside VRAM meet the compare (the core's beyond it are dropped, MEM_DATA's are
   // never issued), so AW + 1 bits are enough
-  wire [AW:0] w_vram   = {1'b0, w_addr[AW-1:0]};
-  wire        w_prot   = prot_active && w_vram >= prot_lo && w_vram < prot_hi;
-  wire m_block = m_writes && w_prot;
-  wire c_block = !m_writes && c_req_we && w_prot;
+  wire [AW:0] m_vram   = {1'b0, m_req_addr[AW-1:0]};
+  wire [AW:0] c_vram   = {1'b0, c_req_addr[AW-1:0]};
+  wire        m_prot   = prot_active && m_vram >= prot_lo && m_vram < prot_hi;
+  wire        c_prot   = prot_active && c_vram >= prot_lo && c_vram < prot_hi;
+  wire m_block = m_writes && m_prot;
+  wire c_block = c_req_we && c_prot;   // (no core request while the unit writes: see pick_c)
   wire c_oor   = c_req_addr[29:AW] != 0;   // beyond VRAM: an upper bit, no comparator
   wire v_oor   = v_req_addr[29:AW] != 0;
   wire v_hold  = v_req_valid && v_oor;       // the scanout and the core wait while it drains the reads
@@ -100,8 +104,15 @@ module mem_arbiter #(
   wire pick_m = m_ok;
   wire pick_v = !pick_m && v_req_valid && (v_oor ? tags_empty && !b_rsp_valid : tags_room);
   wire pick_s = !pick_v && !v_hold && !pick_m && s_ok && (scan_wait == 4'd15 || !(c_ok || c_zero));
-  wire pick_c = !pick_v && !v_hold && !pick_m && !pick_s && c_ok;
-  wire pick_z = !pick_v && !v_hold && !pick_m && !pick_s && !c_ok && c_zero;
+  // The core's grant as if no write of the memory-access unit were blocked: the unit writes only
+  // while the core is idle (no core request), so whenever m_block can be 1, c_req_valid is 0 and
+  // pick_c is 0 either way. This takes the unit's address compare off c_req_ready, which reaches
+  // deep into the core's stall logic (issue 19, 25.125 MHz).
+  wire mc_ok  = m_req_valid && (m_req_we || tags_room);
+  wire vc_pick = !mc_ok && v_req_valid && (v_oor ? tags_empty && !b_rsp_valid : tags_room);
+  wire sc_pick = !vc_pick && !v_hold && !mc_ok && s_ok && (scan_wait == 4'd15 || !(c_ok || c_zero));
+  wire pick_c = !vc_pick && !v_hold && !mc_ok && !sc_pick && c_ok;
+  wire pick_z = !vc_pick && !v_hold && !mc_ok && !sc_pick && !c_ok && c_zero;
 
   assign b_req_valid = (pick_v && !v_oor) || pick_m || pick_s || pick_c;
   assign b_req_we    = pick_m ? m_req_we : pick_c ? c_req_we : 1'b0;
@@ -150,5 +161,15 @@ module mem_arbiter #(
     end
   end
 
-  wire unused_ok = &{1'b0, addr[29:AW], w_addr[29:AW]};
+`ifndef SYNTHESIS
+  // the invariant pick_c, pick_z and c_block rely on, checked in every co-simulation
+  always @(posedge clk) begin
+    if (!rst && m_writes && c_req_valid) begin
+      $display("mem_arbiter: a write of the memory-access unit while the core requests");
+      $stop;
+    end
+  end
+`endif
+
+  wire unused_ok = &{1'b0, addr[29:AW]};
 endmodule

@@ -60,7 +60,7 @@ module spigpu_soc #(
   output wire [183:0] cmd_v2,
   input  wire [3:0]   vp_addr,        // the vertex read port (up5k; docs/gateware.md "soc <-> core")
   output wire [31:0]  vp_data,
-  input  wire         core_idle,
+  input  wire         core_idle,      // the core's pipeline-empty test a clock late (never early)
   input  wire         mem_req_valid,
   output wire         mem_req_ready,
   input  wire         mem_req_we,
@@ -149,6 +149,9 @@ module spigpu_soc #(
   wire        mem_err, scan_err;
   wire        mem_ex_idle;
   wire [6:0]  errors;
+  // core_idle is a clock late and in the clock a command is first offered still says idle: the
+  // FIFO's level counts that command (STATUS.BUSY), and the RESET drain looks at cmd_valid too
+  // (a RESET in that clock must wait for the command the core may already have begun)
   wire        device_busy = fifo_level != 11'd0 || !core_idle || !mem_ex_idle;
 
   wire [4:0]  sh_rd_idx;
@@ -165,7 +168,7 @@ module spigpu_soc #(
     .soft_reset(soft_reset), .ex_wr_req(sh_wr_req), .ex_wr_idx(sh_wr_idx), .ex_wr_data(sh_wr_data),
     .ex_wr_ack(sh_wr_ack), .ex_rd_idx(sh_rd_idx), .ex_rd_data(sh_rd_data), .ex_rd_valid(sh_rd_valid),
     .err_set(ex_err | {mem_err || scan_err, 6'd0}), .core_range_err(core_range_err),
-    .core_idle(core_idle), .core_drain(core_drain), .busy(device_busy), .vblank(vblank),
+    .core_idle(core_idle && !cmd_valid), .core_drain(core_drain), .busy(device_busy), .vblank(vblank),
     .swap_pending(swap_pending_w), .frame_count(frame_count), .frame_crc(frame_crc), .mem_ready(mem_ready),
     .mem_addr(mem_addr), .prefetch(prefetch), .mem_read_strobe(mem_read_strobe), .errors(errors));
 
