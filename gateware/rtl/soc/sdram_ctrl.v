@@ -5,6 +5,12 @@
 //     words and consecutive rows rotate through the banks;
 //   - every bank's row stays open until another row of that bank or a refresh needs it; one command
 //     per clock; a READ or WRITE can issue every 2 clocks (2 bytes per clock at best);
+//   - req_ready is a function of registers only (issue 19): init_done, a refresh due, the served slot
+//     empty, or `issue_next`, registered a clock ahead, which says the request in the slot will issue
+//     its READ or WRITE in this clock (it stays, is a row hit, and its timers reach 0), so the bank
+//     state and timers do not reach the arbiter and the render core's stall logic in the same clock.
+//     It is exact except for a request that issues in the clock after it was taken (an idle
+//     controller): the next request is then taken a clock later than it was;
 //   - auto refresh every T_REFI (all banks precharged first); the JEDEC power-up sequence at reset.
 // All timing is in nanoseconds and converted with the clock frequency, so the behavioural model
 // (gateware/sim/sdram_model.v), which checks every constraint, runs with the same numbers.
@@ -126,7 +132,13 @@ module sdram_ctrl #(
   wire do_act   = init_done && !ref_due && cur_valid && !open[cur_bank] && b_act == 8'd0 && t_rrd == 8'd0;
   wire do_prea  = init_done && ref_due && open != 4'd0 && all_pre_ok;
   wire do_ref   = init_done && ref_due && open == 4'd0 && all_act_ok;
-  assign req_ready = init_done && !ref_due && (!cur_valid || do_rw);
+  // issue_next: do_rw will hold in the next clock. The request stays (no do_rw now), its row is open
+  // and stays so (hit excludes this bank's PRECHARGE and ACTIVE; no refresh is or becomes due, so no
+  // PRECHARGE all), and every timer do_rw waits for is at most 1 now, so 0 then
+  reg    issue_next;
+  wire   issue_next_d = cur_valid && !do_rw && hit && !ref_due && refi != 16'd1 && b_rcd <= 8'd1 &&
+                        t_rw <= 8'd1 && (!cur_we || t_turn <= 8'd1);
+  assign req_ready = init_done && !ref_due && (!cur_valid || issue_next);
   assign refresh   = do_ref;
 
   // read data capture: rd_pipe[k] is set k clocks after a READ was registered
@@ -165,6 +177,7 @@ module sdram_ctrl #(
       icount <= INIT;
       open <= 4'd0;
       cur_valid <= 1'b0;
+      issue_next <= 1'b0;
       ref_due <= 1'b0;
       refi <= REFI;
       rd_pipe <= {(CL + 2){1'b0}};
@@ -198,6 +211,7 @@ module sdram_ctrl #(
           endcase
         end
       end else begin
+        issue_next <= issue_next_d;
         // refresh timer
         if (refi == 16'd1) begin
           refi <= REFI;

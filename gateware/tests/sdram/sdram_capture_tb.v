@@ -7,7 +7,8 @@
 //   EXPECT_OK     1: every word must read back right (and, with CLK_INVERTED, the chip see no timing
 //                 violation); 0: the capture is at the wrong edge for this clock, so reads must come
 //                 back wrong (the chip's data is changing at that edge) — the model must tell.
-// Prints "PASS:" or "FAIL:" (ctest matches them).
+// Also checks the controller's registered ready: issue_next is only ever set for a clock in which the
+// held request issues. Prints "PASS:" or "FAIL:" (ctest matches them).
 `timescale 1ns / 1ps
 module sdram_capture_tb;
   parameter CLK_INVERTED = 1;
@@ -63,6 +64,11 @@ module sdram_capture_tb;
       rnd = seed ^ (seed >> 15);
     end
   endfunction
+
+  // the controller's registered ready (issue 19) promises that the request it holds issues in this
+  // clock: a broken promise would take a second request into the one slot
+  integer broken = 0;
+  always @(posedge clk) if (!rst && ctrl.issue_next && !ctrl.do_rw) broken = broken + 1;
 
   // answers arrive in request order
   always @(posedge clk) begin
@@ -135,7 +141,9 @@ module sdram_capture_tb;
     repeat (40) @(posedge clk);
     $display("CLK_INVERTED=%0d CAPTURE_FALL=%0d: %0d reads checked, %0d wrong; chip: %0d reads, %0d writes, %0d activates, %0d timing violations",
              CLK_INVERTED, CAPTURE_FALL, checked, wrong, reads, writes, activates, violations);
-    if (checked == 0 || pend_head != pend_tail)
+    if (broken != 0)
+      $display("FAIL: issue_next set in %0d clocks without a READ or WRITE issuing", broken);
+    else if (checked == 0 || pend_head != pend_tail)
       $display("FAIL: %0d reads answered of %0d", pend_head, pend_tail);
     else if (EXPECT_OK != 0 && wrong != 0)
       $display("FAIL: reads came back wrong");
