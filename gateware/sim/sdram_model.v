@@ -5,6 +5,18 @@
 // against 8 x tREFI (the JEDEC postponement limit) while running; the power-up sequence; data bus
 // contention. Each violation is counted (the co-simulation fails on any) and printed once per kind.
 // Supported: BL = 2 (sequential), CL 2 or 3, no auto precharge, no burst terminate.
+//
+// Clock phase and read data timing (issue 19): the chip runs on its own clock, which on the ULX3S is
+// the controller's clock inverted (CLK_INVERTED = 1: an ODDRX1F sends 0 then 1), so it takes commands
+// and write data on the controller's falling edges and drives each read beat from tAC after one of
+// its edges until tOH after the next (tLZ / tHZ: off the bus). The model keeps time in picoseconds,
+// runs on both edges of the controller's clock and puts on dq_out, half a clock ahead, what the
+// controller's input register would see at its next edge: a beat inside its valid window, a value
+// that is neither beat (~ the newest beat) where the bus is driven but changing, nothing (dq_out_oe
+// = 0) where the chip does not drive. A controller sampling at the wrong edge reads garbage.
+// The delays between the FPGA and the chip are parameters (the ECP5 -6 figures of docs/gateware.md
+// "SDRAM"); the board traces are neglected, and commands are taken as set up and held (they change
+// on the rising edge and the chip samples half a clock later).
 module sdram_model #(
   parameter CLK_MHZ   = 50,
   parameter CL        = 2,
@@ -19,7 +31,21 @@ module sdram_model #(
   parameter T_RFC_NS  = 63,
   parameter T_REFI_NS = 7800,
   parameter T_MRD     = 2,
-  parameter INIT_US   = 100
+  parameter INIT_US   = 100,
+  parameter CLK_INVERTED = 1,
+  // DQ out (Alliance AS4C32M16SB-7, table 16): access tAC 6.0 ns at CL 2, 5.4 at CL 3, hold tOH 2.5,
+  // low impedance tLZ 0, high impedance tHZ 5.4
+  parameter T_AC_PS   = CL == 3 ? 5400 : 6000,
+  parameter T_OH_PS   = 2500,
+  parameter T_LZ_PS   = 0,
+  parameter T_HZ_PS   = 5400,
+  // the board (ECP5 -6): the chip's clock leaves the FPGA this much after the core clock's edge
+  // (ODDRX1F 0.99 ns + LVCMOS33 output 2.67), DQ reaches the controller's input register this much
+  // after the chip's pin (LVCMOS33 input 1.14 + about 1 ns), and the controller's DQ reaches the pin
+  // this much after its rising edge (about 1 ns of routing + LVCMOS33 output 2.67)
+  parameter T_CLK_OUT_PS = 3660,
+  parameter T_DQ_IN_PS   = 2140,
+  parameter T_DQ_OUT_PS  = 3670
 ) (
   input  wire        clk,
   input  wire        cke,
@@ -61,10 +87,27 @@ module sdram_model #(
   reg [1:0]  refs_at_init;
   reg        mode_set;
   reg [63:0] seen;               // kinds of violation already printed (bit per kind)
-  // read pipeline: rd_pipe[k] = a READ was sampled k clocks ago; its first beat is driven CL - 1
-  // clocks after the command (the controller samples it CL clocks after), the second one clock later
+  // read pipeline: rd_pipe[k] = a READ was sampled k chip clocks ago; its first beat is put out
+  // after the chip's edge CL - 1 clocks after the command (valid tAC later, held until tOH after the
+  // next edge, where a controller sampling in the chip's phase takes it), the second one clock later
   reg [CL:0]  rd_pipe;
   reg [23:0]  rd_addr [0:CL];
+  // the beats put out: [0] after the chip's latest edge, [1] the edge before, [2] before that
+  localparam integer HALF_I = 500000 / CLK_MHZ, LZ_IN_I = T_LZ_PS + T_DQ_IN_PS, AC_IN_I = T_AC_PS + T_DQ_IN_PS,
+                     HZ_IN_I = 2 * HALF_I + T_HZ_PS + T_DQ_IN_PS, OH_IN_I = 2 * HALF_I + T_OH_PS + T_DQ_IN_PS,
+                     HZ_I = 2 * HALF_I + T_HZ_PS, PERIOD_I = 2 * HALF_I;
+  // a beat is valid at the controller's register from AC_IN to OH_IN after the edge it follows, and
+  // the bus driven from LZ_IN to HZ_IN (HZ at the pins)
+  localparam [63:0] HALF = {32'd0, HALF_I[31:0]}, PERIOD = {32'd0, PERIOD_I[31:0]}, LZ_IN = {32'd0, LZ_IN_I[31:0]},
+                    AC_IN = {32'd0, AC_IN_I[31:0]}, HZ_IN = {32'd0, HZ_IN_I[31:0]}, OH_IN = {32'd0, OH_IN_I[31:0]},
+                    LZ = T_LZ_PS, HZ = {32'd0, HZ_I[31:0]}, CLK_OUT = T_CLK_OUT_PS, DQ_OUT = T_DQ_OUT_PS;
+  reg [63:0]  t_ps;              // the controller's current clock edge
+  reg         beat_on [0:2];
+  reg [15:0]  beat_data [0:2];
+  reg [63:0]  beat_t [0:2];      // the chip's clock edge (at its pin) the beat follows
+  reg         bus_drv;
+  reg [15:0]  bus_val;
+  integer     k;
   // write beat 1 comes one clock after the WRITE
   reg         wr_beat1;
   reg [23:0]  wr_addr1;
@@ -87,8 +130,38 @@ module sdram_model #(
     merge = {m[1] ? old[15:8] : d[15:8], m[0] ? old[7:0] : d[7:0]};
   endfunction
 
+  // what the controller's input register sees at time t: a beat in its window, else the bus changing
+  // (the newest beat inverted: neither beat), else not driven
+  task automatic bus_at(input [63:0] t, output drv, output [15:0] val);
+    integer i;
+    reg     got;
+    begin
+      drv = 1'b0;
+      got = 1'b0;
+      val = 16'hFFFF;
+      for (i = 2; i >= 0; i = i - 1) begin
+        if (beat_on[i]) begin
+          if (t >= beat_t[i] + LZ_IN && t <= beat_t[i] + HZ_IN) begin
+            drv = 1'b1;
+            if (!got) val = ~beat_data[i];
+          end
+          if (t >= beat_t[i] + AC_IN && t <= beat_t[i] + OH_IN) begin
+            got = 1'b1;
+            val = beat_data[i];
+          end
+        end
+      end
+    end
+  endtask
+
   integer b;
   initial begin
+    t_ps = 64'd0;
+    for (b = 0; b < 3; b = b + 1) begin
+      beat_on[b] = 1'b0;
+      beat_data[b] = 16'd0;
+      beat_t[b] = 64'd0;
+    end
     now = 32'd0;
     active = 4'd0;
     violations = 32'd0;
@@ -113,28 +186,42 @@ module sdram_model #(
     end
   end
 
-  always @(posedge clk) begin
+  // both edges of the controller's clock: the chip's own edge (commands, data) is one of them
+  always @(posedge clk or negedge clk) begin
+    t_ps = t_ps + HALF;
+    if (clk == (CLK_INVERTED == 0)) chip_edge();
+    // bus contention: the controller drove DQ from its last rising edge (+ its output delay) for a
+    // clock while a read's data was on the bus (tLZ after the edge starting it to tHZ after its end)
+    if (clk && dq_in_oe) begin
+      for (k = 0; k < 3; k = k + 1)
+        if (beat_on[k] && beat_t[k] + LZ < t_ps + DQ_OUT && t_ps + DQ_OUT < beat_t[k] + PERIOD + HZ)
+          violate(0, "controller drives DQ during read data");
+    end
+    bus_at(t_ps + HALF, bus_drv, bus_val);
+    dq_out <= bus_val;
+    dq_out_oe <= bus_drv;
+  end
+
+  task automatic chip_edge;
+    begin
     now = now + 32'd1;
-    // bus contention: the controller drives while this part drives
-    if (dq_in_oe && dq_out_oe) violate(0, "controller drives DQ during read data");
     // second write beat
     if (wr_beat1) begin
       mem[wr_addr1] <= merge(mem[wr_addr1], dq_in, dqm);
       if (!dq_in_oe) violate(1, "write beat 2 without data");
       wr_beat1 = 1'b0;
     end
-    // read data out
+    // read data out: the beat that follows this edge
     rd_pipe = {rd_pipe[CL-1:0], 1'b0};
     for (b = CL; b > 0; b = b - 1) rd_addr[b] = rd_addr[b - 1];
-    dq_out_oe <= 1'b0;
-    if (rd_pipe[CL - 1]) begin
-      dq_out <= mem[rd_addr[CL - 1]];
-      dq_out_oe <= 1'b1;
+    for (b = 2; b > 0; b = b - 1) begin
+      beat_on[b] = beat_on[b - 1];
+      beat_data[b] = beat_data[b - 1];
+      beat_t[b] = beat_t[b - 1];
     end
-    if (rd_pipe[CL]) begin
-      dq_out <= mem[rd_addr[CL] | 24'd1];
-      dq_out_oe <= 1'b1;
-    end
+    beat_on[0] = rd_pipe[CL - 1] || rd_pipe[CL];
+    beat_data[0] = rd_pipe[CL] ? mem[rd_addr[CL] | 24'd1] : mem[rd_addr[CL - 1]];
+    beat_t[0] = t_ps + CLK_OUT;
     // refresh interval (checked once the part is in service)
     if (mode_set && now - t_ref > 32'd8 * REFI + RFC) violate(2, "refresh interval above 8 x tREFI");
     if (!cke) violate(3, "CKE low (not supported)");
@@ -200,5 +287,6 @@ module sdram_model #(
         default: ;
       endcase
     end
-  end
+    end
+  endtask
 endmodule

@@ -1,6 +1,10 @@
 // DVI 1.0 TMDS encoder (section 3.2.2): 8 data bits to a 10-bit symbol, transition-minimised, with the
 // running disparity kept near 0; outside the data-enable period the two control bits (C1, C0) become
-// one of the four control symbols. One symbol per pixel (en), registered.
+// one of the four control symbols. One symbol per pixel (en), in two register stages (issue 19: the
+// ones count, the XOR/XNOR chain and the DC balance in one clock were the ULX3S's worst cone): stage 1
+// takes the pixel on en and registers the chain's word, its ones-minus-zeros and DE / C beside it;
+// stage 2 makes the symbol and the running disparity one clock later, so q changes one core clock
+// after en (the ULX3S top delays its pixel toggle to match; pixels come every second clock).
 module tmds_encoder (
   input  wire       clk,
   input  wire       en,
@@ -25,29 +29,42 @@ module tmds_encoder (
     for (i = 1; i < 8; i = i + 1) qm[i] = use_xnor ? !(qm[i-1] ^ d[i]) : qm[i-1] ^ d[i];
     qm[8] = !use_xnor;
   end
-  // stage 2: DC balance. disp is the running count of ones minus zeros sent, in units of 1
+  // stage 1 registers: the chain's word, its ones - zeros, DE and C of the same pixel
   wire signed [4:0] n1 = {1'b0, ones(qm[7:0])};
-  wire signed [4:0] diff = n1 - (5'sd8 - n1);          // ones - zeros of qm[7:0]
+  reg  [8:0]        qm_r = 9'd0;
+  reg  signed [4:0] diff_r = 5'sd0;                    // ones - zeros of qm[7:0]
+  reg               de_r = 1'b0, en_r = 1'b0;
+  reg  [1:0]        c_r = 2'b00;
+  always @(posedge clk) begin
+    en_r <= en;
+    if (en) begin
+      qm_r <= qm;
+      diff_r <= n1 - (5'sd8 - n1);
+      de_r <= de;
+      c_r <= c;
+    end
+  end
+  // stage 2: DC balance. disp is the running count of ones minus zeros sent, in units of 1
   reg  signed [4:0] disp = 5'sd0;
   always @(posedge clk) begin
-    if (en) begin
-      if (!de) begin
+    if (en_r) begin
+      if (!de_r) begin
         disp <= 5'sd0;
-        case (c)
+        case (c_r)
           2'b00: q <= 10'b1101010100;
           2'b01: q <= 10'b0010101011;
           2'b10: q <= 10'b0101010100;
           default: q <= 10'b1010101011;
         endcase
-      end else if (disp == 5'sd0 || diff == 5'sd0) begin
-        q <= {!qm[8], qm[8], qm[8] ? qm[7:0] : ~qm[7:0]};
-        disp <= qm[8] ? disp + diff : disp - diff;
-      end else if ((disp > 5'sd0 && diff > 5'sd0) || (disp < 5'sd0 && diff < 5'sd0)) begin
-        q <= {1'b1, qm[8], ~qm[7:0]};
-        disp <= disp + (qm[8] ? 5'sd2 : 5'sd0) - diff;
+      end else if (disp == 5'sd0 || diff_r == 5'sd0) begin
+        q <= {!qm_r[8], qm_r[8], qm_r[8] ? qm_r[7:0] : ~qm_r[7:0]};
+        disp <= qm_r[8] ? disp + diff_r : disp - diff_r;
+      end else if ((disp > 5'sd0 && diff_r > 5'sd0) || (disp < 5'sd0 && diff_r < 5'sd0)) begin
+        q <= {1'b1, qm_r[8], ~qm_r[7:0]};
+        disp <= disp + (qm_r[8] ? 5'sd2 : 5'sd0) - diff_r;
       end else begin
-        q <= {1'b0, qm[8], qm[7:0]};
-        disp <= disp - (qm[8] ? 5'sd0 : 5'sd2) + diff;
+        q <= {1'b0, qm_r[8], qm_r[7:0]};
+        disp <= disp - (qm_r[8] ? 5'sd0 : 5'sd2) + diff_r;
       end
     end
   end

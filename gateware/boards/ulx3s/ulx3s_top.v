@@ -5,7 +5,8 @@
 // - Clocks from one PLL on the 25 MHz oscillator (VCO 750 MHz): the core at 50 MHz (the co-simulation's
 //   clock), a pixel every second core clock (25 MHz, 640 x 480 at 59.5 Hz), and 125 MHz for the TMDS
 //   serialisers (10 bits a pixel, two a clock through DDR output cells).
-// - TMDS symbols are encoded in the core domain and change every 40 ns; the 125 MHz domain loads them
+// - TMDS symbols are encoded in the core domain (two stages: a symbol leaves one clock after its pixel)
+//   and change every 40 ns; the 125 MHz domain loads them
 //   2-3 of its clocks after a pixel toggle it synchronises, so always mid-symbol.
 // - SPI from an FT232H wired to the J1 GPIO header (docs/boards.md "ULX3S"), BUSY wired.
 // - The SDRAM clock is the core clock inverted (a DDR output cell, 0 then 1): commands and data change
@@ -83,8 +84,12 @@ module ulx3s_top (
   tmds_encoder u_enc_b (.clk(clk), .en(pix_en), .de(de), .d(b), .c({vs, hs}), .q(sym_b));
   tmds_encoder u_enc_g (.clk(clk), .en(pix_en), .de(de), .d(g), .c(2'b00), .q(sym_g));
   tmds_encoder u_enc_r (.clk(clk), .en(pix_en), .de(de), .d(r), .c(2'b00), .q(sym_r));
-  reg pix_toggle = 1'b0;
-  always @(posedge clk) if (pix_en) pix_toggle <= !pix_toggle;
+  // the encoders' symbols change one clock after pix_en (their two stages): the toggle with them
+  reg pix_en_d = 1'b0, pix_toggle = 1'b0;
+  always @(posedge clk) begin
+    pix_en_d <= pix_en;
+    if (pix_en_d) pix_toggle <= !pix_toggle;
+  end
 
   // 125 MHz: a new symbol 2-3 clocks after each pixel toggle, then two bits a clock, LSB first
   reg [2:0] toggle_sync = 3'd0;

@@ -5,14 +5,27 @@
 //     words and consecutive rows rotate through the banks;
 //   - every bank's row stays open until another row of that bank or a refresh needs it; one command
 //     per clock; a READ or WRITE can issue every 2 clocks (2 bytes per clock at best);
+//   - req_ready is a function of registers only (issue 19): init_done, a refresh due, the served slot
+//     empty, or `issue_next`, registered a clock ahead, which says the request in the slot will issue
+//     its READ or WRITE in this clock (it stays, is a row hit, and its timers reach 0), so the bank
+//     state and timers do not reach the arbiter and the render core's stall logic in the same clock.
+//     It is exact except for a request that issues in the clock after it was taken (an idle
+//     controller): the next request is then taken a clock later than it was;
 //   - auto refresh every T_REFI (all banks precharged first); the JEDEC power-up sequence at reset.
 // All timing is in nanoseconds and converted with the clock frequency, so the behavioural model
 // (gateware/sim/sdram_model.v), which checks every constraint, runs with the same numbers.
-// Read data is sampled CL+1 clocks after the READ command is registered (the model's timing; a board
-// may need a clock phase shift for its trace delays, issue 19).
+// Read capture (issue 19): the boards send the chip the core clock inverted (ULX3S: a DDR output
+// cell), so the chip takes a command on the falling edge after the one that registered it and drives
+// each read beat from tAC after a falling edge until tOH after the next. With the ECP5's I/O delays the
+// beats change around the core's rising edges (docs/gateware.md "SDRAM"), so CAPTURE_FALL = 1 samples
+// DQ on the falling edge, where the chip itself would (the middle of the beat), in an input register
+// meant for the I/O cell, and hands it to the rising edge half a clock later: a beat is in the core
+// CL + 1 clocks after the READ left its register, as with a chip clocked in phase and CAPTURE_FALL = 0
+// (rising-edge sampling of DQ straight from the pin), so the read latency in core clocks is the same.
 module sdram_ctrl #(
   parameter CLK_MHZ   = 50,
   parameter CL        = 2,
+  parameter CAPTURE_FALL = 1,   // 1: chip clock = core clock inverted (the boards); 0: chip clock in phase
   // the slowest of the ULX3S's SDRAM parts checked (Alliance AS4C32M16SB-7TCN, datasheet table 16;
   // Micron MT48LC16M16A2-6A is 18/18/42/60/12/12/60); both take CL 2 at tCK >= 10 ns (100 MHz)
   parameter T_RP_NS   = 21,
@@ -119,11 +132,22 @@ module sdram_ctrl #(
   wire do_act   = init_done && !ref_due && cur_valid && !open[cur_bank] && b_act == 8'd0 && t_rrd == 8'd0;
   wire do_prea  = init_done && ref_due && open != 4'd0 && all_pre_ok;
   wire do_ref   = init_done && ref_due && open == 4'd0 && all_act_ok;
-  assign req_ready = init_done && !ref_due && (!cur_valid || do_rw);
+  // issue_next: do_rw will hold in the next clock. The request stays (no do_rw now), its row is open
+  // and stays so (hit excludes this bank's PRECHARGE and ACTIVE; no refresh is or becomes due, so no
+  // PRECHARGE all), and every timer do_rw waits for is at most 1 now, so 0 then
+  reg    issue_next;
+  wire   issue_next_d = cur_valid && !do_rw && hit && !ref_due && refi != 16'd1 && b_rcd <= 8'd1 &&
+                        t_rw <= 8'd1 && (!cur_we || t_turn <= 8'd1);
+  assign req_ready = init_done && !ref_due && (!cur_valid || issue_next);
   assign refresh   = do_ref;
 
   // read data capture: rd_pipe[k] is set k clocks after a READ was registered
   reg [CL+1:0] rd_pipe;
+  // DQ sampled on the falling edge; syn_useioff asks nextpnr-ecp5 to put it in the pin's I/O register
+  // (yosys synth_ecp5 copies the attribute to the flip-flop), so no fabric routing sits before it
+  (* syn_useioff *) reg [15:0] dq_fall;
+  always @(negedge clk) dq_fall <= sd_dq_i;
+  wire [15:0]  dq_cap = CAPTURE_FALL != 0 ? dq_fall : sd_dq_i;
   reg [15:0]   beat0;
   reg          wr_beat1;
   reg [15:0]   wr_lo;
@@ -153,6 +177,7 @@ module sdram_ctrl #(
       icount <= INIT;
       open <= 4'd0;
       cur_valid <= 1'b0;
+      issue_next <= 1'b0;
       ref_due <= 1'b0;
       refi <= REFI;
       rd_pipe <= {(CL + 2){1'b0}};
@@ -186,6 +211,7 @@ module sdram_ctrl #(
           endcase
         end
       end else begin
+        issue_next <= issue_next_d;
         // refresh timer
         if (refi == 16'd1) begin
           refi <= REFI;
@@ -275,10 +301,10 @@ module sdram_ctrl #(
         sd_dqm <= wr_dqm_lo;
       end
       // read data
-      if (rd_pipe[CL]) beat0 <= sd_dq_i;
+      if (rd_pipe[CL]) beat0 <= dq_cap;
       if (rd_pipe[CL+1]) begin
         rsp_valid <= 1'b1;
-        rsp_rdata <= {beat0, sd_dq_i};
+        rsp_rdata <= {beat0, dq_cap};
       end
     end
   end

@@ -29,15 +29,21 @@ class Encoder {
     m_.de = de;
     m_.d = static_cast<std::uint8_t>(data);
     m_.c = static_cast<std::uint8_t>(c);
-    m_.clk = 0;
-    m_.eval();
-    m_.clk = 1;
-    m_.eval();
+    clock();
+    // the encoder's second stage takes the pixel one clock later (en low: nothing new enters)
+    m_.en = 0;
+    clock();
     const unsigned q = m_.q;
     disparity_ += 2 * int(std::bitset<10>(q).count()) - 10;
     return q;
   }
   int disparity() const { return disparity_; }
+  void clock() {
+    m_.clk = 0;
+    m_.eval();
+    m_.clk = 1;
+    m_.eval();
+  }
   void reset_disparity() { disparity_ = 0; }
 
  private:
