@@ -63,7 +63,7 @@ constexpr int kPrefetchRows = 4;
 // A run stops asking the coarse depth bounds (hier_z.hpp) after this many rows in a row that they
 // did not reject: in front-to-back scenes no row is rejected, and asking on every row cost about
 // 200 instructions a row (1,000-px triangles, callgrind).
-constexpr unsigned kHierZTries = 4;
+constexpr unsigned kHierZTries = 2;
 
 template <bool kGouraud, bool kTextured, bool kDepth, bool kSimple>
 class Kernel {
