@@ -30,6 +30,7 @@ class HierZ {
 
   // Sizes the grid for a width × height buffer. Call while no worker draws.
   void prepare(unsigned width, unsigned height) {
+    if (width == width_ && height == height_) return;
     width_ = width;
     height_ = height;
     per_row_ = (width + (1u << kColsLog) - 1) >> kColsLog;

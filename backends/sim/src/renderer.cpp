@@ -86,6 +86,34 @@ Renderer::~Renderer() { wait_drawing(); }  // the workers read drawing_: stop th
                                          : setup_triangle(a, b, c, st, knobs_.subpixel_bits, observing, t);
 }
 
+// Inlined into draw(): a call per small triangle costs more than its body.
+[[gnu::always_inline]] inline void Renderer::draw_pending() {
+  if (pending_ < 0) return;
+  const Triangle& t = slots_[pending_];
+  if (t.small) {  // no errors (both buffers inside memory), counters straight into the totals
+    const std::uint64_t covered = counters_.covered;
+    rasterize_small(t, pending_small_, counters_, t.y0, t.y1);
+    modes_[pending_state_->mode_class].pixels += counters_.covered - covered;
+    pending_ = -1;
+    return;
+  }
+  RasterContext ctx{mem_, recip_, knobs_.z_bits, 0, {}, vector_};
+  // Boxes narrower than the span solve's 16 pixels never ask the bounds (their writes not marked
+  // only leave bounds looser): no set-up for them (10-px triangles).
+  const bool hz = pending_hz_ && t.x1 - t.x0 >= 16;
+  if (hz) {
+    hier_z_.prepare(pending_state_->fb_width, pending_state_->fb_height);  // no worker draws in this path
+    ctx.hier_z = &hier_z_;
+    ctx.hz_gen = pending_gen_;
+    ctx.hz_run = hz_runs_[0];
+  }
+  rasterize_rows(t, *pending_state_, ctx, t.y0, t.y1);
+  if (hz) hz_runs_[0] = ctx.hz_run;
+  errors_ |= ctx.errors;
+  add_counters(ctx.counters, *pending_state_);
+  pending_ = -1;  // pending_state_ stays: the next triangle most likely uses it again
+}
+
 void Renderer::draw(const Vertex& a, const Vertex& b, const Vertex& c, const std::shared_ptr<const DrawState>& state,
                     std::uint64_t index) {
   const DrawState& st = *state;
@@ -138,6 +166,7 @@ void Renderer::draw(const Vertex& a, const Vertex& b, const Vertex& c, const std
   // only when it changed, not once per triangle.
   if (pending_state_ != state) {
     pending_state_ = state;
+    pending_hz_ = hier_z_applies(st, vector_);
     if (knobs_.preview && st.preview_small != 0) pending_small_ = small_draw(st, mem_, knobs_.z_bits);
   }
 }
@@ -153,23 +182,6 @@ void Renderer::count_rasterised(const Triangle& t, const DrawState& st) {
   if (st.mode_class & 4) texel_footprint_ += texel_footprint_bytes(t, st, covered);
 }
 
-void Renderer::draw_pending() {
-  if (pending_ < 0) return;
-  const Triangle& t = slots_[pending_];
-  if (t.small) {  // no errors (both buffers inside memory), counters straight into the totals
-    const std::uint64_t covered = counters_.covered;
-    rasterize_small(t, pending_small_, counters_, t.y0, t.y1);
-    modes_[pending_state_->mode_class].pixels += counters_.covered - covered;
-    pending_ = -1;
-    return;
-  }
-  RasterContext ctx = context(*pending_state_, pending_gen_, 0);
-  rasterize_rows(t, *pending_state_, ctx, t.y0, t.y1);
-  if (ctx.hier_z) hz_runs_[0] = ctx.hz_run;
-  errors_ |= ctx.errors;
-  add_counters(ctx.counters, *pending_state_);
-  pending_ = -1;  // pending_state_ stays: the next triangle most likely uses it again
-}
 
 void Renderer::flush() {
   draw_pending();

@@ -116,6 +116,7 @@ class Renderer {
   std::uint64_t hz_gen_ = 1;
   std::shared_ptr<const DrawState> hz_state_;
   std::uint64_t batch_gen_ = 0, drawing_gen_ = 0, pending_gen_ = 0;
+  bool pending_hz_ = false;  // the bounds apply to pending_state_
   std::vector<std::uint32_t> hz_runs_;
   void add_counters(const RasterCounters& c, const DrawState& st) {
     counters_.add(c);
