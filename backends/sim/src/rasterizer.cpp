@@ -122,6 +122,12 @@ class Kernel {
     }
     const int w = t_.x1 - t_.x0;
     for (int y = ya; y < yz; ++y) {
+      // A new 16-row band of blocks gets its tries afresh when the bounds rejected rows in this run
+      // so far, or every fourth band (large random-Z triangles: visible at one end, hidden at the
+      // other; front-to-back ones are never rejected and ask only every fourth band).
+      if (kDepth && (y & ((1 << HierZ::kRowsLog) - 1)) == 0 && ctx_.hier_z &&
+          (hz_rejected_ || ((y >> HierZ::kRowsLog) & 3) == 0))
+        hz_tries_ = kHierZTries;
       if (w >= kSpanSolveWidth) {
         std::int64_t kl = 0, kr = w - 1;
         for (int i = 0; i < 3; ++i) {
@@ -299,6 +305,7 @@ class Kernel {
       if (ctx_.hier_z->occludes(zbuf_, y, t_.x0 + static_cast<int>(kl), t_.x0 + static_cast<int>(kr), zm,
                                 st_.z_func == protocol::DepthFunc::Less, ctx_.hz_gen, hz_run_)) {
         hz_tries_ = kHierZTries;
+        hz_rejected_ = true;
         return true;
       }
       --hz_tries_;
@@ -413,6 +420,7 @@ class Kernel {
   std::uint64_t textured_ = 0;  // texture-unit pixels of this run
   std::uint32_t hz_run_ = 0;    // this run's number for the coarse depth bounds
   unsigned hz_tries_ = 0;       // rows left to ask them before giving up on this run (0: not asked)
+  bool hz_rejected_ = false;    // they rejected a row of this run
 };
 
 template <bool G, bool T, bool Z, bool S>
