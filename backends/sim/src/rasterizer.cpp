@@ -60,6 +60,10 @@ constexpr int kSpanSolveWidth = 16;
 constexpr std::int64_t kStepJump = 4;
 // Rows this far ahead of the one being drawn are prefetched.
 constexpr int kPrefetchRows = 4;
+// A run stops asking the coarse depth bounds (hier_z.hpp) after this many rows in a row that they
+// did not reject: in front-to-back scenes no row is rejected, and asking on every row cost about
+// 200 instructions a row (1,000-px triangles, callgrind).
+constexpr unsigned kHierZTries = 2;
 
 template <bool kGouraud, bool kTextured, bool kDepth, bool kSimple>
 class Kernel {
@@ -100,6 +104,12 @@ class Kernel {
   }
 
   void run(int ya, int yz) {
+    if (kDepth && ctx_.hier_z) {
+      hz_run_ = ++ctx_.hz_run;
+      if (hz_run_ == 0) hz_run_ = ++ctx_.hz_run;  // 0 means "not written" in a block
+      hz_tries_ = kHierZTries;
+    }
+    const std::uint64_t passed_before = ctx_.counters.passed;
     const std::int64_t k = ya - t_.y0;
     std::int64_t e[3];
     for (int i = 0; i < 3; ++i) e[i] = t_.edge[i].e + k * t_.edge[i].ey;
@@ -112,6 +122,12 @@ class Kernel {
     }
     const int w = t_.x1 - t_.x0;
     for (int y = ya; y < yz; ++y) {
+      // A new 16-row band of blocks gets its tries afresh when the bounds rejected rows in this run
+      // so far, or every fourth band (large random-Z triangles: visible at one end, hidden at the
+      // other; front-to-back ones are never rejected and ask only every fourth band).
+      if (kDepth && (y & ((1 << HierZ::kRowsLog) - 1)) == 0 && ctx_.hier_z &&
+          (hz_rejected_ || ((y >> HierZ::kRowsLog) & 3) == 0))
+        hz_tries_ = kHierZTries;
       if (w >= kSpanSolveWidth) {
         std::int64_t kl = 0, kr = w - 1;
         for (int i = 0; i < 3; ++i) {
@@ -124,7 +140,8 @@ class Kernel {
         if (kl <= kr) {
           if (simd_ && y + kPrefetchRows < yz) prefetch_row(y + kPrefetchRows, t_.x0 + static_cast<int>(kl), static_cast<int>(kr - kl + 1));
           if (kr - kl + 1 >= kMinSimdSpan && simd_ready()) {
-            simd_span(row, kl, t_.x0 + static_cast<int>(kl), y, static_cast<unsigned>(kr - kl + 1));
+            if (!occluded(row, kl, kr, y))
+              simd_span(row, kl, t_.x0 + static_cast<int>(kl), y, static_cast<unsigned>(kr - kl + 1));
           } else {
             Steppers s = row;
             jump_x(s, kl);
@@ -159,6 +176,9 @@ class Kernel {
       for (int i = 0; i < 3; ++i) e[i] += t_.edge[i].ey;
       step_y(row);
     }
+    // Blocks this run wrote into: read again when another run asks (their bounds only got looser).
+    if (kDepth && ctx_.hier_z && st_.z_write && ctx_.counters.passed != passed_before)
+      ctx_.hier_z->mark(ya, yz, t_.x0, t_.x1 - 1, hz_run_);
     if constexpr (kTextured) {
       ctx_.counters.textured += textured_;
       ctx_.counters.texel_bytes += textured_ * (st_.tex.bilinear ? 4u : 1u) * protocol::bytes_per_pixel(st_.tex.format);
@@ -261,6 +281,36 @@ class Kernel {
     for (std::size_t b = 0; b < color_bytes; b += 64) __builtin_prefetch(color_ + pix * st_.bpp + b, 1);
     if (kDepth)
       for (std::size_t b = 0; b < depth_bytes; b += 64) __builtin_prefetch(zbuf_ + pix * 4 + b, 1);
+  }
+
+  // Whether every pixel of row y's span kl..kr fails the depth test by the coarse bounds
+  // (hier_z.hpp): its smallest depth, masked as the test masks it, is not below (LESS) or not at
+  // or below (LEQUAL) the largest depth stored in the blocks it crosses. Depth is linear along the
+  // row, so its smallest value over the span is at one end, and both ends are covered pixels
+  // (depths within the vertices' 24-bit range). Only with the span routine (den < 2^30).
+  bool occluded(const Steppers& row, std::int64_t kl, std::int64_t kr, int y) {
+    if constexpr (!kDepth) {
+      return false;
+    } else {
+      if (hz_tries_ == 0) return false;
+      const Plane& p = t_.plane[kZ];
+      const std::int64_t k = p.qx >= 0 ? kl : kr;  // the slope qx + rx/den has the sign of qx (0 <= rx < den)
+      const std::int64_t n = row.r[kZ] + k * p.rx;  // 0 <= n < 2^41: exact in double
+      std::int64_t f = static_cast<std::int64_t>(static_cast<double>(n) * simd_tpl_.inv_den);  // off by at most one
+      f -= f * t_.den > n;
+      f += (f + 1) * t_.den <= n;
+      const std::int64_t z = row.q[kZ] + k * p.qx + f;  // the exact depth at pixel k
+      if (z < 0 || z > 0xFFFFFF) return false;  // not a covered depth: never rejects
+      const std::uint32_t zm = static_cast<std::uint32_t>(z) & zmask_;
+      if (ctx_.hier_z->occludes(zbuf_, y, t_.x0 + static_cast<int>(kl), t_.x0 + static_cast<int>(kr), zm,
+                                st_.z_func == protocol::DepthFunc::Less, ctx_.hz_gen, hz_run_)) {
+        hz_tries_ = kHierZTries;
+        hz_rejected_ = true;
+        return true;
+      }
+      --hz_tries_;
+      return false;
+    }
   }
 
   // A span `skip` pixels from the box row's start, whose planes are `row`: the routine does the
@@ -368,6 +418,9 @@ class Kernel {
   bool simd_ = false, simd_checked_ = false;
   SimdSpan simd_tpl_{};
   std::uint64_t textured_ = 0;  // texture-unit pixels of this run
+  std::uint32_t hz_run_ = 0;    // this run's number for the coarse depth bounds
+  unsigned hz_tries_ = 0;       // rows left to ask them before giving up on this run (0: not asked)
+  bool hz_rejected_ = false;    // they rejected a row of this run
 };
 
 template <bool G, bool T, bool Z, bool S>

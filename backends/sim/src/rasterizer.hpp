@@ -7,6 +7,7 @@
 #include <cstdint>
 
 #include "draw_state.hpp"
+#include "hier_z.hpp"
 #include "preview_plain.hpp"
 #include "gpubridge/sim/device.hpp"
 #include "reciprocal.hpp"
@@ -34,6 +35,12 @@ struct RasterContext {
   std::uint16_t errors = 0;  // ERR_MEM_RANGE from out-of-memory accesses
   RasterCounters counters;
   bool vector = true;  // vector routines allowed (DeviceOptions::vector_routines)
+  // Coarse depth bounds (hier_z.hpp) when the renderer keeps them for this draw's state (its
+  // depth test LESS or LEQUAL, buffers in VRAM and disjoint), their generation, and the number of
+  // the last Kernel run drawn with this context.
+  HierZ* hier_z = nullptr;
+  std::uint64_t hz_gen = 0;
+  std::uint32_t hz_run = 0;
 };
 
 // The preview routine (`--accuracy preview`, preview_simd.hpp) can draw with this state: both

@@ -15,6 +15,28 @@ Renderer::Renderer(VideoMemory& mem, const AccuracyKnobs& knobs, unsigned thread
     drawing_.resize(kMaxBatch);
   }
   draw_job_ = [this](unsigned worker) { draw_bands(worker); };
+  hz_runs_.assign(pool_.workers(), 0);
+}
+
+namespace {
+// The coarse depth bounds hold for a state whose depth writes only ever lower the stored depth
+// (a LESS or LEQUAL test) and whose colour writes cannot reach the depth buffer; with the vector
+// routines only (the reference routines stay the plain per-pixel path they are compared with).
+bool hier_z_applies(const DrawState& st, bool vector) {
+  return vector && st.z_test && (st.z_func == protocol::DepthFunc::Less || st.z_func == protocol::DepthFunc::LessEqual) &&
+         st.z_in_vram && st.color_in_vram && st.buffers_disjoint;
+}
+}  // namespace
+
+RasterContext Renderer::context(const DrawState& st, std::uint64_t gen, unsigned w) {
+  RasterContext ctx{mem_, recip_, knobs_.z_bits, 0, {}, vector_};
+  if (hier_z_applies(st, vector_)) {
+    hier_z_.prepare(st.fb_width, st.fb_height);  // no worker is drawing (the callers waited)
+    ctx.hier_z = &hier_z_;
+    ctx.hz_gen = gen;
+    ctx.hz_run = hz_runs_[w];
+  }
+  return ctx;
 }
 
 Renderer::~Renderer() { wait_drawing(); }  // the workers read drawing_: stop them before it goes
@@ -64,6 +86,34 @@ Renderer::~Renderer() { wait_drawing(); }  // the workers read drawing_: stop th
                                          : setup_triangle(a, b, c, st, knobs_.subpixel_bits, observing, t);
 }
 
+// Inlined into draw(): a call per small triangle costs more than its body.
+[[gnu::always_inline]] inline void Renderer::draw_pending() {
+  if (pending_ < 0) return;
+  const Triangle& t = slots_[pending_];
+  if (t.small) {  // no errors (both buffers inside memory), counters straight into the totals
+    const std::uint64_t covered = counters_.covered;
+    rasterize_small(t, pending_small_, counters_, t.y0, t.y1);
+    modes_[pending_state_->mode_class].pixels += counters_.covered - covered;
+    pending_ = -1;
+    return;
+  }
+  RasterContext ctx{mem_, recip_, knobs_.z_bits, 0, {}, vector_};
+  // Boxes narrower than the span solve's 16 pixels never ask the bounds (their writes not marked
+  // only leave bounds looser): no set-up for them (10-px triangles).
+  const bool hz = pending_hz_ && t.x1 - t.x0 >= 16;
+  if (hz) {
+    hier_z_.prepare(pending_state_->fb_width, pending_state_->fb_height);  // no worker draws in this path
+    ctx.hier_z = &hier_z_;
+    ctx.hz_gen = pending_gen_;
+    ctx.hz_run = hz_runs_[0];
+  }
+  rasterize_rows(t, *pending_state_, ctx, t.y0, t.y1);
+  if (hz) hz_runs_[0] = ctx.hz_run;
+  errors_ |= ctx.errors;
+  add_counters(ctx.counters, *pending_state_);
+  pending_ = -1;  // pending_state_ stays: the next triangle most likely uses it again
+}
+
 void Renderer::draw(const Vertex& a, const Vertex& b, const Vertex& c, const std::shared_ptr<const DrawState>& state,
                     std::uint64_t index) {
   const DrawState& st = *state;
@@ -71,6 +121,10 @@ void Renderer::draw(const Vertex& a, const Vertex& b, const Vertex& c, const std
   const bool observing = static_cast<bool>(observer_);
   // No work when nothing is written (unless someone watches the attributes).
   if (st.writes_nothing && !observing) return;
+  if (hz_state_ != state) {  // a new state: the coarse depth bounds start afresh
+    next_generation();
+    hz_state_ = state;
+  }
   const bool batching = pool_.workers() > 1 && !observing && st.bands_independent;
   if (batching) {
     draw_pending();
@@ -86,6 +140,7 @@ void Renderer::draw(const Vertex& a, const Vertex& b, const Vertex& c, const std
     }
     t.index = index;
     count_rasterised(t, st);
+    if (batch_n_ == 0) batch_gen_ = hz_gen_;  // one state and no flush within a batch: one generation
     if (batch_state_ != state) batch_state_ = state;
     if (++batch_n_ >= kMaxBatch) submit();
     return;
@@ -106,10 +161,12 @@ void Renderer::draw(const Vertex& a, const Vertex& b, const Vertex& c, const std
   prefetch_rows(t, st);
   draw_pending();
   pending_ = slot;
+  pending_gen_ = hz_gen_;
   // The state object is shared with the device: copy the pointer (an atomic count update)
   // only when it changed, not once per triangle.
   if (pending_state_ != state) {
     pending_state_ = state;
+    pending_hz_ = hier_z_applies(st, vector_);
     if (knobs_.preview && st.preview_small != 0) pending_small_ = small_draw(st, mem_, knobs_.z_bits);
   }
 }
@@ -125,27 +182,12 @@ void Renderer::count_rasterised(const Triangle& t, const DrawState& st) {
   if (st.mode_class & 4) texel_footprint_ += texel_footprint_bytes(t, st, covered);
 }
 
-void Renderer::draw_pending() {
-  if (pending_ < 0) return;
-  const Triangle& t = slots_[pending_];
-  if (t.small) {  // no errors (both buffers inside memory), counters straight into the totals
-    const std::uint64_t covered = counters_.covered;
-    rasterize_small(t, pending_small_, counters_, t.y0, t.y1);
-    modes_[pending_state_->mode_class].pixels += counters_.covered - covered;
-    pending_ = -1;
-    return;
-  }
-  RasterContext ctx{mem_, recip_, knobs_.z_bits, 0, {}, vector_};
-  rasterize_rows(t, *pending_state_, ctx, t.y0, t.y1);
-  errors_ |= ctx.errors;
-  add_counters(ctx.counters, *pending_state_);
-  pending_ = -1;  // pending_state_ stays: the next triangle most likely uses it again
-}
 
 void Renderer::flush() {
   draw_pending();
   submit();
   wait_drawing();
+  next_generation();  // whoever flushed may now read or write memory
 }
 
 void Renderer::submit() {
@@ -158,10 +200,10 @@ void Renderer::submit() {
   drawing_n_ = batch_n_;
   batch_n_ = 0;
   drawing_state_ = std::move(batch_state_);
+  drawing_gen_ = batch_gen_;
   batch_state_.reset();
   drawing_ctx_.clear();
-  for (unsigned w = 0; w < pool_.workers(); ++w)
-    drawing_ctx_.push_back(RasterContext{mem_, recip_, knobs_.z_bits, 0, {}, vector_});
+  for (unsigned w = 0; w < pool_.workers(); ++w) drawing_ctx_.push_back(context(*drawing_state_, drawing_gen_, w));
   drawing_active_ = true;
   pool_.start(draw_job_);
 }
@@ -169,9 +211,11 @@ void Renderer::submit() {
 void Renderer::wait_drawing() {
   if (!drawing_active_) return;
   pool_.wait();
-  for (const auto& c : drawing_ctx_) {
+  for (unsigned w = 0; w < drawing_ctx_.size(); ++w) {
+    const RasterContext& c = drawing_ctx_[w];
     errors_ |= c.errors;
     add_counters(c.counters, *drawing_state_);  // one state per batch
+    if (c.hier_z) hz_runs_[w] = c.hz_run;
   }
   drawing_n_ = 0;
   drawing_state_.reset();

@@ -75,6 +75,10 @@ class Renderer {
   bool setup(const Vertex& a, const Vertex& b, const Vertex& c, const DrawState& st, bool observing, Triangle& t) const;
   // Counts a triangle that was set up (rasterised, and its state class's triangles, rows, columns).
   void count_rasterised(const Triangle& t, const DrawState& st);
+  // A context for drawing with st in coarse-depth generation gen, for worker w (hier_z.hpp).
+  RasterContext context(const DrawState& st, std::uint64_t gen, unsigned w);
+  // Ends the coarse depth bounds' generation (at every flush and change of state).
+  void next_generation() { ++hz_gen_; }
 
 
   VideoMemory& mem_;
@@ -105,6 +109,15 @@ class Renderer {
   std::array<DeviceStats::ModeWork, DeviceStats::kModeClasses> modes_{};
   SdramRows sdram_;
   std::uint64_t texel_footprint_ = 0;
+  // Coarse depth bounds (hier_z.hpp): their generation, the state it belongs to (held, so a new
+  // state cannot reuse its address unnoticed), the generations of the filling batch, the batch
+  // being drawn and the pending triangle, and each worker's last Kernel run number.
+  HierZ hier_z_;
+  std::uint64_t hz_gen_ = 1;
+  std::shared_ptr<const DrawState> hz_state_;
+  std::uint64_t batch_gen_ = 0, drawing_gen_ = 0, pending_gen_ = 0;
+  bool pending_hz_ = false;  // the bounds apply to pending_state_
+  std::vector<std::uint32_t> hz_runs_;
   void add_counters(const RasterCounters& c, const DrawState& st) {
     counters_.add(c);
     modes_[st.mode_class].pixels += c.covered;

@@ -1,0 +1,177 @@
+// The coarse depth bounds (backends/sim/src/hier_z.hpp) that let the exact path skip occluded
+// spans: the bound itself against a depth buffer written by hand, and whole random-depth scenes
+// against the reference routines (DeviceOptions::vector_routines off, which never use the bounds)
+// with the depth buffer raised behind the bounds' back between draws by every path that can: MEM
+// writes, a depth clear, a draw with an ALWAYS test, and the memory span. A bound that outlived
+// one of them would reject spans the reference draws, and the bytes would differ.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "hier_z.hpp"
+#include "sim_test_util.hpp"
+
+namespace gpubridge::sim::test {
+namespace {
+
+void put_depth(std::vector<std::uint8_t>& z, unsigned width, unsigned x, unsigned y, std::uint32_t v) {
+  std::uint8_t* p = z.data() + (std::size_t{y} * width + x) * 4;
+  p[0] = static_cast<std::uint8_t>(v >> 24);
+  p[1] = static_cast<std::uint8_t>(v >> 16);
+  p[2] = static_cast<std::uint8_t>(v >> 8);
+  p[3] = static_cast<std::uint8_t>(v);
+}
+
+TEST(SimHierZ, BlockMaximumIgnoresTheTopByteAndReadsEveryWord) {
+  std::vector<std::uint8_t> z(40 * 20 * 4, 0);
+  put_depth(z, 40, 5, 3, 0xFF000010);  // top byte set: the test reads 24 bits
+  put_depth(z, 40, 31, 15, 0x000123);  // the block's last word
+  put_depth(z, 40, 32, 0, 0x00FFFF);   // the next block
+  EXPECT_EQ(depth_block_max(z.data(), 40 * 4, 16, 32), 0x123u);
+  EXPECT_EQ(depth_block_max(z.data() + 32 * 4, 40 * 4, 16, 8), 0xFFFFu);
+}
+
+TEST(SimHierZ, OccludesOnlyWhatEveryStoredDepthRejects) {
+  const unsigned width = 70, height = 20;  // blocks of 32 and 6 columns, 16 and 4 rows
+  std::vector<std::uint8_t> z(std::size_t{width} * height * 4, 0);
+  for (unsigned y = 0; y < height; ++y)
+    for (unsigned x = 0; x < width; ++x) put_depth(z, width, x, y, 0x100);
+  put_depth(z, width, 40, 7, 0x500);  // block (1, 0) holds a farther depth
+  HierZ h;
+  h.prepare(width, height);
+  std::uint64_t gen = 1;
+  EXPECT_TRUE(h.occludes(z.data(), 3, 0, 31, 0x100, true, gen, 1));    // LESS: equal fails
+  EXPECT_FALSE(h.occludes(z.data(), 3, 0, 31, 0x100, false, gen, 1));  // LEQUAL: equal passes
+  EXPECT_FALSE(h.occludes(z.data(), 3, 0, 31, 0xFF, true, gen, 1));
+  EXPECT_FALSE(h.occludes(z.data(), 3, 20, 40, 0x400, true, gen, 1));  // crosses into block (1, 0)
+  EXPECT_TRUE(h.occludes(z.data(), 3, 20, 40, 0x500, true, gen, 1));
+  EXPECT_TRUE(h.occludes(z.data(), 17, 64, 69, 0x100, true, gen, 1));  // the partial corner block
+  // Lowered by a write of run 2 (bounds only loosen): asked by run 3, the block is read again.
+  for (unsigned y = 0; y < 16; ++y)
+    for (unsigned x = 32; x < 64; ++x) put_depth(z, width, x, y, 0x80);
+  h.mark(0, 16, 32, 63, 2);
+  EXPECT_TRUE(h.occludes(z.data(), 3, 33, 40, 0x80, true, gen, 3));
+  // Raised behind its back: a new generation reads the block again.
+  put_depth(z, width, 10, 10, 0x900);
+  EXPECT_TRUE(h.occludes(z.data(), 3, 0, 31, 0x200, true, gen, 3));  // the stale bound, same generation
+  EXPECT_FALSE(h.occludes(z.data(), 3, 0, 31, 0x200, true, gen + 1, 3));
+}
+
+enum class Raise { MemWrites, ClearDepth, AlwaysDraw, MemorySpan };
+
+constexpr unsigned kWidth = 200, kHeight = 120;  // 6.25 block columns, 7.5 block rows
+constexpr std::uint64_t kLess = 1 | 4 | (1u << 3) | (1u << 6), kLequal = 1 | 4 | (3u << 3) | (1u << 6);
+
+void random_triangles(Device& d, std::mt19937& rng, int count, std::uint32_t zmin, std::uint32_t zmax) {
+  std::uniform_int_distribution<int> px(-8 * 16, (kWidth + 8) * 16), py(-8 * 16, (kHeight + 8) * 16), dv(-60 * 16, 60 * 16);
+  std::uniform_int_distribution<std::uint32_t> zd(zmin, zmax);
+  for (int i = 0; i < count; ++i) {
+    const int x = px(rng), y = py(rng);
+    const bool flat = i % 3 == 0;  // one depth per triangle, as in sim_throughput --random-z
+    const std::uint32_t z0 = zd(rng);
+    w(d, Reg::PRIM, 0);
+    for (int k = 0; k < 3; ++k) {
+      w(d, Reg::COLOR, color(static_cast<std::uint32_t>(rng())));
+      w(d, Reg::VERTEX, vtx(k == 0 ? x : x + dv(rng), k == 0 ? y : y + dv(rng), flat ? z0 : zd(rng)));
+    }
+  }
+}
+
+struct Scene {
+  std::vector<std::uint8_t> memory;
+  DeviceStats stats;
+};
+
+// Near depth everywhere, random triangles behind it (the bounds reject them), the depth buffer
+// raised in part of the screen by `raise`, then random triangles again, some in front of the
+// raised part only.
+Scene render(Raise raise, std::uint64_t mode, const DeviceOptions& o) {
+  auto dev = make_device(o);
+  Device& d = *dev;
+  std::mt19937 rng(20261127);
+  w(d, Reg::FB_FORMAT, fb_format(kWidth, kHeight));
+  w(d, Reg::FB_DRAW, 0);
+  w(d, Reg::FB_Z, Canvas::kZBase);
+  w(d, Reg::CLEAR_COLOR, 0);
+  w(d, Reg::CLEAR, 0);
+  w(d, Reg::CLEAR_DEPTH, 0xFFFFFF);
+  w(d, Reg::CLEAR_Z, 0);
+  w(d, Reg::TRI_MODE, mode);
+  w(d, Reg::PRIM, 0);
+  const int x1 = kWidth * 16, y1 = kHeight * 16;
+  for (const auto v : {vtx(0, 0, 0x100000), vtx(x1, 0, 0x100000), vtx(0, y1, 0x100000), vtx(x1, y1, 0x100000),
+                       vtx(x1, 0, 0x100000), vtx(0, y1, 0x100000)}) {
+    w(d, Reg::COLOR, color(0x20406080));
+    w(d, Reg::VERTEX, v);
+  }
+  random_triangles(d, rng, 150, 0x100000, 0xFFFFFF);  // behind: rejected
+  random_triangles(d, rng, 50, 0x080000, 0x180000);   // partly in front
+  // Raise rows 20..99, columns 40..167 to 0xE00000 (or the far end).
+  switch (raise) {
+    case Raise::MemWrites:
+      for (unsigned y = 20; y < 100; ++y) {
+        w(d, Reg::MEM_ADDR, Canvas::kZBase + (y * kWidth + 40) * 4);
+        for (unsigned x = 40; x < 168; x += 2) w(d, Reg::MEM_DATA, 0x00E0000000E00000ull);
+      }
+      break;
+    case Raise::ClearDepth:
+      w(d, Reg::SCISSOR, scissor(40, 20, 168, 100));
+      w(d, Reg::CLEAR_DEPTH, 0xE00000);
+      w(d, Reg::CLEAR_Z, 0);
+      w(d, Reg::SCISSOR, scissor(0, 0, kWidth, kHeight));
+      break;
+    case Raise::AlwaysDraw:
+      w(d, Reg::TRI_MODE, (mode & ~std::uint64_t{0x38}) | (7u << 3));
+      w(d, Reg::PRIM, 0);
+      for (const auto v : {vtx(40 * 16, 20 * 16, 0xE00000), vtx(168 * 16, 20 * 16, 0xE00000), vtx(40 * 16, 100 * 16, 0xE00000),
+                           vtx(168 * 16, 100 * 16, 0xE00000), vtx(168 * 16, 20 * 16, 0xE00000), vtx(40 * 16, 100 * 16, 0xE00000)}) {
+        w(d, Reg::COLOR, color(0x80808080));
+        w(d, Reg::VERTEX, v);
+      }
+      w(d, Reg::TRI_MODE, mode);
+      break;
+    case Raise::MemorySpan: {
+      auto m = d.memory();
+      for (unsigned y = 20; y < 100; ++y)
+        for (unsigned x = 40; x < 168; ++x) {
+          std::uint8_t* p = m.data() + Canvas::kZBase + (y * kWidth + x) * 4;
+          p[0] = 0, p[1] = 0xE0, p[2] = 0, p[3] = 0;
+        }
+      break;
+    }
+  }
+  random_triangles(d, rng, 200, 0x180000, 0xF00000);  // in front of the raised part only
+  d.drain();
+  const auto m = d.memory();
+  Scene s;
+  s.memory.assign(m.begin(), m.begin() + Canvas::kZBase + kWidth * kHeight * 4);
+  s.stats = d.stats();
+  return s;
+}
+
+TEST(SimHierZ, RaisedDepthBufferDrawsAsTheReferenceRoutines) {
+  for (const Raise raise : {Raise::MemWrites, Raise::ClearDepth, Raise::AlwaysDraw, Raise::MemorySpan}) {
+    for (const std::uint64_t mode : {kLess, kLequal}) {
+      for (const unsigned z_bits : {24u, 13u}) {
+        DeviceOptions ref;
+        ref.vector_routines = false;
+        ref.accuracy.z_bits = z_bits;
+        const Scene want = render(raise, mode, ref);
+        // Triangles behind the near depth drew nothing; in front of the raised part, many pixels.
+        ASSERT_GT(want.stats.pixels_depth_passed, std::uint64_t{kWidth} * kHeight + 20000) << static_cast<int>(raise);
+        for (const unsigned threads : {1u, 2u, 3u}) {
+          DeviceOptions o;
+          o.threads = threads;
+          o.accuracy.z_bits = z_bits;
+          const Scene got = render(raise, mode, o);
+          ASSERT_EQ(got.memory, want.memory) << "raise " << static_cast<int>(raise) << " mode " << mode << " z_bits "
+                                             << z_bits << " threads " << threads;
+          EXPECT_TRUE(got.stats == want.stats) << "raise " << static_cast<int>(raise) << " threads " << threads;
+        }
+      }
+    }
+  }
+}
+
+}  // namespace
+}  // namespace gpubridge::sim::test
