@@ -252,9 +252,13 @@ module command_exec #(
       wire       is_cd  = idx == `SPIGPU_REG_CLEAR_DEPTH;
       wire       cwrite = go && (idx == `SPIGPU_REG_CLEAR_COLOR || is_cd);
       wire       iwrite = !cinit[1];
-      // CLEAR_COLOR and CLEAR_DEPTH are d[31:0] (validation clears the bits above CLEAR_DEPTH's 24)
-      wire [31:0] wdata = iwrite ? (cinit[0] ? RESET_CLEAR_DEPTH[31:0] : RESET_CLEAR_COLOR[31:0])
-                        : (vwrite && wc == 2'd1) ? {8'd0, d[55:32]} : (vwrite && wc == 2'd2) ? sh_rd_data[31:0] : d[31:0];
+      // CLEAR_COLOR and CLEAR_DEPTH are d[31:0] (validation clears the bits above CLEAR_DEPTH's 24).
+      // Without a depth buffer (DEPTH = 0) nothing reads word 1 (a vertex's Z, CLEAR_DEPTH: Z_TEST,
+      // Z_WRITE and CLEAR_Z are refused), so it is written in the same clock as before with d[31:0]
+      // (no Z source on the 32-bit write multiplexer)
+      wire [31:0] wdata = iwrite ? ((cinit[0] && DEPTH != 0) ? RESET_CLEAR_DEPTH[31:0] : RESET_CLEAR_COLOR[31:0])
+                        : (vwrite && wc == 2'd1 && DEPTH != 0) ? {8'd0, d[55:32]}
+                        : (vwrite && wc == 2'd2) ? sh_rd_data[31:0] : d[31:0];
       wire [3:0]  waddr = vwrite ? {wslot, wc} : iwrite ? {3'b110, cinit[0]} : {3'b110, is_cd};
       assign vert_ok = (!is_vertex || wc == 2'd3) && !iwrite;
       always @(posedge clk) begin
