@@ -100,6 +100,17 @@ module command_exec #(
   function automatic [10:0] clamp_1024(input [10:0] v);
     clamp_1024 = ge_const(16'(v), 1025) ? 11'd1024 : v;
   endfunction
+  // the clamps change a value exactly when these hold (ERR_BAD_VALUE from the range tests, not from
+  // comparing the clamped value with the received one)
+  function automatic log2_out(input [3:0] v);
+    log2_out = !ge_const(16'(v), 3) || ge_const(16'(v), 11);
+  endfunction
+  function automatic dim_out(input [10:0] v, input [10:0] max);
+    dim_out = v == 11'd0 || ge_const(16'(v), 32'(max) + 1);   // max is a constant
+  endfunction
+  function automatic out_1024(input [10:0] v);
+    out_1024 = ge_const(16'(v), 1025);
+  endfunction
   function automatic format_ok(input [1:0] f);
     format_ok = !((f == 2'd1 && !FEATURES[4]) || (f == 2'd2 && !FEATURES[5]));
   endfunction
@@ -113,14 +124,14 @@ module command_exec #(
       `SPIGPU_REG_TEX_FMT: begin
         d[3:0] = clamp_log2(d[3:0]);
         d[7:4] = clamp_log2(d[7:4]);
-        if (d[7:0] != enum_fix[7:0]) bad = 1'b1;
+        if (log2_out(enum_fix[3:0]) || log2_out(enum_fix[7:4])) bad = 1'b1;
         if (d[12] && !FEATURES[0]) begin d[12] = 1'b0; bad = 1'b1; end
         if (!format_ok(d[17:16])) begin d[17:16] = 2'd0; bad = 1'b1; end
       end
       `SPIGPU_REG_FB_FORMAT: begin
         d[10:0] = clamp_dim(d[10:0], MAXW);
         d[26:16] = clamp_dim(d[26:16], MAXH);
-        if (d[10:0] != enum_fix[10:0] || d[26:16] != enum_fix[26:16]) bad = 1'b1;
+        if (dim_out(enum_fix[10:0], MAXW) || dim_out(enum_fix[26:16], MAXH)) bad = 1'b1;
         if (!format_ok(d[33:32])) begin d[33:32] = 2'd0; bad = 1'b1; end
       end
       `SPIGPU_REG_SCISSOR: begin
@@ -128,7 +139,8 @@ module command_exec #(
         d[26:16] = clamp_1024(d[26:16]);
         d[42:32] = clamp_1024(d[42:32]);
         d[58:48] = clamp_1024(d[58:48]);
-        if (d != enum_fix[63:0]) bad = 1'b1;
+        if (out_1024(enum_fix[10:0]) || out_1024(enum_fix[26:16]) || out_1024(enum_fix[42:32])
+            || out_1024(enum_fix[58:48])) bad = 1'b1;
       end
       `SPIGPU_REG_TRI_MODE: begin
         if (d[1] && !FEATURES[7]) begin d[1] = 1'b0; bad = 1'b1; end
@@ -252,9 +264,13 @@ module command_exec #(
       wire       is_cd  = idx == `SPIGPU_REG_CLEAR_DEPTH;
       wire       cwrite = go && (idx == `SPIGPU_REG_CLEAR_COLOR || is_cd);
       wire       iwrite = !cinit[1];
-      // CLEAR_COLOR and CLEAR_DEPTH are d[31:0] (validation clears the bits above CLEAR_DEPTH's 24)
-      wire [31:0] wdata = iwrite ? (cinit[0] ? RESET_CLEAR_DEPTH[31:0] : RESET_CLEAR_COLOR[31:0])
-                        : (vwrite && wc == 2'd1) ? {8'd0, d[55:32]} : (vwrite && wc == 2'd2) ? sh_rd_data[31:0] : d[31:0];
+      // CLEAR_COLOR and CLEAR_DEPTH are d[31:0] (validation clears the bits above CLEAR_DEPTH's 24).
+      // Without a depth buffer (DEPTH = 0) nothing reads word 1 (a vertex's Z, CLEAR_DEPTH: Z_TEST,
+      // Z_WRITE and CLEAR_Z are refused), so it is written in the same clock as before with d[31:0]
+      // (no Z source on the 32-bit write multiplexer)
+      wire [31:0] wdata = iwrite ? ((cinit[0] && DEPTH != 0) ? RESET_CLEAR_DEPTH[31:0] : RESET_CLEAR_COLOR[31:0])
+                        : (vwrite && wc == 2'd1 && DEPTH != 0) ? {8'd0, d[55:32]}
+                        : (vwrite && wc == 2'd2) ? sh_rd_data[31:0] : d[31:0];
       wire [3:0]  waddr = vwrite ? {wslot, wc} : iwrite ? {3'b110, cinit[0]} : {3'b110, is_cd};
       assign vert_ok = (!is_vertex || wc == 2'd3) && !iwrite;
       always @(posedge clk) begin

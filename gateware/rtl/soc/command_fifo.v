@@ -26,12 +26,16 @@ module command_fifo #(
   (* no_rw_check *) reg [70:0] mem [0:(1 << AW) - 1];   // an entry is never read in the clock it is written
   reg [70:0] q;
   reg [AW-1:0] wr, rel, rd;
-  // entries not yet taken, 0..DEPTH (DEPTH <= 1023): in the bits DEPTH needs (7 on up5k, not 11)
+  // entries not yet taken, 0..DEPTH (DEPTH <= 1023): in the bits DEPTH needs (7 on up5k, not 11).
+  // Not a counter of its own: the entries in the RAM not yet read (wr - rd, below 2^AW > DEPTH)
+  // plus the one waiting in q. A push adds to wr, a pop empties q (or q takes the next entry, rd
+  // advancing with it), and a discard sets wr to rel, so this is the count those events kept
+  // in every clock, with one subtractor instead of a register, its two update adders and wr - rel
   localparam integer CW = $clog2(DEPTH + 1);
-  reg [CW-1:0] count;
+  wire [AW-1:0] unread = wr - rd;
+  wire [CW-1:0] count = CW'(unread) + CW'(out_valid);
 `include "const_compare.vh"
 
-  wire [AW-1:0] held_count = wr - rel;
   wire          rd_fire = rd != rel && (!out_valid || pop);
 
   assign out_entry   = q;
@@ -40,7 +44,7 @@ module command_fifo #(
   assign full        = count == DEPTH_C;
   assign nearly_full = ge_const(16'(count), 32'(NEAR));
   assign level       = 11'(count);
-  assign held        = held_count != {AW{1'b0}};
+  assign held        = wr != rel;
 
   always @(posedge clk) begin
     if (push && !full) mem[wr] <= push_entry;
@@ -52,7 +56,6 @@ module command_fifo #(
       wr <= {AW{1'b0}};
       rel <= {AW{1'b0}};
       rd <= {AW{1'b0}};
-      count <= {CW{1'b0}};
       out_valid <= 1'b0;
     end else begin
       if (rd_fire) rd <= rd + 1'b1;
@@ -60,7 +63,6 @@ module command_fifo #(
       else if (pop) out_valid <= 1'b0;
       if (discard_held) begin
         wr <= rel;
-        count <= count - CW'(held_count) - CW'(pop);
       end else begin
         if (push && !full) begin
           wr <= wr + 1'b1;
@@ -68,7 +70,6 @@ module command_fifo #(
         end else if (release_held) begin
           rel <= wr;
         end
-        count <= count + CW'(push && !full) - CW'(pop);
       end
     end
   end

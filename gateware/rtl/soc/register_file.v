@@ -136,8 +136,15 @@ module register_file #(
   wire        imm_wr = wr_imm && (is_host_tag || link_ctrl_strobe);
   wire        sh_we  = seq_active || imm_wr || ex_wr_req;
   wire [4:0]  sh_wa  = seq_active ? seq_idx : imm_wr ? frame_idx[4:0] : ex_wr_idx;
-  wire [63:0] sh_wd  = seq_active ? reg_reset({2'b00, seq_idx})
-                     : imm_wr ? (is_link_ctrl ? {63'd0, link_ctrl_strict} : imm_data) : ex_wr_data;
+  // The immediate writes that reach the RAM are HOST_TAG's (no reserved bits: its data as received,
+  // with the table's mask, a constant) and LINK_CTRL's (STRICT alone), so the write data takes no
+  // mask that depends on the index; written as one-hot selects and an AND-OR
+  wire        sel_seq = seq_active;
+  wire        sel_tag = !seq_active && imm_wr && !is_link_ctrl;
+  wire        sel_lc  = !seq_active && imm_wr && is_link_ctrl;
+  wire        sel_ex  = !seq_active && !imm_wr;
+  wire [63:0] sh_wd  = ({64{sel_seq}} & reg_reset({2'b00, seq_idx})) | ({64{sel_tag}} & frame_data & ~RSV_HOST_TAG)
+                     | {63'd0, sel_lc && link_ctrl_strict} | ({64{sel_ex}} & ex_wr_data);
   assign ex_wr_ack = ex_wr_req && !seq_active && !imm_wr;
 
   wire        spi_reads = !EX_READ || (rd_strobe && rd_from_ram);

@@ -90,7 +90,7 @@ module scanout #(
   // --- swap request: length, end and range ---
   reg        computing, pending, reading;
   reg [3:0]  mul_step;
-  reg [BYTES_W-3:0] mul_acc;   // width x height
+  reg [BYTES_W-1:0] mul_acc;   // width x height x bytes per pixel
   // Addresses in VRAM words: the reader stops at the end of VRAM (what lies beyond reads as 0), so
   // the next word to read needs VAW + 1 bits, plus `above` for a frame starting beyond VRAM.
   reg [VAW:0] rd_addr;         // next word to read (the frame's first word until reading starts)
@@ -128,8 +128,11 @@ module scanout #(
   assign frame_crc    = {frame_count, crc_value};  // the frame number is FRAME_COUNT itself
 
   // bytes of the frame, W x H x bpp (into bytes_left one clock before the end is computed); its
-  // words are ceil(bytes / 4), the rounding the carry into the end's adder below
-  wire [BYTES_W-1:0] bytes = frame_format == 2'd0 ? {mul_acc, 2'b00} : frame_format == 2'd1 ? {1'b0, mul_acc, 1'b0} : {2'b00, mul_acc};
+  // words are ceil(bytes / 4), the rounding the carry into the end's adder below. The bytes per
+  // pixel scale the height on the multiplier's input (13 bits), not the product (BYTES_W bits)
+  wire [BYTES_W-1:0] bytes = mul_acc;
+  wire [12:0] height_bpp = frame_format == 2'd0 ? {frame_height, 2'b00} : frame_format == 2'd1 ? {1'b0, frame_height, 1'b0}
+                         : {2'b00, frame_height};
 
   // --- frame reading ---
   localparam       BAW = BUF_WORDS == 4 ? 2 : 1;
@@ -158,7 +161,7 @@ module scanout #(
   localparam integer EW = (VAW + 2 > BYTES_W - 1) ? VAW + 2 : BYTES_W - 1;
   wire [EW:0]   end_x2 = {EW'(rd_addr), 1'b1} + {EW'(bytes_left[BYTES_W-1:2]), bytes_left[1:0] != 2'b00};
   wire [EW-1:0] end_in = end_x2[EW:1];
-  wire [21:0]   product = frame_width * frame_height;
+  wire [23:0]   product = frame_width * height_bpp;
   wire          unused_ok = &{1'b0, end_x2[0], product};
   // end_in > 2^VAW: a bit above VRAM's, or VRAM's own bit and any below it
   wire          end_beyond = above || end_in[EW-1:VAW+1] != 0 || (end_in[VAW] && end_in[VAW-1:0] != 0);
@@ -261,7 +264,7 @@ module scanout #(
         // mul_acc = width x height, on a multiplier; the swap keeps its 12 clocks
         // (no frame is being read while a swap is computed, so bytes_left is free)
         if (mul_step != 4'd11) begin
-          mul_acc <= product[BYTES_W-3:0];
+          mul_acc <= product[BYTES_W-1:0];
           mul_step <= mul_step + 4'd1;
         end else begin
           computing <= 1'b0;

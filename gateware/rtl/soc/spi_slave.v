@@ -40,10 +40,11 @@ module spi_slave (
   input  wire [63:0] rd_live,       // the value of rd_idx in the rd_strobe cycle
   input  wire        rd_from_ram,   // rd_strobe cycle: the value comes on rd_ram in the next cycle
   input  wire [63:0] rd_ram,
-  // every complete MOSI byte (for the link CRC); byte_first marks byte 0 of a frame
-  output reg         byte_valid,
-  output reg         byte_first,
-  output reg  [7:0]  byte_data,
+  // every complete MOSI byte (for the link CRC), in the clock its last bit is sampled (combinational:
+  // no copy of the byte, the link takes it in that clock); byte_first marks byte 0 of a frame
+  output wire        byte_valid,
+  output wire        byte_first,
+  output wire [7:0]  byte_data,
   // complete frames (one-cycle pulse; rw, idx and data are valid in that cycle)
   output reg         frame_valid,
   output wire        frame_rw,
@@ -82,6 +83,9 @@ module spi_slave (
   assign frame_rw   = hdr[7];
   assign frame_idx  = hdr[6:0];
   assign frame_data = sh;
+  assign byte_valid = sck_rise && bit_cnt[2:0] == 3'd7;
+  assign byte_first = bit_cnt == 7'd7;
+  assign byte_data  = {sh[6:0], mosi};
 
   // The bit launched at this falling edge: bit_cnt bits have been received.
   reg miso_next;
@@ -98,7 +102,6 @@ module spi_slave (
   always @(posedge clk) begin
     frame_valid <= 1'b0;
     frame_abort <= 1'b0;
-    byte_valid  <= 1'b0;
     if (rst) begin
       bit_cnt  <= 7'd0;
       ram_pend <= 1'b0;
@@ -106,8 +109,6 @@ module spi_slave (
       stat     <= 6'd0;
       hdr      <= 8'h00;
       sh       <= 64'h0;
-      byte_first <= 1'b0;
-      byte_data  <= 8'h00;
     end else begin
       if (!cs_active) begin
         if (cs_rise && bit_cnt != 7'd0) frame_abort <= 1'b1;
@@ -119,11 +120,6 @@ module spi_slave (
         ram_pend <= 1'b0;
         if (sck_rise) begin
           bit_cnt <= frame_done ? 7'd0 : bit_cnt + 7'd1;
-          if (bit_cnt[2:0] == 3'd7) begin
-            byte_valid <= 1'b1;
-            byte_first <= bit_cnt == 7'd7;
-            byte_data  <= {sh[6:0], mosi};
-          end
           if (header_done) begin
             hdr      <= {sh[6:0], mosi};
             sh       <= sh[6] ? rd_live : 64'h0;

@@ -161,11 +161,15 @@ module video_out #(
   // is abandoned, its words are garbage anyway), so a read never meets a write to its address and the
   // block RAM needs no soft bypass for that collision (yosys adds about 75 flip-flops for one otherwise)
   (* no_rw_check *) reg [31:0] lb [0:(2 << LINE_AW) - 1];
-  // the next framebuffer line's first byte, and whether it (so every later line) starts beyond VRAM
+  // the next framebuffer line's first byte, and whether it (so every later line) starts beyond VRAM.
+  // Outside the picture they are rewound to the buffer's first line at every line end, so the
+  // picture's first fetch finds them there too (no choice between them and base, beyond): the
+  // picture is always followed by blank lines (V_TOTAL > V_ACTIVE), and the swap's new base, taken
+  // at the vertical sync, is rewound at the next line end, before the first line is fetched
   reg  [VAW+1:0] line_byte;
   reg         line_beyond;
-  wire [VAW+1:0] byte0 = f_first ? base : line_byte;
-  wire        beyond0 = f_first ? beyond : line_beyond;
+  wire [VAW+1:0] byte0 = line_byte;
+  wire        beyond0 = line_beyond;
   wire [VAW+2:0] byte_next = {1'b0, byte0} + (VAW+3)'(stride);
   reg  [VAW:0] f_addr;                     // next word to read (>= 2^VAW: the line ran beyond VRAM)
   reg         f_beyond;
@@ -208,6 +212,9 @@ module video_out #(
           f_left <= n_words;
           line_byte <= byte_next[VAW+1:0];
           line_beyond <= beyond0 || byte_next[VAW+2];
+        end else if (!f_in_new) begin
+          line_byte <= base;
+          line_beyond <= beyond;
         end
       end
     end
