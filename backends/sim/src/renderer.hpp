@@ -51,8 +51,11 @@ class Renderer {
   bool counts_sdram_rows() const { return count_rows_; }
   // Texture bytes the textured triangles' footprints hold (texel_footprint_bytes).
   std::uint64_t texel_footprint() const { return texel_footprint_; }
+  // The ecp5's texel cache replayed beside the rows (its misses are texel reads in the row stream).
+  TexelCache& texel_cache() { return texel_cache_; }
   void reset_counters() {
     sdram_.reset_counts();
+    texel_cache_.reset_counts();
     texel_footprint_ = 0;
     counters_ = {};
     rasterised_ = 0;
@@ -104,6 +107,7 @@ class Renderer {
   RasterCounters counters_;
   std::array<DeviceStats::ModeWork, DeviceStats::kModeClasses> modes_{};
   SdramRows sdram_;
+  TexelCache texel_cache_;
   std::uint64_t texel_footprint_ = 0;
   void add_counters(const RasterCounters& c, const DrawState& st) {
     counters_.add(c);
