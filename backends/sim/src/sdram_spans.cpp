@@ -58,13 +58,28 @@ class TexturedSpans {
       : out_(rows), texels_(texels), t_(t), st_(st) {
     texels_.begin(texture_signature(st));
     texel_bytes_ = protocol::bytes_per_pixel(st.tex.format);
+    // s, t, q times 2D along a row: the edge values' steps per column weigh the vertices
+    for (int i = 0; i < 3; ++i) {
+      const double ex = double(t.edge[i].ex);
+      ds_ += ex * double(t.v[i].s);
+      dt_ += ex * double(t.v[i].t);
+      dq_ += ex * double(t.v[i].q);
+    }
   }
   void span(const SpanAccess& s, std::int64_t k, std::int64_t kl) {
     const std::uint64_t zn = (s.z_read ? 1u : 0u) + (s.z_write ? 1u : 0u);
     const std::uint64_t cn = (s.color_read ? 1u : 0u) + (s.color_write ? 1u : 0u);
+    // s, t, q times 2D at column 0 of row k (the edge values are the vertices' weights)
+    s0_ = t0_ = q0_ = 0;
+    for (int i = 0; i < 3; ++i) {
+      const double e = double(t_.edge[i].e + k * t_.edge[i].ey);
+      s0_ += e * double(t_.v[i].s);
+      t0_ += e * double(t_.v[i].t);
+      q0_ += e * double(t_.v[i].q);
+    }
     for (std::uint64_t p = 0; p < s.pixels; ++p) {
       out_.emit(s.depth + 4 * p, zn);
-      sample(k, kl + static_cast<std::int64_t>(p));
+      sample(double(kl + static_cast<std::int64_t>(p)));
       const std::uint64_t c = s.color + s.bpp * p;
       // the combiner sends the word after its last pixel of the span
       if (p + 1 == s.pixels || ((c + s.bpp) >> 2) != (c >> 2)) out_.emit(c & ~std::uint64_t{3}, cn);
@@ -72,19 +87,12 @@ class TexturedSpans {
   }
 
  private:
-  // The pixel at row k, column kx of the box: its texel indices, each looked up.
-  void sample(std::int64_t k, std::int64_t kx) {
-    double es = 0, et = 0, eq = 0;
-    for (int i = 0; i < 3; ++i) {
-      const Edge& e = t_.edge[i];  // the barycentric weight of vertex i, times 2D
-      const double w = double(e.e + k * e.ey + kx * e.ex);
-      es += w * double(t_.v[i].s);
-      et += w * double(t_.v[i].t);
-      eq += w * double(t_.v[i].q);
-    }
+  // The pixel at column kx of the span's row: its texel indices, each looked up.
+  void sample(double kx) {
+    const double es = s0_ + kx * ds_, et = t0_ + kx * dt_, eq = q0_ + kx * dq_;
     // u = S / Q in texture widths (S = s / 2^24, Q = q / 2^32), in texels; q = 0: texel 0
-    const double u = eq > 0 ? es / eq * 256.0 * double(1u << st_.tex.wl) : 0.0;
-    const double v = eq > 0 ? et / eq * 256.0 * double(1u << st_.tex.hl) : 0.0;
+    const double r = eq > 0 ? 256.0 / eq : 0.0;
+    const double u = es * r * double(1u << st_.tex.wl), v = et * r * double(1u << st_.tex.hl);
     const bool bi = st_.tex.bilinear;
     const auto i0 = static_cast<std::int64_t>(std::floor(bi ? u - 0.5 : u));
     const auto j0 = static_cast<std::int64_t>(std::floor(bi ? v - 0.5 : v));
@@ -102,6 +110,8 @@ class TexturedSpans {
   const Triangle& t_;
   const DrawState& st_;
   std::uint64_t texel_bytes_ = 4;
+  double ds_ = 0, dt_ = 0, dq_ = 0;  // per column
+  double s0_ = 0, t0_ = 0, q0_ = 0;  // at the row's column 0
 };
 
 }  // namespace
