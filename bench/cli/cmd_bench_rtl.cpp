@@ -77,7 +77,7 @@ nlohmann::json counters_json(const sim::DeviceStats& w, const rtl::RtlCounters& 
             {"pixels_textured", w.pixels_textured}, {"pixels_blended", w.pixels_blended}, {"texel_bytes", w.texel_bytes},
             {"clears", w.clears}, {"clear_rows", w.clear_rows}, {"clear_pixels", w.clear_pixels},
             {"clear_bytes", w.clear_bytes}, {"mem_data_writes", w.mem_data_writes}, {"swaps", w.swaps},
-            {"texel_footprint_bytes", w.texel_footprint_bytes}, {"texel_fetches", w.texel_fetches}, {"sdram_accesses", w.sdram_accesses}, {"row_opens", w.row_opens}, {"row_misses", w.row_misses}, {"textured_row_misses", w.textured_row_misses}, {"by_mode", modes}}},
+            {"texel_footprint_bytes", w.texel_footprint_bytes}, {"texel_fetches", w.texel_fetches}, {"sdram_accesses", w.sdram_accesses}, {"row_opens", w.row_opens}, {"row_misses", w.row_misses}, {"textured_row_misses", w.textured_row_misses}, {"depth_tail_pixels", w.depth_tail_pixels}, {"by_mode", modes}}},
           {"rtl",
            {{"work_cycles", r.work_cycles}, {"commands", r.commands}, {"core_busy_cycles", r.core_busy_cycles},
             {"setup_cycles", r.setup_cycles}, {"raster_cycles", r.raster_cycles}, {"core_mem_stalls", r.core_mem_stalls},

@@ -359,5 +359,45 @@ TEST(SimSdramRows, TexelReadMissSplitAndDepthWriteTermsInTheEstimate) {
   EXPECT_EQ(u->cycles_per_depth_write + u->cycles_per_textured_row_miss + u->cycles_per_texel_fetch, 0);
 }
 
+// A depth-class triangle's last pixels (the depth stage's 4 reads in flight) are counted once per
+// triangle, at most its covered pixels; other classes count none. Their credit subtracts, and
+// never makes a negative time.
+TEST(SimSdramRows, DepthTailPixelsPerDepthTriangle) {
+  DeviceOptions counting;
+  counting.sdram_rows = true;
+  Canvas cv(64, 48, 0, counting);
+  w(*cv.dev, Reg::TRI_MODE, kZTest | kLess | kZWrite);
+  cv.dev->reset_stats();
+  cv.tri(2 * 16, 3 * 16, 60 * 16, 5 * 16, 9 * 16, 40 * 16);
+  cv.tri(2 * 16, 3 * 16, 60 * 16, 5 * 16, 9 * 16, 40 * 16);
+  EXPECT_EQ(cv.dev->stats().depth_tail_pixels, 2u * 4u);
+  cv.dev->reset_stats();
+  cv.tri(10 * 16, 10 * 16, 12 * 16, 10 * 16, 10 * 16, 12 * 16);  // a 2 x 2 corner: fewer than 4 pixels
+  const DeviceStats tiny = cv.dev->stats();
+  ASSERT_GT(tiny.pixels_covered, 0u);
+  ASSERT_LT(tiny.pixels_covered, 4u);
+  EXPECT_EQ(tiny.depth_tail_pixels, tiny.pixels_covered);
+  cv.dev->reset_stats();
+  w(*cv.dev, Reg::TRI_MODE, 0);  // flat, no depth
+  cv.tri(2 * 16, 3 * 16, 60 * 16, 5 * 16, 9 * 16, 40 * 16);
+  EXPECT_EQ(cv.dev->stats().depth_tail_pixels, 0u);
+
+  DeviceStats work;
+  work.depth_tail_pixels = 40;
+  work.queued_executed = 100;
+  BoardTiming b;
+  b.memory_bound = false;
+  const double base = estimate_timing(work, b, 4).pipeline_cycles;  // 100 commands at 1 cycle
+  ASSERT_TRUE(apply_timing_setting(b, "drained_cycles_per_tail_pixel=2"));
+  EXPECT_DOUBLE_EQ(estimate_timing(work, b, 4).pipeline_cycles, base - 40 * 2);
+  b.drained_cycles_per_tail_pixel = 100;
+  EXPECT_EQ(estimate_timing(work, b, 4).pipeline_cycles, 0.0);
+  EXPECT_EQ(stats_difference(work, DeviceStats{}).depth_tail_pixels, 40u);
+  auto e = timing_preset("ecp5"), u = timing_preset("up5k");
+  ASSERT_TRUE(e && u);
+  EXPECT_GT(e->drained_cycles_per_tail_pixel, 0);
+  EXPECT_EQ(u->drained_cycles_per_tail_pixel, 0);
+}
+
 }  // namespace
 }  // namespace gpubridge::sim::test

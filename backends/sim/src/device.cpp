@@ -651,6 +651,7 @@ const DeviceStats& Device::stats() const {
   st.row_opens = s_->renderer.sdram_rows().opens();
   st.row_misses = s_->renderer.sdram_rows().misses();
   st.textured_row_misses = s_->renderer.sdram_rows().textured_misses();
+  st.depth_tail_pixels = s_->renderer.depth_tail();
   return st;
 }
 void Device::reset_stats() {

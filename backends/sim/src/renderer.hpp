@@ -53,9 +53,11 @@ class Renderer {
   std::uint64_t texel_footprint() const { return texel_footprint_; }
   // The ecp5's texel cache replayed beside the rows (its misses are texel reads in the row stream).
   TexelCache& texel_cache() { return texel_cache_; }
+  std::uint64_t depth_tail() const { return depth_tail_; }  // depth_tail_pixels of the depth classes
   void reset_counters() {
     sdram_.reset_counts();
     texel_cache_.reset_counts();
+    depth_tail_ = 0;
     texel_footprint_ = 0;
     counters_ = {};
     rasterised_ = 0;
@@ -108,6 +110,7 @@ class Renderer {
   std::array<DeviceStats::ModeWork, DeviceStats::kModeClasses> modes_{};
   SdramRows sdram_;
   TexelCache texel_cache_;
+  std::uint64_t depth_tail_ = 0;
   std::uint64_t texel_footprint_ = 0;
   void add_counters(const RasterCounters& c, const DrawState& st) {
     counters_.add(c);

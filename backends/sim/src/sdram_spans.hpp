@@ -18,6 +18,12 @@ namespace gpubridge::sim {
 // stream between the pixel's depth accesses and its colour word. Returns the covered pixels.
 std::uint64_t access_triangle_rows(SdramRows& rows, TexelCache& texels, const Triangle& t, const DrawState& st);
 
+// The pixels of a depth-class triangle of `covered` pixels still in the ecp5's depth stage when
+// its walk ends (its reads in flight: 4, core_depth.v with AW = 2): their memory work drains under
+// the next triangle's setup, not in the rasteriser's clocks (DeviceStats::depth_tail_pixels).
+constexpr std::uint64_t kDepthReadsInFlight = 4;
+inline std::uint64_t depth_tail_pixels(std::uint64_t covered) { return covered < kDepthReadsInFlight ? covered : kDepthReadsInFlight; }
+
 // The texture bytes a textured triangle of `covered` pixels can fetch at most through a texel
 // cache: its footprint in texture space (the texels inside the triangle of its vertices' texel
 // coordinates, plus a border of one for bilinear's second row and column), never more than its

@@ -133,7 +133,9 @@ TimingEstimate estimate_timing(const DeviceStats& w, const BoardTiming& b, unsig
                       double(w.sdram_accesses) * b.cycles_per_sdram_access + double(w.row_opens) * b.cycles_per_row_open +
                       double(w.row_misses - std::min(w.row_misses, w.textured_row_misses)) * b.cycles_per_row_miss +
                       double(w.textured_row_misses) * b.cycles_per_textured_row_miss +
-                      double(depth_writes(w)) * b.cycles_per_depth_write;
+                      double(depth_writes(w)) * b.cycles_per_depth_write -
+                      double(w.depth_tail_pixels) * b.drained_cycles_per_tail_pixel;
+  e.pipeline_cycles = std::max(e.pipeline_cycles, 0.0);  // a credit never makes time
   e.pipeline_cycles *= refresh_stretch(b);
   // Memory: depth read + write (4 + 4) for every covered pixel (an upper bound: not every draw
   // tests or writes Z), colour write, destination read when blending, texels fetched, clears,
@@ -186,6 +188,7 @@ DeviceStats stats_difference(const DeviceStats& a, const DeviceStats& b) {
   d.row_opens = a.row_opens - b.row_opens;
   d.row_misses = a.row_misses - b.row_misses;
   d.textured_row_misses = a.textured_row_misses - b.textured_row_misses;
+  d.depth_tail_pixels = a.depth_tail_pixels - b.depth_tail_pixels;
   return d;
 }
 
@@ -240,33 +243,35 @@ Result<BoardTiming> timing_preset(std::string_view name) {
     b.spi_clock_mhz = 15.0;
     b.memory_bytes_per_cycle = 2.0;
     // Fitted with the SDRAM row model, the texel cache's reads in it, the textured draws' row
-    // misses apart and the depth writes (`gpubridge bench rtl --fit --profile ecp5`, 2026-11-27, 14
-    // scenes and 48 calibration frames; docs/gateware.md "Timing model"): a depth write costs
-    // 5.514 clocks beyond its pixel, a row miss 2.409 in an untextured draw and
-    // 1.232 in a textured one (the texture unit's wait hides part of it), a byte of texture
-    // footprint 0.5769, a byte sampled 0.06585; the texel reads themselves, a row open and an
-    // access nothing beyond them.
+    // misses apart, the depth writes and the depth stage's tail (`gpubridge bench rtl --fit
+    // --profile ecp5`, 2026-11-27, 14 scenes and 48 calibration frames; docs/gateware.md "Timing
+    // model"): a depth write costs 6.422 clocks beyond its pixel, a row miss 2.397 in an
+    // untextured draw and 1.176 in a textured one (the texture unit's wait hides part of it),
+    // a texel read 0.3179, a byte of texture footprint 0.4863, a byte sampled 0.06006; each of a
+    // depth triangle's last 4 pixels gives back 12.36 (drained under the next setup); a row
+    // open and an access nothing beyond the per-pixel terms.
     b.setup_cycles = {42.72, 170.5, 98.01, 200.8, 164.2, 275.5, 202.4, 310.0};
-    b.row_cycles = {1.354, 0.4292, 0.2603, 0.0, 0.09648, 0.1507, 2.901, 1.844};
-    b.column_cycles = {0.4665, 0.0, 0.0, 0.0, 0.0, 0.09961, 0.111, 0.0};
-    b.pixel_cycles = {0.3618, 0.6088, 1.078, 0.8799, 1.211, 0.9585, 0.3494, 0.5754};
+    b.row_cycles = {1.259, 0.4691, 0.9445, 0.3699, 0.1353, 0.2083, 3.356, 3.319};
+    b.column_cycles = {0.3843, 0.0, 0.0, 0.0, 0.0, 0.169, 0.4137, 0.5054};
+    b.pixel_cycles = {0.4273, 0.6352, 0.5038, 0.4714, 1.381, 1.114, 0.0, 0.05676};
     b.cycles_per_command = 2.736;
     b.cycles_per_triangle = 0.0;
-    b.cycles_per_blended_pixel = 2.97;
+    b.cycles_per_blended_pixel = 3.008;
     b.cycles_per_rejected_triangle = 0.0;
     b.cycles_per_clear = 7.846;
     b.cycles_per_clear_row = 0.0;
-    b.cycles_per_clear_pixel = 0.0;
+    b.cycles_per_clear_pixel = 0.004925;
     b.cycles_per_mem_write = 11.56;
-    b.cycles_per_texel_byte = 0.06585;
-    b.cycles_per_color_byte = 0.3548;
-    b.cycles_per_texel_footprint_byte = 0.5769;
-    b.cycles_per_texel_fetch = 0.0;
+    b.cycles_per_texel_byte = 0.06006;
+    b.cycles_per_color_byte = 0.3302;
+    b.cycles_per_texel_footprint_byte = 0.4863;
+    b.cycles_per_texel_fetch = 0.3179;
     b.cycles_per_sdram_access = 0.0;
     b.cycles_per_row_open = 0.0;
-    b.cycles_per_row_miss = 2.409;
-    b.cycles_per_textured_row_miss = 1.232;
-    b.cycles_per_depth_write = 5.514;
+    b.cycles_per_row_miss = 2.397;
+    b.cycles_per_textured_row_miss = 1.176;
+    b.cycles_per_depth_write = 6.422;
+    b.drained_cycles_per_tail_pixel = 12.36;
     b.clear_bytes_per_cycle = 2.005;
     // The SDRAM (sdram_ctrl.v with the Alliance AS4C32M16SB-7's timing): an auto refresh every
     // tREFI = 7.8 us costs precharge all (tRP 21 ns), tRFC (63 ns) and the first row opened again
@@ -310,6 +315,7 @@ Result<void> apply_timing_setting(BoardTiming& b, std::string_view setting) {
       {"cycles_per_row_miss", &BoardTiming::cycles_per_row_miss},
       {"cycles_per_textured_row_miss", &BoardTiming::cycles_per_textured_row_miss},
       {"cycles_per_depth_write", &BoardTiming::cycles_per_depth_write},
+      {"drained_cycles_per_tail_pixel", &BoardTiming::drained_cycles_per_tail_pixel},
       {"refresh_interval_cycles", &BoardTiming::refresh_interval_cycles},
       {"cycles_per_refresh", &BoardTiming::cycles_per_refresh},
   };

@@ -70,6 +70,9 @@ struct DeviceStats {
   std::uint64_t row_opens = 0;
   std::uint64_t row_misses = 0;
   std::uint64_t textured_row_misses = 0;  // those of textured triangles (class bit 2)
+  // Per triangle of a depth class, its last pixels (at most the depth stage's 4 reads in flight):
+  // the memory work the next triangle's setup hides, beside the rows counted above.
+  std::uint64_t depth_tail_pixels = 0;
   bool operator==(const DeviceStats&) const = default;
 };
 // The class index of DeviceStats::by_mode as a name: "flat", "gouraud", "z", "gouraud_z", "tex",

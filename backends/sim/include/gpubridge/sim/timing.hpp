@@ -60,6 +60,10 @@ struct BoardTiming {
   // A depth write (a passed pixel of a draw with a depth class: Z_WRITE stores only what passes),
   // beside the per-covered-pixel terms of its class.
   double cycles_per_depth_write = 0;
+  // A credit per pixel left in the depth stage when a depth-class triangle's walk ends
+  // (DeviceStats::depth_tail_pixels): its memory work, which the per-pixel terms charge, drains
+  // under the next triangle's setup. Subtracted.
+  double drained_cycles_per_tail_pixel = 0;
   double refresh_interval_cycles = 0;
   double cycles_per_refresh = 0;
   // true: cycles = max(pipeline, bytes / memory_bytes_per_cycle). false: the pipeline terms
