@@ -135,7 +135,13 @@ Result<std::vector<Sample>> measure(const std::string& scene, const std::string&
 
   std::vector<Sample> out;
   std::vector<rtl::RtlCounters> rtl_frames;
-  if (replay) rtl_frames = rtl_frames_of(recorded);
+  if (replay) {
+    try {
+      rtl_frames = rtl_frames_of(recorded);
+    } catch (const nlohmann::json::exception& e) {
+      return make_error("--rtl-counters: " + scene + ": " + e.what());
+    }
+  }
   rtl::RtlCounters last_rtl = g ? g->counters() : rtl::RtlCounters{};
   if (board)
     board->backend->set_scanout_callback([&](std::shared_ptr<const backends::ScanoutFrame>) {

@@ -153,10 +153,10 @@ class RowRunEmitter {
 // otherwise. A miss is a texel read from memory (one 32-bit word), which the row model sees.
 class TexelCache {
  public:
-  TexelCache() : entry_(kEntries, 0) {}
   // A textured draw with `signature` (texture base and format, buffers) starts: a different one
   // forgets every texel.
   void begin(std::uint64_t signature) {
+    if (entry_.empty()) entry_.assign(kEntries, 0);  // only a device that estimates timing pays for it
     if (!valid_ || signature != signature_) invalidate();
     signature_ = signature;
     valid_ = true;
@@ -169,11 +169,12 @@ class TexelCache {
       epoch_ = 1;
     }
   }
-  // Texel (i, j) (wrapped indices, below 1024): true when held; a miss fills its entry.
+  // Texel (i, j) (wrapped indices, below 1024) of the draw begun: true when held; a miss fills its entry.
   bool lookup(unsigned i, unsigned j) {
     const std::size_t bank = ((j & 1u) << 1) | (i & 1u);
     const std::size_t index = bank << 11 | ((j >> 1) & 3u) << 9 | ((i >> 1) & 511u);
     const std::uint32_t want = epoch_ << 8 | ((j >> 3) & 127u);
+    if (entry_.empty()) entry_.assign(kEntries, 0);
     if (entry_[index] == want) {
       ++hits_;
       return true;
