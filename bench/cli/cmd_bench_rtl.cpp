@@ -10,6 +10,8 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <optional>
 
 #include <nlohmann/json.hpp>
 
@@ -42,6 +44,8 @@ struct RtlBenchArgs {
   bool fill = false;
   bool quick = false;
   std::string config_dir;
+  std::string save_rtl;  // --save-rtl-counters: the gateware's counters per stream, to replay
+  std::string load_rtl;  // --rtl-counters: replay them instead of co-simulating (the model only)
 };
 
 // One scanned-out frame measured on both sides.
@@ -73,7 +77,7 @@ nlohmann::json counters_json(const sim::DeviceStats& w, const rtl::RtlCounters& 
             {"pixels_textured", w.pixels_textured}, {"pixels_blended", w.pixels_blended}, {"texel_bytes", w.texel_bytes},
             {"clears", w.clears}, {"clear_rows", w.clear_rows}, {"clear_pixels", w.clear_pixels},
             {"clear_bytes", w.clear_bytes}, {"mem_data_writes", w.mem_data_writes}, {"swaps", w.swaps},
-            {"texel_footprint_bytes", w.texel_footprint_bytes}, {"sdram_accesses", w.sdram_accesses}, {"row_opens", w.row_opens}, {"row_misses", w.row_misses}, {"by_mode", modes}}},
+            {"texel_footprint_bytes", w.texel_footprint_bytes}, {"texel_fetches", w.texel_fetches}, {"sdram_accesses", w.sdram_accesses}, {"row_opens", w.row_opens}, {"row_misses", w.row_misses}, {"textured_row_misses", w.textured_row_misses}, {"depth_tail_pixels", w.depth_tail_pixels}, {"by_mode", modes}}},
           {"rtl",
            {{"work_cycles", r.work_cycles}, {"commands", r.commands}, {"core_busy_cycles", r.core_busy_cycles},
             {"setup_cycles", r.setup_cycles}, {"raster_cycles", r.raster_cycles}, {"core_mem_stalls", r.core_mem_stalls},
@@ -81,29 +85,70 @@ nlohmann::json counters_json(const sim::DeviceStats& w, const rtl::RtlCounters& 
             {"refreshes", r.refreshes}}}};
 }
 
+// The gateware's counters of every frame of a stream, as --save-rtl-counters writes them.
+nlohmann::json rtl_frames_json(const std::vector<rtl::RtlCounters>& frames) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto& r : frames)
+    out.push_back({r.cycles, r.work_cycles, r.commands, r.spi_frames, r.core_mem_stalls, r.triangles, r.pixels, r.passed,
+                   r.textured, r.core_busy_cycles, r.setup_cycles, r.raster_cycles, r.refreshes, r.sdram_violations,
+                   r.sck_edges_too_fast});
+  return out;
+}
+
+std::vector<rtl::RtlCounters> rtl_frames_of(const nlohmann::json& j) {
+  std::vector<rtl::RtlCounters> out;
+  for (const auto& f : j) {
+    rtl::RtlCounters r;
+    std::uint64_t* fields[] = {&r.cycles, &r.work_cycles, &r.commands, &r.spi_frames, &r.core_mem_stalls,
+                               &r.triangles, &r.pixels, &r.passed, &r.textured, &r.core_busy_cycles,
+                               &r.setup_cycles, &r.raster_cycles, &r.refreshes, &r.sdram_violations,
+                               &r.sck_edges_too_fast};
+    for (std::size_t i = 0; i < std::size(fields) && i < f.size(); ++i) *fields[i] = f[i].get<std::uint64_t>();
+    out.push_back(r);
+  }
+  return out;
+}
+
 // Plays `stream` on the gateware board and on a simulator with the same CAPS; one sample per frame.
+// `recorded` (--rtl-counters): the gateware's counters of an earlier run of the same stream; the
+// board is then not co-simulated (the timing model's counters are the simulator's alone), and
+// `recorded` is filled with the frames' counters otherwise (--save-rtl-counters).
 Result<std::vector<Sample>> measure(const std::string& scene, const std::string& gw, const protocol::CommandStream& stream,
-                                    const fs::path& config_dir) {
-  auto profile = usb::find_board_profile(config_dir, board_of(gw));
-  if (!profile) return profile.error();
-  profile->scanout = usb::ScanoutMode::CrcOnly;
-  usb::emu::EmulationOptions eo;
-  eo.pins = usb::emu::rtl_pins();
-  auto board = usb::emu::open_emulated_board(*profile, eo);
-  if (!board) return board.error();
-  rtl::RtlDevice& g = usb::emu::rtl_pins_of(*board->stack)->device();
-  const auto o = rtl::simulator_options(g.caps());
+                                    const fs::path& config_dir, nlohmann::json& recorded) {
+  const bool replay = !recorded.is_null();
+  std::optional<usb::emu::EmulatedBoard> board;
+  rtl::RtlDevice* g = nullptr;
+  if (!replay) {
+    auto profile = usb::find_board_profile(config_dir, board_of(gw));
+    if (!profile) return profile.error();
+    profile->scanout = usb::ScanoutMode::CrcOnly;
+    usb::emu::EmulationOptions eo;
+    eo.pins = usb::emu::rtl_pins();
+    auto opened = usb::emu::open_emulated_board(*profile, eo);
+    if (!opened) return opened.error();
+    board.emplace(std::move(*opened));
+    g = &usb::emu::rtl_pins_of(*board->stack)->device();
+  }
+  const auto o = rtl::simulator_options(g ? g->caps() : rtl::caps_of(*rtl::parse_gateware_profile(gw)));
   auto sim = sim::Device::create(o);
   if (!sim) return sim.error();
 
   std::vector<Sample> out;
   std::vector<rtl::RtlCounters> rtl_frames;
-  rtl::RtlCounters last_rtl = g.counters();
-  board->backend->set_scanout_callback([&](std::shared_ptr<const backends::ScanoutFrame>) {
-    const rtl::RtlCounters now = g.counters();
-    rtl_frames.push_back(now - last_rtl);
-    last_rtl = now;
-  });
+  if (replay) {
+    try {
+      rtl_frames = rtl_frames_of(recorded);
+    } catch (const nlohmann::json::exception& e) {
+      return make_error("--rtl-counters: " + scene + ": " + e.what());
+    }
+  }
+  rtl::RtlCounters last_rtl = g ? g->counters() : rtl::RtlCounters{};
+  if (board)
+    board->backend->set_scanout_callback([&](std::shared_ptr<const backends::ScanoutFrame>) {
+      const rtl::RtlCounters now = g->counters();
+      rtl_frames.push_back(now - last_rtl);
+      last_rtl = now;
+    });
   std::vector<std::pair<sim::DeviceStats, unsigned>> sim_frames;
   sim::DeviceStats last;
   (*sim)->set_scanout_callback([&](std::shared_ptr<const backends::ScanoutFrame> f) {
@@ -111,17 +156,19 @@ Result<std::vector<Sample>> measure(const std::string& scene, const std::string&
     sim_frames.emplace_back(sim::stats_difference(now, last), protocol::bytes_per_pixel(f->format));
     last = now;
   });
-  const double clocks0 = double(g.counters().cycles);
+  const double clocks0 = g ? double(g->counters().cycles) : 0.0;
   const auto t0 = std::chrono::steady_clock::now();
   for (const auto& tc : stream.commands) {
     if (const auto* f = std::get_if<protocol::FramesCmd>(&tc.command)) {
-      if (auto r = board->backend->write_frames(f->view()); !r) return r.error();
+      if (board)
+        if (auto r = board->backend->write_frames(f->view()); !r) return r.error();
       (*sim)->write(f->view());
     } else if (const auto* u = std::get_if<protocol::UploadCmd>(&tc.command)) {
       const std::uint64_t vram = o.vram_bytes;
       if (u->address >= vram) continue;
       const auto n = std::min<std::uint64_t>(u->data.size(), vram - u->address);
-      if (auto r = board->backend->upload(u->address, std::span(u->data).first(n)); !r) return r.error();
+      if (board)
+        if (auto r = board->backend->upload(u->address, std::span(u->data).first(n)); !r) return r.error();
       // the simulator gets what the board driver sends (MEM_ADDR, then MEM_DATA words; a partial
       // last word keeps the bytes in memory), so its counters see the upload as the gateware does
       const auto m = (*sim)->memory();
@@ -134,9 +181,14 @@ Result<std::vector<Sample>> measure(const std::string& scene, const std::string&
       for (const auto& wf : words) (*sim)->write(wf);
     }
   }
-  if (auto r = board->backend->flush(); !r) return r.error();
+  if (board)
+    if (auto r = board->backend->flush(); !r) return r.error();
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  const double clocks = double(g.counters().cycles) - clocks0;
+  double clocks = g ? double(g->counters().cycles) - clocks0 : 0.0;
+  if (replay)
+    for (const auto& r : rtl_frames) clocks += double(r.cycles);
+  else
+    recorded = rtl_frames_json(rtl_frames);
   for (std::size_t i = 0; i < rtl_frames.size() && i < sim_frames.size(); ++i) {
     Sample s;
     s.scene = scene;
@@ -232,13 +284,33 @@ int run_bench_rtl(const GlobalOptions& g, const RtlBenchArgs& a) {
     std::fprintf(stderr, "gpubridge bench rtl: %s\n", all.error().message.c_str());
     return 1;
   }
+  // the gateware's counters per profile and stream: replayed (--rtl-counters) or recorded
+  nlohmann::json rtl_counters = nlohmann::json::object();
+  if (!a.load_rtl.empty()) {
+    std::ifstream in(a.load_rtl);
+    rtl_counters = nlohmann::json::parse(in, nullptr, false);
+    if (!in || rtl_counters.is_discarded() || !rtl_counters.is_object()) {
+      std::fprintf(stderr, "gpubridge bench rtl: --rtl-counters %s: not a file --save-rtl-counters wrote\n", a.load_rtl.c_str());
+      return 1;
+    }
+  }
   nlohmann::json report = nlohmann::json::object();
   for (const auto& gw : a.profiles) {
     auto preset = sim::timing_preset(gw);
     auto before = sim::timing_preset("ecp5-50mhz");
     // the measured frame of each stream: its last one, both sides' counters over the same work
     auto run = [&](const std::string& name, const protocol::CommandStream& stream, std::vector<Sample>& out) -> bool {
-      auto s = measure(name, gw, stream, config_dir);
+      nlohmann::json recorded;  // null: co-simulate
+      if (!a.load_rtl.empty()) {
+        if (!rtl_counters.contains(gw) || !rtl_counters[gw].contains(name)) {
+          std::fprintf(stderr, "gpubridge bench rtl: --rtl-counters %s holds no %s on %s\n", a.load_rtl.c_str(), name.c_str(),
+                       gw.c_str());
+          return false;
+        }
+        recorded = rtl_counters[gw][name];
+      }
+      auto s = measure(name, gw, stream, config_dir, recorded);
+      if (a.load_rtl.empty()) rtl_counters[gw][name] = recorded;
       if (!s) {
         std::fprintf(stderr, "gpubridge bench rtl: %s on %s: %s\n", name.c_str(), gw.c_str(), s.error().message.c_str());
         return false;
@@ -276,7 +348,9 @@ int run_bench_rtl(const GlobalOptions& g, const RtlBenchArgs& a) {
       const double c = sim::estimate_timing(s.work, *preset, s.bpp).board_cycles;
       const double ed = (d - s.rtl_cycles) / s.rtl_cycles * 100, ec = (c - s.rtl_cycles) / s.rtl_cycles * 100;
       worst = std::max(worst, std::fabs(ec));
-      const double cps = s.simulated_clocks / s.wall_s, fps = s.frames / s.wall_s;
+      // a replay (--rtl-counters) co-simulates nothing: no speed to report
+      const bool timed = a.load_rtl.empty() && s.wall_s > 0;
+      const double cps = timed ? s.simulated_clocks / s.wall_s : 0, fps = timed ? s.frames / s.wall_s : 0;
       rows.push_back({{"scene", s.scene}, {"rtl_cycles", s.rtl_cycles}, {"default_cycles", d}, {"default_error_pct", ed},
                       {"calibrated_cycles", c}, {"calibrated_error_pct", ec}, {"simulated_clocks_per_s", cps},
                       {"frames_per_s", fps}, {"triangles", s.work.triangles_rasterised}, {"pixels", s.work.pixels_covered},
@@ -316,6 +390,14 @@ int run_bench_rtl(const GlobalOptions& g, const RtlBenchArgs& a) {
       }
     }
   }
+  if (!a.save_rtl.empty()) {
+    std::ofstream out(a.save_rtl);
+    out << rtl_counters.dump() << "\n";
+    if (!out) {
+      std::fprintf(stderr, "gpubridge bench rtl: --save-rtl-counters %s: cannot write\n", a.save_rtl.c_str());
+      return 1;
+    }
+  }
   if (g.json) std::puts(json_text(report, 2).c_str());
   return 0;
 }
@@ -338,6 +420,14 @@ GPUBRIDGE_COMMAND("bench-rtl", 63, [](CLI::App& app, GlobalOptions& g, auto& run
       ->excludes(fit);
   sub->add_flag("--quick", a->quick, "two examples only (a smoke run); with --fill, 64 x 48 rectangles");
   sub->add_option("--config-dir", a->config_dir, "directory holding boards/");
+  auto* save = sub->add_option("--save-rtl-counters", a->save_rtl,
+                               "write the gateware's counters of every frame to FILE (JSON), for --rtl-counters");
+  sub->add_option("--rtl-counters", a->load_rtl,
+                  "take the gateware's counters from FILE (--save-rtl-counters of the same gateware and streams) "
+                  "instead of co-simulating: seconds instead of minutes, for work on the timing model; stale once "
+                  "the gateware changes")
+      ->excludes(save)
+      ->excludes("--fill");
   runners.emplace_back(sub, [&g, a] { return run_bench_rtl(g, *a); });
 });
 

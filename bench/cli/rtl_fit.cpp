@@ -61,11 +61,20 @@ std::vector<Term> stage_terms(Stage stage, double& clear_byte_cycles, bool sdram
       if (sdram) {
         t.push_back({"cycles_per_texel_footprint_byte", [](const FitSample& s) { return double(s.work.texel_footprint_bytes); },
                      [](BoardTiming& b) -> double& { return b.cycles_per_texel_footprint_byte; }});
+        t.push_back({"cycles_per_texel_fetch", [](const FitSample& s) { return double(s.work.texel_fetches); },
+                     [](BoardTiming& b) -> double& { return b.cycles_per_texel_fetch; }});
         t.push_back({"cycles_per_sdram_access", [](const FitSample& s) { return double(s.work.sdram_accesses); },
                      [](BoardTiming& b) -> double& { return b.cycles_per_sdram_access; }});
         t.push_back({"cycles_per_row_open", [](const FitSample& s) { return double(s.work.row_opens); },
                      [](BoardTiming& b) -> double& { return b.cycles_per_row_open; }});
-        t.push_back({"cycles_per_row_miss", [](const FitSample& s) { return double(s.work.row_misses); },
+        t.push_back({"cycles_per_textured_row_miss", [](const FitSample& s) { return double(s.work.textured_row_misses); },
+                     [](BoardTiming& b) -> double& { return b.cycles_per_textured_row_miss; }});
+        // a credit: the column is negative, so its non-negative parameter subtracts
+        t.push_back({"drained_cycles_per_tail_pixel", [](const FitSample& s) { return -double(s.work.depth_tail_pixels); },
+                     [](BoardTiming& b) -> double& { return b.drained_cycles_per_tail_pixel; }});
+        t.push_back({"cycles_per_depth_write", [](const FitSample& s) { return double(sim::depth_writes(s.work)); },
+                     [](BoardTiming& b) -> double& { return b.cycles_per_depth_write; }});
+        t.push_back({"cycles_per_row_miss", [](const FitSample& s) { return double(s.work.row_misses - std::min(s.work.row_misses, s.work.textured_row_misses)); },
                      [](BoardTiming& b) -> double& { return b.cycles_per_row_miss; }});
       }
       clears();
@@ -141,8 +150,9 @@ TimingFit fit_timing(const std::vector<FitSample>& samples, const BoardTiming& b
   b.setup_cycles = b.row_cycles = b.column_cycles = b.pixel_cycles = {};
   b.cycles_per_rejected_triangle = b.cycles_per_clear = b.cycles_per_clear_row = b.cycles_per_clear_pixel = 0;
   b.cycles_per_mem_write = b.cycles_per_texel_byte = b.cycles_per_color_byte = 0;
-  b.cycles_per_texel_footprint_byte = 0;
+  b.cycles_per_texel_footprint_byte = b.cycles_per_texel_fetch = 0;
   b.cycles_per_sdram_access = b.cycles_per_row_open = b.cycles_per_row_miss = 0;
+  b.cycles_per_textured_row_miss = b.cycles_per_depth_write = b.drained_cycles_per_tail_pixel = 0;
   // The refresh terms are the controller's (tREFI, and tRP + tRFC + tRCD per refresh), kept from
   // `base`: the fit sees each stage's clocks without the refresh's share.
   const bool sdram = b.refresh_interval_cycles > 0;

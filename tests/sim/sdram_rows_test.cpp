@@ -1,7 +1,7 @@
 // The SDRAM row model of the timing model (docs/protocol.md section 19, timing.hpp SdramRows):
 // row hits, opens and misses on hand-made access streams, the span stream of the ecp5 memory
 // port against a literal access-by-access replay, the device's counts of a drawn triangle, and
-// what the row and refresh terms add to an estimate.
+// what the row and refresh terms add to an estimate; the texel cache's reads in the stream.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -238,6 +238,165 @@ TEST(SimSdramRows, RowAndRefreshTermsInTheEstimate) {
   ASSERT_TRUE(u);
   EXPECT_EQ(u->cycles_per_row_miss, 0);
   EXPECT_EQ(refresh_stretch(*u), 1.0);
+}
+
+// The texel cache (core_texture.v): direct mapped by texel parity, eight texel rows of any width.
+TEST(SimSdramRows, TexelCacheHoldsEightTexelRows) {
+  TexelCache c;
+  c.begin(1);
+  for (unsigned j = 0; j < 8; ++j)
+    for (unsigned i = 0; i < 300; ++i) EXPECT_FALSE(c.lookup(i, j)) << i << "," << j;
+  for (unsigned j = 0; j < 8; ++j)
+    for (unsigned i = 0; i < 300; ++i) EXPECT_TRUE(c.lookup(i, j)) << "held: " << i << "," << j;
+  EXPECT_EQ(c.misses(), 8u * 300u);
+  EXPECT_FALSE(c.lookup(5, 8));  // the ninth row takes row 0's entry of that texel
+  EXPECT_FALSE(c.lookup(5, 0));
+  EXPECT_TRUE(c.lookup(6, 0));   // the others stay
+  EXPECT_FALSE(c.lookup(5, 8));
+  c.begin(1);  // the same draw continues: kept
+  EXPECT_TRUE(c.lookup(7, 3));
+  c.begin(2);  // another texture or buffers: forgotten
+  EXPECT_FALSE(c.lookup(7, 3));
+  c.invalidate();
+  c.begin(2);  // anything between (a clear, an untextured triangle): forgotten as well
+  EXPECT_FALSE(c.lookup(7, 3));
+  c.reset_counts();
+  EXPECT_EQ(c.misses(), 0u);
+  EXPECT_EQ(c.hits(), 0u);
+}
+
+constexpr unsigned kTextured = 2;
+constexpr std::uint32_t kTexBase = 0x80000;
+
+// A textured triangle over a 64 x 48 RGBA8888 canvas, its texture (log2 size `lg`, RGBA8888,
+// nearest, REPEAT) spanning `widths` texture widths across the triangle.
+void textured_tri(Canvas& cv, unsigned lg, int widths) {
+  w(*cv.dev, Reg::TEX_BASE, kTexBase);
+  w(*cv.dev, Reg::TEX_FMT, (lg << 4) | lg);
+  w(*cv.dev, Reg::TRI_MODE, kTextured);
+  const std::int32_t one = widths << 24;  // s8.24 over q = 1.0 (u0.32 just below 1)
+  const int x[3] = {2 * 16, 60 * 16, 9 * 16}, y[3] = {3 * 16, 5 * 16, 40 * 16};
+  const std::int32_t s[3] = {0, one, 0}, t[3] = {0, 0, one};
+  w(*cv.dev, Reg::PRIM, 0);
+  for (int k = 0; k < 3; ++k) {
+    w(*cv.dev, Reg::COLOR, color(0xFFFFFFFF, 0xFFFFFFFFu));
+    w(*cv.dev, Reg::TEXCOORD, (std::uint64_t{static_cast<std::uint32_t>(s[k])} << 32) | static_cast<std::uint32_t>(t[k]));
+    w(*cv.dev, Reg::VERTEX, vtx(x[k], y[k]));
+  }
+}
+
+// The device replays a textured triangle's texel lookups: a magnified 8 x 8 texture is read once
+// per texel and kept for the next triangle of the same draw, forgotten after a clear; every miss
+// is a read in the row stream beside the colour writes; a minified texture misses about once a
+// pixel; the textured draw's row misses are counted apart.
+TEST(SimSdramRows, TexelCacheMissesAreReadsInTheRowStream) {
+  DeviceOptions counting;
+  counting.sdram_rows = true;
+  Canvas cv(64, 48, 0, counting);
+  cv.dev->reset_stats();
+  textured_tri(cv, 3, 1);
+  const DeviceStats first = cv.dev->stats();
+  ASSERT_GT(first.pixels_covered, 500u);
+  EXPECT_GT(first.texel_fetches, 16u);
+  EXPECT_LE(first.texel_fetches, 64u) << "magnified: each texel once";
+  // RGBA8888 colour without depth or blend: a write per pixel, plus the texel reads
+  EXPECT_EQ(first.sdram_accesses, first.pixels_covered + first.texel_fetches);
+  EXPECT_EQ(first.textured_row_misses, first.row_misses);
+  textured_tri(cv, 3, 1);
+  EXPECT_EQ(cv.dev->stats().texel_fetches, first.texel_fetches) << "the same draw keeps its texels";
+  w(*cv.dev, Reg::CLEAR, 0);
+  textured_tri(cv, 3, 1);
+  EXPECT_EQ(cv.dev->stats().texel_fetches, 2 * first.texel_fetches) << "a clear forgets them";
+  // minified: 8 texture widths of a 64 x 64 texture across the triangle, a new texel most pixels
+  cv.dev->reset_stats();
+  textured_tri(cv, 6, 8);
+  const DeviceStats minified = cv.dev->stats();
+  EXPECT_GT(minified.texel_fetches, minified.pixels_covered / 2);
+  EXPECT_GT(minified.row_misses, first.row_misses);
+  EXPECT_EQ(minified.textured_row_misses, minified.row_misses);
+  // an untextured draw's misses are not the textured ones
+  cv.dev->reset_stats();
+  w(*cv.dev, Reg::TRI_MODE, kZTest | kLess | kZWrite);
+  cv.tri(2 * 16, 3 * 16, 60 * 16, 5 * 16, 9 * 16, 40 * 16);
+  EXPECT_EQ(cv.dev->stats().texel_fetches, 0u);
+  EXPECT_EQ(cv.dev->stats().textured_row_misses, 0u);
+}
+
+// The terms of the texel reads, the row misses of textured and untextured draws and the depth
+// writes (the passed pixels of the depth classes), each on its own count.
+TEST(SimSdramRows, TexelReadMissSplitAndDepthWriteTermsInTheEstimate) {
+  DeviceStats w;
+  w.by_mode[2].pixels = 100;  // z
+  w.by_mode[0].pixels = 50;   // flat: passes what it covers
+  w.pixels_depth_passed = 120;
+  w.row_misses = 40;
+  w.textured_row_misses = 15;
+  w.texel_fetches = 30;
+  EXPECT_EQ(depth_writes(w), 70u);
+  BoardTiming b;
+  b.memory_bound = false;
+  const double base = estimate_timing(w, b, 4).pipeline_cycles;
+  b.cycles_per_row_miss = 2;  // the 25 untextured misses
+  EXPECT_DOUBLE_EQ(estimate_timing(w, b, 4).pipeline_cycles, base + 25 * 2);
+  b.cycles_per_textured_row_miss = 1;
+  EXPECT_DOUBLE_EQ(estimate_timing(w, b, 4).pipeline_cycles, base + 25 * 2 + 15 * 1);
+  b.cycles_per_texel_fetch = 3;
+  EXPECT_DOUBLE_EQ(estimate_timing(w, b, 4).pipeline_cycles, base + 65 + 30 * 3);
+  b.cycles_per_depth_write = 5;
+  EXPECT_DOUBLE_EQ(estimate_timing(w, b, 4).pipeline_cycles, base + 155 + 70 * 5);
+  ASSERT_TRUE(apply_timing_setting(b, "cycles_per_textured_row_miss=1.5"));
+  ASSERT_TRUE(apply_timing_setting(b, "cycles_per_texel_fetch=0.5"));
+  ASSERT_TRUE(apply_timing_setting(b, "cycles_per_depth_write=4"));
+  EXPECT_EQ(b.cycles_per_textured_row_miss, 1.5);
+  EXPECT_EQ(b.cycles_per_texel_fetch, 0.5);
+  EXPECT_EQ(b.cycles_per_depth_write, 4);
+  EXPECT_EQ(stats_difference(w, DeviceStats{}).textured_row_misses, 15u);
+  EXPECT_EQ(stats_difference(w, DeviceStats{}).texel_fetches, 30u);
+  // the ecp5 preset charges depth writes; up5k (no depth buffer, no SDRAM) none of these
+  auto e = timing_preset("ecp5"), u = timing_preset("up5k");
+  ASSERT_TRUE(e && u);
+  EXPECT_GT(e->cycles_per_depth_write, 0);
+  EXPECT_EQ(u->cycles_per_depth_write + u->cycles_per_textured_row_miss + u->cycles_per_texel_fetch, 0);
+}
+
+// A depth-class triangle's last pixels (the depth stage's 4 reads in flight) are counted once per
+// triangle, at most its covered pixels; other classes count none. Their credit subtracts, and
+// never makes a negative time.
+TEST(SimSdramRows, DepthTailPixelsPerDepthTriangle) {
+  DeviceOptions counting;
+  counting.sdram_rows = true;
+  Canvas cv(64, 48, 0, counting);
+  w(*cv.dev, Reg::TRI_MODE, kZTest | kLess | kZWrite);
+  cv.dev->reset_stats();
+  cv.tri(2 * 16, 3 * 16, 60 * 16, 5 * 16, 9 * 16, 40 * 16);
+  cv.tri(2 * 16, 3 * 16, 60 * 16, 5 * 16, 9 * 16, 40 * 16);
+  EXPECT_EQ(cv.dev->stats().depth_tail_pixels, 2u * 4u);
+  cv.dev->reset_stats();
+  cv.tri(10 * 16, 10 * 16, 12 * 16, 10 * 16, 10 * 16, 12 * 16);  // a 2 x 2 corner: fewer than 4 pixels
+  const DeviceStats tiny = cv.dev->stats();
+  ASSERT_GT(tiny.pixels_covered, 0u);
+  ASSERT_LT(tiny.pixels_covered, 4u);
+  EXPECT_EQ(tiny.depth_tail_pixels, tiny.pixels_covered);
+  cv.dev->reset_stats();
+  w(*cv.dev, Reg::TRI_MODE, 0);  // flat, no depth
+  cv.tri(2 * 16, 3 * 16, 60 * 16, 5 * 16, 9 * 16, 40 * 16);
+  EXPECT_EQ(cv.dev->stats().depth_tail_pixels, 0u);
+
+  DeviceStats work;
+  work.depth_tail_pixels = 40;
+  work.queued_executed = 100;
+  BoardTiming b;
+  b.memory_bound = false;
+  const double base = estimate_timing(work, b, 4).pipeline_cycles;  // 100 commands at 1 cycle
+  ASSERT_TRUE(apply_timing_setting(b, "drained_cycles_per_tail_pixel=2"));
+  EXPECT_DOUBLE_EQ(estimate_timing(work, b, 4).pipeline_cycles, base - 40 * 2);
+  b.drained_cycles_per_tail_pixel = 100;
+  EXPECT_EQ(estimate_timing(work, b, 4).pipeline_cycles, 0.0);
+  EXPECT_EQ(stats_difference(work, DeviceStats{}).depth_tail_pixels, 40u);
+  auto e = timing_preset("ecp5"), u = timing_preset("up5k");
+  ASSERT_TRUE(e && u);
+  EXPECT_GT(e->drained_cycles_per_tail_pixel, 0);
+  EXPECT_EQ(u->drained_cycles_per_tail_pixel, 0);
 }
 
 }  // namespace

@@ -323,6 +323,7 @@ struct Device::State {
     for (unsigned i = 0; i < cols; ++i) std::copy(value, value + bpp, row.begin() + std::size_t{i} * bpp);
     bool dropped = false;
     ++stats.clears;
+    renderer.texel_cache().invalidate();  // the core forgets its texels after another command
     stats.clear_rows += static_cast<std::uint64_t>(st.clip.y1 - st.clip.y0);
     stats.clear_pixels += std::uint64_t{cols} * static_cast<std::uint64_t>(st.clip.y1 - st.clip.y0);
     for (int y = st.clip.y0; y < st.clip.y1; ++y) {
@@ -645,9 +646,12 @@ const DeviceStats& Device::stats() const {
   st.by_mode = s_->renderer.mode_work();
   st.triangles_rejected = s_->renderer.triangles_rejected();
   st.texel_footprint_bytes = s_->renderer.texel_footprint();
+  st.texel_fetches = s_->renderer.texel_cache().misses();
   st.sdram_accesses = s_->renderer.sdram_rows().hits() + s_->renderer.sdram_rows().opens() + s_->renderer.sdram_rows().misses();
   st.row_opens = s_->renderer.sdram_rows().opens();
   st.row_misses = s_->renderer.sdram_rows().misses();
+  st.textured_row_misses = s_->renderer.sdram_rows().textured_misses();
+  st.depth_tail_pixels = s_->renderer.depth_tail();
   return st;
 }
 void Device::reset_stats() {

@@ -178,8 +178,9 @@ void Renderer::count_rasterised(const Triangle& t, const DrawState& st) {
   mode.rows += static_cast<std::uint64_t>(t.y1 - t.y0);
   mode.columns += static_cast<std::uint64_t>(t.x1 - t.x0);
   if (!count_rows_ || t.small || st.writes_nothing) return;
-  const std::uint64_t covered = access_triangle_rows(sdram_, t, st);
+  const std::uint64_t covered = access_triangle_rows(sdram_, texel_cache_, t, st);
   if (st.mode_class & 4) texel_footprint_ += texel_footprint_bytes(t, st, covered);
+  if (st.mode_class & 2) depth_tail_ += depth_tail_pixels(covered);
 }
 
 

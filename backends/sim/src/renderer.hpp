@@ -51,8 +51,13 @@ class Renderer {
   bool counts_sdram_rows() const { return count_rows_; }
   // Texture bytes the textured triangles' footprints hold (texel_footprint_bytes).
   std::uint64_t texel_footprint() const { return texel_footprint_; }
+  // The ecp5's texel cache replayed beside the rows (its misses are texel reads in the row stream).
+  TexelCache& texel_cache() { return texel_cache_; }
+  std::uint64_t depth_tail() const { return depth_tail_; }  // depth_tail_pixels of the depth classes
   void reset_counters() {
     sdram_.reset_counts();
+    texel_cache_.reset_counts();
+    depth_tail_ = 0;
     texel_footprint_ = 0;
     counters_ = {};
     rasterised_ = 0;
@@ -108,6 +113,8 @@ class Renderer {
   RasterCounters counters_;
   std::array<DeviceStats::ModeWork, DeviceStats::kModeClasses> modes_{};
   SdramRows sdram_;
+  TexelCache texel_cache_;
+  std::uint64_t depth_tail_ = 0;
   std::uint64_t texel_footprint_ = 0;
   // Coarse depth bounds (hier_z.hpp): their generation, the state it belongs to (held, so a new
   // state cannot reuse its address unnoticed), the generations of the filling batch, the batch

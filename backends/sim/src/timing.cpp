@@ -22,35 +22,15 @@ double structure_cycles(const DeviceStats& w, const BoardTiming& b, unsigned col
   return c;
 }
 
-// Accesses of a span gathered into runs of one row (SdramRows::access(address, count)).
-class RunEmitter {
- public:
-  RunEmitter(SdramRows& rows, unsigned row_bits) : rows_(rows), row_bits_(row_bits) {}
-  ~RunEmitter() { flush(); }
-  RunEmitter(const RunEmitter&) = delete;
-  RunEmitter& operator=(const RunEmitter&) = delete;
-  void emit(std::uint64_t address, std::uint64_t count) {
-    if (count == 0) return;
-    if (count_ != 0 && (address >> row_bits_) == (address_ >> row_bits_)) {
-      count_ += count;
-      return;
-    }
-    flush();
-    address_ = address;
-    count_ = count;
-  }
-  void flush() {
-    if (count_ != 0) rows_.access(address_, count_);
-    count_ = 0;
-  }
-
- private:
-  SdramRows& rows_;
-  unsigned row_bits_;
-  std::uint64_t address_ = 0, count_ = 0;
-};
-
 }  // namespace
+
+std::uint64_t depth_writes(const DeviceStats& w) {
+  // pixels of the classes without depth pass whatever they cover
+  std::uint64_t plain = 0;
+  for (unsigned m = 0; m < DeviceStats::kModeClasses; ++m)
+    if (!(m & 2)) plain += w.by_mode[m].pixels;
+  return w.pixels_depth_passed - std::min(w.pixels_depth_passed, plain);
+}
 
 double refresh_stretch(const BoardTiming& b) {
   if (b.refresh_interval_cycles <= 0 || b.cycles_per_refresh <= 0) return 1.0;
@@ -74,6 +54,7 @@ SdramRows::Outcome SdramRows::access(std::uint64_t address, std::uint64_t count)
     return Outcome::Open;
   }
   ++misses_;
+  if (textured_) ++textured_misses_;
   return Outcome::Miss;
 }
 
@@ -100,7 +81,7 @@ void access_span(SdramRows& rows, const SpanAccess& span) {
   auto word = [&](std::uint64_t i) { return (span.color + bpp * i) >> 2; };
   // the last pixel of the span in colour word w: the combiner sends the word after it
   auto last_pixel = [&](std::uint64_t w) { return std::min(n, ((w + 1) * 4 - span.color + bpp - 1) / bpp) - 1; };
-  RunEmitter out(rows, g.row_bits);
+  RowRunEmitter out(rows);
   std::uint64_t a = 0;  // first pixel of the segment
   while (a < n) {
     // a segment [a, b): both streams stay in one row each
@@ -148,8 +129,13 @@ TimingEstimate estimate_timing(const DeviceStats& w, const BoardTiming& b, unsig
                       double(w.pixels_blended) * b.cycles_per_blended_pixel +
                       double(w.clear_bytes) / b.clear_bytes_per_cycle + structure_cycles(w, b, color_bpp) +
                       double(w.texel_footprint_bytes) * b.cycles_per_texel_footprint_byte +
+                      double(w.texel_fetches) * b.cycles_per_texel_fetch +
                       double(w.sdram_accesses) * b.cycles_per_sdram_access + double(w.row_opens) * b.cycles_per_row_open +
-                      double(w.row_misses) * b.cycles_per_row_miss;
+                      double(w.row_misses - std::min(w.row_misses, w.textured_row_misses)) * b.cycles_per_row_miss +
+                      double(w.textured_row_misses) * b.cycles_per_textured_row_miss +
+                      double(depth_writes(w)) * b.cycles_per_depth_write -
+                      double(w.depth_tail_pixels) * b.drained_cycles_per_tail_pixel;
+  e.pipeline_cycles = std::max(e.pipeline_cycles, 0.0);  // a credit never makes time
   e.pipeline_cycles *= refresh_stretch(b);
   // Memory: depth read + write (4 + 4) for every covered pixel (an upper bound: not every draw
   // tests or writes Z), colour write, destination read when blending, texels fetched, clears,
@@ -197,9 +183,12 @@ DeviceStats stats_difference(const DeviceStats& a, const DeviceStats& b) {
   d.clear_rows = a.clear_rows - b.clear_rows;
   d.clear_pixels = a.clear_pixels - b.clear_pixels;
   d.texel_footprint_bytes = a.texel_footprint_bytes - b.texel_footprint_bytes;
+  d.texel_fetches = a.texel_fetches - b.texel_fetches;
   d.sdram_accesses = a.sdram_accesses - b.sdram_accesses;
   d.row_opens = a.row_opens - b.row_opens;
   d.row_misses = a.row_misses - b.row_misses;
+  d.textured_row_misses = a.textured_row_misses - b.textured_row_misses;
+  d.depth_tail_pixels = a.depth_tail_pixels - b.depth_tail_pixels;
   return d;
 }
 
@@ -253,29 +242,37 @@ Result<BoardTiming> timing_preset(std::string_view name) {
     b.clock_mhz = 50.0;
     b.spi_clock_mhz = 15.0;
     b.memory_bytes_per_cycle = 2.0;
-    // Fitted with the SDRAM row model and the texel footprint (`gpubridge bench rtl --fit --profile
-    // ecp5`, 2026-11-26, 14 scenes and 48 calibration frames; docs/gateware.md "Timing model"): a row
-    // miss costs 1.92 clocks beyond the per-pixel terms, a byte of texture footprint (texel cache
-    // fills) 0.57, a byte sampled 0.073; a row open and the access itself nothing beyond them.
-    b.setup_cycles = {41.71, 169.5, 97.0, 199.8, 163.2, 274.5, 201.5, 309.0};
-    b.row_cycles = {1.418, 0.4192, 2.721, 2.36, 0.5689, 0.6137, 6.116, 4.173};
-    b.column_cycles = {0.4139, 0.0, 0.7694, 0.1205, 0.0, 0.474, 2.862, 1.223};
-    b.pixel_cycles = {0.3255, 0.5814, 4.594, 4.878, 1.582, 1.226, 4.108, 5.107};
-    b.cycles_per_command = 2.552;
+    // Fitted with the SDRAM row model, the texel cache's reads in it, the textured draws' row
+    // misses apart, the depth writes and the depth stage's tail (`gpubridge bench rtl --fit
+    // --profile ecp5`, 2026-11-27, 14 scenes and 48 calibration frames; docs/gateware.md "Timing
+    // model"): a depth write costs 6.422 clocks beyond its pixel, a row miss 2.397 in an
+    // untextured draw and 1.176 in a textured one (the texture unit's wait hides part of it),
+    // a texel read 0.3179, a byte of texture footprint 0.4863, a byte sampled 0.06006; each of a
+    // depth triangle's last 4 pixels gives back 12.36 (drained under the next setup); a row
+    // open and an access nothing beyond the per-pixel terms.
+    b.setup_cycles = {42.72, 170.5, 98.01, 200.8, 164.2, 275.5, 202.4, 310.0};
+    b.row_cycles = {1.259, 0.4691, 0.9445, 0.3699, 0.1353, 0.2083, 3.356, 3.319};
+    b.column_cycles = {0.3843, 0.0, 0.0, 0.0, 0.0, 0.169, 0.4137, 0.5054};
+    b.pixel_cycles = {0.4273, 0.6352, 0.5038, 0.4714, 1.381, 1.114, 0.0, 0.05676};
+    b.cycles_per_command = 2.736;
     b.cycles_per_triangle = 0.0;
-    b.cycles_per_blended_pixel = 3.182;
+    b.cycles_per_blended_pixel = 3.008;
     b.cycles_per_rejected_triangle = 0.0;
-    b.cycles_per_clear = 8.387;
+    b.cycles_per_clear = 7.846;
     b.cycles_per_clear_row = 0.0;
-    b.cycles_per_clear_pixel = 0.005953;
-    b.cycles_per_mem_write = 11.67;
-    b.cycles_per_texel_byte = 0.07261;
-    b.cycles_per_color_byte = 0.3689;
-    b.cycles_per_texel_footprint_byte = 0.5707;
+    b.cycles_per_clear_pixel = 0.004925;
+    b.cycles_per_mem_write = 11.56;
+    b.cycles_per_texel_byte = 0.06006;
+    b.cycles_per_color_byte = 0.3302;
+    b.cycles_per_texel_footprint_byte = 0.4863;
+    b.cycles_per_texel_fetch = 0.3179;
     b.cycles_per_sdram_access = 0.0;
     b.cycles_per_row_open = 0.0;
-    b.cycles_per_row_miss = 1.919;
-    b.clear_bytes_per_cycle = 2.004;
+    b.cycles_per_row_miss = 2.397;
+    b.cycles_per_textured_row_miss = 1.176;
+    b.cycles_per_depth_write = 6.422;
+    b.drained_cycles_per_tail_pixel = 12.36;
+    b.clear_bytes_per_cycle = 2.005;
     // The SDRAM (sdram_ctrl.v with the Alliance AS4C32M16SB-7's timing): an auto refresh every
     // tREFI = 7.8 us costs precharge all (tRP 21 ns), tRFC (63 ns) and the first row opened again
     // (tRCD 21 ns), in whole clocks; the fit keeps these and fits the rest.
@@ -313,8 +310,12 @@ Result<void> apply_timing_setting(BoardTiming& b, std::string_view setting) {
       {"cycles_per_color_byte", &BoardTiming::cycles_per_color_byte},
       {"cycles_per_sdram_access", &BoardTiming::cycles_per_sdram_access},
       {"cycles_per_texel_footprint_byte", &BoardTiming::cycles_per_texel_footprint_byte},
+      {"cycles_per_texel_fetch", &BoardTiming::cycles_per_texel_fetch},
       {"cycles_per_row_open", &BoardTiming::cycles_per_row_open},
       {"cycles_per_row_miss", &BoardTiming::cycles_per_row_miss},
+      {"cycles_per_textured_row_miss", &BoardTiming::cycles_per_textured_row_miss},
+      {"cycles_per_depth_write", &BoardTiming::cycles_per_depth_write},
+      {"drained_cycles_per_tail_pixel", &BoardTiming::drained_cycles_per_tail_pixel},
       {"refresh_interval_cycles", &BoardTiming::refresh_interval_cycles},
       {"cycles_per_refresh", &BoardTiming::cycles_per_refresh},
   };

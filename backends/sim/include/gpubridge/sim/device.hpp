@@ -62,9 +62,17 @@ struct DeviceStats {
   // Texture bytes inside the textured triangles' texture-space footprints (at most their samples'
   // bytes): what a texel cache fetches from memory at most, without wrapping.
   std::uint64_t texel_footprint_bytes = 0;
+  // Texel reads the ecp5's texel cache makes (timing.hpp TexelCache, replayed per covered pixel of
+  // the textured triangles): its misses, which also enter the row stream below between the pixel's
+  // depth and colour accesses.
+  std::uint64_t texel_fetches = 0;
   std::uint64_t sdram_accesses = 0;  // every access of that stream (a 32-bit word each)
   std::uint64_t row_opens = 0;
   std::uint64_t row_misses = 0;
+  std::uint64_t textured_row_misses = 0;  // those of textured triangles (class bit 2)
+  // Per triangle of a depth class, its last pixels (at most the depth stage's 4 reads in flight):
+  // the memory work the next triangle's setup hides, beside the rows counted above.
+  std::uint64_t depth_tail_pixels = 0;
   bool operator==(const DeviceStats&) const = default;
 };
 // The class index of DeviceStats::by_mode as a name: "flat", "gouraud", "z", "gouraud_z", "tex",

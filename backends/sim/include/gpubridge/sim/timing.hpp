@@ -3,6 +3,7 @@
 // (usually one scanned-out frame), from the device's counters and a board profile, plus the SPI
 // time of the frames that carried it. Not part of the device contract; the simulator never
 // sleeps or stalls because of it.
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <string>
@@ -52,8 +53,17 @@ struct BoardTiming {
   // refresh_interval_cycles).
   double cycles_per_sdram_access = 0;
   double cycles_per_texel_footprint_byte = 0;  // DeviceStats::texel_footprint_bytes: texel cache fills
+  double cycles_per_texel_fetch = 0;           // DeviceStats::texel_fetches: texel cache misses (a word read each)
   double cycles_per_row_open = 0;
-  double cycles_per_row_miss = 0;
+  double cycles_per_row_miss = 0;           // a row miss of an untextured draw
+  double cycles_per_textured_row_miss = 0;  // of a textured draw (DeviceStats::textured_row_misses)
+  // A depth write (a passed pixel of a draw with a depth class: Z_WRITE stores only what passes),
+  // beside the per-covered-pixel terms of its class.
+  double cycles_per_depth_write = 0;
+  // A credit per pixel left in the depth stage when a depth-class triangle's walk ends
+  // (DeviceStats::depth_tail_pixels): its memory work, which the per-pixel terms charge, drains
+  // under the next triangle's setup. Subtracted.
+  double drained_cycles_per_tail_pixel = 0;
   double refresh_interval_cycles = 0;
   double cycles_per_refresh = 0;
   // true: cycles = max(pipeline, bytes / memory_bytes_per_cycle). false: the pipeline terms
@@ -90,14 +100,101 @@ class SdramRows {
   std::uint64_t hits() const { return hits_; }
   std::uint64_t opens() const { return opens_; }
   std::uint64_t misses() const { return misses_; }
-  void reset_counts() { hits_ = opens_ = misses_ = 0; }
+  // The misses of textured draws, counted apart (set_textured): the texture unit's latency is
+  // already waited for there, and hides part of a miss.
+  std::uint64_t textured_misses() const { return textured_misses_; }
+  void set_textured(bool textured) { textured_ = textured; }
+  void reset_counts() { hits_ = opens_ = misses_ = textured_misses_ = 0; }
   const SdramGeometry& geometry() const { return g_; }
 
  private:
   static constexpr std::uint64_t kClosed = ~std::uint64_t{0};
   SdramGeometry g_;
   std::vector<std::uint64_t> open_;  // row per bank, kClosed when precharged
-  std::uint64_t hits_ = 0, opens_ = 0, misses_ = 0;
+  std::uint64_t hits_ = 0, opens_ = 0, misses_ = 0, textured_misses_ = 0;
+  bool textured_ = false;
+};
+
+// Accesses gathered into runs of one row before they reach SdramRows::access(address, count):
+// consecutive accesses to one row are one outcome and hits.
+class RowRunEmitter {
+ public:
+  explicit RowRunEmitter(SdramRows& rows) : rows_(rows), row_bits_(rows.geometry().row_bits) {}
+  ~RowRunEmitter() { flush(); }
+  RowRunEmitter(const RowRunEmitter&) = delete;
+  RowRunEmitter& operator=(const RowRunEmitter&) = delete;
+  // `count` accesses to the row holding byte `address`
+  void emit(std::uint64_t address, std::uint64_t count) {
+    if (count == 0) return;
+    if (count_ != 0 && (address >> row_bits_) == (address_ >> row_bits_)) {
+      count_ += count;
+      return;
+    }
+    flush();
+    address_ = address;
+    count_ = count;
+  }
+  void flush() {
+    if (count_ != 0) rows_.access(address_, count_);
+    count_ = 0;
+  }
+
+ private:
+  SdramRows& rows_;
+  unsigned row_bits_;
+  std::uint64_t address_ = 0, count_ = 0;
+};
+
+// The ecp5 core's texel cache (core_texture.v): four banks by texel parity ({j & 1, i & 1}), each
+// holding one word for each texel of eight texel rows of any width up to 1024 (entry {j bits 2:1,
+// i bits 9:1}, tag j >> 3): direct mapped, so the rows a span samples are still there when the walk
+// comes back on the next row, and a ninth row evicts the first. It is kept across consecutive
+// textured triangles with the same texture and buffers (the draw's signature) and forgotten
+// otherwise. A miss is a texel read from memory (one 32-bit word), which the row model sees.
+class TexelCache {
+ public:
+  // A textured draw with `signature` (texture base and format, buffers) starts: a different one
+  // forgets every texel.
+  void begin(std::uint64_t signature) {
+    if (entry_.empty()) entry_.assign(kEntries, 0);  // only a device that estimates timing pays for it
+    if (!valid_ || signature != signature_) invalidate();
+    signature_ = signature;
+    valid_ = true;
+  }
+  // Anything but a textured triangle of the same draw (a clear, an untextured triangle).
+  void invalidate() {
+    valid_ = false;
+    if (++epoch_ == kEpochs) {  // wrapped: no entry of an older epoch may look current
+      std::fill(entry_.begin(), entry_.end(), 0);
+      epoch_ = 1;
+    }
+  }
+  // Texel (i, j) (wrapped indices, below 1024) of the draw begun: true when held; a miss fills its entry.
+  bool lookup(unsigned i, unsigned j) {
+    const std::size_t bank = ((j & 1u) << 1) | (i & 1u);
+    const std::size_t index = bank << 11 | ((j >> 1) & 3u) << 9 | ((i >> 1) & 511u);
+    const std::uint32_t want = epoch_ << 8 | ((j >> 3) & 127u);
+    if (entry_.empty()) entry_.assign(kEntries, 0);
+    if (entry_[index] == want) {
+      ++hits_;
+      return true;
+    }
+    entry_[index] = want;
+    ++misses_;
+    return false;
+  }
+  std::uint64_t hits() const { return hits_; }
+  std::uint64_t misses() const { return misses_; }
+  void reset_counts() { hits_ = misses_ = 0; }
+
+ private:
+  static constexpr std::size_t kEntries = 4 * 2048;
+  static constexpr std::uint32_t kEpochs = 1u << 24;  // epoch << 8 fits 32 bits
+  std::vector<std::uint32_t> entry_;  // epoch << 8 | tag; epoch 0 is never current
+  std::uint32_t epoch_ = 1;
+  std::uint64_t signature_ = 0;
+  bool valid_ = false;
+  std::uint64_t hits_ = 0, misses_ = 0;
 };
 
 // One span of covered pixels as the ecp5 core's memory port sends it (core_memport.v): per pixel a
@@ -133,6 +230,9 @@ TimingEstimate estimate_timing(const DeviceStats& work, const BoardTiming& board
 // Link time (ms) of `frames` 72-bit SPI frames under `board`: the bits at its SPI clock plus the
 // chip-select gap between bursts of frames_per_burst (docs/protocol.md section 19).
 double spi_link_ms(double frames, const BoardTiming& board);
+// Passed pixels of the depth classes (DeviceStats::by_mode bit 1): the Z writes of draws that
+// write what they test, as the calibration frames and the scenes do.
+std::uint64_t depth_writes(const DeviceStats& work);
 // The factor the auto refresh stretches a board's work by (1 without refresh terms).
 double refresh_stretch(const BoardTiming& board);
 // a − b, field by field.
