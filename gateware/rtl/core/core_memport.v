@@ -2,7 +2,8 @@
 // the stages' requests, a write combiner on colour writes, the order of outstanding reads, and
 // an output register. The stages' requests depend only on their registered state; the grants
 // depend on those requests, the output register and mem_req_ready (which may depend on
-// mem_req_valid: that is a register).
+// mem_req_valid: that is a register). SKID = 1 (up5k) puts a second register behind the output
+// one, so the grants depend on registered state only and mem_req_ready reaches no stage.
 //
 // Priority, highest first: clear writes, colour writes, colour reads, texel reads, depth
 // writes, depth reads - later pipeline stages first, so the pipeline drains. Reads complete in
@@ -16,7 +17,10 @@
 // combiner out: each colour write is a request of its own.
 module core_memport #(
     parameter integer TAGS_AW = 3,   // log2 of reads in flight
-    parameter integer COMBINE = 1
+    parameter integer COMBINE = 1,
+    // 1: a skid register behind the output register; the stages see a flip-flop (the skid
+    // empty), not the soc's mem_req_ready (below)
+    parameter integer SKID = 0
 ) (
     input  wire        clk,
     input  wire        rst,
@@ -119,8 +123,17 @@ module core_memport #(
   assign zr_rsp = mem_rsp_valid && rsp_tag == T_ZR;
 
   // ---- output register ----
+  // SKID = 0: a request is granted when the output register is free or being accepted, so the
+  // soc's mem_req_ready (the arbiter's decision of this clock: priority, swap protection) reaches
+  // every stage's stall logic in one clock. SKID = 1 (issue 19, 25.125 MHz on the UP5K): a
+  // request is granted when the skid register is empty, a flip-flop; a granted request goes to
+  // the output register when that is free or being accepted, else to the skid, and the skid goes
+  // first when the output register frees. One request a clock still leaves, in grant order; a
+  // refusal stops the stages a clock later and lets them go a clock later, as long.
   reg        o_valid;
   wire       o_room = !o_valid || mem_req_ready;
+  wire       s_valid;  // the skid holds a request (0 without SKID)
+  wire       g_room = (SKID != 0) ? !s_valid : o_room;
   reg        g_we;
   reg [29:0] g_addr;
   reg [31:0] g_data;
@@ -130,7 +143,7 @@ module core_memport #(
   reg [5:0]  gnt;  // one-hot: clr, cw (combiner), cr, tr, zw, zr
   always @(*) begin
     gnt = 6'd0;
-    if (o_room) begin
+    if (g_room) begin
       if (clr_valid) gnt[0] = 1'b1;
       else if (p_req) gnt[1] = 1'b1;
       else if (cr_valid && tag_room) gnt[2] = 1'b1;
@@ -167,6 +180,37 @@ module core_memport #(
     end
   end
 
+  // what enters the output register: the skid's request first, else this clock's grant
+  wire        n_we;
+  wire [29:0] n_addr;
+  wire [31:0] n_data;
+  wire [3:0]  n_be;
+  if (SKID != 0) begin : skid
+    reg        k_valid;
+    reg        k_we;
+    reg [29:0] k_addr;
+    reg [31:0] k_data;
+    reg [3:0]  k_be;
+    always @(posedge clk) begin
+      if (rst) k_valid <= 1'b0;
+      else if (o_room) k_valid <= 1'b0;
+      else if (g_any) k_valid <= 1'b1;
+      // a grant implies an empty skid, so loading it on every grant overwrites nothing; one the
+      // output register takes in the same clock leaves k_valid 0
+      if (g_any) begin
+        k_we   <= g_we;
+        k_addr <= g_addr;
+        k_data <= g_data;
+        k_be   <= g_be;
+      end
+    end
+    assign s_valid = k_valid;
+    assign {n_we, n_addr, n_data, n_be} = k_valid ? {k_we, k_addr, k_data, k_be} : {g_we, g_addr, g_data, g_be};
+  end else begin : no_skid
+    assign s_valid = 1'b0;
+    assign {n_we, n_addr, n_data, n_be} = {g_we, g_addr, g_data, g_be};
+  end
+
   reg        o_we;
   reg [29:0] o_addr;
   reg [31:0] o_data;
@@ -175,12 +219,12 @@ module core_memport #(
     if (rst) begin
       o_valid <= 1'b0;
     end else if (o_room) begin
-      o_valid <= g_any;
-      if (g_any) begin
-        o_we   <= g_we;
-        o_addr <= g_addr;
-        o_data <= g_data;
-        o_be   <= g_be;
+      o_valid <= s_valid || g_any;
+      if (s_valid || g_any) begin
+        o_we   <= n_we;
+        o_addr <= n_addr;
+        o_data <= n_data;
+        o_be   <= n_be;
       end
     end
   end
@@ -190,5 +234,5 @@ module core_memport #(
   assign mem_req_wdata = o_data;
   assign mem_req_be    = o_be;
 
-  assign idle = !p_valid && !o_valid && (tw == tr);
+  assign idle = !p_valid && !o_valid && !s_valid && (tw == tr);
 endmodule

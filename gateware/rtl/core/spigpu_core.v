@@ -365,7 +365,7 @@ module spigpu_core #(
   wire stages_idle = d_idle && t_idle && c_idle;
   wire drained = pipe_idle && stages_idle && m_idle && !k_busy;
   wire idle_now;  // the pipeline-empty test; the port core_idle is it a clock late
-  core_memport #(.TAGS_AW((SMALL != 0) ? 1 : 3), .COMBINE(1 - SMALL)) memport (
+  core_memport #(.TAGS_AW((SMALL != 0) ? 1 : 3), .COMBINE(1 - SMALL), .SKID(SMALL)) memport (
       .clk(clk), .rst(rst), .flush(!ras_active || r_serial),
       .clr_valid(k_valid), .clr_ready(k_ready), .clr_addr(k_addr), .clr_data(k_data), .clr_be(k_be),
       .cw_valid(cw_valid), .cw_ready(cw_ready), .cw_addr(cw_addr), .cw_data(cw_data), .cw_be(cw_be),

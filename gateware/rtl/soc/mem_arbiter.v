@@ -87,9 +87,23 @@ module mem_arbiter #(
   // never issued), so AW + 1 bits are enough
   wire [AW:0] m_vram   = {1'b0, m_req_addr[AW-1:0]};
   wire [AW:0] c_vram   = {1'b0, c_req_addr[AW-1:0]};
-  wire        m_prot   = prot_active && m_vram >= prot_lo && m_vram < prot_hi;
   wire        c_prot   = prot_active && c_vram >= prot_lo && c_vram < prot_hi;
-  wire m_block = m_writes && m_prot;
+  // The memory-access unit's write is compared a clock before it is granted (issue 19, 25.125 MHz
+  // on the UP5K: the compare on its address, whose low bit is the unit's phase, led through its
+  // grant into the executor's FIFO pop in one clock). m_out_r: last clock the window was active
+  // and that clock's write outside it. The unit holds a refused request (m_wait_r: this clock's is
+  // last clock's), and while the window is active it only shrinks (prot_lo counts up, prot_hi only
+  // comes down; a new window starts only from an inactive one), so a write outside it then is
+  // outside it now: the registered answer can be late, never early. A write while the window is
+  // active waits its first clock (the unit writes at most two words an SPI frame); without a
+  // window nothing waits, as before. Whether the window is active is last clock's too (m_act_r:
+  // prot_active is the scanout's equality compare of its read address, a LUT tree): a window
+  // starts only when FB_DISPLAY executes, which the executor does only after the unit's last write
+  // was granted and a clock before it can start another, so no unit write meets a window in the
+  // clock it starts (checked in the co-simulation); one that ends is seen a clock late.
+  reg         m_wait_r, m_out_r, m_act_r;
+  wire        m_in_win = m_vram >= prot_lo && m_vram < prot_hi;
+  wire m_block = m_writes && m_act_r && !(m_wait_r && m_out_r);
   wire c_block = c_req_we && c_prot;   // (no core request while the unit writes: see pick_c)
   wire c_oor   = c_req_addr[29:AW] != 0;   // beyond VRAM: an upper bit, no comparator
   wire v_oor   = v_req_addr[29:AW] != 0;
@@ -138,6 +152,9 @@ module mem_arbiter #(
   assign core_stall  = c_req_valid && !c_req_ready;
 
   always @(posedge clk) begin
+    m_wait_r <= !rst && m_writes && !m_req_ready;
+    m_out_r  <= prot_active && !m_in_win;
+    m_act_r  <= prot_active;
     c_range_err <= pick_z;
     zero_rsp <= (pick_z && !c_req_we) || (pick_v && v_oor);
     zero_v <= pick_v && v_oor;
@@ -162,10 +179,20 @@ module mem_arbiter #(
   end
 
 `ifndef SYNTHESIS
-  // the invariant pick_c, pick_z and c_block rely on, checked in every co-simulation
+  // the invariants pick_c, pick_z, c_block and m_block rely on, checked in every co-simulation
+  reg [29:0] m_addr_r;
   always @(posedge clk) begin
+    m_addr_r <= m_req_addr;
     if (!rst && m_writes && c_req_valid) begin
       $display("mem_arbiter: a write of the memory-access unit while the core requests");
+      $stop;
+    end
+    if (!rst && m_writes && prot_active && !m_act_r) begin
+      $display("mem_arbiter: a write of the memory-access unit in the clock a protection window starts");
+      $stop;
+    end
+    if (!rst && m_wait_r && m_writes && m_req_addr != m_addr_r) begin
+      $display("mem_arbiter: the memory-access unit moved a refused write");
       $stop;
     end
   end
