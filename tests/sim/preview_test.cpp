@@ -136,6 +136,51 @@ TEST(SimPreview, TexturedPlainKernelSamplesAsTheFloatRoutine) {
   EXPECT_EQ(filters_seen, 3u);  // nearest and bilinear
 }
 
+// The same comparison with the depth test on (LESS, LEQUAL, GREATER, GEQUAL, ALWAYS; Z written or
+// not), so chunks pass whole, in part or not at all and the wide kernel's deferred combine and
+// store (docs/simulator.md "Preview": a chunk is finished after the next one's fetch) meets every
+// case, across rows and triangles. Each triangle has one Z at its three vertices: both routines
+// then have that Z exactly at every pixel (fixed point and float alike), so the same pixels pass
+// and the colour and depth bytes must be the same.
+TEST(SimPreview, TexturedPlainKernelWithDepthSamplesAsTheFloatRoutine) {
+  std::mt19937 rng(20261127);
+  const unsigned funcs[] = {1, 3, 4, 6, 7};  // LESS, LEQUAL, GREATER, GEQUAL, ALWAYS
+  unsigned textured_pixels = 0, failed_pixels = 0, wraps_seen = 0, filters_seen = 0;
+  for (int i = 0; i < 80; ++i) {
+    Case c = random_case(rng);
+    const bool decal = i % 2 == 0, alpha_blend = i % 3 == 0, z_write = i % 4 != 3;
+    c.tri_mode = 2u | 4u | (std::uint64_t{funcs[i % 5]} << 3) | (z_write ? 1u << 6 : 0u) | (decal ? 1u << 14 : 0u) |
+                 (alpha_blend ? 1u << 7 : 0u);
+    c.tex_fmt &= ~(std::uint64_t{3} << 16);  // RGBA8888 texture
+    c.fb_fmt = fb_format(kW, kH, 0);
+    c.fb_draw = 0;
+    c.fb_z = Canvas::kZBase;
+    c.tex_base = kTexBase;
+    wraps_seen |= 1u << ((c.tex_fmt >> 8) & 3);
+    filters_seen |= 1u << ((c.tex_fmt >> 12) & 1);
+    Case masked = c;
+    masked.tri_mode |= 1u << 13;  // keep alpha: the float routine
+    const Rendered plain = render(c, preview_options(1 + i % 2), true), lanes = render(masked, preview_options(1), true);
+    ASSERT_EQ(plain.stats.pixels_covered, lanes.stats.pixels_covered) << i;
+    ASSERT_EQ(plain.stats.pixels_depth_passed, lanes.stats.pixels_depth_passed) << i;
+    for (std::size_t px = 0; px < std::size_t{kW} * kH; ++px) {
+      for (std::size_t ch = 0; ch < 3; ++ch)
+        ASSERT_EQ(plain.memory[px * 4 + ch], lanes.memory[px * 4 + ch])
+            << "case " << i << " pixel " << px << " channel " << ch << " TRI_MODE 0x" << std::hex << c.tri_mode
+            << " TEX_FMT 0x" << c.tex_fmt;
+      for (std::size_t b = 0; b < 4; ++b)
+        ASSERT_EQ(plain.memory[Canvas::kZBase + px * 4 + b], lanes.memory[Canvas::kZBase + px * 4 + b])
+            << "case " << i << " depth of pixel " << px;
+    }
+    textured_pixels += static_cast<unsigned>(plain.stats.pixels_textured);
+    failed_pixels += static_cast<unsigned>(plain.stats.pixels_covered - plain.stats.pixels_depth_passed);
+  }
+  EXPECT_GT(textured_pixels, 10000u);
+  EXPECT_GT(failed_pixels, 10000u);  // the depth test rejected pixels: chunks passed in part
+  EXPECT_EQ(wraps_seen, 7u);
+  EXPECT_EQ(filters_seen, 3u);
+}
+
 // Vertices anywhere in the s12.4 range (edge values up to 2^36), S/T anywhere in s8.24, Q anywhere
 // including 0: no undefined behaviour (UBSan), coverage still the exact test, and the same bytes
 // with one and two threads.

@@ -56,7 +56,9 @@ struct Rendered {
 
 // Draws 24 random triangles of four size classes (narrow boxes, short and long spans, larger than
 // the target) in state c with device options o; the memory covers colour, depth and texture.
-inline Rendered render(const Case& c, const DeviceOptions& o) {
+// flat_z: each triangle's three vertices take its first vertex's Z, below 2^23 (so that Z + 0.5,
+// the planes' rounding bias, is exact in float as well as in fixed point); the same random draws.
+inline Rendered render(const Case& c, const DeviceOptions& o, bool flat_z = false) {
   Canvas cv(kW, kH, 0, o);
   Device& d = *cv.dev;
   std::mt19937 rng(c.seed);
@@ -82,11 +84,15 @@ inline Rendered render(const Case& c, const DeviceOptions& o) {
     const bool affine = rng() & 1;
     const std::uint32_t q0 = static_cast<std::uint32_t>(rng()) | 0x100000u;
     w(d, Reg::PRIM, 0);
+    std::uint32_t z0 = 0;
     for (int k = 0; k < 3; ++k) {
       const std::uint32_t q = affine ? q0 : static_cast<std::uint32_t>(rng()) | 0x100000u;
       w(d, Reg::COLOR, color(static_cast<std::uint32_t>(rng()), q));
       w(d, Reg::TEXCOORD, (std::uint64_t{static_cast<std::uint32_t>(st(rng))} << 32) | static_cast<std::uint32_t>(st(rng)));
-      w(d, Reg::VERTEX, vtx(k == 0 ? x : x + dv(rng), k == 0 ? y : y + dv(rng), rng() & 0xFFFFFF));
+      const int vx = k == 0 ? x : x + dv(rng), vy = k == 0 ? y : y + dv(rng);
+      const std::uint32_t z = static_cast<std::uint32_t>(rng()) & 0xFFFFFF;
+      if (k == 0) z0 = z & 0x7FFFFF;
+      w(d, Reg::VERTEX, vtx(vx, vy, flat_z ? z0 : z));
     }
   }
   d.drain();
