@@ -99,6 +99,22 @@ TEST(SimPreview, FloatDrawsZWithinEightLsbOfExact) {
   EXPECT_GT(err.max_z, 0);
 }
 
+// An RGBA8888 texture into an RGBA8888 framebuffer at the canvas's bases; records the wrap mode
+// and filter seen, and returns the same case with "keep alpha" set, which sends it through the
+// float routine instead of the textured plain kernel.
+Case textured_rgba8888(Case& c, unsigned& wraps_seen, unsigned& filters_seen) {
+  c.tex_fmt &= ~(std::uint64_t{3} << 16);  // RGBA8888 texture
+  c.fb_fmt = fb_format(kW, kH, 0);
+  c.fb_draw = 0;
+  c.fb_z = Canvas::kZBase;
+  c.tex_base = kTexBase;
+  wraps_seen |= 1u << ((c.tex_fmt >> 8) & 3);
+  filters_seen |= 1u << ((c.tex_fmt >> 12) & 1);
+  Case masked = c;
+  masked.tri_mode |= 1u << 13;  // keep alpha: the float routine
+  return masked;
+}
+
 // Textured RGBA8888 draws take the plain kernel's texture stage (preview_plain_kernel.inc: lanes,
 // gathers); with the alpha channel write-masked the same draws take the float routine and the
 // shared texture stage (preview_simd.cpp, texture8.hpp). Both compute the texel coordinates with
@@ -114,15 +130,7 @@ TEST(SimPreview, TexturedPlainKernelSamplesAsTheFloatRoutine) {
     const bool alpha_blend = i % 3 == 0;
     // Textured, decal or flat modulate, no depth, blend OFF or ALPHA, no write mask, no dither.
     c.tri_mode = 2u | (decal ? 1u << 14 : 0u) | (alpha_blend ? 1u << 7 : 0u);
-    c.tex_fmt &= ~(std::uint64_t{3} << 16);  // RGBA8888 texture
-    c.fb_fmt = fb_format(kW, kH, 0);
-    c.fb_draw = 0;
-    c.fb_z = Canvas::kZBase;
-    c.tex_base = kTexBase;
-    wraps_seen |= 1u << ((c.tex_fmt >> 8) & 3);
-    filters_seen |= 1u << ((c.tex_fmt >> 12) & 1);
-    Case masked = c;
-    masked.tri_mode |= 1u << 13;  // keep alpha: the float routine
+    const Case masked = textured_rgba8888(c, wraps_seen, filters_seen);
     const Rendered plain = render(c, preview_options(1)), lanes = render(masked, preview_options(1 + i % 2));
     EXPECT_EQ(plain.stats.pixels_covered, lanes.stats.pixels_covered) << i;
     for (std::size_t px = 0; px < std::size_t{kW} * kH; ++px)
@@ -151,15 +159,7 @@ TEST(SimPreview, TexturedPlainKernelWithDepthSamplesAsTheFloatRoutine) {
     const bool decal = i % 2 == 0, alpha_blend = i % 3 == 0, z_write = i % 4 != 3;
     c.tri_mode = 2u | 4u | (std::uint64_t{funcs[i % 5]} << 3) | (z_write ? 1u << 6 : 0u) | (decal ? 1u << 14 : 0u) |
                  (alpha_blend ? 1u << 7 : 0u);
-    c.tex_fmt &= ~(std::uint64_t{3} << 16);  // RGBA8888 texture
-    c.fb_fmt = fb_format(kW, kH, 0);
-    c.fb_draw = 0;
-    c.fb_z = Canvas::kZBase;
-    c.tex_base = kTexBase;
-    wraps_seen |= 1u << ((c.tex_fmt >> 8) & 3);
-    filters_seen |= 1u << ((c.tex_fmt >> 12) & 1);
-    Case masked = c;
-    masked.tri_mode |= 1u << 13;  // keep alpha: the float routine
+    const Case masked = textured_rgba8888(c, wraps_seen, filters_seen);
     const Rendered plain = render(c, preview_options(1 + i % 2), true), lanes = render(masked, preview_options(1), true);
     ASSERT_EQ(plain.stats.pixels_covered, lanes.stats.pixels_covered) << i;
     ASSERT_EQ(plain.stats.pixels_depth_passed, lanes.stats.pixels_depth_passed) << i;
