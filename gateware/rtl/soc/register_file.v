@@ -4,10 +4,10 @@
 //     LINK_CTRL, LINK_CHECK, HOST_TAG, RESET) act at once after their validation; queued writes go
 //     to the command FIFO (dropped while the link is DISCARDING, ERR_OVERFLOW when full), and are
 //     validated when they execute (command_exec);
-//   - reads: live registers (STATUS, FRAME_CRC, LINK_STATUS, MEM_ADDR, MEM_DATA, CAPS2, CAPS, ID) from a
-//     small multiplexer in the bit-64 cycle; every other read-write register from a 32 x 64 shadow
-//     RAM that holds the last validated value (written by the executor and the immediate writes),
-//     one cycle later; write-only registers read 0;
+//   - reads: live registers (STATUS, FRAME_CRC, LINK_STATUS, MEM_ADDR, MEM_DATA) from a small
+//     multiplexer in the bit-64 cycle; every other read-write register from a 64 x 64 shadow RAM
+//     that holds the last validated value (written by the executor and the immediate writes), and
+//     the constants CAPS2, CAPS and ID (initial contents), one cycle later; write-only registers read 0;
 //   - the sticky error flags and ERR_CLEAR; RESET's soft reset pulse and the sequencer that writes
 //     the reset values into the shadow RAM (32 cycles; the next frame cannot complete sooner).
 // A RESET while the render core is still busy lets the core finish (the simulator finishes every
@@ -129,7 +129,16 @@ module register_file #(
   assign soft_reset        = reset_ok;
 
   // --- shadow RAM of the read-write registers (indices 0x00..0x1F) ---
-  (* no_rw_check *) reg [63:0] shadow [0:31];   // a read in the clock of a write may return the old value
+  // Entries 0..31 hold the read-write registers; entries 32 + (index & 0x1F) of CAPS2, CAPS and ID
+  // hold those constants from configuration (no port writes there, a soft reset leaves them), so
+  // their reads come from the RAM like a read-write register's and the live multiplexer has no
+  // constant terms. The RAM is 64 bits wide, so its block RAMs are 256 deep anyway: no RAM added.
+  (* no_rw_check *) reg [63:0] shadow [0:63];   // a read in the clock of a write may return the old value
+  initial begin
+    shadow[{1'b1, 5'(`SPIGPU_REG_CAPS2)}] = CAPS2;
+    shadow[{1'b1, 5'(`SPIGPU_REG_CAPS)}]  = CAPS;
+    shadow[{1'b1, 5'(`SPIGPU_REG_ID)}]    = ID;
+  end
   reg  [63:0] shadow_q;
   reg         seq_active;
   reg  [4:0]  seq_idx;
@@ -150,8 +159,8 @@ module register_file #(
   wire        spi_reads = !EX_READ || (rd_strobe && rd_from_ram);
   reg         ex_rd_q;
   always @(posedge clk) begin
-    if (sh_we) shadow[sh_wa] <= sh_wd;
-    shadow_q <= shadow[spi_reads ? rd_idx[4:0] : ex_rd_idx];
+    if (sh_we) shadow[{1'b0, sh_wa}] <= sh_wd;
+    shadow_q <= shadow[spi_reads ? {rd_idx[6], rd_idx[4:0]} : {1'b0, ex_rd_idx}];
     ex_rd_q <= !spi_reads;
   end
   assign ex_rd_data  = shadow_q;
@@ -168,7 +177,8 @@ module register_file #(
 
   // --- reads at bit 64 ---
   wire [1:0] rclass   = reg_class(rd_idx);
-  assign rd_from_ram = rd_idx[6:5] == 2'b00 && reg_is_rw(rd_idx);
+  wire   rd_const    = rd_idx == `SPIGPU_REG_CAPS2 || rd_idx == `SPIGPU_REG_CAPS || rd_idx == `SPIGPU_REG_ID;
+  assign rd_from_ram = (rd_idx[6:5] == 2'b00 && reg_is_rw(rd_idx)) || rd_const;
   assign rd_ram      = shadow_q;
   assign mem_read_strobe = rd_strobe && rd_idx == `SPIGPU_REG_MEM_DATA;
   wire   link_pending = link_strict && fifo_held;
@@ -181,9 +191,6 @@ module register_file #(
       `SPIGPU_REG_LINK_STATUS: rd_live = link_status;
       `SPIGPU_REG_MEM_ADDR:    rd_live = {32'd0, mem_addr, 3'd0};
       `SPIGPU_REG_MEM_DATA:    rd_live = prefetch;
-      `SPIGPU_REG_CAPS2:       rd_live = CAPS2;
-      `SPIGPU_REG_CAPS:        rd_live = CAPS;
-      `SPIGPU_REG_ID:          rd_live = ID;
       default:                 rd_live = 64'h0;
     endcase
   end
