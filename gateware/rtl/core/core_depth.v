@@ -68,22 +68,61 @@ module core_depth #(
   // ---- read queue (Z_TEST) ----
   wire          q_full, q_empty, q_head;
   wire [PW-1:0] q_item;
-  wire [23:0]   q_data;
+  wire          q_pass;   // the head's test result (with several reads in flight: decided on arrival)
   wire          take;
-  core_rdq #(.IW(PW), .DW(24), .AW(AW)) queue (
-      .clk(clk), .rst(rst),
-      .push(rd_valid && rd_ready), .push_item(in_pix),
-      .full(q_full), .empty(q_empty),
-      .rsp_valid(rsp_valid), .rsp_data(rsp_data),
-      .head_valid(q_head), .head_item(q_item), .head_data(q_data), .pop(z_test && take));
+  wire          push = rd_valid && rd_ready;
+  wire [PW-1:0] cur;
+  generate
+    if (AW == 0) begin : one_read
+      wire [23:0] q_data;
+      core_rdq #(.IW(PW), .DW(24), .AW(AW)) queue (
+          .clk(clk), .rst(rst),
+          .push(push), .push_item(in_pix),
+          .full(q_full), .empty(q_empty),
+          .rsp_valid(rsp_valid), .rsp_data(rsp_data),
+          .head_valid(q_head), .head_item(q_item), .head_data(q_data), .pop(z_test && take));
+      assign q_pass = passes(z_func, cur[ZLSB+23:ZLSB], q_data);
+    end else begin : many_reads
+      // The comparison is made when the response arrives (against the depth of the pixel it
+      // answers, kept here in push order beside the queue's items) and the queue stores its
+      // result, so the head's resolution reads one bit instead of comparing two 24-bit words it
+      // has just read from the queue: that compare sat between the queue's head and the
+      // memory port's request (the ULX3S clock, docs/gateware.md "Pipelining the ecp5 cones").
+      // Z_FUNC holds for the draw and the queue is empty when a draw starts.
+      localparam integer N = 1 << AW;
+      reg  [23:0] zs[0:N-1];
+      reg  [AW-1:0] zwp, zdp;
+      always @(posedge clk) begin
+        if (rst) begin
+          zwp <= {AW{1'b0}};
+          zdp <= {AW{1'b0}};
+        end else begin
+          if (push) begin
+            zs[zwp] <= in_pix[ZLSB+23:ZLSB];
+            zwp     <= zwp + 1'b1;
+          end
+          if (rsp_valid) zdp <= zdp + 1'b1;
+        end
+      end
+      wire [24:0] q_data;
+      core_rdq #(.IW(PW), .DW(25), .AW(AW)) queue (
+          .clk(clk), .rst(rst),
+          .push(push), .push_item(in_pix),
+          .full(q_full), .empty(q_empty),
+          .rsp_valid(rsp_valid), .rsp_data({passes(z_func, zs[zdp], rsp_data), rsp_data}),
+          .head_valid(q_head), .head_item(q_item), .head_data(q_data), .pop(z_test && take));
+      assign q_pass = q_data[24];
+      wire unused_q = &{1'b0, q_data[23:0]};
+    end
+  endgenerate
 
   assign rd_valid = z_test && in_valid && !q_full;
 
   // the pixel being resolved: the queue head (Z_TEST) or the input
-  wire [PW-1:0] cur = z_test ? q_item : in_pix;
+  assign        cur = z_test ? q_item : in_pix;
   wire          cur_valid = z_test ? q_head : in_valid;
   wire [23:0]   cur_z = cur[ZLSB+23:ZLSB];
-  wire          pass = !z_test || passes(z_func, cur_z, q_data);
+  wire          pass = !z_test || q_pass;
 
   // output register (depth active); room from registered state only
   reg           o_valid;

@@ -59,6 +59,7 @@ module core_raster #(
   reg        mdir;       // direction of the current move / emission
   reg        last_dir;   // emission direction of the previous row
   reg        order;      // ltr latched
+  wire       pd_entry = order ? DIR_R : ~last_dir;  // emission direction when entering covered
 
   assign active = (st != R_IDLE);
 
@@ -69,6 +70,10 @@ module core_raster #(
   wire s0, s1, s2;     // E < 0 at the current pixel
   wire ns0, ns1, ns2;  // E < 0 at the pixel the move `sel` reaches
   wire commit;         // the move `sel` is made this cycle
+  reg  area;           // rect latched
+  wire ncov;           // the pixel the move `sel` reaches is covered
+  wire ncov_r, ncov_l; // the pixel right / left of the current one is (DSP: ncov)
+  wire nc_fwd, nc_ent; // ... the one in the direction `mdir` / opposite the entry direction (DSP: ncov)
   function signed [35:0] step(input signed [35:0] e, input signed [16:0] dx, input signed [16:0] dy,
                               input [1:0] sl, input sbit);
     reg [35:0] o;
@@ -101,15 +106,30 @@ module core_raster #(
       end
       assign {ns2, ns1, ns0} = ns;
       assign {s2, s1, s0} = s;
+      assign ncov_r = ncov;  // one accumulator per edge: the sum of the move `sel`
+      assign ncov_l = ncov;
+      assign nc_fwd = ncov;
+      assign nc_ent = ncov;
       assign e0 = 36'sd0;
       assign e1 = 36'sd0;
       assign e2 = 36'sd0;
       wire unused_e = &{1'b0, e_data[3:0]};
     end else begin : edge_fabric
       reg  signed [35:0] r0, r1, r2;
-      wire signed [35:0] n0 = step(r0, dx0, dy0, sel, sb);
-      wire signed [35:0] n1 = step(r1, dx1, dy1, sel, sb);
-      wire signed [35:0] n2 = step(r2, dx2, dy2, sel, sb);
+      // One adder per edge and move (right, left, down), all from registers: the coverage of
+      // the pixel to either side is known while the decision is still choosing `sel`, so the
+      // decision reads it instead of waiting for an adder behind its own choice (the walk's
+      // cone, docs/gateware.md "Pipelining the ecp5 cones"); `sel` only picks the sum to keep.
+      wire signed [35:0] n0r = step(r0, dx0, dy0, OP_RIGHT, !flip), n0l = step(r0, dx0, dy0, OP_LEFT, flip);
+      wire signed [35:0] n1r = step(r1, dx1, dy1, OP_RIGHT, !flip), n1l = step(r1, dx1, dy1, OP_LEFT, flip);
+      wire signed [35:0] n2r = step(r2, dx2, dy2, OP_RIGHT, !flip), n2l = step(r2, dx2, dy2, OP_LEFT, flip);
+      wire signed [35:0] n0d = step(r0, dx0, dy0, OP_DOWN, flip);
+      wire signed [35:0] n1d = step(r1, dx1, dy1, OP_DOWN, flip);
+      wire signed [35:0] n2d = step(r2, dx2, dy2, OP_DOWN, flip);
+      wire signed [35:0] n0 = (sel == OP_DOWN) ? n0d : (sel == OP_LEFT) ? n0l : n0r;
+      wire signed [35:0] n1 = (sel == OP_DOWN) ? n1d : (sel == OP_LEFT) ? n1l : n1r;
+      wire signed [35:0] n2 = (sel == OP_DOWN) ? n2d : (sel == OP_LEFT) ? n2l : n2r;
+      wire unused_sb = &{1'b0, sb};
       // edge values: setup's writes (the rasteriser is idle then) or a committed move
       always @(posedge clk) begin
         if (e_we[0] || commit) r0 <= e_we[0] ? e_data : n0;
@@ -117,14 +137,18 @@ module core_raster #(
         if (e_we[2] || commit) r2 <= e_we[2] ? e_data : n2;
       end
       assign {ns0, ns1, ns2} = {n0[35], n1[35], n2[35]};
+      assign ncov_r = area || (!n0r[35] && !n1r[35] && !n2r[35]);
+      assign ncov_l = area || (!n0l[35] && !n1l[35] && !n2l[35]);
+      assign nc_fwd = (mdir == DIR_R) ? ncov_r : ncov_l;
+      assign nc_ent = (pd_entry == DIR_R) ? ncov_l : ncov_r;
+      wire unused_ncov = &{1'b0, ncov};
       assign {s0, s1, s2} = {r0[35], r1[35], r2[35]};
       assign e0 = r0;
       assign e1 = r1;
       assign e2 = r2;
     end
   endgenerate
-  reg  area;  // rect latched
-  wire ncov = area || (!ns0 && !ns1 && !ns2);
+  assign ncov = area || (!ns0 && !ns1 && !ns2);
   wire cov = area || (!s0 && !s1 && !s2);
   // sides on which covered pixels of this row can lie, from the failing edges
   // (ex = -16 dy, or 16 dy when exchanged: a failing edge with ex > 0 grows to the right)
@@ -151,7 +175,6 @@ module core_raster #(
   reg       emit_n;
   reg [2:0] st_n;
   reg       mdir_n, last_dir_n;
-  wire      pd_entry = order ? DIR_R : ~last_dir;  // emission direction when entering covered
   always @(*) begin
     sel        = OP_NONE;
     go         = 1'b0;
@@ -164,7 +187,7 @@ module core_raster #(
         if (cov) begin
           // walk to the end of the span behind the emission direction first
           sel = (pd_entry == DIR_R) ? OP_LEFT : OP_RIGHT;
-          if (((pd_entry == DIR_R) ? can_l : can_r) && ncov) begin
+          if (((pd_entry == DIR_R) ? can_l : can_r) && nc_ent) begin
             go     = 1'b1;
             st_n   = R_TOEND;
             mdir_n = ~pd_entry;
@@ -177,15 +200,15 @@ module core_raster #(
           sel    = OP_RIGHT;
           go     = 1'b1;
           mdir_n = DIR_R;
-          emit_n = ncov;
-          st_n   = ncov ? R_EMIT : R_SEEK;
+          emit_n = ncov_r;
+          st_n   = ncov_r ? R_EMIT : R_SEEK;
         end else if (left_ok && can_l) begin
           sel    = OP_LEFT;
           go     = 1'b1;
           mdir_n = DIR_L;
           // arriving at the right end: emit from here, or (left-to-right order) walk on to the left end
-          emit_n = ncov && !order;
-          st_n   = !ncov ? R_SEEK : order ? R_TOEND : R_EMIT;
+          emit_n = ncov_l && !order;
+          st_n   = !ncov_l ? R_SEEK : order ? R_TOEND : R_EMIT;
         end else if (last_row) begin
           st_n = R_IDLE;  // empty row, last row
         end else begin
@@ -198,7 +221,7 @@ module core_raster #(
         sel = (mdir == DIR_R) ? OP_RIGHT : OP_LEFT;
         if ((mdir == DIR_R) ? (right_ok && can_r) : (left_ok && can_l)) begin
           go = 1'b1;
-          if (ncov) begin
+          if (nc_fwd) begin
             emit_n = !(order && mdir == DIR_L);
             st_n   = (order && mdir == DIR_L) ? R_TOEND : R_EMIT;
           end
@@ -212,7 +235,7 @@ module core_raster #(
       end
       R_TOEND: begin
         sel = (mdir == DIR_R) ? OP_RIGHT : OP_LEFT;
-        if (((mdir == DIR_R) ? can_r : can_l) && ncov) begin
+        if (((mdir == DIR_R) ? can_r : can_l) && nc_fwd) begin
           go = 1'b1;
         end else begin
           emit_n = 1'b1;
@@ -222,7 +245,7 @@ module core_raster #(
       end
       R_EMIT: begin
         sel = (mdir == DIR_R) ? OP_RIGHT : OP_LEFT;
-        if (((mdir == DIR_R) ? can_r : can_l) && ncov) begin
+        if (((mdir == DIR_R) ? can_r : can_l) && nc_fwd) begin
           go     = 1'b1;
           emit_n = 1'b1;
         end else begin
