@@ -28,14 +28,16 @@ bool hier_z_applies(const DrawState& st, bool vector) {
 }
 }  // namespace
 
+void Renderer::use_hier_z(RasterContext& ctx, const DrawState& st, std::uint64_t gen, unsigned w) {
+  hier_z_.prepare(st.fb_width, st.fb_height);  // no worker is drawing (the callers waited)
+  ctx.hier_z = &hier_z_;
+  ctx.hz_gen = gen;
+  ctx.hz_run = hz_runs_[w];
+}
+
 RasterContext Renderer::context(const DrawState& st, std::uint64_t gen, unsigned w) {
   RasterContext ctx{mem_, recip_, knobs_.z_bits, 0, {}, vector_};
-  if (hier_z_applies(st, vector_)) {
-    hier_z_.prepare(st.fb_width, st.fb_height);  // no worker is drawing (the callers waited)
-    ctx.hier_z = &hier_z_;
-    ctx.hz_gen = gen;
-    ctx.hz_run = hz_runs_[w];
-  }
+  if (hier_z_applies(st, vector_)) use_hier_z(ctx, st, gen, w);
   return ctx;
 }
 
@@ -101,12 +103,7 @@ Renderer::~Renderer() { wait_drawing(); }  // the workers read drawing_: stop th
   // Boxes narrower than the span solve's 16 pixels never ask the bounds (their writes not marked
   // only leave bounds looser): no set-up for them (10-px triangles).
   const bool hz = pending_hz_ && t.x1 - t.x0 >= 16;
-  if (hz) {
-    hier_z_.prepare(pending_state_->fb_width, pending_state_->fb_height);  // no worker draws in this path
-    ctx.hier_z = &hier_z_;
-    ctx.hz_gen = pending_gen_;
-    ctx.hz_run = hz_runs_[0];
-  }
+  if (hz) use_hier_z(ctx, *pending_state_, pending_gen_, 0);
   rasterize_rows(t, *pending_state_, ctx, t.y0, t.y1);
   if (hz) hz_runs_[0] = ctx.hz_run;
   errors_ |= ctx.errors;
@@ -182,7 +179,6 @@ void Renderer::count_rasterised(const Triangle& t, const DrawState& st) {
   if (st.mode_class & 4) texel_footprint_ += texel_footprint_bytes(t, st, covered);
   if (st.mode_class & 2) depth_tail_ += depth_tail_pixels(covered);
 }
-
 
 void Renderer::flush() {
   draw_pending();

@@ -82,6 +82,8 @@ class Renderer {
   void count_rasterised(const Triangle& t, const DrawState& st);
   // A context for drawing with st in coarse-depth generation gen, for worker w (hier_z.hpp).
   RasterContext context(const DrawState& st, std::uint64_t gen, unsigned w);
+  // Lets ctx use the coarse depth bounds for st in generation gen, as worker w's run (no worker draws).
+  void use_hier_z(RasterContext& ctx, const DrawState& st, std::uint64_t gen, unsigned w);
   // Ends the coarse depth bounds' generation (at every flush and change of state).
   void next_generation() { ++hz_gen_; }
 
