@@ -139,7 +139,7 @@ void Renderer::draw(const Vertex& a, const Vertex& b, const Vertex& c, const std
     count_rasterised(t, st);
     if (batch_n_ == 0) batch_gen_ = hz_gen_;  // one state and no flush within a batch: one generation
     if (batch_state_ != state) batch_state_ = state;
-    if (++batch_n_ >= kMaxBatch) submit();
+    if (++batch_n_ >= batch_limit_) submit();
     return;
   }
   if (batch_n_ != 0 || drawing_active_) flush();
@@ -185,6 +185,7 @@ void Renderer::flush() {
   submit();
   wait_drawing();
   next_generation();  // whoever flushed may now read or write memory
+  batch_limit_ = kFirstBatch;  // the workers are idle: the next batch starts them soon
 }
 
 void Renderer::submit() {
@@ -196,6 +197,7 @@ void Renderer::submit() {
   std::swap(batch_, drawing_);
   drawing_n_ = batch_n_;
   batch_n_ = 0;
+  batch_limit_ = std::min(2 * batch_limit_, kMaxBatch);
   drawing_state_ = std::move(batch_state_);
   drawing_gen_ = batch_gen_;
   batch_state_.reset();

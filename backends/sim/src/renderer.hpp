@@ -67,6 +67,11 @@ class Renderer {
 
   static constexpr int kBandRows = 16;
   static constexpr std::size_t kMaxBatch = 4096;
+  // The first batch after a flush holds at most this many triangles, and each batch after it
+  // twice as many as the one before, up to kMaxBatch: the workers start drawing after the first
+  // few set-up triangles instead of after 4,096 of them (a frame of 2,000 triangles was set up
+  // whole on the device thread before either worker drew a pixel).
+  static constexpr std::size_t kFirstBatch = 128;
 
  private:
   // Hands the filling batch to the workers (after the one they are drawing) and returns.
@@ -97,6 +102,7 @@ class Renderer {
   PixelObserver observer_;
   std::vector<Triangle> batch_;  // being filled by the front end: its first batch_n_
   std::size_t batch_n_ = 0;
+  std::size_t batch_limit_ = kFirstBatch;  // the filling batch is handed over at this many triangles
   std::shared_ptr<const DrawState> batch_state_;
   std::vector<Triangle> drawing_;  // being drawn by the workers: its first drawing_n_
   std::size_t drawing_n_ = 0;
