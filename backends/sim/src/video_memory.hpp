@@ -2,50 +2,75 @@
 // Video memory (docs/protocol.md section 6): one byte-addressed space. Accesses beyond the end are
 // dropped (writes) or read 0 (reads); the caller raises ERR_MEM_RANGE when a check fails.
 #include <cstdint>
+#include <cstdlib>
 #include <cstring>
+#include <memory>
+#include <new>
 #include <span>
-#include <vector>
+
+#include <sys/mman.h>
 
 namespace gpubridge::sim {
 
 class VideoMemory {
  public:
-  explicit VideoMemory(std::uint64_t size) : bytes_(size, 0) {}
+  // Zero-filled. Backed by 2 MiB pages where the kernel grants them (transparent huge pages on
+  // request): a bilinear sample of a 4 MiB texture reads two texel rows 4 KiB apart, so with 4 KiB
+  // pages every sample of a minified texture walks two pages (the page size changes no byte).
+  explicit VideoMemory(std::uint64_t size) : size_(size), bytes_(allocate(size)) {}
 
-  std::uint64_t size() const { return bytes_.size(); }
-  std::uint8_t* data() { return bytes_.data(); }
-  const std::uint8_t* data() const { return bytes_.data(); }
-  std::span<std::uint8_t> span() { return bytes_; }
-  std::span<const std::uint8_t> span() const { return bytes_; }
+  std::uint64_t size() const { return size_; }
+  std::uint8_t* data() { return bytes_.get(); }
+  const std::uint8_t* data() const { return bytes_.get(); }
+  std::span<std::uint8_t> span() { return {bytes_.get(), size_}; }
+  std::span<const std::uint8_t> span() const { return {bytes_.get(), size_}; }
 
   // True when [address, address + length) lies inside memory (64-bit math: never wraps).
   bool contains(std::uint64_t address, std::uint64_t length) const {
-    return address <= bytes_.size() && length <= bytes_.size() - address;
+    return address <= size_ && length <= size_ - address;
   }
   // Copies length bytes at address into out; bytes beyond the end read 0. Returns false when any
   // byte was out of range.
   bool read(std::uint64_t address, std::uint8_t* out, std::size_t length) const {
     if (contains(address, length)) {
-      std::memcpy(out, bytes_.data() + address, length);
+      std::memcpy(out, bytes_.get() + address, length);
       return true;
     }
     for (std::size_t i = 0; i < length; ++i)
-      out[i] = address + i < bytes_.size() ? bytes_[address + i] : 0;
+      out[i] = address + i < size_ ? bytes_[address + i] : 0;
     return false;
   }
   // Writes the bytes that fall inside memory; returns false when any byte was dropped.
   bool write(std::uint64_t address, const std::uint8_t* in, std::size_t length) {
     if (contains(address, length)) {
-      std::memcpy(bytes_.data() + address, in, length);
+      std::memcpy(bytes_.get() + address, in, length);
       return true;
     }
     for (std::size_t i = 0; i < length; ++i)
-      if (address + i < bytes_.size()) bytes_[address + i] = in[i];
+      if (address + i < size_) bytes_[address + i] = in[i];
     return false;
   }
 
  private:
-  std::vector<std::uint8_t> bytes_;
+  struct Free {
+    void operator()(std::uint8_t* p) const { std::free(p); }
+  };
+  static constexpr std::size_t kHugePage = std::size_t{2} << 20;
+  static std::unique_ptr<std::uint8_t[], Free> allocate(std::uint64_t size) {
+    // Memories of at least one huge page are rounded up to whole ones (aligned_alloc wants a
+    // multiple of the alignment); smaller ones (tests) to a cache line, at least one, so that
+    // data() is never null.
+    const bool huge = size >= kHugePage;
+    const std::size_t align = huge ? kHugePage : 64;
+    const std::size_t bytes = (static_cast<std::size_t>(size == 0 ? 1 : size) + align - 1) & ~(align - 1);
+    auto* p = static_cast<std::uint8_t*>(std::aligned_alloc(align, bytes));
+    if (!p) throw std::bad_alloc();
+    if (huge) (void)madvise(p, bytes, MADV_HUGEPAGE);  // a hint: without it (or refused) 4 KiB pages
+    std::memset(p, 0, bytes);
+    return std::unique_ptr<std::uint8_t[], Free>(p);
+  }
+  std::uint64_t size_;
+  std::unique_ptr<std::uint8_t[], Free> bytes_;
 };
 
 }  // namespace gpubridge::sim
