@@ -30,10 +30,6 @@ class ReciprocalUnit {
     return {static_cast<std::uint32_t>(y), n};
   }
   unsigned table_bits() const { return bits_; }
-  // For the vector routines' lane version of operator() (texture8.hpp): the table, 2^table_bits
-  // entries, and the Newton-Raphson step count.
-  const std::uint32_t* table() const { return table_.data(); }
-  unsigned nr_steps() const { return steps_; }
 
  private:
   unsigned bits_, steps_;

@@ -40,57 +40,6 @@ namespace gpubridge::sim {
   return out;
 }
 
-// Sections 10.1 and 10.2 for eight lanes at once, in four 64-bit lanes at a time: the reciprocal
-// unit (ReciprocalUnit::operator()) and texel_coords of every lane, integer-exact, so the same
-// values as the scalar functions (q = 0 gives (0, 0)). Scalar per lane, the leading-zero count,
-// the table read, the Newton-Raphson step's 128-bit multiply and the two shifted products were
-// the largest share of the perspective road's span time (perf) after its texel loads.
-[[gnu::always_inline]] inline void texel_coords8(const ReciprocalUnit& recip, const std::uint32_t* sv,
-                                                 const std::uint32_t* tv, const std::uint32_t* qv, unsigned wl,
-                                                 unsigned hl, TexelCoords* tc) {
-  using u64x4 = std::uint64_t __attribute__((vector_size(32)));
-  using i64x4 = std::int64_t __attribute__((vector_size(32)));
-  using f64x4 = double __attribute__((vector_size(32)));
-  const std::uint32_t* table = recip.table();
-  const unsigned bits = recip.table_bits(), steps = recip.nr_steps();
-  const u64x4 index_mask = u64x4{} + ((std::uint64_t{1} << bits) - 1);
-  for (unsigned h = 0; h < 8; h += 4) {
-    const u64x4 q = {qv[h], qv[h + 1], qv[h + 2], qv[h + 3]};
-    const i64x4 zero_q = (i64x4)(q == 0);        // all ones where q = 0
-    const u64x4 q1 = q | (u64x4)(zero_q & 1);  // q = 0 is computed as q = 1, then zeroed
-    // floor(log2 q1) from the exponent of the exact double 2^52 + q1 minus 2^52.
-    const u64x4 magic = u64x4{} + 0x4330000000000000ull;
-    f64x4 d;
-    const u64x4 qm = q1 | magic;
-    std::memcpy(&d, &qm, sizeof d);
-    d -= f64x4{} + 4503599627370496.0;  // 2^52
-    u64x4 e;
-    std::memcpy(&e, &d, sizeof e);
-    const u64x4 lz = 31u - ((e >> 52) - 1023u);  // leading zeros of the 32-bit q1
-    const u64x4 m = q1 << lz;                    // 2^31 <= m < 2^32
-    const u64x4 idx = (m >> (31u - bits)) & index_mask;
-    u64x4 y = {table[idx[0]], table[idx[1]], table[idx[2]], table[idx[3]]};
-    for (unsigned k = 0; k < steps; ++k) {
-      const u64x4 p = m * y;              // < 2^64
-      const u64x4 t = (0u - p) >> 32;     // u1.31
-      const u64x4 yt = (y * t) >> 31;     // y, t < 2^32: the product fits 64 bits
-      const u64x4 over = (u64x4)(yt > 0xFFFFFFFFu);
-      y = (yt & ~over) | (0xFFFFFFFFu & over);
-    }
-    // (s · y) >> (43 − n − wl), arithmetic: a logical shift of the value with its sign folded in.
-    auto product_shift = [&](const std::uint32_t* a, unsigned log2) {
-      const i64x4 v = {static_cast<std::int32_t>(a[h]), static_cast<std::int32_t>(a[h + 1]),
-                       static_cast<std::int32_t>(a[h + 2]), static_cast<std::int32_t>(a[h + 3])};
-      const i64x4 x = v * (i64x4)y;  // |x| < 2^63
-      const i64x4 sign = (i64x4)(x < 0);
-      const u64x4 shift = (43u - log2) - lz;
-      return ((i64x4)(((u64x4)(x ^ sign)) >> shift) ^ sign) & ~zero_q;
-    };
-    const i64x4 tu = product_shift(sv, wl), tvv = product_shift(tv, hl);
-    for (unsigned k = 0; k < 4; ++k) tc[h + k] = {tu[k], tvv[k]};
-  }
-}
-
 // The texture stage for eight pixels (section 10): texel coordinates of every lane from the exact
 // (s, t, q) planes through the reciprocal unit, then texture8_sample.
 [[gnu::always_inline]] inline simd::u32x8 texture8(const TextureLanes& s, simd::u32x8 sq, simd::u32x8 tq,
@@ -106,7 +55,12 @@ namespace gpubridge::sim {
     for (unsigned k = 0; k < n; ++k)
       tc[k] = texel_coords(static_cast<std::int32_t>(sv[k]), static_cast<std::int32_t>(tv[k]), s.const_rc, s.wl, s.hl);
   } else {
-    texel_coords8(*s.recip, sv, tv, qv, s.wl, s.hl, tc);
+    for (unsigned k = 0; k < n; ++k) {
+      const std::uint32_t q = qv[k];
+      const TexelCoords c = texel_coords(static_cast<std::int32_t>(sv[k]), static_cast<std::int32_t>(tv[k]),
+                                         (*s.recip)(q != 0 ? q : 1), s.wl, s.hl);
+      tc[k] = q != 0 ? c : TexelCoords{};
+    }
   }
   return texture8_sample(s, tc, pass, n, color);
 }
