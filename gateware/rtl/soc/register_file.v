@@ -113,8 +113,8 @@ module register_file #(
   // The immediate writes' values are used only under their own index's test, on bits that index
   // does not reserve (ERR_CLEAR 6:0, LINK_CTRL 0 and 63:32, LINK_CHECK 31:0), so they take the
   // frame's data as received: masking it with the index-dependent reserved mask gave each of those
-  // bits a decode term (`rtl.regs_header` keeps the table; a mask change there fails the
-  // co-simulation's reserved-bit tests)
+  // bits a decode term (an assumption on the generated table, spigpu_regs.vh: should one of those
+  // bits ever become reserved, its mask has to come back here)
 
   wire strict_refused = is_link_ctrl && frame_data[0] && !FEATURES[3];
   // leaving strict mode takes the key, so no single bit error can switch the protection off:
