@@ -9,7 +9,8 @@
 //     that holds the last validated value (written by the executor and the immediate writes), and
 //     the constants CAPS2, CAPS and ID (initial contents), one cycle later; write-only registers read 0;
 //   - the sticky error flags and ERR_CLEAR; RESET's soft reset pulse and the sequencer that writes
-//     the reset values into the shadow RAM (32 cycles; the next frame cannot complete sooner).
+//     0 into the shadow RAM's read-write entries (32 cycles; the next frame cannot complete sooner);
+//     the registers whose reset value is not 0 read it from a second entry until they are written.
 // A RESET while the render core is still busy lets the core finish (the simulator finishes every
 // executed command too) but drops the memory-range errors it raises after the reset; the executor
 // starts no new core command until the core is idle again (core_drain).
@@ -109,12 +110,16 @@ module register_file #(
   wire [63:0] rsv_mask = is_err_clear ? RSV_ERR_CLEAR : is_link_ctrl ? RSV_LINK_CTRL : is_check ? RSV_CHECK
                        : is_host_tag ? RSV_HOST_TAG : is_reset ? RSV_RESET : 64'h0;
   wire        imm_rsv  = wr_imm && (frame_data & rsv_mask) != 64'h0;
-  wire [63:0] imm_data = frame_data & ~rsv_mask;
+  // The immediate writes' values are used only under their own index's test, on bits that index
+  // does not reserve (ERR_CLEAR 6:0, LINK_CTRL 0 and 63:32, LINK_CHECK 31:0), so they take the
+  // frame's data as received: masking it with the index-dependent reserved mask gave each of those
+  // bits a decode term (an assumption on the generated table, spigpu_regs.vh: should one of those
+  // bits ever become reserved, its mask has to come back here)
 
-  wire strict_refused = is_link_ctrl && imm_data[0] && !FEATURES[3];
+  wire strict_refused = is_link_ctrl && frame_data[0] && !FEATURES[3];
   // leaving strict mode takes the key, so no single bit error can switch the protection off:
   // without it the write is refused whole (no restart, no discard, the value stays)
-  wire clear_refused  = is_link_ctrl && link_strict && !imm_data[0] && imm_data[63:32] != CLEAR_KEY;
+  wire clear_refused  = is_link_ctrl && link_strict && !frame_data[0] && frame_data[63:32] != CLEAR_KEY;
   wire reset_ok       = wr_imm && is_reset && frame_data == RESET_MAGIC;
   wire imm_bad_value  = wr_imm && ((is_reset && frame_data != RESET_MAGIC) || strict_refused || clear_refused);
 
@@ -123,9 +128,9 @@ module register_file #(
   assign fifo_entry     = {frame_idx, frame_data};
   assign drop_overflow  = wr_queue && !link_discarding && fifo_full;
   assign link_check_strobe = wr_imm && is_check;
-  assign link_check_crc    = imm_data[31:0];
+  assign link_check_crc    = frame_data[31:0];   // read only with link_check_strobe
   assign link_ctrl_strobe  = wr_imm && is_link_ctrl && !clear_refused;
-  assign link_ctrl_strict  = imm_data[0] && FEATURES[3];
+  assign link_ctrl_strict  = frame_data[0] && FEATURES[3];
   assign soft_reset        = reset_ok;
 
   // --- shadow RAM of the read-write registers (indices 0x00..0x1F) ---
@@ -133,8 +138,25 @@ module register_file #(
   // hold those constants from configuration (no port writes there, a soft reset leaves them), so
   // their reads come from the RAM like a read-write register's and the live multiplexer has no
   // constant terms. The RAM is 64 bits wide, so its block RAMs are 256 deep anyway: no RAM added.
+  // Entries 32 + index of the read-write registers whose reset value is not 0 (COLOR, TEX_FMT,
+  // SCISSOR, CLEAR_COLOR, CLEAR_DEPTH, FB_FORMAT: RESET_NZ) hold that value, never written either;
+  // such a register reads from there from a reset until its first write (`at_reset`), so the reset
+  // sequencer writes 0 to every entry and its write data needs no table of reset values (77 LUT4:
+  // COLOR's all-ones alone put a fifth input on every bit of the write multiplexer).
+  function automatic [31:0] nonzero_resets(input [5:0] n);
+    integer k;
+    begin
+      nonzero_resets = 32'd0;
+      for (k = 0; k < n; k = k + 1)
+        nonzero_resets[k] = reg_is_rw(7'(k)) && reg_reset(7'(k)) != 64'h0;
+    end
+  endfunction
+  localparam [31:0] RESET_NZ = nonzero_resets(6'd32);
   (* no_rw_check *) reg [63:0] shadow [0:63];   // a read in the clock of a write may return the old value
+  integer init_k;
   initial begin
+    for (init_k = 0; init_k < 32; init_k = init_k + 1)
+      if (RESET_NZ[init_k]) shadow[32 + init_k] = reg_reset(7'(init_k));
     shadow[{1'b1, 5'(`SPIGPU_REG_CAPS2)}] = CAPS2;
     shadow[{1'b1, 5'(`SPIGPU_REG_CAPS)}]  = CAPS;
     shadow[{1'b1, 5'(`SPIGPU_REG_ID)}]    = ID;
@@ -147,20 +169,29 @@ module register_file #(
   wire [4:0]  sh_wa  = seq_active ? seq_idx : imm_wr ? frame_idx[4:0] : ex_wr_idx;
   // The immediate writes that reach the RAM are HOST_TAG's (no reserved bits: its data as received,
   // with the table's mask, a constant) and LINK_CTRL's (STRICT alone), so the write data takes no
-  // mask that depends on the index; written as one-hot selects and an AND-OR
-  wire        sel_seq = seq_active;
+  // mask that depends on the index; written as one-hot selects and an AND-OR (the sequencer's 0:
+  // none of them)
   wire        sel_tag = !seq_active && imm_wr && !is_link_ctrl;
   wire        sel_lc  = !seq_active && imm_wr && is_link_ctrl;
   wire        sel_ex  = !seq_active && !imm_wr;
-  wire [63:0] sh_wd  = ({64{sel_seq}} & reg_reset({2'b00, seq_idx})) | ({64{sel_tag}} & frame_data & ~RSV_HOST_TAG)
+  wire [63:0] sh_wd  = ({64{sel_tag}} & frame_data & ~RSV_HOST_TAG)
                      | {63'd0, sel_lc && link_ctrl_strict} | ({64{sel_ex}} & ex_wr_data);
   assign ex_wr_ack = ex_wr_req && !seq_active && !imm_wr;
+  // at_reset[i]: register i (in RESET_NZ) has not been written since the last reset, so its value is
+  // entry 32 + i. A read in the clock of the first write still sees the reset value there, the old
+  // value, as a read of entry i would; the sequencer's zeros do not count as writes
+  reg  [31:0] at_reset_q;
+  always @(posedge clk) begin
+    if (rst || reset_ok) at_reset_q <= RESET_NZ;
+    else if (sh_we && !seq_active) at_reset_q <= at_reset_q & ~(32'd1 << sh_wa);
+  end
+  wire [31:0] at_reset = at_reset_q & RESET_NZ;   // the other flags are constant 0 (no flip-flops)
 
   wire        spi_reads = !EX_READ || (rd_strobe && rd_from_ram);
   reg         ex_rd_q;
   always @(posedge clk) begin
     if (sh_we) shadow[{1'b0, sh_wa}] <= sh_wd;
-    shadow_q <= shadow[spi_reads ? {rd_idx[6], rd_idx[4:0]} : {1'b0, ex_rd_idx}];
+    shadow_q <= shadow[spi_reads ? {rd_idx[6] || at_reset[rd_idx[4:0]], rd_idx[4:0]} : {at_reset[ex_rd_idx], ex_rd_idx}];
     ex_rd_q <= !spi_reads;
   end
   assign ex_rd_data  = shadow_q;
@@ -220,7 +251,7 @@ module register_file #(
       core_drain <= !core_idle;
     end else begin
       if (core_idle) core_drain <= 1'b0;
-      if (wr_imm && is_err_clear) errors <= (errors & ~imm_data[6:0]) | set_now;
+      if (wr_imm && is_err_clear) errors <= (errors & ~frame_data[6:0]) | set_now;
       else errors <= errors | set_now;
     end
   end

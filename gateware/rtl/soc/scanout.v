@@ -59,7 +59,8 @@ module scanout #(
   output wire [2:0]  frame_nbytes,
   output wire        frame_start,  // the clock a frame's reading starts (frame_format/width/height valid)
   output wire        frame_end,    // the clock of its last byte
-  output wire [27:0] frame_addr,   // with frame_start: the frame's byte address / 16 (beyond VRAM: all ones)
+  output wire [27:0] frame_addr,   // with frame_start: the frame's byte address / 16 (beyond VRAM: the bits
+                                   // from VRAM's size up all ones, the rest the address's)
   output reg  [1:0]  frame_format,
   output reg  [10:0] frame_width,
   output reg  [10:0] frame_height
@@ -223,8 +224,10 @@ module scanout #(
   assign frame_word   = fold_word;
   assign frame_nbytes = n_fold;
   assign frame_start  = vsync && pending;
-  // until reading starts, rd_addr is the frame's first word (and above says it lies beyond VRAM)
-  assign frame_addr   = above ? 28'hFFFFFFF : 28'(rd_addr[VAW-1:2]);
+  // until reading starts, rd_addr is the frame's first word (and above says it lies beyond VRAM):
+  // beyond VRAM the bits above VRAM's are all ones and the rest are the wrapped address's (a
+  // video output shows such a frame black whatever its low bits say: no 13-bit choice here)
+  assign frame_addr   = {{(30 - VAW){above}}, rd_addr[VAW-1:2]};
   assign frame_end    = last;
   assign frame_done   = folding && last;
 

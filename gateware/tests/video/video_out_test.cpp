@@ -73,7 +73,8 @@ class VideoBench {
 
   // runs `cycles` core clocks from reset with the scanout's counters; the swap of `f` is latched where
   // the scanout's vertical sync falls (end of visible line 479), as frame_start does on a board
-  std::vector<Sample> run(const Frame& f, long cycles) {
+  // frame_addr: what the scanout hands over with frame_start (default: the frame's address / 16)
+  std::vector<Sample> run(const Frame& f, long cycles, std::uint32_t frame_addr = kAddrOfFrame) {
     std::vector<Sample> out;
     const long line_clocks = long(kHTotal) * kPixDiv;
     const long vsync_cycle = (kVActive - 1) * line_clocks + line_clocks - 1;
@@ -86,7 +87,8 @@ class VideoBench {
       m_.hcount = static_cast<std::uint16_t>(k % line_clocks);
       m_.vcount = static_cast<std::uint16_t>(k / line_clocks % kVTotal);
       m_.frame_start = k == vsync_cycle;
-      m_.frame_addr = k == vsync_cycle ? f.addr / 16 : 0xFFFFFFFu;  // valid with frame_start only
+      const std::uint32_t latched = frame_addr == kAddrOfFrame ? f.addr / 16 : frame_addr;
+      m_.frame_addr = k == vsync_cycle ? latched : 0xFFFFFFFu;  // valid with frame_start only
       m_.frame_format = static_cast<std::uint8_t>(f.format);
       m_.frame_width = static_cast<std::uint16_t>(f.width);
       m_.frame_height = static_cast<std::uint16_t>(f.height);
@@ -97,6 +99,7 @@ class VideoBench {
     return out;
   }
 
+  static constexpr std::uint32_t kAddrOfFrame = 0xFFFFFFFFu;  // not a 28-bit frame_addr
   long requests() const { return requests_; }
   long beyond_requests() const { return beyond_requests_; }
 
@@ -260,4 +263,16 @@ TEST(VideoOut, ResetSizeRgba8888BeyondVramIsBlack) {
     EXPECT_GT(bench.beyond_requests(), 0) << "lines beyond VRAM are asked of the arbiter, which answers 0";
   else
     EXPECT_EQ(bench.beyond_requests(), 0);
+}
+
+// a frame starting beyond VRAM is black whatever the low bits of the address the scanout hands over:
+// the scanout sets the bits from VRAM's size up and passes the wrapped address's below them
+// (docs/gateware.md fit-soc8), here a wrapped address inside VRAM holding a pattern
+TEST(VideoOut, FrameBeyondVramIsBlackWhateverItsLowBits) {
+  const Frame inside = pattern(2, 101, 37, 0x1230, 9);
+  VideoBench bench(19);
+  bench.store(inside);
+  const std::uint32_t above = (0xFFFFFFFu << (kVaw - 2)) & 0xFFFFFFFu;
+  const Frame f{inside.format, inside.width, inside.height, std::uint32_t{4} << kVaw, inside.pixels};
+  check(bench.run(f, two_frames_and_a_bit(), above | inside.addr / 16), f, 0);
 }
