@@ -242,9 +242,14 @@ module core_setup_tm #(
   // A_BOX: some row to walk, box_y0 < min(fy, cy1). The clip half is compared a clock ahead
   // (box_y0 is loaded at A_FY0, two instructions before A_BOX; the clip rectangle is the
   // command's), so the branch does not wait for the scissor's clamp and the fy clamp in series.
+  // The fy half without fy's adder (A_BOX reads with box2 set, fy = (y + 8) >> 4):
+  // box_y0 < floor((y + 8) / 16) <=> 16 (box_y0 + 1) <= y + 8 <=> y >= 16 box_y0 + 8, one
+  // comparison of rd's Y with a concatenation, so the branch into the program ROM's address
+  // has one carry chain instead of two (fmax-setup, docs/gateware.md).
   reg         y0_in_clip;
   always @(posedge clk) y0_in_clip <= $signed({2'b0, box_y0}) < cy1;
-  wire        rows = !by0_big && y0_in_clip && $signed({2'b0, box_y0}) < fy;
+  wire        rows = !by0_big && y0_in_clip &&
+                     $signed({rc[15], rc}) >= $signed({2'b0, box_y0, 4'b1000});
   // box_xl (the last column, clip_x1 - 1, loaded at the start) is the clamp's upper bound too
   wire [10:0] xs = (xt < cx0) ? clip_x0 : (xt > $signed({2'b0, box_xl})) ? box_xl : xt[10:0];
   wire [4:0] r_sel = (i_addr == R_YTOP) ? r_y(top) : (i_addr == R_XTOP) ? r_x(top) :
