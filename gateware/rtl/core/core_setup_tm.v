@@ -18,11 +18,11 @@
 // cycles before one that reads it (the sequencer waits for an empty pipeline where needed).
 // Multiplies a1*m1 +/- a2*m2 are Horner's rule, most significant bit first, two cycles per
 // bit: m1 and m2 alternate on the operand RAM's read port while a copy of the RAM (the a
-// operands' low 25 bits) gives the bit of a1 or a2; the value at the origin adds a third
-// product, A0 * |D| (three cycles per bit), so that its quotient is a0 plus the plane's and no
-// adder or register holds a0 after the division. The one divider takes a plane's three
-// numerators in turn; a multiply overlaps the previous division. The origin index
-// y0 * width + x_start is a DSP multiply.
+// operands' low 25 bits, read a cycle ahead of m: below) gives the bit of a1 or a2; the value
+// at the origin adds a third product, A0 * |D| (three cycles per bit), so that its quotient is
+// a0 plus the plane's and no adder or register holds a0 after the division. The one divider
+// takes a plane's three numerators in turn; a multiply overlaps the previous division. The
+// origin index y0 * width + x_start is a DSP multiply.
 //
 // Instruction (32 bits): [4:0] addr (read address of a uop, or the word a uop or the field
 // multiplexer writes, or m1 of a multiply), [7:5] accumulator op, [8] w (the uop writes acc to
@@ -158,19 +158,29 @@ module core_setup_tm #(
   reg        v1_, w1, dv1;        // stage 1: valid, write acc to wa1, start the divider
   reg  [4:0] op1, wa1;
   reg        v2_, w2, dv2;        // stage 2: acts this cycle, with rd
-  reg  [4:0] op2, wa2;
+  reg  [4:0] wa2;
 
-  // multiply: fetch (fr, fph, fk) runs a cycle ahead of execution (xr, xph, xk); phase 2 is
-  // the third product of the value at the origin, A0 * |D| (A0 is the word after D2)
-  reg        fr, xr, xfirst, three;
-  reg  [1:0] fph, xph;
-  reg  [4:0] fk, xk, mbits;
+  // multiply: fetch (fr, fph, fk) runs a cycle ahead of execution (xr); phase 2 is the third
+  // product of the value at the origin, A0 * |D| (A0 is the word after D2). fk is the bit of a
+  // fetched (mbits, the top one, down to 0).
+  reg        fr, xr, three;
+  reg  [1:0] fph;
+  reg  [4:0] fk, mbits;
   reg  [4:0] m1a, m2a, a1a;
   reg        mneg, msub;
   wire       quiet = !fr && !xr && !v1_ && !v2_;
 
+  // The a operand's word is read a cycle ahead of the fetch that takes its bit (in the issue
+  // cycle the pair's first word, then the word of the next phase), so that the bit is picked
+  // from the RAM's output into ctl's register in the fetch cycle: the accumulator's control
+  // is flip-flops only (fmax-setup, docs/gateware.md; it was xk -> the bit select -> ctl ->
+  // b_in -> the carry chain, 48 ns). Safe because a multiply issues only on an empty pipeline
+  // (wait "quiet", gen_setup_prog.py) and nothing writes the RAM while it fetches.
+  wire       f_last = (fph == {three, !three});
+  wire [1:0] fph_n = f_last ? 2'd0 : fph + 2'd1;
+  wire [4:0] pair_a = (i_pair == P_DX) ? R_DX1 : (i_pair == P_E) ? R_EY : R_D1;
   wire [4:0] raddr = !fr ? ra : (fph == 2'd0) ? m1a : fph[0] ? m2a : R_ABSD;
-  wire [4:0] aaddr = a1a + {3'd0, fph};  // a2 (a3) is the word after a1 (a2)
+  wire [4:0] aaddr = fr ? a1a + {3'd0, fph_n} : pair_a;  // a2 (a3) is the word after a1 (a2)
   reg  [ACC_W-1:0] acc;
   wire signed [ACC_W-1:0] acc_s = $signed(acc);
   assign e_data = acc_s[35:0];
@@ -188,10 +198,14 @@ module core_setup_tm #(
   end
 
   // ---------------------------------------------------------------- accumulator
-  wire       b = rda[xk - 5'd1];
-  wire       msb = (xk == mbits);
-  wire       c_neg = mneg ^ msb ^ (xph[0] & msub);
-  wire [4:0] ctl = xr ? {xfirst, xph == 2'd0, b, c_neg, c_neg} : (v2_ ? op2 : 5'd0);
+  // ctl = {clr, dbl, use, neg, cin} of the cycle, decided a cycle ahead from the fetch (a
+  // multiply's bit) or from stage 1's uop
+  reg  [4:0] ctl;
+  wire       f_msb = (fk == mbits);
+  wire       f_neg = mneg ^ f_msb ^ (fph[0] & msub);
+  always @(posedge clk)
+    ctl <= rst ? 5'd0 : fr ? {f_msb && fph == 2'd0, fph == 2'd0, rda[fk], f_neg, f_neg} :
+                        v1_ ? op1 : 5'd0;
   wire [ACC_W-1:0] a_in = ctl[4] ? {ACC_W{1'b0}} : ctl[3] ? acc << 1 : acc;
   wire [ACC_W-1:0] b_in = (ctl[2] ? ACC_W'($signed(rd)) : {ACC_W{1'b0}}) ^ {ACC_W{ctl[1]}};
   always @(posedge clk) acc <= a_in + b_in + {{(ACC_W-1){1'b0}}, ctl[0]};
@@ -228,9 +242,14 @@ module core_setup_tm #(
   // A_BOX: some row to walk, box_y0 < min(fy, cy1). The clip half is compared a clock ahead
   // (box_y0 is loaded at A_FY0, two instructions before A_BOX; the clip rectangle is the
   // command's), so the branch does not wait for the scissor's clamp and the fy clamp in series.
+  // The fy half without fy's adder (A_BOX reads with box2 set, fy = (y + 8) >> 4):
+  // box_y0 < floor((y + 8) / 16) <=> 16 (box_y0 + 1) <= y + 8 <=> y >= 16 box_y0 + 8, one
+  // comparison of rd's Y with a concatenation, so the branch into the program ROM's address
+  // has one carry chain instead of two (fmax-setup, docs/gateware.md).
   reg         y0_in_clip;
   always @(posedge clk) y0_in_clip <= $signed({2'b0, box_y0}) < cy1;
-  wire        rows = !by0_big && y0_in_clip && $signed({2'b0, box_y0}) < fy;
+  wire        rows = !by0_big && y0_in_clip &&
+                     $signed({rc[15], rc}) >= $signed({2'b0, box_y0, 4'b1000});
   // box_xl (the last column, clip_x1 - 1, loaded at the start) is the clamp's upper bound too
   wire [10:0] xs = (xt < cx0) ? clip_x0 : (xt > $signed({2'b0, box_xl})) ? box_xl : xt[10:0];
   wire [4:0] r_sel = (i_addr == R_YTOP) ? r_y(top) : (i_addr == R_XTOP) ? r_x(top) :
@@ -292,14 +311,13 @@ module core_setup_tm #(
     fw_ok <= !adv && pc != 7'd0;
     // pipeline
     v1_ <= 1'b0; w1 <= 1'b0; dv1 <= 1'b0;
-    v2_ <= v1_; w2 <= w1; dv2 <= dv1; op2 <= op1; wa2 <= wa1;
-    xr <= fr; xph <= fph; xk <= fk; xfirst <= fr && fph == 2'd0 && fk == mbits;
+    v2_ <= v1_; w2 <= w1; dv2 <= dv1; wa2 <= wa1;
+    xr <= fr;
     if (fr) begin
-      fph <= fph + 2'd1;
-      if (fph == {three, !three}) begin
-        fph <= 2'd0;
-        fk  <= fk - 5'd1;
-        if (fk == 5'd1) fr <= 1'b0;
+      fph <= fph_n;
+      if (f_last) begin
+        fk <= fk - 5'd1;
+        if (fk == 5'd0) fr <= 1'b0;
       end
     end
     // results the rasteriser holds, loaded with their RAM words
@@ -360,16 +378,16 @@ module core_setup_tm #(
           wa1 <= i_addr;
         end
         if (i_pair != 2'd0) begin  // a1*m1 +/- a2*m2, a from the pair, m1 = addr, m2 = tgt
-          a1a   <= (i_pair == P_DX) ? R_DX1 : (i_pair == P_E) ? R_EY : R_D1;
+          a1a   <= pair_a;
           m1a   <= i_addr;
           m2a   <= i_tgt[4:0];
           msub  <= (i_pair != 2'd3);
           mneg  <= (i_neg == 2'd1) ? flip : (i_neg == 2'd2) ? !flip : 1'b0;
           three <= (i_neg == 2'd3);
-          mbits <= (i_pair == P_DX) ? 5'd17 : (i_pair == P_E) ? 5'd18 : (ak == 3'd4) ? 5'd25 : 5'd9;
+          mbits <= (i_pair == P_DX) ? 5'd16 : (i_pair == P_E) ? 5'd17 : (ak == 3'd4) ? 5'd24 : 5'd8;
           fr    <= 1'b1;
           fph   <= 2'd0;
-          fk    <= (i_pair == P_DX) ? 5'd17 : (i_pair == P_E) ? 5'd18 : (ak == 3'd4) ? 5'd25 : 5'd9;
+          fk    <= (i_pair == P_DX) ? 5'd16 : (i_pair == P_E) ? 5'd17 : (ak == 3'd4) ? 5'd24 : 5'd8;
         end
         case (i_act)
           A_FLIP: flip <= 1'b1;
