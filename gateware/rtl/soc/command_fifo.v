@@ -4,10 +4,11 @@
 //
 // Storage is one block RAM (2^AW entries, AW chosen so that 2^AW > DEPTH); the executor sees the
 // oldest released entry in a first-word-fall-through register and takes one entry per clock.
-// HEAD = 1 (up5k, issue 19 "fmax-cmd"): the entry the executor sees is a flip-flop copy of the
-// block RAM's output register, loaded only while that copy is empty, so neither the RAM's slow
-// clock-to-out runs into the executor's decode nor the executor's `pop` into the RAM's read and
-// the count in the same clock; the price is a clock per entry (two clocks an entry at most).
+// HEAD = 1 (ecp5, issue 19 "fmax-cmd"; on the up5k it bought no clock): the entry the executor
+// sees is a flip-flop copy of the block RAM's output register, loaded only while that copy is
+// empty, so neither the RAM's slow clock-to-out runs into the executor's decode nor the executor's
+// `pop` into the RAM's read and the count in the same clock; the price is a clock per entry taken
+// from a backlog (two clocks an entry at most).
 module command_fifo #(
   parameter DEPTH = 64,     // CAPS.FIFO_DEPTH
   parameter AW = 7,         // storage address bits, 2^AW > DEPTH
