@@ -9,7 +9,10 @@ module core_depth #(
     parameter integer ZLSB = 20,
     parameter integer IDX_W = 20,
     parameter integer AW = 2,
-    parameter integer ADDR_W = 32
+    parameter integer ADDR_W = 32,
+    // 1 (ecp5): the output is the register also without Z_TEST and Z_WRITE (a clock of latency);
+    // 0 (up5k, no depth buffer: the stage is a wire there): the input passes straight through
+    parameter integer OUT_REG = 0
 ) (
     input  wire          clk,
     input  wire          rst,
@@ -128,6 +131,7 @@ module core_depth #(
   reg           o_valid;
   reg [PW-1:0]  o_pix;
   wire          room = !o_valid;
+  wire          through = OUT_REG != 0 && !active && in_valid && (out_ready || !o_valid);   // below
   // a pixel is resolved when it fails, or passes with room behind and its depth write accepted
   assign take     = cur_valid && (!pass || (room && (!z_write || wr_ready)));
   assign wr_valid = active && cur_valid && pass && z_write && room;
@@ -145,21 +149,26 @@ module core_depth #(
     end
   endgenerate
   assign wr_data  = cur_z;
-  assign in_ready = !active ? out_ready : z_test ? (!q_full && rd_ready) : take;
-  assign passed   = active ? (take && pass) : (in_valid && out_ready);
+  assign in_ready = !active ? (OUT_REG != 0 ? out_ready || !o_valid : out_ready) : z_test ? (!q_full && rd_ready) : take;
+  assign passed   = active ? (take && pass) : OUT_REG != 0 ? through : (in_valid && out_ready);
 
+  // OUT_REG: without Z_TEST and Z_WRITE the register passes every pixel on (a pixel a clock, taken while
+  // it is empty or being emptied), so the stage's output is always a flip-flop: the next stages'
+  // input cones (the texture's and the colour's) start there, not at a multiplexer between this
+  // register and the input (the ULX3S clock, docs/gateware.md "Clock estimate"). A clock of
+  // latency a draw; the register is empty when a draw starts, so `active` switches only then.
   always @(posedge clk) begin
     if (rst) begin
       o_valid <= 1'b0;
-    end else if (active && take && pass) begin
+    end else if ((active && take && pass) || through) begin
       o_valid <= 1'b1;
       o_pix   <= cur;
     end else if (out_ready) begin
       o_valid <= 1'b0;
     end
   end
-  assign out_valid = active ? o_valid : in_valid;
-  assign out_pix   = active ? o_pix : in_pix;
+  assign out_valid = (OUT_REG != 0 || active) ? o_valid : in_valid;
+  assign out_pix   = (OUT_REG != 0 || active) ? o_pix : in_pix;
 
   assign idle = q_empty && !o_valid;
 endmodule

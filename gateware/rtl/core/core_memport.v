@@ -6,7 +6,8 @@
 // one, so the grants depend on registered state only and mem_req_ready reaches no stage.
 //
 // Priority, highest first: clear writes, colour writes, colour reads, texel reads, depth
-// writes, depth reads - later pipeline stages first, so the pipeline drains. Reads complete in
+// writes, depth reads - later pipeline stages first, so the pipeline drains (READS_FIRST = 1
+// lets colour reads before colour writes, in runs). Reads complete in
 // request order; a small tag queue routes each response to the stage that asked.
 //
 // Colour writes to the same word merge (RGB565 and RGBA2222 pixels share words; byte enables
@@ -20,7 +21,9 @@ module core_memport #(
     parameter integer COMBINE = 1,
     // 1: a skid register behind the output register; the stages see a flip-flop (the skid
     // empty), not the soc's mem_req_ready (below)
-    parameter integer SKID = 0
+    parameter integer SKID = 0,
+    // 1 (ecp5): colour reads before colour writes, writes in runs (below)
+    parameter integer READS_FIRST = 0
 ) (
     input  wire        clk,
     input  wire        rst,
@@ -141,11 +144,26 @@ module core_memport #(
   reg        g_any, g_read;
   reg [1:0]  g_tag;
   reg [5:0]  gnt;  // one-hot: clr, cw (combiner), cr, tr, zw, zr
+  // READS_FIRST (issue 19, the ULX3S's SDRAM): a colour write waits while a colour read can go,
+  // unless the last of the two granted was a write (wmode): the port then sends whole runs of
+  // reads and of writes. In plain priority order the blend's reads and writes fell into one of
+  // several stable patterns (runs of 5-6, or a write after every read), each costing the SDRAM a
+  // 4-clock read-to-write turn per switch, and a refresh's phase picked which: the draw's clocks
+  // varied by 8 % with the moment it started (docs/gateware.md "Why the blended draw depended on
+  // the SPI clock"). A read may overtake a colour write because a draw writes a pixel once, the
+  // buffers are disjoint outside serial mode (which moves a pixel at a time) and a draw starts
+  // with the port drained: the write combiner's held word relies on the same.
+  reg        wmode;
+  always @(posedge clk) begin
+    if (rst) wmode <= 1'b0;
+    else if (gnt[1]) wmode <= 1'b1;
+    else if (gnt[2]) wmode <= 1'b0;
+  end
   always @(*) begin
     gnt = 6'd0;
     if (g_room) begin
       if (clr_valid) gnt[0] = 1'b1;
-      else if (p_req) gnt[1] = 1'b1;
+      else if (p_req && (READS_FIRST == 0 || wmode || !(cr_valid && tag_room))) gnt[1] = 1'b1;
       else if (cr_valid && tag_room) gnt[2] = 1'b1;
       else if (tr_valid && tag_room) gnt[3] = 1'b1;
       else if (zw_valid) gnt[4] = 1'b1;

@@ -273,7 +273,7 @@ module spigpu_core #(
   wire         zr_valid, zr_ready, zr_rsp, zw_valid, zw_ready;
   wire [29:0]  zr_addr, zw_addr;
   wire [23:0]  zw_data;
-  core_depth #(.PW(PW), .ZLSB(IDX_W), .IDX_W(IDX_W), .AW(Q_AW), .ADDR_W(ADDR_W)) depth (
+  core_depth #(.PW(PW), .ZLSB(IDX_W), .IDX_W(IDX_W), .AW(Q_AW), .ADDR_W(ADDR_W), .OUT_REG(1 - SMALL)) depth (
       .clk(clk), .rst(rst), .z_test(r_ztest), .z_func(r_zfunc), .z_write(r_zwrite), .fb_z16(r_fb_z),
       .in_valid(emit2), .in_ready(d_in_ready), .in_pix(pix),
       .out_valid(d_out_valid), .out_ready(d_out_ready), .out_pix(d_out),
@@ -365,7 +365,7 @@ module spigpu_core #(
   wire stages_idle = d_idle && t_idle && c_idle;
   wire drained = pipe_idle && stages_idle && m_idle && !k_busy;
   wire idle_now;  // the pipeline-empty test; the port core_idle is it a clock late
-  core_memport #(.TAGS_AW((SMALL != 0) ? 1 : 3), .COMBINE(1 - SMALL), .SKID(SMALL)) memport (
+  core_memport #(.TAGS_AW((SMALL != 0) ? 1 : 3), .COMBINE(1 - SMALL), .SKID(SMALL), .READS_FIRST(1 - SMALL)) memport (
       .clk(clk), .rst(rst), .flush(!ras_active || r_serial),
       .clr_valid(k_valid), .clr_ready(k_ready), .clr_addr(k_addr), .clr_data(k_data), .clr_be(k_be),
       .cw_valid(cw_valid), .cw_ready(cw_ready), .cw_addr(cw_addr), .cw_data(cw_data), .cw_be(cw_be),

@@ -87,7 +87,15 @@ module mem_arbiter #(
   // never issued), so AW + 1 bits are enough
   wire [AW:0] m_vram   = {1'b0, m_req_addr[AW-1:0]};
   wire [AW:0] c_vram   = {1'b0, c_req_addr[AW-1:0]};
-  wire        c_prot   = prot_active && c_vram >= prot_lo && c_vram < prot_hi;
+  // Whether the window is active is last clock's (m_act_r, below) for the core too (the ULX3S
+  // clock, docs/gateware.md "The next cones toward 52 MHz": prot_active is the scanout's equality
+  // compare of its read address, a LUT tree, and it led through this compare, the grant and the
+  // core's stall logic into the walk). Exact for the same reason as for the memory-access unit: a
+  // window starts only when FB_DISPLAY executes, which the executor does only with the core idle
+  // and its memory requests done, so no core request meets a window in the clock it starts; one
+  // that ends is seen a clock late (a write may wait a clock longer, never less).
+  wire        c_act;
+  wire        c_prot   = c_act && c_vram >= prot_lo && c_vram < prot_hi;
   // The memory-access unit's write is compared a clock before it is granted (issue 19, 25.125 MHz
   // on the UP5K: the compare on its address, whose low bit is the unit's phase, led through its
   // grant into the executor's FIFO pop in one clock). m_out_r: last clock the window was active
@@ -104,6 +112,7 @@ module mem_arbiter #(
   reg         m_wait_r, m_out_r, m_act_r;
   wire        m_in_win = m_vram >= prot_lo && m_vram < prot_hi;
   wire m_block = m_writes && m_act_r && !(m_wait_r && m_out_r);
+  assign c_act = m_act_r;
   wire c_block = c_req_we && c_prot;   // (no core request while the unit writes: see pick_c)
   wire c_oor   = c_req_addr[29:AW] != 0;   // beyond VRAM: an upper bit, no comparator
   wire v_oor   = v_req_addr[29:AW] != 0;
@@ -189,6 +198,10 @@ module mem_arbiter #(
     end
     if (!rst && m_writes && prot_active && !m_act_r) begin
       $display("mem_arbiter: a write of the memory-access unit in the clock a protection window starts");
+      $stop;
+    end
+    if (!rst && c_req_valid && c_req_we && prot_active && !m_act_r) begin
+      $display("mem_arbiter: a core write in the clock a protection window starts");
       $stop;
     end
     if (!rst && m_wait_r && m_writes && m_req_addr != m_addr_r) begin

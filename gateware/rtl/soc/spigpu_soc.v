@@ -130,6 +130,7 @@ module spigpu_soc #(
   wire        soft_reset;
   wire        rst_any = rst || soft_reset;
   wire        fifo_push, fifo_push_held, fifo_full, fifo_nearly_full, fifo_held, fifo_out_valid, fifo_pop;
+  wire        fifo_read_any;   // an entry waits in the FIFO's output (HEAD: in either of its two registers)
   wire [70:0] fifo_entry, fifo_out;
   wire [10:0] fifo_level;
   wire        link_strict, link_discarding, link_release, link_discard, err_link_crc, drop_overflow;
@@ -179,10 +180,11 @@ module spigpu_soc #(
     .strict(link_strict), .discarding(link_discarding), .release_held(link_release), .discard_held(link_discard),
     .err_link_crc(err_link_crc), .link_status(link_status));
 
-  command_fifo #(.DEPTH(FIFO_DEPTH), .AW(FIFO_AW)) u_fifo (
+  command_fifo #(.DEPTH(FIFO_DEPTH), .AW(FIFO_AW), .HEAD(PROFILE == 1 ? 1 : 0)) u_fifo (
     .clk(clk), .rst(rst_any), .push(fifo_push), .push_held(fifo_push_held), .push_entry(fifo_entry),
     .release_held(link_release), .discard_held(link_discard), .full(fifo_full), .nearly_full(fifo_nearly_full),
-    .level(fifo_level), .held(fifo_held), .out_valid(fifo_out_valid), .out_entry(fifo_out), .pop(fifo_pop));
+    .level(fifo_level), .held(fifo_held), .out_valid(fifo_out_valid), .out_entry(fifo_out), .read_any(fifo_read_any),
+    .pop(fifo_pop));
   assign busy_pin = fifo_nearly_full;
 
   // --- executor ---
@@ -289,7 +291,7 @@ module spigpu_soc #(
           {cycles, work, cmds, frames, stalls, refreshes} <= 192'd0;
         end else begin
           cycles <= cycles + 32'd1;
-          if ((fifo_out_valid && !waiting_vsync) || !core_idle || !mem_ex_idle) work <= work + 32'd1;
+          if ((fifo_read_any && !waiting_vsync) || !core_idle || !mem_ex_idle) work <= work + 32'd1;
           if (executed) cmds <= cmds + 32'd1;
           if (f_valid) frames <= frames + 32'd1;
           if (core_stall) stalls <= stalls + 32'd1;
@@ -300,7 +302,7 @@ module spigpu_soc #(
              {cycles, work, cmds, frames, stalls, refreshes};
     end else begin : g_noperf
       assign {perf_cycles, perf_work_cycles, perf_cmds, perf_frames, perf_core_stalls, perf_refreshes} = 192'd0;
-      wire unused_perf = &{1'b0, executed, core_stall, refresh_pulse, waiting_vsync};
+      wire unused_perf = &{1'b0, executed, core_stall, refresh_pulse, waiting_vsync, fifo_read_any};
     end
   endgenerate
 
