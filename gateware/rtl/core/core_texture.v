@@ -4,7 +4,7 @@
 //   addressing REPEAT / CLAMP / MIRROR per axis;  nearest (one texel) or bilinear (four texels,
 //   each index addressed separately) fetches;  texels expanded to 8 bits;  the bilinear weights
 //   of section 10.4, done as two exact linear steps;  MODULATE (div255 of texel * colour) or
-//   DECAL.
+//   DECAL. A texel that the pixel ahead still waits for is not read again: its response is shared.
 // Pixels flow through a stalling pipeline (coordinates, addresses) into a fetch step that issues
 // the texel reads, then wait in a read queue for their words. Pixel record in: the depth stage's
 // {q, t, s, rgba, yl, xl, z, idx}; out: the colour stage's {yl, xl, idx, rgba}.
@@ -191,8 +191,9 @@ module core_texture #(
   // stage 5 registers: the fetch step's work
   reg         v5, bil5;
   // Coordinates shared with the pixel ahead (the one in stage 5 as this one entered it, pushed
-  // into the read queue just before this one): mi[{a, b}] says this pixel's i_a equals its i_b
-  // (a, b: 0 for i0, 1 for i1), mj the same for j; adj5: there was such a pixel (and the cache is on).
+  // into the read queue just before this one): mi[{a, b}] says this pixel's i_a equals that
+  // pixel's i_b (a, b: 0 for i0, 1 for i1), mj the same for j; adj5: there was such a pixel (and
+  // the cache is on: serial mode shares nothing).
   reg         adj5;
   reg  [3:0]  mi5, mj5;
   reg [29:0]  w00, w10, w01, w11;
