@@ -255,11 +255,16 @@ int run_bench_rtl_fill(const GlobalOptions& g, const RtlBenchArgs& a, const fs::
                      {"depth", r.depth}, {"blend", r.blend}, {"textured", r.textured}, {"bilinear", r.bilinear},
                      {"pixels", r.pixels}, {"draw_clocks", r.draw_clocks}, {"core_busy_clocks", r.core_busy_clocks},
                      {"setup_clocks", r.setup_clocks}, {"mem_stall_clocks", r.mem_stall_clocks},
-                     {"refreshes", r.refreshes}, {"px_per_clock", r.px_per_clock}, {"mpixel_per_s", r.mpixel_per_s}});
+                     {"refreshes", r.refreshes}, {"bytes_compared", r.bytes_compared},
+                     {"bytes_differing", r.bytes_differing}, {"px_per_clock", r.px_per_clock},
+                     {"mpixel_per_s", r.mpixel_per_s}});
       if (!g.json)
         std::printf("  %-44s %4ux%-4u %10llu %8.3f %10.1f %6.1f%% %6.1f%%\n", r.name.c_str(), r.width, r.height,
                     static_cast<unsigned long long>(r.draw_clocks), r.px_per_clock, r.mpixel_per_s,
                     100 * double(r.setup_clocks) / clocks, 100 * double(r.mem_stall_clocks) / clocks);
+      if (!g.json && r.bytes_differing)
+        std::printf("    ^ %llu of %llu VRAM bytes differ from the simulator's\n",
+                    static_cast<unsigned long long>(r.bytes_differing), static_cast<unsigned long long>(r.bytes_compared));
     }
     report[gw] = {{"board", board_of(gw)}, {"core_hz", caps.core_hz}, {"quick", a.quick}, {"rows", out}};
   }

@@ -47,10 +47,13 @@ struct FillResult {
   std::uint64_t setup_clocks = 0;      // of which in triangle setup
   std::uint64_t mem_stall_clocks = 0;  // clocks a core memory request waited (arbiter, SPRAM / SDRAM)
   std::uint64_t refreshes = 0;         // SDRAM auto refreshes during the draw
+  std::uint64_t bytes_compared = 0;    // VRAM compared with the simulator's after the same streams
+  std::uint64_t bytes_differing = 0;   // of which differing (0: the draw is the simulator's)
   double px_per_clock = 0, mpixel_per_s = 0;
 };
 
-// Plays each draw on a fresh emulated board of the profile (board profile from `config_dir`).
+// Plays each draw on a fresh emulated board of the profile (board profile from `config_dir`) and on
+// the simulator, and compares the buffers and texture in VRAM afterwards.
 Result<std::vector<FillResult>> measure_fill(rtl::GatewareProfile profile, bool quick, const std::filesystem::path& config_dir);
 
 }  // namespace gpubridge::cli

@@ -9,7 +9,7 @@ import predict  # noqa: E402
 
 REPORT = {"icebreaker": {"target_mhz": 25.125}, "ulx3s": {"target_mhz": 50}}
 CORE = {"ecp5": [{"name": "fill RGBA8888 flat", "value": 0.977, "unit": "px/clk"},
-                 {"name": "RGBA8888 textured bilinear (64x64 RGBA8888)", "value": 0.636, "unit": "px/clk"}],
+                 {"name": "RGB565 textured bilinear (64x64 RGBA8888)", "value": 0.690, "unit": "px/clk"}],
         "up5k": [{"name": "fill RGB565 flat", "value": 0.966, "unit": "px/clk"}]}
 
 
@@ -18,7 +18,8 @@ def fill_row(name, px):
 
 
 FILL = {"ecp5": {"rows": [fill_row("fill RGBA8888 flat", 0.45),
-                          fill_row("RGBA8888 textured bilinear (64x64 RGBA8888)", 0.55)]},
+                          fill_row("RGBA8888 textured bilinear (64x64 RGBA8888)", 0.35),
+                          fill_row("RGB565 textured bilinear (64x64 RGBA8888)", 0.55)]},
         "up5k": {"rows": [fill_row("fill RGB565 flat", 0.995)]}}
 
 
@@ -34,12 +35,19 @@ class PredictFill(unittest.TestCase):
         self.assertIn("22.5 Mpixel/s", flat)
         self.assertIn("**missed**", flat)
         self.assertIn("the core alone 48.9", flat)
-        bilinear = goal_line(text, "ulx3s", "RGBA8888 textured bilinear")
+        bilinear = goal_line(text, "ulx3s", "RGB565 textured bilinear")
         self.assertIn("27.5 Mpixel/s", bilinear)
         self.assertTrue(bilinear.endswith(": met"))
         up5k = goal_line(text, "icebreaker", "fill RGB565 flat")
         self.assertIn("25.0 Mpixel/s", up5k)  # 0.995 x 25.125 = 24.999...
         self.assertIn("**missed**", up5k)
+
+    def test_bilinear_goal_is_judged_into_rgb565(self):
+        # the ULX3S's screen format; the RGBA8888 class (0.35 px/clock: 17.5 Mpixel/s) is shown, not judged
+        text = predict.fill_rates(CORE, FILL, REPORT)
+        self.assertFalse(any(line.startswith("- goal ulx3s RGBA8888 textured bilinear") for line in text.splitlines()))
+        self.assertIn("| RGBA8888 textured bilinear (64x64 RGBA8888) | — | — | — | — | 640 × 480 | — | 0.350 | 17.5 |", text)
+        self.assertIn("the core alone 34.5", goal_line(text, "ulx3s", "RGB565 textured bilinear"))
 
     def test_table_shows_both_figures(self):
         text = predict.fill_rates(CORE, FILL, REPORT)
@@ -53,7 +61,7 @@ class PredictFill(unittest.TestCase):
 
     def test_core_alone_never_meets_a_goal(self):
         text = predict.fill_rates(CORE, {}, REPORT)
-        flat = goal_line(text, "ulx3s", "RGBA8888 textured bilinear")
+        flat = goal_line(text, "ulx3s", "RGB565 textured bilinear")
         self.assertIn("not judged", flat)
         self.assertNotIn(": met", text)
 
@@ -62,7 +70,7 @@ class PredictFill(unittest.TestCase):
                   "ulx3s": {"target_mhz": 50, "clock_estimate": {"core_mhz": 20.0, "core_mhz_cells_only": 40.0}}}
         text = predict.fill_rates(CORE, FILL, report)
         # 0.55 px/clock x 20 MHz = 11.0, not the 27.5 the PLL's 50 MHz would give
-        bilinear = goal_line(text, "ulx3s", "RGBA8888 textured bilinear")
+        bilinear = goal_line(text, "ulx3s", "RGB565 textured bilinear")
         self.assertIn("11.0 Mpixel/s at 20 MHz", bilinear)
         self.assertIn("**missed**", bilinear)
         mhz, state = predict.board_clock(report, "ulx3s")

@@ -2,7 +2,10 @@
 """rtl.cli.bench_fill: `gpubridge --json bench rtl --fill --quick` on both gateware profiles, its
 figures checked against physics, not against themselves:
 
-  - every class covers its rectangle exactly (two triangles sharing a diagonal, top-left rule);
+  - every class covers its rectangle exactly (two triangles sharing a diagonal, top-left rule) and
+    leaves VRAM (colour, depth buffer, texture) byte for byte as the simulator does with the same
+    streams, so no class is fast by drawing wrong;
+  - the ecp5 has every class named in REQUIRED (the RGB565 textured ones judge the bilinear goal);
   - 0 < px/clock <= 1 (the rasteriser emits at most a pixel a clock) and
     px/clock <= memory bytes per clock / bytes the memory must move per pixel, where the memory
     moves a 32-bit SPRAM word a clock on the up5k (4 bytes) and one 16-bit SDRAM beat a clock on
@@ -18,6 +21,9 @@ Usage: check_fill_bench.py GPUBRIDGE CONFIGS
 import json, os, shutil, subprocess, sys, tempfile
 
 MEMORY_BYTES_PER_CLOCK = {"up5k": 4, "ecp5": 2}
+REQUIRED = {"up5k": ["fill RGB565 flat"],
+            "ecp5": ["fill RGBA8888 flat", "fill RGB565 flat", "RGBA8888 textured bilinear (64x64 RGBA8888)",
+                     "RGB565 textured nearest (64x64 RGBA8888)", "RGB565 textured bilinear (64x64 RGBA8888)"]}
 CORE_HZ = {"up5k": 25.125e6, "ecp5": 50e6}  # backends/rtl/src/gateware_profile.cpp
 
 
@@ -48,13 +54,18 @@ def main():
     failures = []
     for profile, mem in MEMORY_BYTES_PER_CLOCK.items():
         rows = report[profile]["rows"]
-        if len(rows) < (4 if profile == "up5k" else 10):
+        if len(rows) < (4 if profile == "up5k" else 12):
             failures.append(f"{profile}: only {len(rows)} scene classes")
+        names = [r["name"] for r in rows]
+        failures += [f"{profile}: no class {n!r}" for n in REQUIRED[profile] if n not in names]
         for r in rows:
             name = f"{profile} {r['name']}"
             moved = r["bytes_per_pixel"] + (8 if r["depth"] else 0) + (r["bytes_per_pixel"] if r["blend"] else 0)
             bound = min(1.0, mem / moved)
             px = r["px_per_clock"]
+            if r["bytes_compared"] < r["width"] * r["height"] * r["bytes_per_pixel"] or r["bytes_differing"]:
+                failures.append(f"{name}: {r['bytes_differing']} of {r['bytes_compared']} VRAM bytes differ from the "
+                                "simulator's")
             if r["pixels"] != r["width"] * r["height"]:
                 failures.append(f"{name}: {r['pixels']} pixels drawn, the rectangle has {r['width'] * r['height']}")
             if not 0 < px <= bound:

@@ -4,7 +4,7 @@
 //   addressing REPEAT / CLAMP / MIRROR per axis;  nearest (one texel) or bilinear (four texels,
 //   each index addressed separately) fetches;  texels expanded to 8 bits;  the bilinear weights
 //   of section 10.4, done as two exact linear steps;  MODULATE (div255 of texel * colour) or
-//   DECAL.
+//   DECAL. A texel that the pixel ahead still waits for is not read again: its response is shared.
 // Pixels flow through a stalling pipeline (coordinates, addresses) into a fetch step that issues
 // the texel reads, then wait in a read queue for their words. Pixel record in: the depth stage's
 // {q, t, s, rgba, yl, xl, z, idx}; out: the colour stage's {yl, xl, idx, rgba}.
@@ -190,6 +190,12 @@ module core_texture #(
 
   // stage 5 registers: the fetch step's work
   reg         v5, bil5;
+  // Coordinates shared with the pixel ahead (the one in stage 5 as this one entered it, pushed
+  // into the read queue just before this one): mi[{a, b}] says this pixel's i_a equals that
+  // pixel's i_b (a, b: 0 for i0, 1 for i1), mj the same for j; adj5: there was such a pixel (and
+  // the cache is on: serial mode shares nothing).
+  reg         adj5;
+  reg  [3:0]  mi5, mj5;
   reg [29:0]  w00, w10, w01, w11;
   reg [7:0]   lanes5, fu5, fv5;
   reg [9:0]   ia5, ib5, ja5, jb5;
@@ -334,7 +340,17 @@ module core_texture #(
   reg  [3:0]  asked;      // slots of this pixel already requested
   reg         pushed;     // this pixel's queue entry exists
   wire        q_full;
-  wire [3:0]  need = (bil5 ? 4'b1111 : 4'b1000) & ~hit5;
+  wire [3:0]  miss5 = (bil5 ? 4'b1111 : 4'b1000) & ~hit5;
+  // A texel the pixel ahead still waits for (its own read or one it shares) is not read again:
+  // at half a texel per pixel the next pixel, looked up before that read's response lands, misses
+  // the same texels, and each would otherwise go to memory two to four times (docs/gateware.md
+  // "Where bilinear loses its clocks"). Decided as the entry is pushed, from registers only (the
+  // response of this clock is taken into the entry instead, below), so rd_valid does not wait for
+  // the response routing.
+  wire [3:0]  shr_now;    // slots shared (bit 3 - k for slot k)
+  wire [4*(QA+2)-1:0] shr_src;  // slot k's source {entry, slot} at [k*(QA+2) +: QA+2]
+  reg  [3:0]  shr_r;      // shr_now as the entry was pushed
+  wire [3:0]  need = miss5 & ~(pushed ? shr_r : shr_now);
   wire [3:0]  rem = need & ~asked;
   wire [1:0]  slot = rem[3] ? 2'd0 : rem[2] ? 2'd1 : rem[1] ? 2'd2 : 2'd3;
   wire        can = v5 && (pushed || !q_full) && !sweeping;
@@ -357,6 +373,9 @@ module core_texture #(
         asked  <= 4'd0;
         pushed <= 1'b0;
         bil5   <= bilinear;
+        adj5   <= v5 && cache_en;
+        mi5    <= {ib == ib5, ib == ia5, ia == ib5, ia == ia5};
+        mj5    <= {jb == jb5, jb == ja5, ja == jb5, ja == ja5};
         w00    <= a00[31:2];
         w10    <= a10[31:2];
         w01    <= a01[31:2];
@@ -371,6 +390,7 @@ module core_texture #(
         pay5   <= pay4w;
       end else begin
         if (push) pushed <= 1'b1;
+        if (push) shr_r <= shr_now;
         if (rd_valid && rd_ready) asked <= asked | slot_bit;
       end
     end
@@ -379,14 +399,42 @@ module core_texture #(
   // ---------------------------------------------------------------- texel read queue
   // An entry per pixel: the words of the slots that hit, and the slots still to come from memory
   // (responses arrive in request order: the oldest entry with slots outstanding takes each).
+  // An entry's shared slots (cp) wait for the response to another entry's read: src names it
+  // ({entry, slot} per slot, as shr_src).
   reg [IW-1:0]  items[0:N-1];
   reg [127:0]   words[0:N-1];
   reg [3:0]     miss[0:N-1];
+  reg [3:0]     cp[0:N-1];
+  reg [4*(QA+2)-1:0] src[0:N-1];
   reg [QA:0]    wp, rp;
   assign q_full = (wp - rp) == N[QA:0];
   wire [IW-1:0] hitem = items[rp[QA-1:0]];
   wire [127:0]  hword = words[rp[QA-1:0]];
-  wire          hvalid = (wp != rp) && (miss[rp[QA-1:0]] == 4'd0);
+  wire          hvalid = (wp != rp) && (miss[rp[QA-1:0]] == 4'd0) && (cp[rp[QA-1:0]] == 4'd0);
+  // The last pushed pixel's slots: lpend[s] says its slot s (number s: 0 = 00, 1 = 10, 2 = 01,
+  // 3 = 11) still waits for memory (its own read or one it shares): the read of slot ls[s] of entry
+  // le[s], which cannot have left the queue. A register, set at the push and cleared by that read's
+  // response, rather than looked up in `miss`: the lookup put 23 cells between le and the
+  // pipeline's enable (22.7 ns by the ULX3S clock estimate).
+  reg  [3:0]    lpend;
+  reg  [QA-1:0] le[0:3];
+  reg  [1:0]    ls[0:3];
+  // slot k of this pixel takes the first slot s of the last one holding the same texel and pending
+  function [QA+2:0] share_k(input [1:0] k, input [3:0] mi, input [3:0] mj, input [3:0] pend,
+                            input [4*(QA+2)-1:0] lsrc);
+    integer sk;
+    begin
+      share_k = {1'b0, {(QA+2){1'b0}}};
+      for (sk = 3; sk >= 0; sk = sk - 1)
+        if (mi[{k[0], 1'(sk)}] && mj[{k[1], 1'(sk >> 1)}] && pend[sk])
+          share_k = {1'b1, lsrc[sk*(QA+2) +: QA+2]};
+    end
+  endfunction
+  wire [4*(QA+2)-1:0] lsrc = {le[3], ls[3], le[2], ls[2], le[1], ls[1], le[0], ls[0]};
+  wire [QA+2:0] sh0 = share_k(2'd0, mi5, mj5, lpend, lsrc), sh1 = share_k(2'd1, mi5, mj5, lpend, lsrc);
+  wire [QA+2:0] sh2 = share_k(2'd2, mi5, mj5, lpend, lsrc), sh3 = share_k(2'd3, mi5, mj5, lpend, lsrc);
+  assign shr_now = {4{adj5}} & miss5 & {sh0[QA+2], sh1[QA+2], sh2[QA+2], sh3[QA+2]};
+  assign shr_src = {sh3[QA+1:0], sh2[QA+1:0], sh1[QA+1:0], sh0[QA+1:0]};
   wire          pop;
   // the entry the next response belongs to: the oldest with slots outstanding
   reg  [QA-1:0] fe;
@@ -402,16 +450,28 @@ module core_texture #(
   assign f_ib = items[fe][IW-11:IW-20];
   assign f_ja = items[fe][IW-21:IW-30];
   assign f_jb = items[fe][IW-31:IW-40];
+  // the response of this clock: {entry, slot}
+  wire [QA+1:0] rsrc = {fe, fslot};
+  integer qe, qs, pk;
+  reg [127:0] pw;       // the pushed entry's words
+  reg [3:0]   pcp;      // its slots still waiting for a shared response
+  always @(*) begin
+    pw = hdata5;
+    pcp = shr_now;
+    for (pk = 0; pk < 4; pk = pk + 1)
+      // a shared read answered in the push's own clock: its word goes in now
+      if (shr_now[3 - pk] && rsp_valid && shr_src[pk*(QA+2) +: QA+2] == rsrc) begin
+        pw[(3 - pk)*32 +: 32] = rsp_data;
+        pcp[3 - pk] = 1'b0;
+      end
+  end
   always @(posedge clk) begin
     if (rst) begin
       wp <= 0; rp <= 0;
+      lpend <= 4'd0;
     end else begin
-      if (push) begin
-        items[wp[QA-1:0]] <= {ia5, ib5, ja5, jb5, bil5, lanes5, fu5, fv5, pay5};
-        words[wp[QA-1:0]] <= hdata5;
-        miss[wp[QA-1:0]]  <= need;
-        wp <= wp + 1'b1;
-      end
+      for (qs = 0; qs < 4; qs = qs + 1)
+        if (rsp_valid && {le[qs], ls[qs]} == rsrc) lpend[qs] <= 1'b0;
       if (rsp_valid) begin
         case (fslot)
           2'd0: words[fe][127:96] <= rsp_data;
@@ -420,6 +480,27 @@ module core_texture #(
           default: words[fe][31:0] <= rsp_data;
         endcase
         miss[fe] <= fmiss & ~(4'b1000 >> fslot);
+        // the entries sharing that read take the word too
+        for (qe = 0; qe < N; qe = qe + 1)
+          for (qs = 0; qs < 4; qs = qs + 1)
+            if (cp[qe][3 - qs] && src[qe][qs*(QA+2) +: QA+2] == rsrc) begin
+              words[qe][(3 - qs)*32 +: 32] <= rsp_data;
+              cp[qe][3 - qs] <= 1'b0;
+            end
+      end
+      if (push) begin
+        items[wp[QA-1:0]] <= {ia5, ib5, ja5, jb5, bil5, lanes5, fu5, fv5, pay5};
+        words[wp[QA-1:0]] <= pw;
+        miss[wp[QA-1:0]]  <= need;
+        cp[wp[QA-1:0]]    <= pcp;
+        src[wp[QA-1:0]]   <= shr_src;
+        wp <= wp + 1'b1;
+        // what the next pixel may share: the slots this one reads, or shares and still waits for
+        for (qs = 0; qs < 4; qs = qs + 1) begin
+          lpend[qs] <= need[3 - qs] || pcp[3 - qs];
+          le[qs] <= need[3 - qs] ? wp[QA-1:0] : shr_src[qs*(QA+2) + 2 +: QA];
+          ls[qs] <= need[3 - qs] ? 2'(qs) : shr_src[qs*(QA+2) +: 2];
+        end
       end
       if (pop) rp <= rp + 1'b1;
     end

@@ -173,6 +173,8 @@ int main(int argc, char** argv) {
   fill("RGBA8888 alpha blend", 0, 0x1 | (1u << 7));
   fill("RGBA8888 textured nearest (64x64 RGBA8888)", 0, 0x2);
   fill("RGBA8888 textured bilinear (64x64 RGBA8888)", 0, 0x2, 256, 128, true);
+  fill("RGB565 textured nearest (64x64 RGBA8888)", 1, 0x2);
+  fill("RGB565 textured bilinear (64x64 RGBA8888)", 1, 0x2, 256, 128, true);
   setup_cost("flat", 0);
   setup_cost("flat, Z", 0x4 | (1u << 3) | 0x40);
   setup_cost("Gouraud", 0x1);
