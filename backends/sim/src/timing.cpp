@@ -244,35 +244,37 @@ Result<BoardTiming> timing_preset(std::string_view name) {
     b.memory_bytes_per_cycle = 2.0;
     // Fitted with the SDRAM row model, the texel cache's reads in it, the textured draws' row
     // misses apart, the depth writes and the depth stage's tail (`gpubridge bench rtl --fit
-    // --profile ecp5`, 2026-11-27, 14 scenes and 48 calibration frames; docs/gateware.md "Timing
-    // model"): a depth write costs 6.422 clocks beyond its pixel, a row miss 2.397 in an
-    // untextured draw and 1.176 in a textured one (the texture unit's wait hides part of it),
-    // a texel read 0.3179, a byte of texture footprint 0.4863, a byte sampled 0.06006; each of a
-    // depth triangle's last 4 pixels gives back 12.36 (drained under the next setup); a row
-    // open and an access nothing beyond the per-pixel terms.
-    b.setup_cycles = {42.72, 170.5, 98.01, 200.8, 164.2, 275.5, 202.4, 310.0};
-    b.row_cycles = {1.259, 0.4691, 0.9445, 0.3699, 0.1353, 0.2083, 3.356, 3.319};
-    b.column_cycles = {0.3843, 0.0, 0.0, 0.0, 0.0, 0.169, 0.4137, 0.5054};
-    b.pixel_cycles = {0.4273, 0.6352, 0.5038, 0.4714, 1.381, 1.114, 0.0, 0.05676};
-    b.cycles_per_command = 2.736;
+    // --profile ecp5`, 2026-11-27 on the gateware of the ninth session: reads first with write
+    // runs in the memory port, the texture unit sharing a texel read the pixel ahead waits for;
+    // 14 scenes and 48 calibration frames; docs/gateware.md "Timing model"): a depth write costs
+    // 6.674 clocks beyond its pixel, a row miss 2.394 in an untextured draw and 1.199 in a textured
+    // one (the texture unit's wait hides part of it), a texel read 1.176, a byte of texture
+    // footprint 0.3025, a byte sampled 0.001906; each of a depth triangle's last 4 pixels gives
+    // back 12.87 (drained under the next setup); a row open and an access nothing beyond the
+    // per-pixel terms.
+    b.setup_cycles = {42.75, 170.5, 98.04, 200.8, 164.2, 275.4, 202.5, 310.0};
+    b.row_cycles = {1.322, 0.5602, 0.9725, 0.3464, 0.7485, 0.6328, 3.598, 3.297};
+    b.column_cycles = {0.4277, 0.0, 0.0, 0.0, 0.0, 0.0, 0.6138, 0.7006};
+    b.pixel_cycles = {0.4376, 0.6412, 0.3418, 0.3117, 1.282, 1.123, 0.0, 0.04504};
+    b.cycles_per_command = 3.039;
     b.cycles_per_triangle = 0.0;
-    b.cycles_per_blended_pixel = 3.008;
+    b.cycles_per_blended_pixel = 2.527;
     b.cycles_per_rejected_triangle = 0.0;
-    b.cycles_per_clear = 7.846;
+    b.cycles_per_clear = 7.204;
     b.cycles_per_clear_row = 0.0;
-    b.cycles_per_clear_pixel = 0.004925;
-    b.cycles_per_mem_write = 11.56;
-    b.cycles_per_texel_byte = 0.06006;
-    b.cycles_per_color_byte = 0.3302;
-    b.cycles_per_texel_footprint_byte = 0.4863;
-    b.cycles_per_texel_fetch = 0.3179;
+    b.cycles_per_clear_pixel = 0.0;
+    b.cycles_per_mem_write = 11.31;
+    b.cycles_per_texel_byte = 0.001906;
+    b.cycles_per_color_byte = 0.329;
+    b.cycles_per_texel_footprint_byte = 0.3025;
+    b.cycles_per_texel_fetch = 1.176;
     b.cycles_per_sdram_access = 0.0;
     b.cycles_per_row_open = 0.0;
-    b.cycles_per_row_miss = 2.397;
-    b.cycles_per_textured_row_miss = 1.176;
-    b.cycles_per_depth_write = 6.422;
-    b.drained_cycles_per_tail_pixel = 12.36;
-    b.clear_bytes_per_cycle = 2.005;
+    b.cycles_per_row_miss = 2.394;
+    b.cycles_per_textured_row_miss = 1.199;
+    b.cycles_per_depth_write = 6.674;
+    b.drained_cycles_per_tail_pixel = 12.87;
+    b.clear_bytes_per_cycle = 2.007;
     // The SDRAM (sdram_ctrl.v with the Alliance AS4C32M16SB-7's timing): an auto refresh every
     // tREFI = 7.8 us costs precharge all (tRP 21 ns), tRFC (63 ns) and the first row opened again
     // (tRCD 21 ns), in whole clocks; the fit keeps these and fits the rest.
