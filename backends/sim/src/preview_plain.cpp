@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstring>
 
+#include "hier_z.hpp"
 #include "setup.hpp"
 #include "simd_lanes.hpp"
 

@@ -38,6 +38,40 @@ struct PreviewTexels {
   float scale_u = 0, scale_v = 0;        // 2^(20 + log2 size): texel units of 1/4096 per S/Q
 };
 
+class HierZ;
+
+// The coarse depth bounds (hier_z.hpp) for a draw the renderer keeps them for (a LESS or LEQUAL
+// test, both buffers in VRAM and disjoint): the wide rows skip a span whose smallest depth, in the
+// kernel's own arithmetic (preview_span_min_depth), fails against every block it crosses. The
+// bounds' generations and the runs' numbers are the exact path's (RasterContext).
+struct PreviewBounds {
+  HierZ* hier_z = nullptr;              // null: no bounds
+  const std::uint8_t* zbuf = nullptr;   // the depth buffer's first word
+  std::uint64_t gen = 0;                // RasterContext::hz_gen
+  std::uint32_t* run = nullptr;         // RasterContext::hz_run (the last run's number)
+  int x0 = 0, y0 = 0;                   // the box origin in pixels (the kernel's kx = 0, ky = 0)
+};
+
+// The smallest depth the plain kernel stores or compares over `count` pixels of a row (count >= 1)
+// whose 32.32 Z lane is `za` at the first pixel and steps by `zdx` (both modulo 2^64, as the lanes
+// hold them): the kernel's depth at a pixel is the lane's high word masked by `zmask`. Every such
+// depth is at least `zmin` when this returns true. It returns false (nothing known) unless both
+// ends lie in [0, 2^56) and count·|zdx| < 2^56: then the lane's value is the integer za + k·zdx
+// with no wrap at every pixel k (it lies between the ends), its high word is below 2^24, where
+// masking low bits keeps the order, so the smallest depth is at the end with the smaller lane.
+// No margin for float error: the lanes are exact integer sums whatever the double planes were.
+inline bool preview_span_min_depth(std::uint64_t za, std::uint64_t zdx, unsigned count, std::uint32_t zmask,
+                                   std::uint32_t& zmin) {
+  constexpr std::uint64_t kLimit = std::uint64_t{1} << 56;
+  const std::uint64_t steps = count - 1u;
+  const std::uint64_t zb = za + steps * zdx;
+  const std::uint64_t mag = static_cast<std::int64_t>(zdx) < 0 ? 0 - zdx : zdx;
+  std::uint64_t reach = 0;
+  if (za >= kLimit || zb >= kLimit || __builtin_mul_overflow(steps, mag, &reach) || reach >= kLimit) return false;
+  zmin = static_cast<std::uint32_t>((za < zb ? za : zb) >> 32) & zmask;
+  return true;
+}
+
 struct PreviewPlain {
   std::int64_t e[3], ex[3], ey[3];  // biased edge values at the box origin, steps
   const FixedPlanes* planes = nullptr;
@@ -53,6 +87,7 @@ struct PreviewPlain {
   bool depth_on = false;            // depth test or write
   bool z_write = false;
   PreviewTexels tex;                // textured draws only
+  PreviewBounds bounds;             // LESS / LEQUAL draws with coarse depth bounds only
 };
 
 // Whether the plain kernel draws this state (the caller also checks preview_applies): with or

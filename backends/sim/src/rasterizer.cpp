@@ -577,6 +577,7 @@ void draw_preview_plain(const Triangle& t, const DrawState& st, RasterContext& c
   p.blend = st.blend;
   p.depth_on = depth;
   p.z_write = st.z_write;
+  if (ctx.hier_z) p.bounds = {ctx.hier_z, ctx.mem.data() + st.fb_z, ctx.hz_gen, &ctx.hz_run, t.x0, t.y0};
   if (st.textured) {
     p.tex = {ctx.mem.data() + st.tex.base, &t.fplane, st.tex.wl, st.tex.hl, st.tex.wrap_s, st.tex.wrap_t,
              st.tex.bilinear, st.decal, std::ldexp(1.0f, 20 + static_cast<int>(st.tex.wl)),

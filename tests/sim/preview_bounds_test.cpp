@@ -1,0 +1,239 @@
+// The coarse depth bounds (hier_z.hpp) in the preview's plain kernel (preview_plain_kernel.inc,
+// issue 24): a span is skipped when its smallest depth in the kernel's own arithmetic fails against
+// every block it crosses, so the bytes must be those of drawing it. Checked three ways: the
+// smallest depth of a span (preview_span_min_depth) against every pixel's depth computed as the
+// kernel's lanes compute it, on the cases where the lanes wrap or reach past 24 bits; whole scenes
+// drawn with the bounds (vector routines on) against the same preview without them
+// (DeviceOptions::vector_routines off: preview draws with the same kernels, the bounds are not
+// kept), at 1, 2 and 3 threads; and the ties (coplanar redraws, a constant depth equal to the
+// stored one, one LSB either side, LESS against LEQUAL, z_bits 24 and 13), where a bound one LSB
+// too high or a test off by its equality would reject pixels the kernel passes.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "preview_plain.hpp"
+#include "sim_test_util.hpp"
+
+namespace gpubridge::sim::test {
+namespace {
+
+// The depths the plain kernel computes at pixels 0..count-1 of a row whose Z lane starts at za
+// and steps by zdx (modulo 2^64, as shade_wide's lanes and plane_lanes), masked as it masks them.
+std::uint32_t kernel_min_depth(std::uint64_t za, std::uint64_t zdx, unsigned count, std::uint32_t zmask) {
+  std::uint32_t m = 0xFFFFFFFFu;
+  std::uint64_t z = za;
+  for (unsigned k = 0; k < count; ++k, z += zdx) m = std::min(m, static_cast<std::uint32_t>(z >> 32) & zmask);
+  return m;
+}
+
+TEST(SimPreviewBounds, SpanMinimumDepthIsTheKernelsOwn) {
+  std::mt19937_64 rng(20261127);
+  const std::uint32_t masks[] = {0xFFFFFFu, 0xFFFFFFu & ~((1u << 11) - 1)};  // z_bits 24 and 13
+  unsigned known = 0, wrapping = 0;
+  for (int i = 0; i < 200000; ++i) {
+    const unsigned count = 1 + static_cast<unsigned>(rng() % (i % 4 == 0 ? 1024 : 64));
+    std::uint64_t za = 0, zdx = 0;
+    switch (i % 6) {
+      case 0:  // ordinary: a covered depth, a slope of a few LSB per pixel either way
+        za = (rng() % 0xFFFFFFull) << 32 | (rng() & 0xFFFFFFFFu);
+        zdx = static_cast<std::uint64_t>(static_cast<std::int64_t>(rng() % (std::uint64_t{1} << 40)) -
+                                         (std::int64_t{1} << 39));
+        break;
+      case 1:  // near 0: the lane goes a little negative (high word 0xFFFFFFFF)
+        za = rng() % (std::uint64_t{1} << 36);
+        zdx = 0 - (rng() % (std::uint64_t{1} << 34));
+        break;
+      case 2:  // near the top of 24 bits: the high word passes 2^24
+        za = ((std::uint64_t{0xFFFFFF} << 32) - (rng() % (std::uint64_t{1} << 38)));
+        zdx = rng() % (std::uint64_t{1} << 34);
+        break;
+      case 3:  // steep: a few pixels cross the whole range, or wrap 2^64
+        za = rng();
+        zdx = rng();
+        break;
+      case 4:  // negative lane values throughout (mod 2^64: huge)
+        za = 0 - (rng() % (std::uint64_t{1} << 50));
+        zdx = rng() % (std::uint64_t{1} << 30);
+        break;
+      default:  // flat: one depth, 1 LSB either side of a half
+        za = ((rng() % 0xFFFFFFull) << 32) | (0x80000000u + (rng() % 3) - 1);
+        zdx = 0;
+        break;
+    }
+    for (const std::uint32_t zmask : masks) {
+      const std::uint32_t want = kernel_min_depth(za, zdx, count, zmask);
+      std::uint32_t got = 0;
+      if (!preview_span_min_depth(za, zdx, count, zmask, got)) {
+        ++wrapping;
+        continue;
+      }
+      ++known;
+      // Conservative (no pixel below it) and tight (some pixel at it).
+      ASSERT_EQ(got, want) << "za 0x" << std::hex << za << " zdx 0x" << zdx << " count " << std::dec << count;
+    }
+  }
+  // Both answers occur: the ordinary and flat cases are known, the wrapping ones are not.
+  EXPECT_GT(known, 100000u);
+  EXPECT_GT(wrapping, 50000u);
+}
+
+constexpr unsigned kWidth = 200, kHeight = 120;  // 6.25 block columns, 7.5 block rows
+constexpr std::uint64_t kLess = 1 | 4 | (1u << 3) | (1u << 6), kLequal = 1 | 4 | (3u << 3) | (1u << 6);
+constexpr std::uint64_t kAlways = 1 | 4 | (7u << 3) | (1u << 6);
+
+struct Scene {
+  std::vector<std::uint8_t> memory;
+  DeviceStats stats;
+};
+
+Scene finish(Device& d) {
+  d.drain();
+  const auto m = d.memory();
+  Scene s;
+  s.memory.assign(m.begin(), m.begin() + Canvas::kZBase + kWidth * kHeight * 4);
+  s.stats = d.stats();
+  return s;
+}
+
+void setup(Device& d, std::uint32_t clear_depth) {
+  w(d, Reg::FB_FORMAT, fb_format(kWidth, kHeight));
+  w(d, Reg::FB_DRAW, 0);
+  w(d, Reg::FB_Z, Canvas::kZBase);
+  w(d, Reg::CLEAR_COLOR, 0);
+  w(d, Reg::CLEAR, 0);
+  w(d, Reg::CLEAR_DEPTH, clear_depth);
+  w(d, Reg::CLEAR_Z, 0);
+}
+
+void triangle(Device& d, std::mt19937& rng, const int (&xy)[6], const std::uint32_t (&z)[3]) {
+  w(d, Reg::PRIM, 0);
+  for (int k = 0; k < 3; ++k) {
+    w(d, Reg::COLOR, color(static_cast<std::uint32_t>(rng())));
+    w(d, Reg::VERTEX, vtx(xy[2 * k], xy[2 * k + 1], z[k]));
+  }
+}
+
+void random_triangles(Device& d, std::mt19937& rng, int count, std::uint32_t zmin, std::uint32_t zmax) {
+  std::uniform_int_distribution<int> px(-8 * 16, (kWidth + 8) * 16), py(-8 * 16, (kHeight + 8) * 16), dv(-60 * 16, 60 * 16);
+  std::uniform_int_distribution<std::uint32_t> zd(zmin, zmax);
+  for (int i = 0; i < count; ++i) {
+    const int x = px(rng), y = py(rng);
+    const bool flat = i % 3 == 0;  // one depth per triangle, as in sim_throughput --random-z
+    const std::uint32_t z0 = zd(rng);
+    triangle(d, rng, {x, y, x + dv(rng), y + dv(rng), x + dv(rng), y + dv(rng)},
+             {z0, flat ? z0 : zd(rng), flat ? z0 : zd(rng)});
+  }
+}
+
+// Near depth everywhere, random triangles behind it (the bounds reject them), the depth buffer
+// raised in one part of the screen by a scissored clear, by MEM_DATA writes and by an ALWAYS draw,
+// and random triangles in front of the raised parts only.
+Scene random_scene(std::uint64_t mode, const DeviceOptions& o) {
+  auto dev = make_device(o);
+  Device& d = *dev;
+  std::mt19937 rng(20261127);
+  setup(d, 0xFFFFFF);
+  w(d, Reg::TRI_MODE, mode);
+  const int x1 = kWidth * 16, y1 = kHeight * 16;
+  triangle(d, rng, {0, 0, x1, 0, 0, y1}, {0x100000, 0x100000, 0x100000});
+  triangle(d, rng, {x1, y1, x1, 0, 0, y1}, {0x100000, 0x100000, 0x100000});
+  random_triangles(d, rng, 150, 0x100000, 0xFFFFFF);  // behind: rejected
+  random_triangles(d, rng, 50, 0x080000, 0x180000);   // partly in front
+  w(d, Reg::SCISSOR, scissor(40, 20, 100, 60));
+  w(d, Reg::CLEAR_DEPTH, 0xE00000);
+  w(d, Reg::CLEAR_Z, 0);
+  w(d, Reg::SCISSOR, scissor(0, 0, kWidth, kHeight));
+  for (unsigned y = 60; y < 100; ++y) {
+    w(d, Reg::MEM_ADDR, Canvas::kZBase + (y * kWidth + 100) * 4);
+    for (unsigned x = 100; x < 168; x += 2) w(d, Reg::MEM_DATA, 0x00E0000000E00000ull);
+  }
+  w(d, Reg::TRI_MODE, kAlways);
+  triangle(d, rng, {130 * 16, 0, 200 * 16, 0, 130 * 16, 40 * 16}, {0xF00000, 0xF00000, 0xF00000});
+  w(d, Reg::TRI_MODE, mode);
+  random_triangles(d, rng, 200, 0x180000, 0xF00000);  // in front of the raised parts only
+  return finish(d);
+}
+
+// The ties: a sloped plane and a flat one written into the depth buffer, then drawn again over
+// themselves (the same vertices: the same lanes, so LESS fails and LEQUAL passes at every pixel),
+// with the depth one and two LSB higher and lower, and flat triangles at the cleared depth and one
+// LSB either side; planes reaching 0 and 2^24 - 1 (the lanes' ends).
+Scene tie_scene(std::uint64_t mode, const DeviceOptions& o) {
+  auto dev = make_device(o);
+  Device& d = *dev;
+  std::mt19937 rng(7);
+  const std::uint32_t cleared = 0x654321;
+  setup(d, cleared);
+  w(d, Reg::TRI_MODE, mode);
+  const int x1 = kWidth * 16, y1 = kHeight * 16;
+  // The left half: sloped planes, the right half flat at the cleared depth (not drawn at first).
+  const int sloped[3][6] = {{0, 0, 100 * 16, 8, 0, y1}, {100 * 16, 8, 100 * 16, y1, 0, y1},
+                            {0, 0, 100 * 16, 8, 50 * 16, 60 * 16}};
+  const std::uint32_t zs[3][3] = {{0x300000, 0x300100, 0x2FF000}, {0x300100, 0x301234, 0x2FF000},
+                                  {0x300000, 0x300100, 0x300080}};
+  for (const std::int32_t dz : {0, 0, 1, -1, 2, -2, 0}) {
+    for (int i = 0; i < 2; ++i) {
+      const auto z = [&](int k) { return static_cast<std::uint32_t>(static_cast<std::int32_t>(zs[i][k]) + dz); };
+      triangle(d, rng, sloped[i], {z(0), z(1), z(2)});
+    }
+  }
+  triangle(d, rng, sloped[2], {zs[2][0], zs[2][1], zs[2][2]});
+  const int flat[6] = {100 * 16 + 5, 3, x1, 0, x1 - 7, y1};
+  for (const std::int32_t dz : {1, 0, -1, 0, -1}) {
+    const auto z = static_cast<std::uint32_t>(static_cast<std::int32_t>(cleared) + dz);
+    triangle(d, rng, flat, {z, z, z});
+  }
+  // The depth's ends: a plane from 0 to the far end across the screen, drawn twice, and slivers
+  // at 0 and at 0xFFFFFF.
+  for (int i = 0; i < 2; ++i) triangle(d, rng, {0, 70 * 16, x1, 90 * 16, 0, 110 * 16}, {0, 0xFFFFFF, 0});
+  triangle(d, rng, {3, 100 * 16, x1, y1, 0, y1 - 3}, {0, 0, 0});
+  triangle(d, rng, {3, 100 * 16, x1, y1, 0, y1 - 3}, {0xFFFFFF, 0xFFFFFF, 0xFFFFFF});
+  return finish(d);
+}
+
+// `passed` gets the pixels that passed the depth test without the bounds, per mode (LESS, LEQUAL)
+// and z_bits (24, 13).
+template <class Draw>
+void same_with_and_without_bounds(Draw draw, const char* what, std::vector<std::uint64_t>& passed) {
+  for (const std::uint64_t mode : {kLess, kLequal}) {
+    for (const unsigned z_bits : {24u, 13u}) {
+      DeviceOptions plain = preview_options(1);
+      plain.vector_routines = false;  // no bounds: every span drawn
+      plain.accuracy.z_bits = z_bits;
+      const Scene want = draw(mode, plain);
+      passed.push_back(want.stats.pixels_depth_passed);
+      EXPECT_GT(want.stats.pixels_depth_passed, std::uint64_t{kWidth} * kHeight / 2) << what;
+      for (const unsigned threads : {1u, 2u, 3u}) {
+        DeviceOptions o = preview_options(threads);
+        o.accuracy.z_bits = z_bits;
+        for (int run = 0; run < 2; ++run) {
+          const Scene got = draw(mode, o);
+          ASSERT_EQ(got.memory, want.memory) << what << " mode 0x" << std::hex << mode << std::dec << " z_bits " << z_bits
+                                             << " threads " << threads << " run " << run;
+          EXPECT_TRUE(got.stats == want.stats) << what << " z_bits " << z_bits << " threads " << threads;
+        }
+      }
+    }
+  }
+}
+
+TEST(SimPreviewBounds, RandomDepthScenesDrawAsWithoutTheBounds) {
+  std::vector<std::uint64_t> passed;
+  same_with_and_without_bounds(random_scene, "random", passed);
+  // The preview kernels drew the scene (Gouraud colour and Z are not the exact path's bytes).
+  EXPECT_NE(random_scene(kLess, preview_options(1)).memory, random_scene(kLess, DeviceOptions{}).memory);
+}
+
+TEST(SimPreviewBounds, TiesDrawAsWithoutTheBounds) {
+  std::vector<std::uint64_t> passed;
+  same_with_and_without_bounds(tie_scene, "ties", passed);
+  ASSERT_EQ(passed.size(), 4u);
+  // The ties were there to decide: the coplanar redraws (a sloped half of the screen twice, the
+  // flat one twice) pass under LEQUAL and fail under LESS.
+  EXPECT_GT(passed[2], passed[0] + 3 * 100 * kHeight / 2) << "z_bits 24";
+  EXPECT_GT(passed[3], passed[1] + 3 * 100 * kHeight / 2) << "z_bits 13";
+}
+
+}  // namespace
+}  // namespace gpubridge::sim::test
