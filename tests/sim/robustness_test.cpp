@@ -2,10 +2,13 @@
 // the sanitizer build), the device keeps answering, and RESET brings it back.
 #include <gtest/gtest.h>
 
+#include <cstdint>
+#include <new>
 #include <random>
 #include <utility>
 
 #include "sim_test_util.hpp"
+#include "video_memory.hpp"
 
 namespace gpubridge::sim::test {
 namespace {
@@ -50,6 +53,19 @@ TEST(SimRobustness, RandomFramesNeverBreakTheDevice) {
     EXPECT_EQ(d->read(index_of(Reg::TRI_MODE)), 0u);
     EXPECT_GT(d->stats().triangles_kicked, 0u);
   }
+}
+
+// The memory is rounded up to whole pages before it is allocated: a size whose rounding would wrap
+// must be refused, not turned into a tiny buffer that size() and contains() then overstate.
+TEST(SimRobustness, VideoMemoryRefusesASizeWhoseRoundingWraps) {
+  EXPECT_THROW(VideoMemory(SIZE_MAX - 5), std::bad_alloc);
+  EXPECT_THROW(VideoMemory(SIZE_MAX - (std::uint64_t{2} << 20) + 1), std::bad_alloc);
+  const VideoMemory small(3);
+  EXPECT_EQ(small.size(), 3u);
+  EXPECT_FALSE(small.contains(0, 4));
+  const VideoMemory huge(std::uint64_t{4} << 20);
+  EXPECT_EQ(huge.size(), std::uint64_t{4} << 20);
+  EXPECT_EQ(huge.data()[(std::uint64_t{4} << 20) - 1], 0);
 }
 
 }  // namespace

@@ -62,6 +62,7 @@ class VideoMemory {
     // data() is never null.
     const bool huge = size >= kHugePage;
     const std::size_t align = huge ? kHugePage : 64;
+    if (size > SIZE_MAX - align) throw std::bad_alloc();  // the rounding below must not wrap
     const std::size_t bytes = (static_cast<std::size_t>(size == 0 ? 1 : size) + align - 1) & ~(align - 1);
     auto* p = static_cast<std::uint8_t*>(std::aligned_alloc(align, bytes));
     if (!p) throw std::bad_alloc();
