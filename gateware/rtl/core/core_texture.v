@@ -59,12 +59,31 @@ module core_texture #(
     end
   endfunction
   wire [5:0]        in_n_in = clz32(in_pix[IDX_W+155:IDX_W+124]);
-  wire              f_valid;
+  // The two entries stay where they were written and the head is read through a pointer, so that
+  // `en` (which ends the memory port's grant cone) enables only the pointer and the count, not the
+  // 181-bit head register a shifting FIFO (core_fifo2) moves on every pop (the ULX3S clock,
+  // docs/gateware.md "The texture unit's cones").
+  reg  [IDX_W+160:0] fq0, fq1;
+  reg  [1:0]        fn;        // entries held
+  reg               fwp, frp;  // the entry written next, the head
+  wire              f_valid = (fn != 2'd0);
+  wire              f_push = in_valid && in_ready;
+  wire              f_pop = en && f_valid;
+  assign in_ready = (fn != 2'd2);
+  always @(posedge clk) begin
+    if (rst) begin
+      fn <= 2'd0; fwp <= 1'b0; frp <= 1'b0;
+    end else begin
+      fn <= fn + {1'b0, f_push} - {1'b0, f_pop};
+      if (f_push) fwp <= !fwp;
+      if (f_pop) frp <= !frp;
+    end
+    if (f_push && !fwp) fq0 <= {in_n_in[4:0], in_pix};
+    if (f_push && fwp) fq1 <= {in_n_in[4:0], in_pix};
+  end
   wire [IDX_W+155:0] f_pix;
   wire [4:0]        in_n;
-  core_fifo2 #(.W(IDX_W + 161)) in_fifo (
-      .clk(clk), .rst(rst), .push(in_valid && in_ready), .din({in_n_in[4:0], in_pix}), .room(in_ready),
-      .valid(f_valid), .dout({in_n, f_pix}), .pop(en));
+  assign {in_n, f_pix} = frp ? fq1 : fq0;
   wire [31:0] in_q = f_pix[IDX_W+155:IDX_W+124];
   wire [31:0] in_t = f_pix[IDX_W+123:IDX_W+92];
   wire [31:0] in_s = f_pix[IDX_W+91:IDX_W+60];
