@@ -59,12 +59,31 @@ module core_texture #(
     end
   endfunction
   wire [5:0]        in_n_in = clz32(in_pix[IDX_W+155:IDX_W+124]);
-  wire              f_valid;
+  // The two entries stay where they were written and the head is read through a pointer, so that
+  // `en` (which ends the memory port's grant cone) enables only the pointer and the count, not the
+  // 181-bit head register a shifting FIFO (core_fifo2) moves on every pop (the ULX3S clock,
+  // docs/gateware.md "The texture unit's cones").
+  reg  [IDX_W+160:0] fq0, fq1;
+  reg  [1:0]        fn;        // entries held
+  reg               fwp, frp;  // the entry written next, the head
+  wire              f_valid = (fn != 2'd0);
+  wire              f_push = in_valid && in_ready;
+  wire              f_pop = en && f_valid;
+  assign in_ready = (fn != 2'd2);
+  always @(posedge clk) begin
+    if (rst) begin
+      fn <= 2'd0; fwp <= 1'b0; frp <= 1'b0;
+    end else begin
+      fn <= fn + {1'b0, f_push} - {1'b0, f_pop};
+      if (f_push) fwp <= !fwp;
+      if (f_pop) frp <= !frp;
+    end
+    if (f_push && !fwp) fq0 <= {in_n_in[4:0], in_pix};
+    if (f_push && fwp) fq1 <= {in_n_in[4:0], in_pix};
+  end
   wire [IDX_W+155:0] f_pix;
   wire [4:0]        in_n;
-  core_fifo2 #(.W(IDX_W + 161)) in_fifo (
-      .clk(clk), .rst(rst), .push(in_valid && in_ready), .din({in_n_in[4:0], in_pix}), .room(in_ready),
-      .valid(f_valid), .dout({in_n, f_pix}), .pop(en));
+  assign {in_n, f_pix} = frp ? fq1 : fq0;
   wire [31:0] in_q = f_pix[IDX_W+155:IDX_W+124];
   wire [31:0] in_t = f_pix[IDX_W+123:IDX_W+92];
   wire [31:0] in_s = f_pix[IDX_W+91:IDX_W+60];
@@ -80,12 +99,26 @@ module core_texture #(
   reg [4:0]  n1;
   reg [31:0] m1, s1, t1;
   reg [PAY-1:0] pay1;
+  // stage 1b: the table entry in flip-flops. The block RAM's clock-to-output (5.8 ns) and its
+  // long net ended in the Newton step's multiply and its adders (`rom.y` -> `p2`, 19.0 ns by the
+  // ULX3S clock estimate, docs/gateware.md "The texture unit's cones"); the multiply now starts at
+  // a register. A clock of latency a pixel, none of throughput (one enable moves every stage).
+  reg        v1b, qz1b;
+  reg [4:0]  n1b;
+  reg [31:0] m1b, y01b, s1b, t1b;
+  reg [PAY-1:0] pay1b;
   // stage 2: p = m * y0
   reg        v2, qz2;
   reg [4:0]  n2;
   reg [63:0] p2;
   reg [31:0] y02, s2, t2;
   reg [PAY-1:0] pay2;
+  // stage 2b: 2 - M y0, negated in a clock of its own (its 64-bit carry chain and the multiply
+  // behind it were 17.8 ns by the ULX3S clock estimate, `p2` -> `yt3`)
+  reg        v2b, qz2b;
+  reg [4:0]  n2b;
+  reg [31:0] tnr2b, y02b, s2b, t2b;
+  reg [PAY-1:0] pay2b;
   // stage 3: y0 * (2 - M y0)
   reg        v3, qz3;
   reg [4:0]  n3;
@@ -104,17 +137,26 @@ module core_texture #(
   wire [31:0] ynr = ysh[32] ? 32'hFFFFFFFF : ysh[31:0];   // min(2^32 - 1, (y t) >> 31)
   wire unused_low = &{1'b0, yt3[30:0], negp[31:0], in_n_in[5], f_pix[IDX_W+23:IDX_W]};  // depth: not here
 
+  // Only the valid bits are reset: the data registers take `en` alone as their clock enable, not
+  // `en` and the reset through a LUT and the slice's LSR (the ULX3S clock: `en` ends the memory
+  // port's grant cone, docs/gateware.md "The texture unit's cones"); they matter only when valid.
   always @(posedge clk) begin
     if (rst) begin
-      v1 <= 1'b0; v2 <= 1'b0; v3 <= 1'b0; v4 <= 1'b0;
+      v1 <= 1'b0; v1b <= 1'b0; v2 <= 1'b0; v2b <= 1'b0; v3 <= 1'b0; v4 <= 1'b0;
     end else if (en) begin
-      v1 <= f_valid; qz1 <= (in_q == 32'd0); n1 <= in_n; m1 <= in_m; s1 <= in_s; t1 <= in_t;
+      v1 <= f_valid; v1b <= v1; v2 <= v1b; v2b <= v2; v3 <= v2b; v4 <= v3;
+    end
+    if (en) begin
+      qz1 <= (in_q == 32'd0); n1 <= in_n; m1 <= in_m; s1 <= in_s; t1 <= in_t;
       pay1 <= in_pay;
-      v2 <= v1; qz2 <= qz1; n2 <= n1; p2 <= {32'd0, m1} * {32'd0, y0}; y02 <= y0; s2 <= s1; t2 <= t1;
-      pay2 <= pay1;
-      v3 <= v2; qz3 <= qz2; n3 <= n2; yt3 <= {32'd0, y02} * {32'd0, tnr}; s3 <= s2; t3 <= t2;
-      pay3 <= pay2;
-      v4 <= v3; qz4 <= qz3; n4 <= n3; su4 <= $signed(s3) * $signed({32'd0, ynr});
+      qz1b <= qz1; n1b <= n1; m1b <= m1; y01b <= y0; s1b <= s1; t1b <= t1;
+      pay1b <= pay1;
+      qz2 <= qz1b; n2 <= n1b; p2 <= {32'd0, m1b} * {32'd0, y01b}; y02 <= y01b; s2 <= s1b;
+      t2 <= t1b; pay2 <= pay1b;
+      qz2b <= qz2; n2b <= n2; tnr2b <= tnr; y02b <= y02; s2b <= s2; t2b <= t2; pay2b <= pay2;
+      qz3 <= qz2b; n3 <= n2b; yt3 <= {32'd0, y02b} * {32'd0, tnr2b}; s3 <= s2b; t3 <= t2b;
+      pay3 <= pay2b;
+      qz4 <= qz3; n4 <= n3; su4 <= $signed(s3) * $signed({32'd0, ynr});
       tv4 <= $signed(t3) * $signed({32'd0, ynr}); pay4 <= pay3;
     end
   end
@@ -141,19 +183,21 @@ module core_texture #(
   wire [7:0] fu = fuw;
   wire [7:0] fv = fvw;
 
+  // REPEAT / CLAMP / MIRROR with no adder or shifter (lg is 3..10: the register file clamps it), so
+  // the cache's lookup address is a few LUTs after stage 4a (the ULX3S clock, docs/gateware.md "The
+  // texture unit's cones"): i >>> lg is nonzero exactly when a bit of i at lg or above is set, and
+  // MIRROR's k = i mod 2 size is at least size exactly when bit lg of i is set, when 2 size - 1 - k
+  // is the complement of i's low lg bits.
   function [9:0] wrap(input signed [51:0] i, input [1:0] mode, input [3:0] lg);
-    reg [10:0] size, k;
+    reg [51:0] low;  // the bits below lg
     reg big;
     begin
-      size = 11'd1 << lg;
-      big = (i >>> lg) != 52'sd0;
+      low = ~(52'hF_FFFF_FFFF_FFFF << lg);
+      big = |(i & ~low);
       case (mode)
-        2'd1: wrap = i[51] ? 10'd0 : big ? 10'(size - 11'd1) : i[9:0];
-        2'd2: begin
-          k = i[10:0] & ((size << 1) - 11'd1);
-          wrap = (k < size) ? k[9:0] : 10'((size << 1) - 11'd1 - k);
-        end
-        default: wrap = i[9:0] & 10'(size - 11'd1);
+        2'd1: wrap = i[51] ? 10'd0 : big ? low[9:0] : i[9:0];
+        2'd2: wrap = (i[6'(lg)] ? ~i[9:0] : i[9:0]) & low[9:0];
+        default: wrap = i[9:0] & low[9:0];
       endcase
     end
   endfunction
@@ -358,8 +402,10 @@ module core_texture #(
   assign rd_valid = can && (rem != 4'd0);
   assign rd_addr  = (slot == 2'd0) ? w00 : (slot == 2'd1) ? w10 : (slot == 2'd2) ? w01 : w11;
   wire [3:0]  slot_bit = 4'b1000 >> slot;
-  wire [3:0]  rem_after = rem & ~((rd_valid && rd_ready) ? slot_bit : 4'd0);
-  wire        done5 = can && (rem_after == 4'd0);
+  // done5 = can && (rem_after == 0), written so that rd_ready (the memory port's grant, late in
+  // the clock) is one gate from `en`: with one slot left the grant is of that slot.
+  wire        rem_one = (rem == 4'b1000) || (rem == 4'b0100) || (rem == 4'b0010) || (rem == 4'b0001);
+  wire        done5 = can && ((rem == 4'd0) || (rem_one && rd_ready));
   assign en = (!v5 || done5) && !sweeping;
 
   always @(posedge clk) begin
@@ -372,28 +418,31 @@ module core_texture #(
         v5     <= v4w;
         asked  <= 4'd0;
         pushed <= 1'b0;
-        bil5   <= bilinear;
-        adj5   <= v5 && cache_en;
-        mi5    <= {ib == ib5, ib == ia5, ia == ib5, ia == ia5};
-        mj5    <= {jb == jb5, jb == ja5, ja == jb5, ja == ja5};
-        w00    <= a00[31:2];
-        w10    <= a10[31:2];
-        w01    <= a01[31:2];
-        w11    <= a11[31:2];
-        lanes5 <= {a00[1:0], a10[1:0], a01[1:0], a11[1:0]};
-        fu5    <= fu;
-        fv5    <= fv;
-        ia5    <= ia;
-        ib5    <= ib;
-        ja5    <= ja;
-        jb5    <= jb;
-        pay5   <= pay4w;
       end else begin
         if (push) pushed <= 1'b1;
-        if (push) shr_r <= shr_now;
         if (rd_valid && rd_ready) asked <= asked | slot_bit;
       end
     end
+    // the data: `en` alone (see stage 1)
+    if (en) begin
+      bil5   <= bilinear;
+      adj5   <= v5 && cache_en;
+      mi5    <= {ib == ib5, ib == ia5, ia == ib5, ia == ia5};
+      mj5    <= {jb == jb5, jb == ja5, ja == jb5, ja == ja5};
+      w00    <= a00[31:2];
+      w10    <= a10[31:2];
+      w01    <= a01[31:2];
+      w11    <= a11[31:2];
+      lanes5 <= {a00[1:0], a10[1:0], a01[1:0], a11[1:0]};
+      fu5    <= fu;
+      fv5    <= fv;
+      ia5    <= ia;
+      ib5    <= ib;
+      ja5    <= ja;
+      jb5    <= jb;
+      pay5   <= pay4w;
+    end
+    if (!en && push) shr_r <= shr_now;
   end
 
   // ---------------------------------------------------------------- texel read queue
@@ -590,5 +639,5 @@ module core_texture #(
     end
   end
   assign textured = pop;
-  assign idle = !f_valid && !v1 && !v2 && !v3 && !v4 && !v4a && !v4w && !v5 && (wp == rp) && !f1v && !f2v && !f3v && !out_valid;
+  assign idle = !f_valid && !v1 && !v1b && !v2 && !v2b && !v3 && !v4 && !v4a && !v4w && !v5 && (wp == rp) && !f1v && !f2v && !f3v && !out_valid;
 endmodule
