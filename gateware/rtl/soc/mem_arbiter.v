@@ -95,10 +95,7 @@ module mem_arbiter #(
   // and its memory requests done, so no core request meets a window in the clock it starts; one
   // that ends is seen a clock late (a write may wait a clock longer, never less).
   wire        c_act;
-  // `a >= b` written as `!(a < b)`: yosys's alumacc makes >= a carry chain's less-than OR an equality of
-  // the chain's XOR bits, a LUT tree four levels deep on the core's address, which led through the
-  // grant into the SPRAM's address (fmax-soc9); < is the carry chain's out alone
-  wire        c_prot   = c_act && !(c_vram < prot_lo) && c_vram < prot_hi;
+  wire        c_prot   = c_act && c_vram >= prot_lo && c_vram < prot_hi;
   // The memory-access unit's write is compared a clock before it is granted (issue 19, 25.125 MHz
   // on the UP5K: the compare on its address, whose low bit is the unit's phase, led through its
   // grant into the executor's FIFO pop in one clock). m_out_r: last clock the window was active
@@ -113,7 +110,7 @@ module mem_arbiter #(
   // was granted and a clock before it can start another, so no unit write meets a window in the
   // clock it starts (checked in the co-simulation); one that ends is seen a clock late.
   reg         m_wait_r, m_out_r, m_act_r;
-  wire        m_in_win = !(m_vram < prot_lo) && m_vram < prot_hi;
+  wire        m_in_win = m_vram >= prot_lo && m_vram < prot_hi;
   wire m_block = m_writes && m_act_r && !(m_wait_r && m_out_r);
   assign c_act = m_act_r;
   wire c_block = c_req_we && c_prot;   // (no core request while the unit writes: see pick_c)
