@@ -115,7 +115,9 @@ void triangle(Device& d, std::mt19937& rng, const int (&xy)[6], const std::uint3
 }
 
 void random_triangles(Device& d, std::mt19937& rng, int count, std::uint32_t zmin, std::uint32_t zmax) {
-  std::uniform_int_distribution<int> px(-8 * 16, (kWidth + 8) * 16), py(-8 * 16, (kHeight + 8) * 16), dv(-60 * 16, 60 * 16);
+  // Vertices up to 100 pixels from the first: boxes up to 200 wide, past kAskWidth (128), so the
+  // rows that ask the bounds are drawn in runs around the rejected ones.
+  std::uniform_int_distribution<int> px(-8 * 16, (kWidth + 8) * 16), py(-8 * 16, (kHeight + 8) * 16), dv(-100 * 16, 100 * 16);
   std::uniform_int_distribution<std::uint32_t> zd(zmin, zmax);
   for (int i = 0; i < count; ++i) {
     const int x = px(rng), y = py(rng);
