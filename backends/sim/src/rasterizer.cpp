@@ -60,10 +60,6 @@ constexpr int kSpanSolveWidth = 16;
 constexpr std::int64_t kStepJump = 4;
 // Rows this far ahead of the one being drawn are prefetched.
 constexpr int kPrefetchRows = 4;
-// A run stops asking the coarse depth bounds (hier_z.hpp) after this many rows in a row that they
-// did not reject: in front-to-back scenes no row is rejected, and asking on every row cost about
-// 200 instructions a row (1,000-px triangles, callgrind).
-constexpr unsigned kHierZTries = 2;
 
 template <bool kGouraud, bool kTextured, bool kDepth, bool kSimple>
 class Kernel {
@@ -105,9 +101,8 @@ class Kernel {
 
   void run(int ya, int yz) {
     if (kDepth && ctx_.hier_z) {
-      hz_run_ = ++ctx_.hz_run;
-      if (hz_run_ == 0) hz_run_ = ++ctx_.hz_run;  // 0 means "not written" in a block
-      hz_tries_ = kHierZTries;
+      hz_run_ = HierZ::next_run(ctx_.hz_run);
+      hz_tries_ = HierZ::kTries;
     }
     const std::uint64_t passed_before = ctx_.counters.passed;
     const std::int64_t k = ya - t_.y0;
@@ -122,12 +117,10 @@ class Kernel {
     }
     const int w = t_.x1 - t_.x0;
     for (int y = ya; y < yz; ++y) {
-      // A new 16-row band of blocks gets its tries afresh when the bounds rejected rows in this run
-      // so far, or every fourth band (large random-Z triangles: visible at one end, hidden at the
-      // other; front-to-back ones are never rejected and ask only every fourth band).
+      // A new 16-row band of blocks: its tries afresh (HierZ::band_asks_afresh).
       if (kDepth && (y & ((1 << HierZ::kRowsLog) - 1)) == 0 && ctx_.hier_z &&
-          (hz_rejected_ || ((y >> HierZ::kRowsLog) & 3) == 0))
-        hz_tries_ = kHierZTries;
+          HierZ::band_asks_afresh(y >> HierZ::kRowsLog, hz_rejected_))
+        hz_tries_ = HierZ::kTries;
       if (w >= kSpanSolveWidth) {
         std::int64_t kl = 0, kr = w - 1;
         for (int i = 0; i < 3; ++i) {
@@ -304,7 +297,7 @@ class Kernel {
       const std::uint32_t zm = static_cast<std::uint32_t>(z) & zmask_;
       if (ctx_.hier_z->occludes(zbuf_, y, t_.x0 + static_cast<int>(kl), t_.x0 + static_cast<int>(kr), zm,
                                 st_.z_func == protocol::DepthFunc::Less, ctx_.hz_gen, hz_run_)) {
-        hz_tries_ = kHierZTries;
+        hz_tries_ = HierZ::kTries;
         hz_rejected_ = true;
         return true;
       }
