@@ -23,8 +23,9 @@ import synth  # noqa: E402  (the device's sources and the cell counting are synt
 
 # iCEBreaker: one 25.125 MHz domain (12 MHz x 67 / 32) for the core and the 640 x 480 pixel clock
 ICEBREAKER = {"part": "iCE40UP5K-SG48", "target_mhz": 25.125}
-# ULX3S: 50 MHz core (a pixel every second clock), 125 MHz TMDS shift clock, LFE5U-85F-6BG381C
-ULX3S = {"part": "LFE5U-85F-6BG381C", "target_mhz": 50.0,
+# ULX3S: one PLL, VCO 625 MHz: the core at 625 / 12 = 52.083 MHz, the 25 MHz pixel clock (/25) and
+# the 125 MHz TMDS shift clock (/5), LFE5U-85F-6BG381C (ulx3s_top.v)
+ULX3S = {"part": "LFE5U-85F-6BG381C", "target_mhz": 52.083, "pixel_mhz": 25.0, "tmds_mhz": 125.0,
          "available": {"lut4": 83640, "ff": 83640, "ebr": 208, "dsp": 156}}
 ICE40_CELLS = {"ICESTORM_LC": "lc", "ICESTORM_RAM": "bram", "ICESTORM_SPRAM": "spram", "ICESTORM_DSP": "dsp",
                "ICESTORM_PLL": "pll", "SB_IO": "io", "SB_GB": "global"}
@@ -172,6 +173,7 @@ def ulx3s(out_dir):
         "method": est["method"], "route_ns": est["route_ns"], "route_block_ns": est["route_block_ns"],
         "core_mhz": core.get("fmax_mhz"), "core_mhz_cells_only": bound["clocks"].get("clk", {}).get("fmax_mhz"),
         "tmds_mhz": est["clocks"].get("clk_tmds", {}).get("fmax_mhz"),
+        "pixel_mhz": est["clocks"].get("pclk", {}).get("fmax_mhz"),
         "critical": [{k: d[k] for k in ("ns", "from", "to", "levels")} for d in core.get("distinct", [])],
         "meets_target": bool(core.get("fmax_mhz")) and core["fmax_mhz"] >= ULX3S["target_mhz"],
         "known_error": "no placement: routing is an allowance per net (nextpnr-ecp5 routes most nets in 0.3-1.1 ns, "

@@ -12,7 +12,8 @@ clocks and checked against the issue's goals (UP5K: >= 25 Mpixel/s untextured; E
 untextured, >= 25 bilinear-textured). --core takes build/gateware/tests/core/rtl_core_<profile>_bench
 --json: the core alone with an ideal memory port, shown beside them (never used for the goals).
 
-A board runs at the clock its PLL makes (iCEBreaker 25.125 MHz, ULX3S 50 MHz), provided the routed
+A board runs at the clock its PLL makes (iCEBreaker 25.125 MHz; ULX3S 52.083 MHz, its 25 MHz pixel
+clock apart: build.py's target_mhz is the core's), provided the routed
 design's fmax reaches it: the prediction is cycles / clock, and the report says whether the fmax was
 measured (placed and routed) or is still only the target. A design that is not routed but carries a
 clock estimate below the target (the ULX3S's `clock_estimate`, gateware/boards/ecp5_timing.py) is
@@ -96,7 +97,8 @@ def figures(report):
             lines.append(f"  Clock estimate (`gateware/boards/ecp5_timing.py`: -6 cell delays, {ce['route_ns']:g} ns "
                          f"routing per net, {ce['route_block_ns']:g} ns to a block RAM or multiplier): core "
                          f"**{ce['core_mhz']:g} MHz**, {ce['core_mhz_cells_only']:g} MHz with no routing at all (a bound), "
-                         f"TMDS {ce.get('tmds_mhz', 0):g} MHz; target {ulx['target_mhz']:g} MHz: "
+                         f"pixel {ce.get('pixel_mhz') or 0:g} MHz (needs {ulx.get('pixel_mhz', 25.0):g}), "
+                         f"TMDS {ce.get('tmds_mhz') or 0:g} MHz; core target {ulx['target_mhz']:g} MHz: "
                          + ("backed" if ce.get("meets_target") else "**not backed**") + f". Worst cones: {cones}.")
     elif ulx and "error" in ulx:
         lines.append(f"- **ULX3S** fails: {ulx['error']}")

@@ -6,6 +6,7 @@ import os, sys, unittest
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import predict  # noqa: E402
+import build  # noqa: E402  (the boards' PLL clocks)
 
 REPORT = {"icebreaker": {"target_mhz": 25.125}, "ulx3s": {"target_mhz": 50}}
 CORE = {"ecp5": [{"name": "fill RGBA8888 flat", "value": 0.977, "unit": "px/clk"},
@@ -108,7 +109,33 @@ class PredictFill(unittest.TestCase):
         self.assertIn("**not backed**", text)
         self.assertIn("`a` → `b` 48.7 ns (59 cells)", text)
         ulx["clock_estimate"] = dict(est, core_mhz=60.0, meets_target=True)
-        self.assertIn("target 50 MHz: backed", predict.figures({"ulx3s": ulx}))
+        self.assertIn("core target 50 MHz: backed", predict.figures({"ulx3s": ulx}))
+
+    def test_the_ulx3s_core_clock_is_its_own(self):
+        # the ULX3S's core runs on the PLL's 625 / 12 MHz, apart from the 25 MHz pixel clock: a RGB565
+        # flat fill of 0.969 px/clock (bench rtl --fill) makes 50.5 Mpixel/s there, 48.5 at the old 50 MHz
+        self.assertAlmostEqual(build.ULX3S["target_mhz"], 625 / 12, places=2)
+        self.assertEqual(build.ULX3S["pixel_mhz"], 25.0)
+        fill = {"ecp5": {"rows": [fill_row("fill RGB565 flat", 0.969)]}}
+        report = {"ulx3s": {"target_mhz": build.ULX3S["target_mhz"],
+                            "clock_estimate": {"core_mhz": 53.4, "core_mhz_cells_only": 90.0}}}
+        line = goal_line(predict.fill_rates({}, fill, report), "ulx3s", "fill RGB565 flat")
+        self.assertIn("50.5 Mpixel/s at 52.083 MHz", line)
+        self.assertIn(": met", line)
+        # an estimate below the new clock still rules
+        report["ulx3s"]["clock_estimate"]["core_mhz"] = 46.7
+        line = goal_line(predict.fill_rates({}, fill, report), "ulx3s", "fill RGB565 flat")
+        self.assertIn("at 46.7 MHz", line)
+        self.assertIn("**missed**", line)
+
+    def test_figures_show_the_pixel_clock(self):
+        synth = {"lut4": 1, "ccu2c": 1, "dpr16x4": 1, "lut4_equivalent": 7, "ff": 1, "ebr": 1, "dsp": 1}
+        margin = {"lut4": 99.0, "ff": 99.0, "ebr": 99.0, "dsp": 99.0}
+        est = {"route_ns": 1.0, "route_block_ns": 2.0, "core_mhz": 53.0, "core_mhz_cells_only": 90.0, "tmds_mhz": 218.1,
+               "pixel_mhz": 120.0, "meets_target": True, "critical": []}
+        ulx = {"part": "LFE5U-85F-6BG381C", "target_mhz": 52.083, "pixel_mhz": 25.0, "synth": synth,
+               "margin_pct": margin, "clock_estimate": est}
+        self.assertIn("pixel 120 MHz (needs 25)", predict.figures({"ulx3s": ulx}))
 
 
 if __name__ == "__main__":

@@ -8,10 +8,13 @@
 // VIDEO = 1 adds a board's video output (soc/video_out.v: the displayed buffer every refresh, its own
 // memory-arbiter client and line buffer); the co-simulation and the rtl tests keep VIDEO = 0, where
 // the video_* outputs are 0 and the arbiter's video client is tied off. LINE_CLOCKS must then be
-// 800 x VIDEO_PIX_DIV, so that the scanout's vertical sync is the video's.
+// 800 x VIDEO_PIX_DIV, so that the scanout's vertical sync is the video's; with VIDEO_PCLK = 1 the pixels
+// run on their own clock pclk, the scanout's timing advances once per pixel (video_out's synchronised
+// tick) and LINE_CLOCKS is 800.
 module spigpu_top #(
   parameter PROFILE     = 0,
   parameter CLK_MHZ     = PROFILE == 0 ? 25 : 50,
+  parameter CLK_KHZ     = CLK_MHZ * 1000,   // the core clock the SDRAM's timings are converted with
   parameter LINE_CLOCKS = PROFILE == 0 ? 800 : 1600,
   parameter V_ACTIVE    = 480,
   parameter V_TOTAL     = 525,
@@ -21,10 +24,12 @@ module spigpu_top #(
   parameter VIDEO_SCALE_LOG2 = 1, // framebuffer pixels shown 2^n x 2^n
   parameter VIDEO_LINE_AW    = 8, // line buffer: 2 x 2^n words
   parameter VIDEO_BITS       = 4, // bits per colour channel at the pins
-  parameter VIDEO_CENTRE     = 1  // a smaller framebuffer centred (1) or at the top left (0)
+  parameter VIDEO_CENTRE     = 1, // a smaller framebuffer centred (1) or at the top left (0)
+  parameter VIDEO_PCLK       = 0  // 1: pixels on pclk, not on clk (docs/gateware.md "Video out")
 ) (
   input  wire        clk,
   input  wire        rst,
+  input  wire        pclk,        // VIDEO_PCLK = 1: the pixel clock (else unused)
   input  wire        spi_sck,
   input  wire        spi_cs_n,
   input  wire        spi_mosi,
@@ -108,14 +113,14 @@ module spigpu_top #(
   wire [29:0]  mem_req_addr;
   wire [31:0]  mem_req_wdata, mem_rsp_rdata;
   wire [3:0]   mem_req_be;
-  wire         v_req_valid, v_req_ready, v_rsp_valid;
+  wire         v_req_valid, v_req_ready, v_rsp_valid, disp_tick;
   wire [10:0]  disp_hcount, disp_vcount;
   wire [27:0]  disp_frame_addr;
   wire [29:0]  v_req_addr;
 
   spigpu_soc #(
     .PROFILE(PROFILE), .FEATURES(FEATURES), .DEPTH(DEPTH), .MAX_WIDTH(MAX_WIDTH), .MAX_HEIGHT(MAX_HEIGHT),
-    .FIFO_DEPTH(FIFO_DEPTH), .FIFO_AW(FIFO_AW), .VRAM_KIB(VRAM_KIB), .VARIANT(VARIANT), .CLK_MHZ(CLK_MHZ),
+    .FIFO_DEPTH(FIFO_DEPTH), .FIFO_AW(FIFO_AW), .VRAM_KIB(VRAM_KIB), .VARIANT(VARIANT), .CLK_MHZ(CLK_MHZ), .CLK_KHZ(CLK_KHZ),
     .LINE_CLOCKS(LINE_CLOCKS), .V_ACTIVE(V_ACTIVE), .V_TOTAL(V_TOTAL), .CRC_BYTES(CRC_BYTES),
     .SCAN_BUF(SCAN_BUF), .PERF(PERF)
   ) u_soc (
@@ -134,7 +139,7 @@ module spigpu_top #(
     .frame_word(frame_word), .frame_nbytes(frame_nbytes), .frame_start(frame_start), .frame_end(frame_end),
     .frame_format(frame_format), .frame_width(frame_width), .frame_height(frame_height), .perf_cycles(perf_cycles),
     .perf_work_cycles(perf_work_cycles), .perf_cmds(perf_cmds), .perf_frames(perf_frames),
-    .perf_core_stalls(perf_core_stalls), .perf_refreshes(perf_refreshes), .disp_hcount(disp_hcount),
+    .perf_core_stalls(perf_core_stalls), .perf_refreshes(perf_refreshes), .disp_tick(disp_tick), .disp_hcount(disp_hcount),
     .disp_vcount(disp_vcount), .disp_frame_addr(disp_frame_addr), .v_req_valid(v_req_valid), .v_req_ready(v_req_ready), .v_req_addr(v_req_addr),
     .v_rsp_valid(v_rsp_valid));
 
@@ -142,8 +147,8 @@ module spigpu_top #(
     if (VIDEO != 0) begin : g_video
       localparam VAW = PROFILE == 0 ? 15 : 23;
       video_out #(.VAW(VAW), .PIX_DIV(VIDEO_PIX_DIV), .SCALE_LOG2(VIDEO_SCALE_LOG2),
-                  .LINE_AW(VIDEO_LINE_AW), .OUT_BITS(VIDEO_BITS), .CENTRE(VIDEO_CENTRE)) u_video (
-        .clk(clk), .rst(rst), .hcount(disp_hcount), .vcount(disp_vcount), .frame_start(frame_start),
+                  .LINE_AW(VIDEO_LINE_AW), .OUT_BITS(VIDEO_BITS), .CENTRE(VIDEO_CENTRE), .PCLK(VIDEO_PCLK)) u_video (
+        .clk(clk), .rst(rst), .pclk(pclk), .tick(disp_tick), .hcount(disp_hcount), .vcount(disp_vcount), .frame_start(frame_start),
         .frame_addr(disp_frame_addr),
         .frame_format(frame_format), .frame_width(frame_width), .frame_height(frame_height),
         .req_valid(v_req_valid), .req_ready(v_req_ready), .req_addr(v_req_addr), .rsp_valid(v_rsp_valid),
@@ -152,9 +157,10 @@ module spigpu_top #(
     end else begin : g_novideo
       assign v_req_valid = 1'b0;
       assign v_req_addr = 30'd0;
+      assign disp_tick = 1'b1;
       assign {video_pix_en, video_hsync, video_vsync, video_de} = 4'd0;
       assign {video_r, video_g, video_b} = {(3 * VIDEO_BITS){1'b0}};
-      wire unused_video = &{1'b0, disp_hcount, disp_vcount, disp_frame_addr, v_req_ready, v_rsp_valid};
+      wire unused_video = &{1'b0, pclk, disp_hcount, disp_vcount, disp_frame_addr, v_req_ready, v_rsp_valid};
     end
   endgenerate
 

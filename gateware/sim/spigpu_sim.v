@@ -53,7 +53,7 @@ module spigpu_sim #(
 
   spigpu_top #(.PROFILE(PROFILE), .CLK_MHZ(CLK_MHZ), .LINE_CLOCKS(LINE_CLOCKS), .V_ACTIVE(V_ACTIVE),
                .V_TOTAL(V_TOTAL), .PERF(1)) dut (
-    .clk(clk), .rst(rst), .spi_sck(spi_sck), .spi_cs_n(spi_cs_n), .spi_mosi(spi_mosi), .spi_miso(spi_miso),
+    .clk(clk), .rst(rst), .pclk(1'b0), .spi_sck(spi_sck), .spi_cs_n(spi_cs_n), .spi_mosi(spi_mosi), .spi_miso(spi_miso),
     .spi_miso_oe(spi_miso_oe), .busy_pin(busy_pin), .sd_cke(sd_cke), .sd_cs_n(sd_cs_n), .sd_ras_n(sd_ras_n),
     .sd_cas_n(sd_cas_n), .sd_we_n(sd_we_n), .sd_ba(sd_ba), .sd_a(sd_a), .sd_dqm(sd_dqm), .sd_dq_o(sd_dq_o),
     .sd_dq_oe(sd_dq_oe), .sd_dq_i(sd_dq_i), .vblank(vblank), .vsync(vsync), .frame_valid(frame_valid),

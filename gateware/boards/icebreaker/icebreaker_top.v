@@ -57,7 +57,7 @@ module icebreaker_top #(
   spigpu_top #(.PROFILE(0), .CLK_MHZ(25), .LINE_CLOCKS(800), .V_ACTIVE(480), .V_TOTAL(525), .PERF(0),
                .VIDEO(VIDEO), .VIDEO_PIX_DIV(1), .VIDEO_SCALE_LOG2(1), .VIDEO_LINE_AW(8), .VIDEO_BITS(4),
                .VIDEO_CENTRE(0)) u_gpu (
-    .clk(clk), .rst(rst), .spi_sck(spi_sck), .spi_cs_n(spi_cs_n), .spi_mosi(spi_mosi), .spi_miso(miso),
+    .clk(clk), .rst(rst), .pclk(1'b0), .spi_sck(spi_sck), .spi_cs_n(spi_cs_n), .spi_mosi(spi_mosi), .spi_miso(miso),
     .spi_miso_oe(miso_oe), .busy_pin(), .sd_cke(), .sd_cs_n(), .sd_ras_n(), .sd_cas_n(), .sd_we_n(), .sd_ba(),
     .sd_a(), .sd_dqm(), .sd_dq_o(), .sd_dq_oe(), .sd_dq_i(16'd0), .vblank(), .vsync(), .frame_valid(),
     .frame_word(), .frame_nbytes(), .frame_start(), .frame_end(), .frame_format(), .frame_width(),

@@ -11,7 +11,9 @@
 // raise ERR_MEM_RANGE when the swap is requested (the simulator raises it when FB_DISPLAY executes).
 // Until the reader has passed them, the not-yet-read words of the pending frame are write-protected
 // (mem_arbiter), so the frame is the buffer as it was when FB_DISPLAY executed.
-// Timing is in core clocks: LINE_CLOCKS per line, V_ACTIVE visible lines of V_TOTAL.
+// Timing is in core clocks: LINE_CLOCKS per line, V_ACTIVE visible lines of V_TOTAL. A board whose
+// pixels run on their own clock (ULX3S) advances it by `tick`, one core clock per pixel-clock edge
+// (video_out's synchronised pixel tick), and LINE_CLOCKS is then the line's pixels; elsewhere tick = 1.
 module scanout #(
   parameter        VAW = 15,              // VRAM size = 2^VAW 32-bit words
   parameter        LINE_CLOCKS = 800,
@@ -25,6 +27,7 @@ module scanout #(
   input  wire        clk,
   input  wire        rst,
   input  wire        soft_reset,   // RESET: the pending swap and a frame being read are dropped, counters 0
+  input  wire        tick,         // the display timing advances (1: every core clock)
   // swap request from the executor
   input  wire        swap_req,
   input  wire [27:0] swap_addr,    // byte address / 16
@@ -66,7 +69,7 @@ module scanout #(
   output reg  [10:0] frame_height
 );
   // --- display timing ---
-  wire line_end = hcount == LINE_CLOCKS[10:0] - 11'd1;
+  wire line_end = tick && hcount == LINE_CLOCKS[10:0] - 11'd1;
   wire frame_last = vcount == V_TOTAL[10:0] - 11'd1;
   assign vsync  = line_end && vcount == V_ACTIVE[10:0] - 11'd1;
   // vblank = vcount >= V_ACTIVE, as a flag turned at the two edges (no magnitude comparator)
@@ -74,7 +77,7 @@ module scanout #(
   // SB_MAC16s hold counters worth more cells each (docs/gateware.md, fit-soc3 and the merge after it)
   wire [15:0] hcount16, vcount16;
   dsp_counter #(.DSP(0), .WIDE(0)) u_display (
-    .clk(clk), .ld_top(rst || line_end), .d_top(16'd0), .inc_top(1'b1),
+    .clk(clk), .ld_top(rst || line_end), .d_top(16'd0), .inc_top(tick),
     .ld_bot(rst || (line_end && frame_last)), .d_bot(16'd0), .inc_bot(line_end), .q_top(hcount16), .q_bot(vcount16));
   assign hcount = hcount16[10:0];
   assign vcount = vcount16[10:0];

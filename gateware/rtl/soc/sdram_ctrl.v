@@ -12,8 +12,10 @@
 //     It is exact except for a request that issues in the clock after it was taken (an idle
 //     controller): the next request is then taken a clock later than it was;
 //   - auto refresh every T_REFI (all banks precharged first); the JEDEC power-up sequence at reset.
-// All timing is in nanoseconds and converted with the clock frequency, so the behavioural model
-// (gateware/sim/sdram_model.v), which checks every constraint, runs with the same numbers.
+// All timing is in nanoseconds and converted with the clock frequency (CLK_KHZ: the ULX3S's 52.083 MHz
+// is 52,084 kHz, rounded up so that every minimum spacing in clocks is at least the chip's, while the
+// refresh interval is rounded down), so the behavioural model (gateware/sim/sdram_model.v), which
+// checks every constraint, runs with the same numbers.
 // Read capture (issue 19): the boards send the chip the core clock inverted (ULX3S: a DDR output
 // cell), so the chip takes a command on the falling edge after the one that registered it and drives
 // each read beat from tAC after a falling edge until tOH after the next. With the ECP5's I/O delays the
@@ -24,6 +26,7 @@
 // (rising-edge sampling of DQ straight from the pin), so the read latency in core clocks is the same.
 module sdram_ctrl #(
   parameter CLK_MHZ   = 50,
+  parameter CLK_KHZ   = CLK_MHZ * 1000,   // the clock the timings are converted with
   parameter CL        = 2,
   parameter CAPTURE_FALL = 1,   // 1: chip clock = core clock inverted (the boards); 0: chip clock in phase
   // the slowest of the ULX3S's SDRAM parts checked (Alliance AS4C32M16SB-7TCN, datasheet table 16;
@@ -64,14 +67,15 @@ module sdram_ctrl #(
 );
   function integer cycles(input integer ns);
     begin
-      cycles = (ns * CLK_MHZ + 999) / 1000;
+      cycles = (ns * CLK_KHZ + 999999) / 1000000;
       if (cycles < 1) cycles = 1;
     end
   endfunction
   // timers hold (spacing - 1): a command may issue in the cycle its timer reads 0
   localparam integer RP_I = cycles(T_RP_NS) - 1, RCD_I = cycles(T_RCD_NS) - 1, RAS_I = cycles(T_RAS_NS) - 1,
                      RC_I = cycles(T_RC_NS) - 1, RRD_I = cycles(T_RRD_NS) - 1, RFC_I = cycles(T_RFC_NS) - 1,
-                     WR_I = cycles(T_WR_NS), TURN_I = CL + 1, REFI_I = cycles(T_REFI_NS);
+                     WR_I = cycles(T_WR_NS), TURN_I = CL + 1,
+                     REFI_I = T_REFI_NS * CLK_KHZ / 1000000;   // at most tREFI (the others at least theirs)
   localparam [7:0] RP  = RP_I[7:0];
   localparam [7:0] RCD = RCD_I[7:0];
   localparam [7:0] RAS = RAS_I[7:0];
@@ -81,7 +85,7 @@ module sdram_ctrl #(
   localparam [7:0] RFC = RFC_I[7:0];
   localparam [7:0] TURN = TURN_I[7:0];      // READ -> WRITE: read data off the bus
   localparam [15:0] REFI = REFI_I[15:0];
-  localparam integer INIT_I = INIT_US * CLK_MHZ;
+  localparam integer INIT_I = (INIT_US * CLK_KHZ + 999) / 1000;
   localparam [17:0] INIT = INIT_I[17:0];
   localparam [2:0]  CL3 = CL;
 

@@ -12,6 +12,7 @@ module spigpu_soc #(
   parameter        VRAM_KIB    = 128,
   parameter [15:0] VARIANT     = 16'h0001,
   parameter        CLK_MHZ     = 25,
+  parameter        CLK_KHZ     = CLK_MHZ * 1000,  // the SDRAM's timings are converted with it
   parameter        LINE_CLOCKS = 800,        // display timing in core clocks
   parameter        V_ACTIVE    = 480,
   parameter        V_TOTAL     = 525,
@@ -82,6 +83,7 @@ module spigpu_soc #(
   output wire [10:0]  frame_height,
   // a board's video output (video_out): the scanout's display timing, the latched frame's address
   // and a memory-arbiter client (tie v_req_valid to 0 where there is none, as the co-simulation does)
+  input  wire         disp_tick,      // the display timing advances (1 unless the pixels have their own clock)
   output wire [10:0]  disp_hcount,
   output wire [10:0]  disp_vcount,
   output wire [27:0]  disp_frame_addr,
@@ -230,7 +232,7 @@ module spigpu_soc #(
             // with a load costs the most cells of the scanout's; docs/gateware.md fit-soc5)
             .CRC_BYTES(CRC_BYTES), .BUF_WORDS(SCAN_BUF), .BYTES_W(SCAN_BYTES_W),
             .DSP(PROFILE == 0 && DEPTH == 0 ? 1 : 0)) u_scan (
-    .clk(clk), .rst(rst), .soft_reset(soft_reset), .swap_req(swap_req), .swap_addr(swap_addr),
+    .clk(clk), .rst(rst), .soft_reset(soft_reset), .tick(disp_tick), .swap_req(swap_req), .swap_addr(swap_addr),
     .swap_format(cmd_fb_format), .swap_width(cmd_fb_width), .swap_height(cmd_fb_height), .swap_ready(swap_ready),
     .swap_pending(swap_pending_w), .err_range(scan_err), .vblank(vblank), .vsync(vsync),
     .req_valid(s_req_valid), .req_ready(s_req_ready), .req_addr(s_req_addr), .rsp_valid(s_rsp_valid),
@@ -272,7 +274,7 @@ module spigpu_soc #(
       wire unused_sd = &{1'b0, sd_dq_i};
     end else begin : g_sdram
       wire sd_init_done;
-      sdram_ctrl #(.CLK_MHZ(CLK_MHZ)) u_vram (
+      sdram_ctrl #(.CLK_MHZ(CLK_MHZ), .CLK_KHZ(CLK_KHZ)) u_vram (
         .clk(clk), .rst(rst), .req_valid(b_req_valid), .req_ready(b_req_ready), .req_we(b_req_we),
         .req_addr(b_req_addr), .req_wdata(b_req_wdata), .req_be(b_req_be), .rsp_valid(b_rsp_valid),
         .rsp_rdata(b_rsp_rdata), .sd_cke(sd_cke), .sd_cs_n(sd_cs_n), .sd_ras_n(sd_ras_n), .sd_cas_n(sd_cas_n),

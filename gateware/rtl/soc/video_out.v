@@ -14,6 +14,31 @@
 // (the arbiter answers them so).
 // The timing is the scanout's (LINE_CLOCKS = H_TOTAL x PIX_DIV), so its vertical sync, where the swap is
 // latched, is the end of this stage's last visible line.
+//
+// PCLK = 1 (the ULX3S): the pixels have their own clock `pclk` (25 MHz, the sink's), independent of the
+// core clock `clk` (faster, from the same PLL, but treated as unrelated). Split in two domains:
+//   - pclk: the display timing counters (hc, vc: H_TOTAL x V_TOTAL pixels), the line buffer's read
+//     port, the pixel pipeline and the pins (pix_en = 1);
+//   - clk: the swap's latch (frame_start), the line decisions and the fill through the arbiter client;
+//     the scanout's timing is advanced by `tick` (LINE_CLOCKS = H_TOTAL), so hcount / vcount here are
+//     pclk's counters a few core clocks late, and frame_start (the swap, VBLANK) falls at the same
+//     pixel as before: the end of the last visible line, as pclk shows it;
+//   - the line buffer is a block RAM written in clk and read in pclk (a true dual-clock RAM);
+//   - crossings: (1) a toggle flipping at every pixel, through three flip-flops into clk: `tick`,
+//     one core clock per pixel. Each level of the toggle lasts a pixel (40 ns), longer than a core
+//     clock plus a flip-flop's aperture, so some core edge samples it cleanly: no pixel is lost or
+//     counted twice; a metastable first stage only moves a tick a clock later. The scanout's
+//     counters therefore stay in step with pclk's, both starting at the reset (pclk's reset is clk's
+//     `rst` through two flip-flops; the toggle is not reset, so a reset makes no edge, and rst must
+//     last at least 12 core clocks so that the ticks still in flight arrive inside it).
+//     (2) everything pclk takes from clk (the line's show / half / lead, the picture's x0, x_end and
+//     format) is sampled at pclk's line end only. clk changes these only at its own line ends,
+//     frame_start included, which come 2-3 core clocks (at least 2 x 19.2 ns) after pclk's line end
+//     that caused them through (1): at pclk's sample they have been still for a line less a few core
+//     clocks and stay still for at least two more, so all their bits are taken in one consistent state.
+//     (3) the line buffer: a half is read in pclk while the other one is written in clk, as in
+//     one clock (the write of line n + 2 begins after pclk has left line n, whose half it reuses).
+//   pclk's reset comes from rst; nothing goes from pclk to clk but the toggle.
 module video_out #(
   parameter VAW        = 15,   // VRAM = 2^VAW 32-bit words
   parameter PIX_DIV    = 1,    // core clocks per pixel: 1 or 2
@@ -29,10 +54,14 @@ module video_out #(
   parameter V_SYNC     = 2,
   parameter V_BACK     = 33,
   parameter SYNC_NEG   = 1,    // sync pulses low (640 x 480 at 60 Hz)
-  parameter CENTRE     = 1     // 1: a smaller picture centred; 0: at the top left (no placement adders)
+  parameter CENTRE     = 1,    // 1: a smaller picture centred; 0: at the top left (no placement adders)
+  parameter PCLK       = 0     // 1: pixels on their own clock pclk (then PIX_DIV is 1), 0: on clk's pix_en
 ) (
   input  wire                clk,
   input  wire                rst,
+  input  wire                pclk,          // PCLK = 1: the pixel clock (else unused)
+  output wire                tick,          // PCLK = 1: in clk, one clock per pixel (the scanout's
+                                            // timing advance); 0: 1
   // the scanout's display timing: clock in the line (0 .. H_TOTAL x PIX_DIV - 1) and line
   input  wire [10:0]         hcount,
   input  wire [10:0]         vcount,
@@ -48,7 +77,8 @@ module video_out #(
   output wire [29:0]         req_addr,
   input  wire                rsp_valid,
   input  wire [31:0]         rsp_rdata,
-  // to the pins (registered): pixel clock enable, syncs at their pin level, data enable, colour
+  // to the pins (registered; PCLK = 1: in pclk): pixel clock enable, syncs at their pin level, data
+  // enable, colour
   output wire                pix_en,
   output reg                 hsync,
   output reg                 vsync,
@@ -64,20 +94,34 @@ module video_out #(
 `include "const_compare.vh"
 
   // --- pixel enable and display timing: the scanout's counters (a pixel in the last clock of each
-  // PIX_DIV) ---
+  // PIX_DIV; PCLK = 1: a pixel a tick) ---
   wire [10:0] hc, vc;
+  wire        pix_c;                       // clk: a pixel's clock
+  wire        prst;                        // pclk's reset (PCLK = 1)
   generate
-    if (PIX_DIV == 2) begin : g_div2
-      assign pix_en = hcount[0];
+    if (PCLK != 0) begin : g_tick
+      // crossing (1): the pixel toggle into clk, three flip-flops (two to settle, one to see the edge)
+      // (public: the video bench reads them and resolves the first stage's metastability at random)
+      reg       ptoggle /*verilator public_flat_rd*/ = 1'b0;
+      reg [2:0] tsync /*verilator public_flat_rw*/ = 3'b000;
+      always @(posedge pclk) ptoggle <= prst ? ptoggle : !ptoggle;
+      always @(posedge clk) tsync <= {tsync[1:0], ptoggle};
+      assign tick = tsync[2] != tsync[1];
+      assign pix_c = tick;
+      assign hc = hcount;
+    end else if (PIX_DIV == 2) begin : g_div2
+      assign tick = 1'b1;
+      assign pix_c = hcount[0];
       assign hc = {1'b0, hcount[10:1]};
     end else begin : g_div1
-      assign pix_en = 1'b1;
+      assign tick = 1'b1;
+      assign pix_c = 1'b1;
       assign hc = hcount;
     end
   endgenerate
   assign vc = vcount;
   wire        h_last = hc == 11'(H_TOTAL - 1);
-  wire        line_end = pix_en && h_last;
+  wire        line_end = pix_c && h_last;
 
   // --- the displayed buffer, from frame_start on: where it is and its placement on the screen,
   // centred: [x0, x_end) x [y0, y_end), cropped from the top left when larger (only these are kept,
@@ -188,7 +232,7 @@ module video_out #(
     if (rst) begin
       f_left <= F_DONE;
       wr_idx <= {LINE_AW{1'b0}};
-      {f_in, f_rep, f_half, n_show, n_half, l_show} <= 6'd0;
+      {f_in, f_rep, f_half, n_show, n_half} <= 5'd0;
     end else begin
       if (rsp_valid) begin
         lb[{wr_half, wr_idx}] <= rsp_rdata;
@@ -201,8 +245,6 @@ module video_out #(
       if (line_end) begin
         {f_in, f_rep, f_half} <= {f_in_new, f_rep_new, f_half_new};
         {n_show, n_half} <= {f_in_new, f_half_new};
-        {l_show, l_half} <= {n_show, n_half};
-        l_lead <= lead[n_half];
         if (fetch_new) begin
           wr_half <= f_half_new;
           wr_idx <= {LINE_AW{1'b0}};
@@ -220,42 +262,90 @@ module video_out #(
     end
   end
 
+  // --- the display's clock, reset, pixel enable and timing: clk's (PCLK = 0) or pclk's own, with the
+  // values it takes from clk sampled at its line end (PCLK = 1, crossing (2)) ---
+  wire        dclk, drst, den;
+  wire [10:0] dhc, dvc;
+  wire [10:0] dx0, dx_end;
+  wire [1:0]  dppw;
+  wire        d_line_end = den && dhc == 11'(H_TOTAL - 1);
+  generate
+    if (PCLK != 0) begin : g_pclk
+      reg  [1:0]  prst_sync = 2'b11;
+      reg  [10:0] phc /*verilator public_flat_rd*/, pvc;
+      reg  [10:0] px0, px_end;
+      reg  [1:0]  pppw;
+      // rst into pclk (it is held long enough for two flip-flops to pass it)
+      always @(posedge pclk) prst_sync <= {prst_sync[0], rst};
+      assign prst = prst_sync[1];
+      always @(posedge pclk) begin
+        if (prst) begin
+          {phc, pvc} <= 22'd0;
+        end else if (d_line_end) begin
+          phc <= 11'd0;
+          pvc <= pvc == 11'(V_TOTAL - 1) ? 11'd0 : pvc + 11'd1;
+        end else begin
+          phc <= phc + 11'd1;
+        end
+        if (d_line_end) {px0, px_end, pppw} <= {x0, x_end, ppw_l2};
+      end
+      assign {dclk, drst, den, dhc, dvc} = {pclk, prst, 1'b1, phc, pvc};
+      assign {dx0, dx_end, dppw} = {px0, px_end, pppw};
+      assign pix_en = 1'b1;
+    end else begin : g_one
+      assign prst = rst;
+      assign {dclk, drst, den, dhc, dvc} = {clk, rst, pix_c, hc, vc};
+      wire unused_pclk = &{1'b0, pclk, prst};
+      assign {dx0, dx_end, dppw} = {x0, x_end, ppw_l2};
+      assign pix_en = pix_c;
+    end
+  endgenerate
+  // the line being shown, from the decisions a line earlier (at the display's line end)
+  always @(posedge dclk) begin
+    if (drst) begin
+      l_show <= 1'b0;
+    end else if (d_line_end) begin
+      {l_show, l_half} <= {n_show, n_half};
+      l_lead <= lead[n_half];
+    end
+  end
+
   // --- display: a two-stage pixel pipeline ---
-  // the pixel's place in the framebuffer line: from x0 on, a pixel every 2^S screen pixels, a word
-  // every 2^ppw_l2 pixels (the first word from the line's lead on)
+  // the pixel's place in the framebuffer line: from dx0 on, a pixel every 2^S screen pixels, a word
+  // every 2^dppw pixels (the first word from the line's lead on)
   reg         x_in_r, rep_r;
   reg  [1:0]  sub_r;
   reg  [LINE_AW:0] widx_r;                 // the top bit: beyond the line buffer half (black)
-  wire        x_start = hc == x0;
-  wire        x_in = hc != x_end && (x_start || x_in_r);
+  wire        x_start = dhc == dx0;
+  wire        x_in = dhc != dx_end && (x_start || x_in_r);
   wire        rep = x_start ? 1'b0 : rep_r;
   wire [1:0]  sub = x_start ? l_lead : sub_r;
   wire [LINE_AW:0] widx = x_start ? {(LINE_AW+1){1'b0}} : widx_r;
   wire        advance = S == 0 || rep;
-  wire        word_end = sub == (2'd1 << ppw_l2) - 2'd1;
-  always @(posedge clk) begin
-    if (pix_en) begin
+  wire        word_end = sub == (2'd1 << dppw) - 2'd1;
+  always @(posedge dclk) begin
+    if (den) begin
       x_in_r <= x_in;
       rep_r <= !rep;
       sub_r <= advance ? (word_end ? 2'd0 : sub + 2'd1) : sub;
       widx_r <= advance && word_end && !widx[LINE_AW] ? widx + 1'b1 : widx;
     end
   end
-  // visible part and sync pulses of the line and the frame, decoded from hc / vc (no flag registers)
-  wire        active = !ge_const(16'(hc), H_ACTIVE) && !ge_const(16'(vc), V_ACTIVE);
-  wire        hs0 = ge_const(16'(hc), H_ACTIVE + H_FRONT) && !ge_const(16'(hc), H_ACTIVE + H_FRONT + H_SYNC);
-  wire        vs0 = ge_const(16'(vc), V_ACTIVE + V_FRONT) && !ge_const(16'(vc), V_ACTIVE + V_FRONT + V_SYNC);
+  // visible part and sync pulses of the line and the frame, decoded from dhc / dvc (no flag registers)
+  wire        active = !ge_const(16'(dhc), H_ACTIVE) && !ge_const(16'(dvc), V_ACTIVE);
+  wire        hs0 = ge_const(16'(dhc), H_ACTIVE + H_FRONT) && !ge_const(16'(dhc), H_ACTIVE + H_FRONT + H_SYNC);
+  wire        vs0 = ge_const(16'(dvc), V_ACTIVE + V_FRONT) && !ge_const(16'(dvc), V_ACTIVE + V_FRONT + V_SYNC);
   reg  [31:0] word1;
   reg         on1, de1, hs1, vs1;
   reg  [1:0]  sub1;
-  always @(posedge clk) begin
-    if (pix_en) begin
+  always @(posedge dclk) begin
+    if (den) begin
       word1 <= lb[{l_half, widx[LINE_AW-1:0]}];
       sub1 <= sub;
     end
-    if (rst) begin
+    if (drst) begin
       {on1, de1, hs1, vs1} <= 4'd0;
-    end else if (pix_en) begin
+    end else if (den) begin
       on1 <= active && l_show && x_in && !widx[LINE_AW];
       de1 <= active;
       hs1 <= hs0;
@@ -273,18 +363,18 @@ module video_out #(
       default: byte_px = word1[7:0];
     endcase
   end
-  wire [7:0] r8 = ppw_l2 == 2'd0 ? word1[31:24] : ppw_l2 == 2'd1 ? {half[15:11], half[15:13]} : {4{byte_px[7:6]}};
-  wire [7:0] g8 = ppw_l2 == 2'd0 ? word1[23:16] : ppw_l2 == 2'd1 ? {half[10:5], half[10:9]} : {4{byte_px[5:4]}};
-  wire [7:0] b8 = ppw_l2 == 2'd0 ? word1[15:8] : ppw_l2 == 2'd1 ? {half[4:0], half[4:2]} : {4{byte_px[3:2]}};
+  wire [7:0] r8 = dppw == 2'd0 ? word1[31:24] : dppw == 2'd1 ? {half[15:11], half[15:13]} : {4{byte_px[7:6]}};
+  wire [7:0] g8 = dppw == 2'd0 ? word1[23:16] : dppw == 2'd1 ? {half[10:5], half[10:9]} : {4{byte_px[5:4]}};
+  wire [7:0] b8 = dppw == 2'd0 ? word1[15:8] : dppw == 2'd1 ? {half[4:0], half[4:2]} : {4{byte_px[3:2]}};
   // the bits below OUT_BITS and the alpha of RGBA2222 do not leave; rows past the line parity are
   // the fetch side's
   wire unused_ok = &{1'b0, byte_px[1:0], r8, g8, b8, x0_new, y0_m2_new};
-  always @(posedge clk) begin
-    if (rst) begin
+  always @(posedge dclk) begin
+    if (drst) begin
       {hsync, vsync} <= SYNC_NEG != 0 ? 2'b11 : 2'b00;
       de <= 1'b0;
       {red, green, blue} <= {(3 * OUT_BITS){1'b0}};
-    end else if (pix_en) begin
+    end else if (den) begin
       hsync <= hs1 ^ (SYNC_NEG != 0);
       vsync <= vs1 ^ (SYNC_NEG != 0);
       de <= de1;

@@ -5,6 +5,14 @@
 // it (frame_start with the frame's address at the vertical sync), and two frames of output checked
 // sample by sample against VESA 640 x 480 at 60 Hz timing and the expected picture (scaled, centred
 // or at the top left as the board's CENTRE says, expanded as docs/protocol.md section 6 says, black around it and before the first swap).
+// A board whose pixels have their own clock (PCLK = 1, the ULX3S) runs two clocks at their real ratio:
+// the core at 52.08 MHz, one picosecond a clock slower so that its phase drifts through every
+// position against the 25 MHz pixel clock, the scanout's counters advanced by the module's tick as
+// the scanout does; a core edge up to 2 ns after a pixel edge sees the pixel toggle metastable and
+// the first synchroniser stage resolves to the old or the new level at random. Every value the pixel
+// domain takes from the core at its line end must then have been still at least two core clocks
+// (less that aperture) before and after it (crossing (2) in video_out.v): the bench checks that at
+// every core-domain line end.
 #include <gtest/gtest.h>
 
 #include <cstdint>
@@ -13,6 +21,9 @@
 #include <vector>
 
 #include GPUBRIDGE_VIDEO_HEADER
+#if GPUBRIDGE_VIDEO_PCLK
+#include GPUBRIDGE_VIDEO_ROOT_HEADER
+#endif
 
 namespace {
 
@@ -23,6 +34,9 @@ constexpr int kBits = GPUBRIDGE_VIDEO_BITS;
 constexpr bool kCentre = GPUBRIDGE_VIDEO_CENTRE != 0;  // else a smaller picture is at the top left
 constexpr int kVaw = GPUBRIDGE_VIDEO_VAW;
 constexpr long kLineWords = 1L << GPUBRIDGE_VIDEO_LINE_AW;  // words of a line buffer half
+constexpr bool kPclk = GPUBRIDGE_VIDEO_PCLK != 0;           // pixels on their own clock
+// PCLK = 1: periods in picoseconds (ULX3S: 625 MHz / 25 and / 12, the core a picosecond slower to drift)
+constexpr long kPixPs = 40000, kCorePs = 19201, kAperturePs = 2000;
 
 struct Sample {
   bool hs, vs, de;
@@ -74,7 +88,9 @@ class VideoBench {
   // runs `cycles` core clocks from reset with the scanout's counters; the swap of `f` is latched where
   // the scanout's vertical sync falls (end of visible line 479), as frame_start does on a board
   // frame_addr: what the scanout hands over with frame_start (default: the frame's address / 16)
-  std::vector<Sample> run(const Frame& f, long cycles, std::uint32_t frame_addr = kAddrOfFrame) {
+  std::vector<Sample> run(const Frame& f, long pixels, std::uint32_t frame_addr = kAddrOfFrame) {
+    if (kPclk) return run_two_clocks(f, pixels, frame_addr);
+    const long cycles = pixels * kPixDiv;
     std::vector<Sample> out;
     const long line_clocks = long(kHTotal) * kPixDiv;
     const long vsync_cycle = (kVActive - 1) * line_clocks + line_clocks - 1;
@@ -102,10 +118,98 @@ class VideoBench {
   static constexpr std::uint32_t kAddrOfFrame = 0xFFFFFFFFu;  // not a 28-bit frame_addr
   long requests() const { return requests_; }
   long beyond_requests() const { return beyond_requests_; }
+  // PCLK = 1: the least time from a pixel-domain line end to the core-domain line end after it (ps)
+  long min_margin_ps() const { return min_margin_ps_; }
+  long metastable_samples() const { return metastable_; }
 
  private:
-  void tick() {
-    // the memory answers the oldest read whose latency has passed
+  // PCLK = 1: core and pixel edges in time order (both at once where they meet), the scanout's
+  // display counters in the core clock, advanced by `tick` (ld at reset and at the line's end)
+  std::vector<Sample> run_two_clocks(const Frame& f, long pixels, std::uint32_t frame_addr) {
+    std::vector<Sample> out;
+#if GPUBRIDGE_VIDEO_PCLK
+    auto& root = *m_.rootp;
+    const std::uint32_t latched = frame_addr == kAddrOfFrame ? f.addr / 16 : frame_addr;
+    long h = 0, v = 0, core_edges = 0;
+    bool swapped = false;
+    long tc = kCorePs, tp = kPixPs / 2 + dist_(rng_) * (kPixPs / 200);   // a phase of the seed's
+    long last_pe = -kPixPs, last_sample_pe = -kPixPs;   // the last pixel edge, the last pixel line end
+    bool toggle_before = false;                          // the pixel toggle before the last pixel edge
+    m_.clk = 0;
+    m_.pclk = 0;
+    m_.rst = 1;
+    m_.eval();
+    while (long(out.size()) < pixels) {
+      const long t = std::min(tc, tp);
+      const bool ce = tc == t, pe = tp == t;
+      bool line_end = false;
+      if (ce) {
+        m_.rst = core_edges < 16;   // video_out needs at least 12
+        core_inputs();
+        m_.eval();                  // tick, from the synchroniser's flip-flops
+        const bool tk = m_.tick != 0;
+        line_end = tk && h == kHTotal - 1;
+        const bool vsync = line_end && v == kVActive - 1;
+        m_.hcount = static_cast<std::uint16_t>(h);
+        m_.vcount = static_cast<std::uint16_t>(v);
+        m_.frame_start = vsync && !swapped;
+        m_.frame_addr = m_.frame_start ? latched : 0xFFFFFFFu;
+        m_.frame_format = static_cast<std::uint8_t>(f.format);
+        m_.frame_width = static_cast<std::uint16_t>(f.width);
+        m_.frame_height = static_cast<std::uint16_t>(f.height);
+        m_.eval();
+        memory_accepts();
+        if (m_.frame_start) swapped = true;
+        if (m_.rst) {
+          h = v = 0;
+        } else if (line_end) {
+          h = 0;
+          v = v == kVTotal - 1 ? 0 : v + 1;
+        } else if (tk) {
+          ++h;
+        }
+      }
+      if (pe) {
+        toggle_before = root.video_out__DOT__g_tick__DOT__ptoggle != 0;
+        if (root.video_out__DOT__g_pclk__DOT__phc == kHTotal - 1) last_sample_pe = t;
+        last_pe = t;
+      }
+      m_.clk = ce;
+      m_.pclk = pe;
+      m_.eval();
+      if (ce) {
+        // a core edge just after the toggle moved: the first stage resolves to either level
+        auto& sync = root.video_out__DOT__g_tick__DOT__tsync;
+        const bool seen = (sync & 1) != 0;
+        if (t - last_pe < kAperturePs && seen != toggle_before) {
+          ++metastable_;
+          if (dist_(rng_) < 50) sync = static_cast<std::uint8_t>((sync & ~1u) | (toggle_before ? 1u : 0u));
+        }
+        // everything the pixel domain samples at its line end changes at this line end
+        if (line_end) min_margin_ps_ = std::min(min_margin_ps_, t - last_sample_pe);
+        ++now_;
+        ++core_edges;
+        tc += kCorePs;
+      }
+      if (pe) {
+        out.push_back({m_.hsync != 0, m_.vsync != 0, m_.de != 0, m_.red, m_.green, m_.blue});
+        tp += kPixPs;
+      }
+      m_.clk = 0;
+      m_.pclk = 0;
+      m_.eval();
+    }
+#else
+    (void)f;
+    (void)pixels;
+    (void)frame_addr;
+#endif
+    return out;
+  }
+
+  // the memory's side of a core clock: it answers the oldest read whose latency has passed and
+  // refuses requests at random
+  void core_inputs() {
     m_.rsp_valid = 0;
     if (!inflight_.empty() && inflight_.front().due <= now_) {
       m_.rsp_valid = 1;
@@ -113,8 +217,20 @@ class VideoBench {
       inflight_.pop_front();
     }
     m_.req_ready = dist_(rng_) < 70;
+  }
+
+  void tick() {
+    core_inputs();
     m_.clk = 0;
     m_.eval();
+    memory_accepts();
+    m_.clk = 1;
+    m_.eval();
+    ++now_;
+  }
+
+  // a request taken in this clock (inputs settled, before the edge)
+  void memory_accepts() {
     if (m_.req_valid && m_.req_ready) {
       // a read at or beyond VRAM's end (2^VAW words) is answered with 0, in order, as the arbiter
       // does; the video asks for such a word only where the displayed buffer runs past VRAM
@@ -126,9 +242,6 @@ class VideoBench {
       ++requests_;
       if (a >= mem_.size()) ++beyond_requests_;
     }
-    m_.clk = 1;
-    m_.eval();
-    ++now_;
   }
 
   struct Read {
@@ -141,6 +254,7 @@ class VideoBench {
   std::vector<std::uint32_t> mem_;
   std::deque<Read> inflight_;
   long now_ = 0, requests_ = 0, beyond_requests_ = 0;
+  long min_margin_ps_ = 1L << 40, metastable_ = 0;
 };
 
 int top_bits(int v8) { return v8 >> (8 - kBits); }
@@ -190,7 +304,17 @@ Frame pattern(int format, int width, int height, std::uint32_t addr, std::uint32
   return f;
 }
 
-long two_frames_and_a_bit() { return (2L * kVTotal + 1) * kHTotal * kPixDiv + 64; }
+// pixels: two frames from the first data enable, and the line before it
+long two_frames_and_a_bit() { return (2L * kVTotal + 1) * kHTotal + 64; }
+
+// PCLK = 1: the crossings' margins held in a run (see the file's head)
+void check_crossings(const VideoBench& bench) {
+  if (!kPclk) return;
+  EXPECT_GE(bench.min_margin_ps(), 2 * kCorePs - kAperturePs)
+      << "a core-domain line end came too soon after the pixel domain sampled its values";
+  EXPECT_LT(bench.min_margin_ps(), 4 * kCorePs) << "the core's line end lags the pixels by more than the synchroniser";
+  EXPECT_GT(bench.metastable_samples(), 100) << "the drifting phase must reach the aperture";
+}
 
 }  // namespace
 
@@ -201,6 +325,7 @@ TEST(VideoOut, FullScreen) {
   VideoBench bench(11);
   bench.store(f);
   check(bench.run(f, two_frames_and_a_bit()), f);
+  check_crossings(bench);
 }
 
 // a smaller RGBA2222 buffer with an odd width, so lines start inside a word: centred (iCEBreaker: at the
@@ -210,6 +335,7 @@ TEST(VideoOut, Rgba2222OddWidthPlaced) {
   VideoBench bench(12);
   bench.store(f);
   check(bench.run(f, two_frames_and_a_bit()), f);
+  check_crossings(bench);
 }
 
 // the smallest buffers: one line (on the iCEBreaker two screen lines, whose last line decision wraps
@@ -219,10 +345,12 @@ TEST(VideoOut, OneAndTwoLines) {
   VideoBench ba(17);
   ba.store(a);
   check(ba.run(a, two_frames_and_a_bit()), a);
+  check_crossings(ba);
   const Frame b = pattern(1, 5, 2, 0x80, 8);
   VideoBench bb(18);
   bb.store(b);
   check(bb.run(b, two_frames_and_a_bit()), b);
+  check_crossings(bb);
 }
 
 // RGB565 with an odd width (lines start on half words), and RGBA8888
@@ -231,10 +359,12 @@ TEST(VideoOut, Rgb565OddWidthAndRgba8888) {
   VideoBench ba(13);
   ba.store(a);
   check(ba.run(a, two_frames_and_a_bit()), a);
+  check_crossings(ba);
   const Frame b = pattern(0, 64, 40, 0x100, 4);
   VideoBench bb(14);
   bb.store(b);
   check(bb.run(b, two_frames_and_a_bit()), b);
+  check_crossings(bb);
 }
 
 // a buffer larger than the screen is cropped at the right and bottom (shown from its top-left), and
@@ -245,6 +375,7 @@ TEST(VideoOut, LargerThanTheScreenIsCropped) {
   VideoBench bench(15);
   bench.store(f);
   check(bench.run(f, two_frames_and_a_bit()), f);
+  check_crossings(bench);
   EXPECT_LE(bench.requests(), long(kVActive / kScale + 3) * (kHActive / kScale / 4 + 2));
 }
 
@@ -257,6 +388,7 @@ TEST(VideoOut, ResetSizeRgba8888BeyondVramIsBlack) {
   VideoBench bench(16);
   bench.store(f, true);
   check(bench.run(f, two_frames_and_a_bit()), f, std::size_t{4} << kVaw);
+  check_crossings(bench);
   // where the buffer runs past VRAM (the iCEBreaker's 128 KiB), those words are asked of the arbiter,
   // which answers 0; the ULX3S's 32 MiB hold it all
   if (640L * 480 * 4 > (4L << kVaw))
@@ -275,4 +407,5 @@ TEST(VideoOut, FrameBeyondVramIsBlackWhateverItsLowBits) {
   const std::uint32_t above = (0xFFFFFFFu << (kVaw - 2)) & 0xFFFFFFFu;
   const Frame f{inside.format, inside.width, inside.height, std::uint32_t{4} << kVaw, inside.pixels};
   check(bench.run(f, two_frames_and_a_bit(), above | inside.addr / 16), f, 0);
+  check_crossings(bench);
 }
