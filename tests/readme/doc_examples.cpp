@@ -251,7 +251,7 @@ std::vector<Example> make() {
            "rewrites docs/gateware.md from reports that take an hour of synthesis and co-simulation, by hand"),
   }});
   all.push_back({"docs/gateware.md", "Building the bitstreams", 1, "docs_gateware_BuildingTheBitstreamsEcp5", {
-      skip("nextpnr-ecp5 --85k --package CABGA381 --speed 6 --lpf gateware/boards/ulx3s/ulx3s.lpf --freq 50 --json "
+      skip("nextpnr-ecp5 --85k --package CABGA381 --speed 6 --lpf gateware/boards/ulx3s/ulx3s.lpf --freq 52.083 --json "
            "build/gateware/boards/ulx3s.json --textcfg build/gateware/boards/ulx3s.config --report "
            "build/gateware/boards/ulx3s-pnr.json",
            "nextpnr-ecp5 is not in Debian 12; scripts/gateware.sh runs it when it is on PATH"),
