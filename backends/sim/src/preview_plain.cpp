@@ -147,6 +147,15 @@ SmallSetupRoutine small_setup_routine() {
   return has_avx512() ? &plain_avx512::setup_small : has_avx2() ? &plain_avx2::setup_small : &plain_baseline::setup_small;
 }
 
+SmallSetupRoutine small_setup_instance(unsigned isa) {
+  switch (isa) {
+    case 0: return &plain_baseline::setup_small;
+    case 1: return has_avx2() ? &plain_avx2::setup_small : nullptr;
+    case 2: return has_avx512() ? &plain_avx512::setup_small : nullptr;
+    default: return nullptr;
+  }
+}
+
 SmallKernel small_kernel(const DrawState& st) { return small_kernel_table()[st.preview_small - 1]; }
 
 SmallRecordKernel small_record_kernel(const DrawState& st) { return small_record_table()[st.preview_small - 1]; }

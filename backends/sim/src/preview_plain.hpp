@@ -142,6 +142,9 @@ using SmallSetupRoutine = SmallSetup (*)(const Vertex& a, const Vertex& b, const
 using SmallKernel = PreviewCounts (*)(const Triangle& t, const SmallTarget& d);
 using SmallRecordKernel = PreviewCounts (*)(const SmallTriangle& t, const SmallTarget& d);
 SmallSetupRoutine small_setup_routine();
+// One instance of the small setup: 0 the baseline, 1 AVX2, 2 AVX-512; null when this CPU cannot run
+// it. For the tests that compare the instances (the renderer uses small_setup_routine).
+SmallSetupRoutine small_setup_instance(unsigned isa);
 SmallKernel small_kernel(const DrawState& st);                // st.preview_small != 0
 SmallRecordKernel small_record_kernel(const DrawState& st);   // st.preview_small != 0
 
