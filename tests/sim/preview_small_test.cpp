@@ -234,6 +234,67 @@ TEST(SimPreviewSmall, RecognisesItsTriangles) {
   EXPECT_EQ(setup_small_preview(make(100, 130), make(140, 130), make(100, 134), st, 4, t), SmallSetup::Empty);
 }
 
+// The small setup's instances (baseline, AVX2, AVX-512 where the CPU has them) write the same
+// record: the vector instances round the Z plane in lanes (floor, then an exact split into 32-bit
+// halves) where the baseline calls round_mod64 per value. Random small triangles of random depth,
+// and slivers of D = 1 and 2 with far-apart depths, whose Z steps reach past 2^62 (the lanes fall
+// back to the scalar there) or land on halves.
+TEST(SimPreviewSmall, SetupInstancesWriteTheSameRecord) {
+  std::mt19937 rng(2413);
+  const SmallSetupRoutine base = small_setup_instance(0);
+  ASSERT_NE(base, nullptr);
+  unsigned compared = 0, thin = 0;
+  for (unsigned isa = 1; isa <= 2; ++isa) {
+    const SmallSetupRoutine vec = small_setup_instance(isa);
+    if (!vec) continue;  // this CPU lacks the instance
+    for (int i = 0; i < 20000; ++i) {
+      const DrawState st = random_state(rng, i % 2 == 0);
+      const bool sliver = i % 3 == 0;
+      const int cx = static_cast<int>(rng() % (kFbW * 16)), cy = static_cast<int>(rng() % (kFbH * 16));
+      Vertex a = random_vertex(rng, cx, cy, sliver ? 0 : 120), b = random_vertex(rng, cx, cy, sliver ? 0 : 120),
+             c = random_vertex(rng, cx, cy, sliver ? 0 : 120);
+      if (sliver) {  // a long thin triangle: b up to 127 away, c one or two subpixels off the line
+        b.x = a.x + static_cast<int>(rng() % 128);
+        b.y = a.y + static_cast<int>(rng() % 128);
+        c.x = a.x + 1;
+        c.y = a.y + static_cast<int>(rng() % 3);
+        if (i % 2) c.z = a.z ^ 0xFFFFFF;
+      }
+      SmallTriangle r0{}, r1{};
+      const SmallSetup s0 = base(a, b, c, st, i % 5 == 0 ? 3 : 4, r0);
+      const SmallSetup s1 = vec(a, b, c, st, i % 5 == 0 ? 3 : 4, r1);
+      ASSERT_EQ(s0, s1) << "isa " << isa << " case " << i;
+      if (s0 != SmallSetup::Drawn) continue;
+      ++compared;
+      thin += r0.den <= 4 && (st.z_test || st.z_write) ? 1u : 0u;  // D of 1 or 2: the steepest Z steps
+      ASSERT_EQ(r0.x0, r1.x0) << i;
+      ASSERT_EQ(r0.y0, r1.y0) << i;
+      ASSERT_EQ(r0.x1, r1.x1) << i;
+      ASSERT_EQ(r0.y1, r1.y1) << i;
+      ASSERT_EQ(r0.den, r1.den) << i;
+      ASSERT_EQ(r0.small, r1.small) << i;
+      for (int k = 0; k < 3; ++k) {
+        ASSERT_EQ(r0.e[k], r1.e[k]) << i;
+        ASSERT_EQ(r0.ex[k], r1.ex[k]) << i;
+        ASSERT_EQ(r0.ey[k], r1.ey[k]) << i;
+      }
+      for (int ch = 0; ch < 4; ++ch) {
+        ASSERT_EQ(r0.xplane.c[ch], r1.xplane.c[ch]) << i;
+        ASSERT_EQ(r0.xplane.cdx[ch], r1.xplane.cdx[ch]) << i;
+        ASSERT_EQ(r0.xplane.cdy[ch], r1.xplane.cdy[ch]) << i;
+      }
+      if (st.z_test || st.z_write) {
+        ASSERT_EQ(r0.xplane.z, r1.xplane.z) << "isa " << isa << " case " << i;
+        ASSERT_EQ(r0.xplane.zdx, r1.xplane.zdx) << "isa " << isa << " case " << i;
+        ASSERT_EQ(r0.xplane.zdy, r1.xplane.zdy) << "isa " << isa << " case " << i;
+      }
+    }
+  }
+  if (!small_setup_instance(1)) GTEST_SKIP() << "no vector instance on this CPU";
+  EXPECT_GT(compared, 10000u);
+  EXPECT_GT(thin, 100u);  // with far-apart depths: Z steps past 2^62, the lanes' scalar fallback
+}
+
 // Small triangles (up to 15 pixels wide and tall) around the 16-row band boundaries of the thread
 // split, in every plain state: 1, 2 and 3 threads and a second run give the same bytes; coverage
 // is the exact path's; colour and Z within 1 LSB of exact (depth ALWAYS with the write: the last

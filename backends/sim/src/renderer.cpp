@@ -11,8 +11,11 @@ Renderer::Renderer(VideoMemory& mem, const AccuracyKnobs& knobs, unsigned thread
       pool_(threads) {
   if (pool_.workers() > 1) {
     // Constructed once: a batch's triangles are set up in place (no triangle constructed per draw).
-    batch_.resize(kMaxBatch);
-    drawing_.resize(kMaxBatch);
+    for (Batch* b : {&batch_, &drawing_}) {
+      b->rows.resize(kMaxBatch);
+      b->small.resize(kMaxBatch);
+      b->full.resize(kMaxBatch);
+    }
   }
   draw_job_ = [this](unsigned worker) { draw_bands(worker); };
   hz_runs_.assign(pool_.workers(), 0);
@@ -25,6 +28,28 @@ namespace {
 bool hier_z_applies(const DrawState& st, bool vector) {
   return vector && st.z_test && (st.z_func == protocol::DepthFunc::Less || st.z_func == protocol::DepthFunc::LessEqual) &&
          st.z_in_vram && st.color_in_vram && st.buffers_disjoint;
+}
+
+// rasterize_small (rasterizer.hpp) for a compact record: the rows [row_begin, row_end) of a small
+// triangle, clipped to its box, counted into c.
+[[gnu::always_inline]] inline void draw_small(const SmallTriangle& t, const SmallDraw& d, SmallRecordKernel kernel,
+                                              RasterCounters& c, int row_begin, int row_end) {
+  const int ya = row_begin > t.y0 ? row_begin : t.y0, yz = row_end < t.y1 ? row_end : t.y1;
+  if (ya >= yz) return;
+  SmallTarget s;
+  const std::size_t pix = static_cast<std::size_t>(ya) * d.width + static_cast<std::size_t>(t.x0);
+  s.color = d.color + pix * 4;
+  if (d.depth) s.depth = d.depth + pix * 4;
+  s.pitch = d.pitch;
+  s.ky0 = ya - t.y0;
+  s.rows = yz - ya;
+  s.zmask = d.zmask;
+  s.z_write = d.z_write;
+  const PreviewCounts n = kernel(t, s);
+  c.scanned += n.scanned;  // count_drawn's counts
+  c.covered += n.covered;
+  c.passed += n.passed;
+  if (d.blended) c.blended += n.passed;
 }
 }  // namespace
 
@@ -47,12 +72,12 @@ Renderer::~Renderer() { wait_drawing(); }  // the workers read drawing_: stop th
 // positions miss the caches): start those loads for the triangle just set up, so they overlap
 // drawing the previous one and setting up the next. Its clipped bounding box is known by now (a
 // box from the raw vertices before setup cost 60 more instructions per triangle).
-[[gnu::always_inline]] inline void Renderer::prefetch_rows(const Triangle& t, const DrawState& st) const {
+[[gnu::always_inline]] inline void Renderer::prefetch_rows(int x0, int y0, int x1, int y1, const DrawState& st) const {
   if (!st.color_in_vram || !st.z_in_vram) return;
-  const int rows = std::min(t.y1 - t.y0, 8);
+  const int rows = std::min(y1 - y0, 8);
   // The row's first 8 pixels (32 bytes at 4 bytes per pixel) may straddle two cache lines.
-  const std::size_t last = static_cast<std::size_t>(std::min(7, t.x1 - 1 - t.x0));
-  const std::size_t first = static_cast<std::size_t>(t.y0) * st.fb_width + static_cast<std::size_t>(t.x0);
+  const std::size_t last = static_cast<std::size_t>(std::min(7, x1 - 1 - x0));
+  const std::size_t first = static_cast<std::size_t>(y0) * st.fb_width + static_cast<std::size_t>(x0);
   const std::uint8_t* color = mem_.data() + st.fb_draw + first * st.bpp;
   const std::size_t cpitch = std::size_t{st.fb_width} * st.bpp, clast = last * st.bpp;
   if (!st.z_test && !st.z_write) {
@@ -76,29 +101,33 @@ Renderer::~Renderer() { wait_drawing(); }  // the workers read drawing_: stop th
 // Preview mode sets up float planes for the preview routine where it applies (the exact path
 // draws the rest).
 // Inlined into both callers: a call per triangle costs more than its checks.
-[[gnu::always_inline]] inline bool Renderer::setup(const Vertex& a, const Vertex& b, const Vertex& c,
-                                                   const DrawState& st, bool observing, Triangle& t) const {
+[[gnu::always_inline]] inline Renderer::SetUp Renderer::setup(const Vertex& a, const Vertex& b, const Vertex& c,
+                                                              const DrawState& st, bool observing, Triangle& t,
+                                                              SmallTriangle& s) const {
   // Small triangles of a plain untextured preview draw: their own setup (setup_triangle_preview's
-  // first step), entered directly.
+  // first step), entered directly, into the compact record.
   if (knobs_.preview && st.preview_small != 0 && !observing) {
-    const SmallSetup s = small_setup_(a, b, c, st, knobs_.subpixel_bits, t);
-    if (s != SmallSetup::NotSmall) return s == SmallSetup::Drawn;
+    const SmallSetup r = small_setup_(a, b, c, st, knobs_.subpixel_bits, s);
+    if (r != SmallSetup::NotSmall) return r == SmallSetup::Drawn ? SetUp::Small : SetUp::None;
   }
-  return knobs_.preview && st.preview_ok ? setup_triangle_preview(a, b, c, st, knobs_.subpixel_bits, observing, t)
-                                         : setup_triangle(a, b, c, st, knobs_.subpixel_bits, observing, t);
+  const bool drawn = knobs_.preview && st.preview_ok
+                         ? setup_triangle_preview(a, b, c, st, knobs_.subpixel_bits, observing, t)
+                         : setup_triangle(a, b, c, st, knobs_.subpixel_bits, observing, t);
+  return drawn ? SetUp::Full : SetUp::None;
 }
 
 // Inlined into draw(): a call per small triangle costs more than its body.
 [[gnu::always_inline]] inline void Renderer::draw_pending() {
   if (pending_ < 0) return;
-  const Triangle& t = slots_[pending_];
-  if (t.small) {  // no errors (both buffers inside memory), counters straight into the totals
+  if (pending_is_small_) {  // no errors (both buffers inside memory), counters straight into the totals
+    const SmallTriangle& s = small_slots_[pending_];
     const std::uint64_t covered = counters_.covered;
-    rasterize_small(t, pending_small_, counters_, t.y0, t.y1);
+    draw_small(s, pending_small_, pending_small_kernel_, counters_, s.y0, s.y1);
     modes_[pending_state_->mode_class].pixels += counters_.covered - covered;
     pending_ = -1;
     return;
   }
+  const Triangle& t = slots_[pending_];
   RasterContext ctx{mem_, recip_, knobs_.z_bits, 0, {}, vector_};
   // Boxes narrower than the span solve's 16 pixels never ask the bounds (their writes not marked
   // only leave bounds looser): no set-up for them (10-px triangles).
@@ -130,13 +159,22 @@ void Renderer::draw(const Vertex& a, const Vertex& b, const Vertex& c, const std
     // the workers instead (an equal run each, then a barrier, then the bands) took the front end's
     // setup off the busiest thread but lost this overlap: on two cores it was slower at 2 threads
     // (10-px triangles, exact 7.8 -> 6.9, preview 15.5 -> 10.2 Mtri/s; docs/simulator.md, "Threads").
-    Triangle& t = batch_[batch_n_];
-    if (!setup(a, b, c, st, false, t)) {
+    BatchRows& rows = batch_.rows[batch_n_];
+    Triangle& t = batch_.full[batch_n_];
+    SmallTriangle& s = batch_.small[batch_n_];
+    const SetUp how = setup(a, b, c, st, false, t, s);
+    if (how == SetUp::None) {
       ++rejected_;
       return;
     }
-    t.index = index;
-    count_rasterised(t, st);
+    if (how == SetUp::Small) {
+      rows = {s.y0, s.y1, true};
+      count_box(s.x0, s.y0, s.x1, s.y1, st);
+    } else {
+      rows = {static_cast<std::int16_t>(t.y0), static_cast<std::int16_t>(t.y1), false};
+      t.index = index;
+      count_rasterised(t, st);
+    }
     if (batch_n_ == 0) batch_gen_ = hz_gen_;  // one state and no flush within a batch: one generation
     if (batch_state_ != state) batch_state_ = state;
     if (++batch_n_ >= batch_limit_) submit();
@@ -147,33 +185,49 @@ void Renderer::draw(const Vertex& a, const Vertex& b, const Vertex& c, const std
   // the prefetched rows of this one arrive while it is drawn (order of pixel writes unchanged).
   const int slot = pending_ == 0 ? 1 : 0;
   Triangle& t = slots_[slot];
-  if (!setup(a, b, c, st, observing, t)) {
+  SmallTriangle& s = small_slots_[slot];
+  const SetUp how = setup(a, b, c, st, observing, t, s);
+  if (how == SetUp::None) {
     ++rejected_;
     return;
   }
-  t.index = index;
-  count_rasterised(t, st);
-  if (observing) observe_triangle(t, st, observer_);
-  if (st.writes_nothing) return;
-  prefetch_rows(t, st);
+  const bool small = how == SetUp::Small;  // never observed, never a state that writes nothing
+  if (small) {
+    count_box(s.x0, s.y0, s.x1, s.y1, st);
+    prefetch_rows(s.x0, s.y0, s.x1, s.y1, st);
+  } else {
+    t.index = index;
+    count_rasterised(t, st);
+    if (observing) observe_triangle(t, st, observer_);
+    if (st.writes_nothing) return;
+    prefetch_rows(t.x0, t.y0, t.x1, t.y1, st);
+  }
   draw_pending();
   pending_ = slot;
+  pending_is_small_ = small;
   pending_gen_ = hz_gen_;
   // The state object is shared with the device: copy the pointer (an atomic count update)
   // only when it changed, not once per triangle.
   if (pending_state_ != state) {
     pending_state_ = state;
     pending_hz_ = hier_z_applies(st, vector_);
-    if (knobs_.preview && st.preview_small != 0) pending_small_ = small_draw(st, mem_, knobs_.z_bits);
+    if (knobs_.preview && st.preview_small != 0) {
+      pending_small_ = small_draw(st, mem_, knobs_.z_bits);
+      pending_small_kernel_ = small_record_kernel(st);
+    }
   }
 }
 
-void Renderer::count_rasterised(const Triangle& t, const DrawState& st) {
+[[gnu::always_inline]] inline void Renderer::count_box(int x0, int y0, int x1, int y1, const DrawState& st) {
   ++rasterised_;
   auto& mode = modes_[st.mode_class];
   ++mode.triangles;
-  mode.rows += static_cast<std::uint64_t>(t.y1 - t.y0);
-  mode.columns += static_cast<std::uint64_t>(t.x1 - t.x0);
+  mode.rows += static_cast<std::uint64_t>(y1 - y0);
+  mode.columns += static_cast<std::uint64_t>(x1 - x0);
+}
+
+void Renderer::count_rasterised(const Triangle& t, const DrawState& st) {
+  count_box(t.x0, t.y0, t.x1, t.y1, st);
   if (!count_rows_ || t.small || st.writes_nothing) return;
   const std::uint64_t covered = access_triangle_rows(sdram_, texel_cache_, t, st);
   if (st.mode_class & 4) texel_footprint_ += texel_footprint_bytes(t, st, covered);
@@ -226,14 +280,25 @@ void Renderer::draw_bands(unsigned worker) {
   const DrawState& st = *drawing_state_;
   const unsigned n = pool_.workers();
   RasterContext& c = drawing_ctx_[worker];
-  const SmallDraw small = knobs_.preview && st.preview_small != 0 ? small_draw(st, mem_, knobs_.z_bits) : SmallDraw{};
-  for (std::size_t i = 0; i < drawing_n_; ++i) {
-    const Triangle& t = drawing_[i];
-    int band = t.y0 / kBandRows;
-    band += static_cast<int>((worker + n - static_cast<unsigned>(band) % n) % n);
-    for (; band * kBandRows < t.y1; band += static_cast<int>(n)) {
-      if (t.small) rasterize_small(t, small, c.counters, band * kBandRows, (band + 1) * kBandRows);
-      else rasterize_rows(t, st, c, band * kBandRows, (band + 1) * kBandRows);
+  const bool has_small = knobs_.preview && st.preview_small != 0;
+  const SmallDraw small = has_small ? small_draw(st, mem_, knobs_.z_bits) : SmallDraw{};
+  const SmallRecordKernel kernel = has_small ? small_record_kernel(st) : nullptr;
+  // In locals: the kernels are called through pointers, so the compiler would load the batch's
+  // fields again for every triangle.
+  const BatchRows* const rows = drawing_.rows.data();
+  const SmallTriangle* const smalls = drawing_.small.data();
+  const Triangle* const full = drawing_.full.data();
+  const std::size_t count = drawing_n_;
+  for (std::size_t i = 0; i < count; ++i) {
+    const BatchRows r = rows[i];
+    // This worker's first band from the box's first (boxes lie inside the clip rectangle: y0 >= 0):
+    // one division by n per triangle, not two.
+    const unsigned first = static_cast<unsigned>(r.y0) / kBandRows;
+    unsigned ahead = worker + n - first % n;
+    if (ahead >= n) ahead -= n;
+    for (int band = static_cast<int>(first + ahead); band * kBandRows < r.y1; band += static_cast<int>(n)) {
+      if (r.small) draw_small(smalls[i], small, kernel, c.counters, band * kBandRows, (band + 1) * kBandRows);
+      else rasterize_rows(full[i], st, c, band * kBandRows, (band + 1) * kBandRows);
     }
   }
 }

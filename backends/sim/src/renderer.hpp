@@ -80,11 +80,16 @@ class Renderer {
   void wait_drawing();
   void draw_bands(unsigned worker);
   void draw_pending();
-  void prefetch_rows(const Triangle& t, const DrawState& st) const;
-  // Sets up a triangle as the state and the accuracy want it (false: it draws nothing).
-  bool setup(const Vertex& a, const Vertex& b, const Vertex& c, const DrawState& st, bool observing, Triangle& t) const;
+  void prefetch_rows(int x0, int y0, int x1, int y1, const DrawState& st) const;
+  // How a triangle was set up: not at all (it draws nothing), as a compact small-triangle record
+  // (SmallTriangle, preview) or as a Triangle.
+  enum class SetUp { None, Small, Full };
+  // Sets up a triangle as the state and the accuracy want it, into s or t.
+  SetUp setup(const Vertex& a, const Vertex& b, const Vertex& c, const DrawState& st, bool observing, Triangle& t,
+              SmallTriangle& s) const;
   // Counts a triangle that was set up (rasterised, and its state class's triangles, rows, columns).
   void count_rasterised(const Triangle& t, const DrawState& st);
+  void count_box(int x0, int y0, int x1, int y1, const DrawState& st);
   // A context for drawing with st in coarse-depth generation gen, for worker w (hier_z.hpp).
   RasterContext context(const DrawState& st, std::uint64_t gen, unsigned w);
   // Lets ctx use the coarse depth bounds for st in generation gen, as worker w's run (no worker draws).
@@ -100,20 +105,36 @@ class Renderer {
   ReciprocalUnit recip_;
   BandPool pool_;
   PixelObserver observer_;
-  std::vector<Triangle> batch_;  // being filled by the front end: its first batch_n_
+  // What a band worker reads of every triangle of a batch to find its rows (the box rows, and
+  // whether the triangle is in the batch's compact small records or its Triangles): 6 bytes
+  // instead of a line of a 920-byte Triangle for the triangles not in its bands.
+  struct BatchRows {
+    std::int16_t y0 = 0, y1 = 0;
+    bool small = false;
+  };
+  // A batch: entry i is rows[i] and, as rows[i].small says, small[i] or full[i].
+  struct Batch {
+    std::vector<BatchRows> rows;
+    std::vector<SmallTriangle> small;
+    std::vector<Triangle> full;
+  };
+  Batch batch_;  // being filled by the front end: its first batch_n_
   std::size_t batch_n_ = 0;
   std::size_t batch_limit_ = kFirstBatch;  // the filling batch is handed over at this many triangles
   std::shared_ptr<const DrawState> batch_state_;
-  std::vector<Triangle> drawing_;  // being drawn by the workers: its first drawing_n_
+  Batch drawing_;  // being drawn by the workers: its first drawing_n_
   std::size_t drawing_n_ = 0;
   std::shared_ptr<const DrawState> drawing_state_;
   std::vector<RasterContext> drawing_ctx_;  // one per worker
   bool drawing_active_ = false;
   std::function<void(unsigned)> draw_job_;
   Triangle slots_[2];
+  SmallTriangle small_slots_[2];
   int pending_ = -1;  // slot set up but not yet drawn (single-thread pipelining)
+  bool pending_is_small_ = false;  // the pending triangle is small_slots_[pending_], not slots_[pending_]
   std::shared_ptr<const DrawState> pending_state_;
   SmallDraw pending_small_;  // for pending_state_ when it has small preview triangles
+  SmallRecordKernel pending_small_kernel_ = nullptr;
   SmallSetupRoutine small_setup_ = small_setup_routine();
   std::uint16_t errors_ = 0;
   std::uint64_t rasterised_ = 0;

@@ -94,6 +94,21 @@ struct Triangle {
   FixedPlanes xplane;                   // preview of an untextured state: fplane in fixed point
 };
 
+// A small triangle of an untextured plain preview draw as its kernel reads it (preview_plain.hpp
+// "Small triangles"): what setup_small writes and the row kernel reads, 128 bytes (two cache
+// lines) against a Triangle's 920. The renderer's batches carry these for small triangles, so the
+// band workers read what the device thread wrote in two lines per triangle (docs/simulator.md,
+// "Ninth round" of the preview). Every edge value at a box pixel of such a triangle fits 32 bits
+// (below 2^17), so do its steps (16 times a coordinate difference below 2^8).
+struct alignas(64) SmallTriangle {
+  FixedPlanes xplane;                   // colour in 8.24, Z in 32.32 (the Triangle's xplane)
+  std::int32_t e[3], ex[3], ey[3];      // biased edge values at the box origin, steps (Triangle::edge)
+  std::int32_t den = 0;                 // 2D
+  std::int16_t x0 = 0, y0 = 0, x1 = 0, y1 = 0;  // clipped bounding box (a clip rectangle is below 2^11)
+  std::uint8_t small = 0;               // preview small-triangle kernel + 1 (Triangle::small)
+};
+static_assert(sizeof(SmallTriangle) == 128, "two cache lines");
+
 // Returns false when the triangle draws nothing (D = 0 or an empty clipped box). Planes are set up
 // only for the attributes the state needs (colour when Gouraud, S/T/Q when textured, Z when the
 // depth test or depth write is on). subpixel_bits < 4 truncates vertex coordinates first.
