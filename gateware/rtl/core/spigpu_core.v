@@ -71,6 +71,17 @@ module spigpu_core #(
   localparam integer PW     = IDX_W + 60 + ((TEX != 0) ? 96 : 0);        // pixel record
   localparam integer CW     = IDX_W + 36;                         // colour stage record
   localparam [1:0] OP_TRI = 2'd0, OP_CLEAR = 2'd1, OP_CLEAR_Z = 2'd2;
+  // up5k: the rasteriser's column and row bits. The soc's FB_FORMAT holds a width and height of
+  // at most MAX_WIDTH x MAX_HEIGHT or its reset value 640 x 480 (command_exec's WB, HB bits), and
+  // every column and row drawn is below them (fit9, docs/gateware.md); ecp5 keeps 11 bits.
+  localparam integer RAS_XW = (SMALL != 0) ? $clog2(((MAX_WIDTH > 640) ? MAX_WIDTH : 640) + 1) : 11;
+  localparam integer RAS_YW = (SMALL != 0) ? $clog2(((MAX_HEIGHT > 480) ? MAX_HEIGHT : 480) + 1) : 11;
+  // up5k: the colour buffer's base as its block bits below 2^ADDR_W and one bit for "any above"
+  // (all core_color's byte_addr reads of it), so the draw's copy keeps 14 flip-flops, not 28
+  localparam integer BLK_W = ADDR_W - 4;
+  function [27:0] fold_base(input [27:0] b16);
+    fold_base = 28'({|(b16 >> BLK_W), b16[BLK_W-1:0]});
+  endfunction
 
   // ---------------------------------------------------------------- command decode
   wire [10:0] sc_x0 = cmd_scissor[10:0], sc_y0 = cmd_scissor[21:11];
@@ -177,7 +188,7 @@ module spigpu_core #(
   reg         ras_go;
   wire        adv, hold;
   wire        draw_go;   // the draw starts: render state copied, command accepted (sequencer below)
-  core_raster #(.DSP(SMALL)) raster (
+  core_raster #(.DSP(SMALL), .XW(RAS_XW), .YW(RAS_YW)) raster (
       .clk(clk), .rst(rst), .start(ras_go),
       .e_we(su_e_we), .e_data(su_e_data), .e0(ras_e0), .e1(ras_e1), .e2(ras_e2),
       .dx0(su_dx0), .dx1(su_dx1), .dx2(su_dx2), .dy0(su_dy0), .dy1(su_dy1), .dy2(su_dy2),
@@ -194,7 +205,7 @@ module spigpu_core #(
     if (SMALL != 0) begin : tm_steppers
       // one shared datapath, a cycle per interpolated attribute per move
       wire [31:0] tm_rgba;
-      core_interp_tm #(.RW(35)) interp (
+      core_interp_tm #(.RW(35), .QW((DEPTH != 0) ? 24 : 8)) interp (
           .clk(clk), .rst(rst), .we(pw_en), .attr(pw_attr), .field(pw_field), .wq(pw_q[23:0]),
           .wr(pw_r), .den(su_den), .mask(r_need[4:0]),
           // a flat draw's colour and a clear's value straight into the output registers when
@@ -451,7 +462,7 @@ module spigpu_core #(
           ras_go      <= 1'b1;
           cst         <= C_IDLE;
           r_fmt       <= cmd_fb_format;
-          r_fb_draw   <= cmd_fb_draw;
+          r_fb_draw   <= (SMALL != 0) ? fold_base(cmd_fb_draw) : cmd_fb_draw;
           r_fb_z      <= cmd_fb_z;
           r_tex_base  <= cmd_tex_base;
           r_tex_fmt   <= cmd_tex_fmt;
