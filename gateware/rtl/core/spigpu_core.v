@@ -268,7 +268,9 @@ module spigpu_core #(
   // up5k: the stepper's output registers hold a flat colour and a clear's depth too (loaded when
   // the draw starts), so the record needs no choice; ecp5 keeps them in r_flat
   wire [31:0] src_rgba = (SMALL != 0 || r_gouraud) ? {a_r, a_g, a_b, a_a} : r_flat;
-  wire [23:0] src_z = (SMALL == 0 && r_zsel) ? r_flat[23:0] : a_z;
+  // without a depth buffer the record's depth is 0: nothing reads it, and the steppers' depth
+  // register then goes (fit9, docs/gateware.md)
+  wire [23:0] src_z = (DEPTH == 0) ? 24'd0 : (SMALL == 0 && r_zsel) ? r_flat[23:0] : a_z;
   wire [PW-1:0] pix;
   generate
     if (TEX != 0) begin : pix_tex
@@ -284,12 +286,24 @@ module spigpu_core #(
   wire         zr_valid, zr_ready, zr_rsp, zw_valid, zw_ready;
   wire [29:0]  zr_addr, zw_addr;
   wire [23:0]  zw_data;
+  // Without a depth buffer the stage never reads or writes (Z_TEST and Z_WRITE are 0): its
+  // requests are constants here, so the memory port's choices lose their depth inputs (its
+  // address and data multiplexers took them as their default, keeping the depth address adder,
+  // FB_Z's copy and the steppers' depth register alive; fit9, docs/gateware.md)
+  wire         zr_valid_d, zw_valid_d;
+  wire [29:0]  zr_addr_d, zw_addr_d;
+  wire [23:0]  zw_data_d;
+  assign zr_valid = (DEPTH != 0) && zr_valid_d;
+  assign zw_valid = (DEPTH != 0) && zw_valid_d;
+  assign zr_addr  = (DEPTH != 0) ? zr_addr_d : 30'd0;
+  assign zw_addr  = (DEPTH != 0) ? zw_addr_d : 30'd0;
+  assign zw_data  = (DEPTH != 0) ? zw_data_d : 24'd0;
   core_depth #(.PW(PW), .ZLSB(IDX_W), .IDX_W(IDX_W), .AW(Q_AW), .ADDR_W(ADDR_W), .OUT_REG(1 - SMALL)) depth (
       .clk(clk), .rst(rst), .z_test(r_ztest), .z_func(r_zfunc), .z_write(r_zwrite), .fb_z16(r_fb_z),
       .in_valid(emit2), .in_ready(d_in_ready), .in_pix(pix),
       .out_valid(d_out_valid), .out_ready(d_out_ready), .out_pix(d_out),
-      .rd_valid(zr_valid), .rd_ready(zr_ready), .rd_addr(zr_addr), .rsp_valid(zr_rsp), .rsp_data(mem_rsp_rdata[23:0]),
-      .wr_valid(zw_valid), .wr_ready(zw_ready), .wr_addr(zw_addr), .wr_data(zw_data), .idle(d_idle),
+      .rd_valid(zr_valid_d), .rd_ready(zr_ready), .rd_addr(zr_addr_d), .rsp_valid(zr_rsp), .rsp_data(mem_rsp_rdata[23:0]),
+      .wr_valid(zw_valid_d), .wr_ready(zw_ready), .wr_addr(zw_addr_d), .wr_data(zw_data_d), .idle(d_idle),
       .passed(d_passed));
 
   // ---------------------------------------------------------------- texture unit
