@@ -218,14 +218,23 @@ module core_color #(
   wire [3:0] t5 = dith ? {1'b0, thr[3:1]} : 4'd0;  // (t << 3) >> 4
   wire [3:0] t6 = dith ? {2'b0, thr[3:2]} : 4'd0;  // (t << 2) >> 4
   wire [7:0] t2 = dith ? {2'd0, thr, 2'd0} : 8'd0; // (t << 6) >> 4
-  wire [4:0] r5q = tdith ? 5'(temporal_q(cr, 3'd5, thr)) : 5'(sat8({1'b0, cr} + {5'd0, t5}) >> 3);
-  wire [5:0] g6q = tdith ? temporal_q(cg, 3'd6, thr) : 6'(sat8({1'b0, cg} + {5'd0, t6}) >> 2);
-  wire [4:0] b5q = tdith ? 5'(temporal_q(cb, 3'd5, thr)) : 5'(sat8({1'b0, cb} + {5'd0, t5}) >> 3);
-  function [1:0] q2(input [7:0] v, input [7:0] add, input td, input [3:0] t);
-    q2 = td ? 2'(temporal_q(v, 3'd2, t)) : 2'(sat8({1'b0, v} + {1'b0, add}) >> 6);
+  // PACKQ (up5k, no temporal dither): one saturating add per channel for both packed formats,
+  // its threshold scaled by the format (RGBA2222: t2, RGB565: t5 or t6), instead of an adder
+  // per channel and format (fit9, docs/gateware.md: 16 carry cells)
+  wire       f2 = (fmt == 2'd2);
+  wire [7:0] sq_r = sat8({1'b0, cr} + {1'b0, f2 ? t2 : {4'd0, t5}});
+  wire [7:0] sq_g = sat8({1'b0, cg} + {1'b0, f2 ? t2 : {4'd0, t6}});
+  wire [7:0] sq_b = sat8({1'b0, cb} + {1'b0, f2 ? t2 : {4'd0, t5}});
+  wire [7:0] sq_a = sat8({1'b0, ca} + {1'b0, t2});
+  wire [4:0] r5q = tdith ? 5'(temporal_q(cr, 3'd5, thr)) : (PACKQ != 0) ? sq_r[7:3] : 5'(sat8({1'b0, cr} + {5'd0, t5}) >> 3);
+  wire [5:0] g6q = tdith ? temporal_q(cg, 3'd6, thr) : (PACKQ != 0) ? sq_g[7:2] : 6'(sat8({1'b0, cg} + {5'd0, t6}) >> 2);
+  wire [4:0] b5q = tdith ? 5'(temporal_q(cb, 3'd5, thr)) : (PACKQ != 0) ? sq_b[7:3] : 5'(sat8({1'b0, cb} + {5'd0, t5}) >> 3);
+  function [1:0] q2(input [7:0] v, input [7:0] add, input [1:0] s, input td, input [3:0] t);
+    q2 = td ? 2'(temporal_q(v, 3'd2, t)) : (PACKQ != 0) ? s : 2'(sat8({1'b0, v} + {1'b0, add}) >> 6);
   endfunction
-  wire [1:0] r2q = q2(cr, t2, tdith, thr), g2q = q2(cg, t2, tdith, thr);
-  wire [1:0] b2q = q2(cb, t2, tdith, thr), a2q = q2(ca, t2, tdith, thr);
+  wire [1:0] r2q = q2(cr, t2, sq_r[7:6], tdith, thr), g2q = q2(cg, t2, sq_g[7:6], tdith, thr);
+  wire [1:0] b2q = q2(cb, t2, sq_b[7:6], tdith, thr), a2q = q2(ca, t2, sq_a[7:6], tdith, thr);
+  wire unused_sq = &{1'b0, sq_r[2:0], sq_g[1:0], sq_b[2:0], sq_a[5:0]};
 
   // ---- pack, write mask ----
   assign pk_n = (fmt == 2'd1) ? {r5q, g6q, b5q} : {8'd0, r2q, g2q, b2q, a2q};

@@ -17,7 +17,9 @@
 // Outputs form a two-stage pipeline with the steppers: `op` (stepper move), `emit` and the
 // pixel position are registered together; the steppers apply `op` in the next enabled cycle.
 module core_raster #(
-    parameter integer DSP = 0    // 1: the edge values in three SB_MAC16 accumulators (iCE40)
+    parameter integer DSP = 0,   // 1: the edge values in three SB_MAC16 accumulators (iCE40)
+    parameter integer XW = 11,   // bits of a column and of a row: every column is below
+    parameter integer YW = 11    //   FB_FORMAT.WIDTH, every row below HEIGHT (the soc's bounds)
 ) (
     input  wire               clk,
     input  wire               rst,
@@ -48,10 +50,12 @@ module core_raster #(
   localparam DIR_R = 1'b0, DIR_L = 1'b1;
 
   reg [2:0] st;
-  reg [10:0] x, y;
+  reg [XW-1:0] x;
+  reg [YW-1:0] y;
   // the last column and row: setup holds the box while the walk runs (a setup starts only when the
-  // rasteriser is idle), so no copy of it is kept here
-  wire [10:0] xlo = box_x0, xhi = box_xl, yhi = box_y1 - 11'd1;
+  // rasteriser is idle), so no copy of it is kept here; all below 2^XW and 2^YW
+  wire [XW-1:0] xlo = box_x0[XW-1:0], xhi = box_xl[XW-1:0];
+  wire [YW-1:0] yhi = box_y1[YW-1:0] - YW'(1);
   // x != xhi, x != xlo, y == yhi, registered: compared when x or y is loaded or moves (the
   // comparison of the position the move reaches, which does not wait for the step decision), so
   // the decision reads one flip-flop each instead of an 11-bit comparison
@@ -264,8 +268,8 @@ module core_raster #(
 
   // one adder each: the position a move of `sel` reaches (or the start), x +/- 1, y + 1, and its
   // bound flags; the decision only enables the registers
-  wire [10:0] x_mv = (start ? x_start : x) + (start ? 11'd0 : (sel == OP_LEFT) ? 11'h7FF : 11'd1);
-  wire [10:0] y_mv = start ? box_y0 : y + 11'd1;
+  wire [XW-1:0] x_mv = (start ? x_start[XW-1:0] : x) + (start ? XW'(0) : (sel == OP_LEFT) ? {XW{1'b1}} : XW'(1));
+  wire [YW-1:0] y_mv = start ? box_y0[YW-1:0] : y + YW'(1);
   wire        hmove = commit && (sel == OP_RIGHT || sel == OP_LEFT);
   wire        vmove = commit && (sel == OP_DOWN);
   always @(posedge clk) begin
@@ -315,4 +319,5 @@ module core_raster #(
   assign py   = y[1:0];
 
   assign commit = !rst && !start && adv && !hold && st != R_IDLE && go;
+  wire unused_box = &{1'b0, box_x0, box_xl, box_y0, box_y1, x_start};  // bits above XW / YW
 endmodule

@@ -103,18 +103,22 @@ module core_setup_tm #(
   reg  [2:0] ak;
   reg  [6:0] pc;
   reg        fw_ok;     // vp_data is the word the instruction's field select names
-  assign vp_addr = (pc == 7'd0) ? vp_idle : {fsel[1:0], !fsel[3] ? 2'd0 : ak[2] ? 2'd1 : 2'd2};
+  // ak = 4 is Z. Without a depth buffer no Z plane is set up (need[4] = 0, so A_NEXTA chooses 4
+  // only when no attribute is left, and branches away in the same instruction): the attribute
+  // field, the vertex word and the multiply's bit count are a colour's (fit9, docs/gateware.md)
+  wire       ak_z = (DEPTH != 0) && ak[2];
+  assign vp_addr = (pc == 7'd0) ? vp_idle : {fsel[1:0], !fsel[3] ? 2'd0 : ak_z ? 2'd1 : 2'd2};
   reg  [AW-1:0] fld;
   always @(*) begin
     case (fsel[3:2])
       2'd0: fld = AW'($signed(vp_data[15:0]));
       2'd1: fld = AW'($signed(vp_data[31:16]));
-      2'd2: case (ak)
-              3'd0: fld = AW'(vp_data[31:24]);
-              3'd1: fld = AW'(vp_data[23:16]);
-              3'd2: fld = AW'(vp_data[15:8]);
-              3'd3: fld = AW'(vp_data[7:0]);
-              default: fld = AW'(vp_data[23:0]);
+      2'd2: if (ak_z) fld = AW'(vp_data[23:0]);
+            else case (ak[1:0])
+              2'd0: fld = AW'(vp_data[31:24]);
+              2'd1: fld = AW'(vp_data[23:16]);
+              2'd2: fld = AW'(vp_data[15:8]);
+              default: fld = AW'(vp_data[7:0]);
             endcase
       default: fld = AW'({fsel[0] ? x_start : box_y0, 4'b1000});
     endcase
@@ -226,7 +230,10 @@ module core_setup_tm #(
   reg        box2;  // rd is the bottom vertex's Y
   wire signed [15:0] rc = $signed(rd[15:0]);
   // samples 16p + 8 inside [min, max]: p from (min + 7) >> 4 to (max + 8) >> 4, exclusive
-  wire signed [12:0] fy = 13'(($signed({rc[15], rc}) + (box2 ? 17'sd8 : 17'sd7)) >>> 4);
+  // as (rc >> 4) + the carry out of rc's low four bits (+ 8: rc[3]; + 7: rc[3:0] >= 9), an
+  // incrementer instead of a 17-bit adder whose low bits are dropped
+  wire        fy_c = rc[3] && (box2 || rc[2:0] != 3'd0);
+  wire signed [12:0] fy = $signed({rc[15], rc[15:4]}) + $signed({12'd0, fy_c});
   // Each clamped value goes straight into its output register when its vertex field is read
   // (A_FY0: the first row, rd the top vertex's Y; A_XT: the first column, rd its X; A_BOX: the
   // row end, rd the bottom vertex's Y), so no register holds the unclamped ones. by0 is in
@@ -234,8 +241,12 @@ module core_setup_tm #(
   wire signed [12:0] xt = 13'(rc >>> 4);
   wire signed [12:0] cx0 = $signed({2'b0, clip_x0});
   wire signed [12:0] cy0 = $signed({2'b0, clip_y0}), cy1 = $signed({2'b0, clip_y1});
-  wire signed [12:0] by0 = (fy > cy0) ? fy : cy0;
-  wire signed [12:0] by1 = (fy < cy1) ? fy : cy1;
+  // Idle (pc = 0), the clamps give the clip rectangle itself, which a clear (rect) loads at its
+  // start through the same registers' inputs: box_y0, x_start and box_y1 have one source each,
+  // not a second one for clears (fit9, docs/gateware.md)
+  wire        idle = (pc == 7'd0);
+  wire signed [12:0] by0 = (fy > cy0 && !idle) ? fy : cy0;
+  wire signed [12:0] by1 = (fy < cy1 && !idle) ? fy : cy1;
   reg         by0_big;
   wire        unused_by0 = by0[12];  // by0 >= 0
   wire        unused_by1 = &{1'b0, by1[12:11]};  // stored only when box_y0 < by1 <= cy1 < 2048
@@ -251,7 +262,7 @@ module core_setup_tm #(
   wire        rows = !by0_big && y0_in_clip &&
                      $signed({rc[15], rc}) >= $signed({2'b0, box_y0, 4'b1000});
   // box_xl (the last column, clip_x1 - 1, loaded at the start) is the clamp's upper bound too
-  wire [10:0] xs = (xt < cx0) ? clip_x0 : (xt > $signed({2'b0, box_xl})) ? box_xl : xt[10:0];
+  wire [10:0] xs = (xt < cx0 || idle) ? clip_x0 : (xt > $signed({2'b0, box_xl})) ? box_xl : xt[10:0];
   wire [4:0] r_sel = (i_addr == R_YTOP) ? r_y(top) : (i_addr == R_XTOP) ? r_x(top) :
                      (i_addr == R_YBOT) ? r_y(bot) : i_addr;
 
@@ -362,10 +373,10 @@ module core_setup_tm #(
         box_x0 <= clip_x0;
         box_xl <= clip_x1 - 11'd1;  // clip_x1 > clip_x0 >= 0: a setup starts only then
         flip   <= 1'b0;
-        if (rect) begin  // a clear: the clip rectangle
-          box_y0  <= clip_y0;
-          box_y1  <= clip_y1;
-          x_start <= clip_x0;
+        if (rect) begin  // a clear: the clip rectangle (the clamps' values while idle)
+          box_y0  <= by0[10:0];
+          box_y1  <= by1[10:0];
+          x_start <= xs;
           draw    <= 1'b1;
         end
       end
@@ -384,10 +395,10 @@ module core_setup_tm #(
           msub  <= (i_pair != 2'd3);
           mneg  <= (i_neg == 2'd1) ? flip : (i_neg == 2'd2) ? !flip : 1'b0;
           three <= (i_neg == 2'd3);
-          mbits <= (i_pair == P_DX) ? 5'd16 : (i_pair == P_E) ? 5'd17 : (ak == 3'd4) ? 5'd24 : 5'd8;
+          mbits <= (i_pair == P_DX) ? 5'd16 : (i_pair == P_E) ? 5'd17 : ak_z ? 5'd24 : 5'd8;
           fr    <= 1'b1;
           fph   <= 2'd0;
-          fk    <= (i_pair == P_DX) ? 5'd16 : (i_pair == P_E) ? 5'd17 : (ak == 3'd4) ? 5'd24 : 5'd8;
+          fk    <= (i_pair == P_DX) ? 5'd16 : (i_pair == P_E) ? 5'd17 : ak_z ? 5'd24 : 5'd8;
         end
         case (i_act)
           A_FLIP: flip <= 1'b1;

@@ -71,6 +71,17 @@ module spigpu_core #(
   localparam integer PW     = IDX_W + 60 + ((TEX != 0) ? 96 : 0);        // pixel record
   localparam integer CW     = IDX_W + 36;                         // colour stage record
   localparam [1:0] OP_TRI = 2'd0, OP_CLEAR = 2'd1, OP_CLEAR_Z = 2'd2;
+  // up5k: the rasteriser's column and row bits. The soc's FB_FORMAT holds a width and height of
+  // at most MAX_WIDTH x MAX_HEIGHT or its reset value 640 x 480 (command_exec's WB, HB bits), and
+  // every column and row drawn is below them (fit9, docs/gateware.md); ecp5 keeps 11 bits.
+  localparam integer RAS_XW = (SMALL != 0) ? $clog2(((MAX_WIDTH > 640) ? MAX_WIDTH : 640) + 1) : 11;
+  localparam integer RAS_YW = (SMALL != 0) ? $clog2(((MAX_HEIGHT > 480) ? MAX_HEIGHT : 480) + 1) : 11;
+  // up5k: the colour buffer's base as its block bits below 2^ADDR_W and one bit for "any above"
+  // (all core_color's byte_addr reads of it), so the draw's copy keeps 14 flip-flops, not 28
+  localparam integer BLK_W = ADDR_W - 4;
+  function [27:0] fold_base(input [27:0] b16);
+    fold_base = 28'({|(b16 >> BLK_W), b16[BLK_W-1:0]});
+  endfunction
 
   // ---------------------------------------------------------------- command decode
   wire [10:0] sc_x0 = cmd_scissor[10:0], sc_y0 = cmd_scissor[21:11];
@@ -177,7 +188,7 @@ module spigpu_core #(
   reg         ras_go;
   wire        adv, hold;
   wire        draw_go;   // the draw starts: render state copied, command accepted (sequencer below)
-  core_raster #(.DSP(SMALL)) raster (
+  core_raster #(.DSP(SMALL), .XW(RAS_XW), .YW(RAS_YW)) raster (
       .clk(clk), .rst(rst), .start(ras_go),
       .e_we(su_e_we), .e_data(su_e_data), .e0(ras_e0), .e1(ras_e1), .e2(ras_e2),
       .dx0(su_dx0), .dx1(su_dx1), .dx2(su_dx2), .dy0(su_dy0), .dy1(su_dy1), .dy2(su_dy2),
@@ -194,7 +205,7 @@ module spigpu_core #(
     if (SMALL != 0) begin : tm_steppers
       // one shared datapath, a cycle per interpolated attribute per move
       wire [31:0] tm_rgba;
-      core_interp_tm #(.RW(35)) interp (
+      core_interp_tm #(.RW(35), .QW((DEPTH != 0) ? 24 : 8)) interp (
           .clk(clk), .rst(rst), .we(pw_en), .attr(pw_attr), .field(pw_field), .wq(pw_q[23:0]),
           .wr(pw_r), .den(su_den), .mask(r_need[4:0]),
           // a flat draw's colour and a clear's value straight into the output registers when
@@ -257,7 +268,9 @@ module spigpu_core #(
   // up5k: the stepper's output registers hold a flat colour and a clear's depth too (loaded when
   // the draw starts), so the record needs no choice; ecp5 keeps them in r_flat
   wire [31:0] src_rgba = (SMALL != 0 || r_gouraud) ? {a_r, a_g, a_b, a_a} : r_flat;
-  wire [23:0] src_z = (SMALL == 0 && r_zsel) ? r_flat[23:0] : a_z;
+  // without a depth buffer the record's depth is 0: nothing reads it, and the steppers' depth
+  // register then goes (fit9, docs/gateware.md)
+  wire [23:0] src_z = (DEPTH == 0) ? 24'd0 : (SMALL == 0 && r_zsel) ? r_flat[23:0] : a_z;
   wire [PW-1:0] pix;
   generate
     if (TEX != 0) begin : pix_tex
@@ -273,12 +286,24 @@ module spigpu_core #(
   wire         zr_valid, zr_ready, zr_rsp, zw_valid, zw_ready;
   wire [29:0]  zr_addr, zw_addr;
   wire [23:0]  zw_data;
+  // Without a depth buffer the stage never reads or writes (Z_TEST and Z_WRITE are 0): its
+  // requests are constants here, so the memory port's choices lose their depth inputs (its
+  // address and data multiplexers took them as their default, keeping the depth address adder,
+  // FB_Z's copy and the steppers' depth register alive; fit9, docs/gateware.md)
+  wire         zr_valid_d, zw_valid_d;
+  wire [29:0]  zr_addr_d, zw_addr_d;
+  wire [23:0]  zw_data_d;
+  assign zr_valid = (DEPTH != 0) && zr_valid_d;
+  assign zw_valid = (DEPTH != 0) && zw_valid_d;
+  assign zr_addr  = (DEPTH != 0) ? zr_addr_d : 30'd0;
+  assign zw_addr  = (DEPTH != 0) ? zw_addr_d : 30'd0;
+  assign zw_data  = (DEPTH != 0) ? zw_data_d : 24'd0;
   core_depth #(.PW(PW), .ZLSB(IDX_W), .IDX_W(IDX_W), .AW(Q_AW), .ADDR_W(ADDR_W), .OUT_REG(1 - SMALL)) depth (
       .clk(clk), .rst(rst), .z_test(r_ztest), .z_func(r_zfunc), .z_write(r_zwrite), .fb_z16(r_fb_z),
       .in_valid(emit2), .in_ready(d_in_ready), .in_pix(pix),
       .out_valid(d_out_valid), .out_ready(d_out_ready), .out_pix(d_out),
-      .rd_valid(zr_valid), .rd_ready(zr_ready), .rd_addr(zr_addr), .rsp_valid(zr_rsp), .rsp_data(mem_rsp_rdata[23:0]),
-      .wr_valid(zw_valid), .wr_ready(zw_ready), .wr_addr(zw_addr), .wr_data(zw_data), .idle(d_idle),
+      .rd_valid(zr_valid_d), .rd_ready(zr_ready), .rd_addr(zr_addr_d), .rsp_valid(zr_rsp), .rsp_data(mem_rsp_rdata[23:0]),
+      .wr_valid(zw_valid_d), .wr_ready(zw_ready), .wr_addr(zw_addr_d), .wr_data(zw_data_d), .idle(d_idle),
       .passed(d_passed));
 
   // ---------------------------------------------------------------- texture unit
@@ -451,7 +476,7 @@ module spigpu_core #(
           ras_go      <= 1'b1;
           cst         <= C_IDLE;
           r_fmt       <= cmd_fb_format;
-          r_fb_draw   <= cmd_fb_draw;
+          r_fb_draw   <= (SMALL != 0) ? fold_base(cmd_fb_draw) : cmd_fb_draw;
           r_fb_z      <= cmd_fb_z;
           r_tex_base  <= cmd_tex_base;
           r_tex_fmt   <= cmd_tex_fmt;
