@@ -180,7 +180,7 @@ module spigpu_soc #(
     .strict(link_strict), .discarding(link_discarding), .release_held(link_release), .discard_held(link_discard),
     .err_link_crc(err_link_crc), .link_status(link_status));
 
-  command_fifo #(.DEPTH(FIFO_DEPTH), .AW(FIFO_AW), .HEAD(PROFILE == 1 ? 1 : 0)) u_fifo (
+  command_fifo #(.DEPTH(FIFO_DEPTH), .AW(FIFO_AW), .HEAD(PROFILE == 1 ? 1 : 2)) u_fifo (
     .clk(clk), .rst(rst_any), .push(fifo_push), .push_held(fifo_push_held), .push_entry(fifo_entry),
     .release_held(link_release), .discard_held(link_discard), .full(fifo_full), .nearly_full(fifo_nearly_full),
     .level(fifo_level), .held(fifo_held), .out_valid(fifo_out_valid), .out_entry(fifo_out), .read_any(fifo_read_any),
