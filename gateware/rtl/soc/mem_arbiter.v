@@ -101,7 +101,12 @@ module mem_arbiter #(
   // cones toward 52 MHz": prot_active is the scanout's equality compare of its read address, a
   // LUT tree). A window starts only when FB_DISPLAY executes, which the executor does only with
   // the core idle and its memory requests done, so no core request meets a window in the clock it
-  // starts (checked below).
+  // starts. The scanout takes the request a clock after FB_DISPLAY executes, and the window's first
+  // clock has the old bounds; the compare of that clock is used in the next one, in which no write
+  // can arrive either: the next FIFO entry executes two clocks after FB_DISPLAY at the earliest (the
+  // command FIFO's registered pop, HEAD = 2, or its head copy, HEAD = 1) and its first memory
+  // request comes a clock after that. Both checked below in every co-simulation (no core write
+  // passes into the window of its own clock).
   reg         c_prot_r;
   wire        c_leave  = !c_req_valid || c_req_ready;   // the core's output register loads
   wire [AW:0] c_cmp    = c_leave ? {1'b0, c_next_addr[AW-1:0]} : c_vram;

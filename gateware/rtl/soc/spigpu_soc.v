@@ -231,7 +231,7 @@ module spigpu_soc #(
             // with a load costs the most cells of the scanout's; docs/gateware.md fit-soc5)
             .CRC_BYTES(CRC_BYTES), .BUF_WORDS(SCAN_BUF), .BYTES_W(SCAN_BYTES_W),
             .DSP(PROFILE == 0 && DEPTH == 0 ? 1 : 0)) u_scan (
-    .clk(clk), .rst(rst), .soft_reset(soft_reset), .swap_req(swap_req), .swap_addr(swap_addr),
+    .clk(clk), .rst(rst), .soft_reset(soft_reset), .swap_in(swap_req), .swap_addr_in(swap_addr),
     .swap_format(cmd_fb_format), .swap_width(cmd_fb_width), .swap_height(cmd_fb_height), .swap_ready(swap_ready),
     .swap_pending(swap_pending_w), .err_range(scan_err), .vblank(vblank), .vsync(vsync),
     .req_valid(s_req_valid), .req_ready(s_req_ready), .req_addr(s_req_addr), .rsp_valid(s_rsp_valid),
