@@ -67,9 +67,6 @@ module core_memport #(
     output wire [29:0] mem_req_addr,
     output wire [31:0] mem_req_wdata,
     output wire [3:0]  mem_req_be,
-    // the address the output register takes this clock if it is free or its request leaves (the
-    // skid's or this clock's grant): the soc's swap-protection compare runs on it a clock ahead
-    output wire [29:0] mem_next_addr,
     input  wire        mem_rsp_valid,
     output wire        idle,
     output wire        pending_write  // the combiner holds a word
@@ -254,7 +251,6 @@ module core_memport #(
   assign mem_req_addr  = o_addr;
   assign mem_req_wdata = o_data;
   assign mem_req_be    = o_be;
-  assign mem_next_addr = n_addr;
 
   assign idle = !p_valid && !o_valid && !s_valid && (tw == tr);
 endmodule

@@ -40,7 +40,6 @@ module command_exec #(
   output wire [4:0]   sh_wr_idx,
   output wire [63:0]  sh_wr_data,
   input  wire         sh_wr_ack,
-  input  wire         sh_wr_free,    // sh_wr_ack's condition without the request
   output wire [4:0]   sh_rd_idx,     // VPORT: COLOR, read from the shadow RAM (no copy here)
   input  wire [63:0]  sh_rd_data,
   input  wire         sh_rd_valid,
@@ -220,10 +219,7 @@ module command_exec #(
   wire mem_ok     = !is_mem || mem_op_ack;                     // the unit waits for its own idle
   wire wait_ok    = is_mem ? core_quiet : (is_display || is_fence) ? quiet : 1'b1;
   wire swap_ok    = !is_display || swap_ready;
-  // sh_wr_ack is sh_wr_req && sh_wr_free, and every condition of sh_wr_req is also one of `go`'s
-  // (a kick's mem_idle and !core_drain are in core_ok), so `go` reads sh_wr_free: the same value
-  // without the loop from go's conditions through the request into the acknowledgement (issue 19)
-  wire shadow_ok  = !to_shadow || sh_wr_free || kick_shadowed;
+  wire shadow_ok  = !to_shadow || sh_wr_ack || kick_shadowed;
   wire vert_ok;                                                // VPORT: the vertex's words are written
   wire go         = in_valid && core_ok && wait_ok && swap_ok && shadow_ok && mem_ok && vert_ok;
 

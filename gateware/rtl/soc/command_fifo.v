@@ -9,16 +9,10 @@
 // empty, so neither the RAM's slow clock-to-out runs into the executor's decode nor the executor's
 // `pop` into the RAM's read and the count in the same clock; the price is a clock per entry taken
 // from a backlog (two clocks an entry at most).
-// HEAD = 2 (up5k, issue 19 "fmax-soc10"): the same price without the copy's 71 flip-flops: the
-// executor's `pop` is registered (`popped`), and the RAM's next read, the read pointer and the
-// output register's enable follow it a clock later; the popped entry is hidden from the executor
-// (and from the count) in that clock. The executor's `go` (the FIFO head's decode, the core's,
-// the memory-access unit's and the scanout's handshakes) then ends in one flip-flop instead of
-// running on into the RAM's read enable, its address counter and the count.
 module command_fifo #(
   parameter DEPTH = 64,     // CAPS.FIFO_DEPTH
   parameter AW = 7,         // storage address bits, 2^AW > DEPTH
-  parameter HEAD = 0        // 1: the executor's entry is a flip-flop copy of the RAM's output; 2: a registered pop
+  parameter HEAD = 0        // 1: the executor's entry is a flip-flop copy of the RAM's output
 ) (
   input  wire        clk,
   input  wire        rst,            // power-on or RESET: empty
@@ -48,33 +42,20 @@ module command_fifo #(
   localparam integer CW = $clog2(DEPTH + 1);
   wire [AW-1:0] unread = wr - rd;
   wire          h_valid;
-  wire          q_shown;    // q's entry counts (not popped last clock: HEAD = 2)
-  wire [CW-1:0] count = CW'(unread) + CW'(q_shown) + CW'(h_valid);
+  wire [CW-1:0] count = CW'(unread) + CW'(q_valid) + CW'(h_valid);
 `include "const_compare.vh"
 
   wire          q_take;     // q's entry leaves this clock (to the executor, or to h)
-  // HEAD = 2: in the clock after a pop, work waits if another entry is released (the original's q
-  // would already hold it)
-  assign read_any = q_shown || h_valid || (q_valid && rd != rel);
+  assign read_any = q_valid || h_valid;
   wire          rd_fire = rd != rel && (!q_valid || q_take);
 
   generate
-    if (HEAD == 2) begin : g_popr
-      // q's entry leaves in the clock after the executor's pop; in that clock it is not offered
-      reg popped;
-      assign q_take    = popped;
-      assign q_shown   = q_valid && !popped;
-      assign h_valid   = 1'b0;
-      assign out_valid = q_shown;
-      assign out_entry = q;
-      always @(posedge clk) popped <= !rst && pop;
-    end else if (HEAD != 0) begin : g_head
+    if (HEAD != 0) begin : g_head
       // h and its valid depend on registers only: h loads when it is empty (the executor's pop,
       // which empties it, is a clock earlier), q then takes the next entry in the same clock
       reg [70:0] h;
       reg        hv;
       assign q_take    = q_valid && !hv;
-      assign q_shown   = q_valid;
       assign h_valid   = hv;
       assign out_valid = hv;
       assign out_entry = h;
@@ -86,7 +67,6 @@ module command_fifo #(
       end
     end else begin : g_fwft
       assign q_take    = pop;
-      assign q_shown   = q_valid;
       assign h_valid   = 1'b0;
       assign out_valid = q_valid;
       assign out_entry = q;

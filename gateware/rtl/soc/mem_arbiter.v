@@ -48,7 +48,6 @@ module mem_arbiter #(
   input  wire [29:0] c_req_addr,
   input  wire [31:0] c_req_wdata,
   input  wire [3:0]  c_req_be,
-  input  wire [29:0] c_next_addr,     // the core's request address of the next clock if this one leaves
   output wire        c_rsp_valid,
   output wire [31:0] rsp_rdata,       // data of whichever response is valid
   output reg         c_range_err,
@@ -88,29 +87,15 @@ module mem_arbiter #(
   // never issued), so AW + 1 bits are enough
   wire [AW:0] m_vram   = {1'b0, m_req_addr[AW-1:0]};
   wire [AW:0] c_vram   = {1'b0, c_req_addr[AW-1:0]};
-  // The core's compare is a clock ahead (issue 19, 25.125 MHz on the UP5K, "fmax-soc10": the
-  // compare of its address with the scanout's window ran through the grant into the SPRAM's
-  // address and chip select in one clock). c_prot_r: the request of this clock lies in last
-  // clock's window. Last clock it was either the request then waiting (it did not leave: the core
-  // holds it) or, if that left or none waited, the address the core's output register took then,
-  // which core_memport gives as c_next_addr. While the window is active it only shrinks (prot_lo
-  // counts up, prot_hi only comes down; a new window starts only from an inactive one), so a
-  // write outside last clock's window is outside this clock's: the answer can be late (a write
-  // waits a clock longer as the window's start passes it, or as the window ends), never early.
-  // Whether the window is active is last clock's too (the ULX3S clock, docs/gateware.md "The next
-  // cones toward 52 MHz": prot_active is the scanout's equality compare of its read address, a
-  // LUT tree). A window starts only when FB_DISPLAY executes, which the executor does only with
-  // the core idle and its memory requests done, so no core request meets a window in the clock it
-  // starts. The scanout takes the request a clock after FB_DISPLAY executes, and the window's first
-  // clock has the old bounds; the compare of that clock is used in the next one, in which no write
-  // can arrive either: the next FIFO entry executes two clocks after FB_DISPLAY at the earliest (the
-  // command FIFO's registered pop, HEAD = 2, or its head copy, HEAD = 1) and its first memory
-  // request comes a clock after that. Both checked below in every co-simulation (no core write
-  // passes into the window of its own clock).
-  reg         c_prot_r;
-  wire        c_leave  = !c_req_valid || c_req_ready;   // the core's output register loads
-  wire [AW:0] c_cmp    = c_leave ? {1'b0, c_next_addr[AW-1:0]} : c_vram;
-  wire        c_prot   = c_prot_r;
+  // Whether the window is active is last clock's (m_act_r, below) for the core too (the ULX3S
+  // clock, docs/gateware.md "The next cones toward 52 MHz": prot_active is the scanout's equality
+  // compare of its read address, a LUT tree, and it led through this compare, the grant and the
+  // core's stall logic into the walk). Exact for the same reason as for the memory-access unit: a
+  // window starts only when FB_DISPLAY executes, which the executor does only with the core idle
+  // and its memory requests done, so no core request meets a window in the clock it starts; one
+  // that ends is seen a clock late (a write may wait a clock longer, never less).
+  wire        c_act;
+  wire        c_prot   = c_act && c_vram >= prot_lo && c_vram < prot_hi;
   // The memory-access unit's write is compared a clock before it is granted (issue 19, 25.125 MHz
   // on the UP5K: the compare on its address, whose low bit is the unit's phase, led through its
   // grant into the executor's FIFO pop in one clock). m_out_r: last clock the window was active
@@ -127,6 +112,7 @@ module mem_arbiter #(
   reg         m_wait_r, m_out_r, m_act_r;
   wire        m_in_win = m_vram >= prot_lo && m_vram < prot_hi;
   wire m_block = m_writes && m_act_r && !(m_wait_r && m_out_r);
+  assign c_act = m_act_r;
   wire c_block = c_req_we && c_prot;   // (no core request while the unit writes: see pick_c)
   wire c_oor   = c_req_addr[29:AW] != 0;   // beyond VRAM: an upper bit, no comparator
   wire v_oor   = v_req_addr[29:AW] != 0;
@@ -178,7 +164,6 @@ module mem_arbiter #(
     m_wait_r <= !rst && m_writes && !m_req_ready;
     m_out_r  <= prot_active && !m_in_win;
     m_act_r  <= prot_active;
-    c_prot_r <= prot_active && c_cmp >= prot_lo && c_cmp < prot_hi;
     c_range_err <= pick_z;
     zero_rsp <= (pick_z && !c_req_we) || (pick_v && v_oor);
     zero_v <= pick_v && v_oor;
@@ -204,21 +189,9 @@ module mem_arbiter #(
 
 `ifndef SYNTHESIS
   // the invariants pick_c, pick_z, c_block and m_block rely on, checked in every co-simulation
-  reg [29:0] m_addr_r, c_next_r;
-  reg        c_leave_r;
+  reg [29:0] m_addr_r;
   always @(posedge clk) begin
     m_addr_r <= m_req_addr;
-    c_next_r <= c_next_addr;
-    c_leave_r <= !rst && c_leave;
-    if (!rst && c_leave_r && c_req_valid && c_req_addr != c_next_r) begin
-      $display("mem_arbiter: the core's request is not the address core_memport announced");
-      $stop;
-    end
-    if (!rst && c_req_valid && c_req_we && c_req_ready && !c_oor && prot_active
-        && c_vram >= prot_lo && c_vram < prot_hi) begin
-      $display("mem_arbiter: a core write passed into the protection window");
-      $stop;
-    end
     if (!rst && m_writes && c_req_valid) begin
       $display("mem_arbiter: a write of the memory-access unit while the core requests");
       $stop;
@@ -238,5 +211,5 @@ module mem_arbiter #(
   end
 `endif
 
-  wire unused_ok = &{1'b0, addr[29:AW], c_next_addr[29:AW]};
+  wire unused_ok = &{1'b0, addr[29:AW]};
 endmodule

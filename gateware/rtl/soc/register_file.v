@@ -60,7 +60,6 @@ module register_file #(
   input  wire [4:0]  ex_wr_idx,
   input  wire [63:0] ex_wr_data,
   output wire        ex_wr_ack,
-  output wire        ex_wr_free,     // a request would be acknowledged now (ex_wr_ack without ex_wr_req)
   // executor reads (EX_READ = 1): the shadow RAM's read port is the SPI side's only in the bit-64
   // cycle of a read of a shadowed register; in every other clock it reads ex_rd_idx, and
   // ex_rd_valid says the clock before was such a clock (ex_rd_data is then that entry)
@@ -177,8 +176,7 @@ module register_file #(
   wire        sel_ex  = !seq_active && !imm_wr;
   wire [63:0] sh_wd  = ({64{sel_tag}} & frame_data & ~RSV_HOST_TAG)
                      | {63'd0, sel_lc && link_ctrl_strict} | ({64{sel_ex}} & ex_wr_data);
-  assign ex_wr_free = !seq_active && !imm_wr;
-  assign ex_wr_ack  = ex_wr_req && ex_wr_free;
+  assign ex_wr_ack = ex_wr_req && !seq_active && !imm_wr;
   // at_reset[i]: register i (in RESET_NZ) has not been written since the last reset, so its value is
   // entry 32 + i. A read in the clock of the first write still sees the reset value there, the old
   // value, as a read of entry i would; the sequencer's zeros do not count as writes

@@ -26,8 +26,8 @@ module scanout #(
   input  wire        rst,
   input  wire        soft_reset,   // RESET: the pending swap and a frame being read are dropped, counters 0
   // swap request from the executor
-  input  wire        swap_in,      // FB_DISPLAY executes (taken a clock later: swap_req)
-  input  wire [27:0] swap_addr_in, // byte address / 16
+  input  wire        swap_req,
+  input  wire [27:0] swap_addr,    // byte address / 16
   input  wire [1:0]  swap_format,
   input  wire [10:0] swap_width,
   input  wire [10:0] swap_height,
@@ -89,21 +89,6 @@ module scanout #(
   end
 
   // --- swap request: length, end and range ---
-  // The executor's request is registered here (fmax-soc9, kept in fmax-soc10 once the command FIFO's
-  // pop was registered and this was the path under it): its `go` is a long decode of the command
-  // FIFO's head, the SPI side's shadow write and the memory-access unit's acknowledgement, and the
-  // request's loads (the frame's address into the SB_MAC16 counter, `above`, the computing flag)
-  // would otherwise end that path. Everything the swap does starts a clock later; the clock between
-  // counts as a swap in progress (swap_ready low, SWAP_PENDING high, a protection window active), so
-  // no register reads differently before the swap is computed, and the window is active from the
-  // same clock as before (with the old bounds for that clock, which can only block: no write of the
-  // unit or the core reaches the arbiter in the clock after FB_DISPLAY executes).
-  reg        swap_req;
-  reg [27:0] swap_addr;
-  always @(posedge clk) begin
-    swap_req <= swap_in && !(rst || soft_reset);
-    if (swap_in) swap_addr <= swap_addr_in;
-  end
   reg        computing, pending, reading;
   reg [3:0]  mul_step;
   reg [BYTES_W-1:0] mul_acc;   // width x height x bytes per pixel
@@ -139,8 +124,8 @@ module scanout #(
       wire unused_rd = &{1'b0, rd_addr16};
     end
   endgenerate
-  assign swap_ready   = !swap_req && !computing && !pending && !reading;
-  assign swap_pending = swap_req || computing || pending || reading;
+  assign swap_ready   = !computing && !pending && !reading;
+  assign swap_pending = computing || pending || reading;
   assign frame_crc    = {frame_count, crc_value};  // the frame number is FRAME_COUNT itself
 
   // bytes of the frame, W x H x bpp (into bytes_left one clock before the end is computed); its
@@ -169,7 +154,7 @@ module scanout #(
   // a frame starting beyond VRAM protects nothing (no multiplexer on prot_lo for it); while the end
   // is being computed, everything from the frame's start up is protected: end_vram is VRAM_END from
   // the swap request until the end is known (no multiplexer on prot_hi)
-  assign prot_active = swap_req || (!above && (computing || pending || (reading && in_frame)));
+  assign prot_active = !above && (computing || pending || (reading && in_frame));
   assign prot_lo     = rd_addr;
   assign prot_hi     = end_vram;
   // the frame's end in words, rd_addr + ceil(bytes / 4), from its start inside VRAM (beyond it:

@@ -67,7 +67,6 @@ module spigpu_soc #(
   input  wire [29:0]  mem_req_addr,
   input  wire [31:0]  mem_req_wdata,
   input  wire [3:0]   mem_req_be,
-  input  wire [29:0]  mem_next_addr,  // the core's next request address, a clock ahead (swap protection)
   output wire         mem_rsp_valid,
   output wire [31:0]  mem_rsp_rdata,
   // display
@@ -138,7 +137,7 @@ module spigpu_soc #(
   wire        check_strobe, ctrl_strobe, ctrl_strict;
   wire [31:0] check_crc;
   wire [63:0] link_status;
-  wire        sh_wr_req, sh_wr_ack, sh_wr_free;
+  wire        sh_wr_req, sh_wr_ack;
   wire [4:0]  sh_wr_idx;
   wire [63:0] sh_wr_data;
   wire [6:0]  ex_err;
@@ -168,7 +167,7 @@ module spigpu_soc #(
     .err_link_crc(err_link_crc), .drop_overflow(drop_overflow), .link_check_strobe(check_strobe),
     .link_check_crc(check_crc), .link_ctrl_strobe(ctrl_strobe), .link_ctrl_strict(ctrl_strict),
     .soft_reset(soft_reset), .ex_wr_req(sh_wr_req), .ex_wr_idx(sh_wr_idx), .ex_wr_data(sh_wr_data),
-    .ex_wr_ack(sh_wr_ack), .ex_wr_free(sh_wr_free), .ex_rd_idx(sh_rd_idx), .ex_rd_data(sh_rd_data), .ex_rd_valid(sh_rd_valid),
+    .ex_wr_ack(sh_wr_ack), .ex_rd_idx(sh_rd_idx), .ex_rd_data(sh_rd_data), .ex_rd_valid(sh_rd_valid),
     .err_set(ex_err | {mem_err || scan_err, 6'd0}), .core_range_err(core_range_err),
     .core_idle(core_idle && !cmd_valid), .core_drain(core_drain), .busy(device_busy), .vblank(vblank),
     .swap_pending(swap_pending_w), .frame_count(frame_count), .frame_crc(frame_crc), .mem_ready(mem_ready),
@@ -181,7 +180,7 @@ module spigpu_soc #(
     .strict(link_strict), .discarding(link_discarding), .release_held(link_release), .discard_held(link_discard),
     .err_link_crc(err_link_crc), .link_status(link_status));
 
-  command_fifo #(.DEPTH(FIFO_DEPTH), .AW(FIFO_AW), .HEAD(PROFILE == 1 ? 1 : 2)) u_fifo (
+  command_fifo #(.DEPTH(FIFO_DEPTH), .AW(FIFO_AW), .HEAD(PROFILE == 1 ? 1 : 0)) u_fifo (
     .clk(clk), .rst(rst_any), .push(fifo_push), .push_held(fifo_push_held), .push_entry(fifo_entry),
     .release_held(link_release), .discard_held(link_discard), .full(fifo_full), .nearly_full(fifo_nearly_full),
     .level(fifo_level), .held(fifo_held), .out_valid(fifo_out_valid), .out_entry(fifo_out), .read_any(fifo_read_any),
@@ -196,7 +195,7 @@ module spigpu_soc #(
   command_exec #(.FEATURES(FEATURES), .MAX_WIDTH(MAX_WIDTH), .MAX_HEIGHT(MAX_HEIGHT), .VRAM_KIB(VRAM_KIB), .DEPTH(DEPTH),
                  .VPORT(PROFILE == 0 ? 1 : 0)) u_exec (
     .clk(clk), .rst(rst_any), .in_valid(fifo_out_valid), .in_entry(fifo_out), .in_pop(fifo_pop),
-    .sh_wr_req(sh_wr_req), .sh_wr_idx(sh_wr_idx), .sh_wr_data(sh_wr_data), .sh_wr_ack(sh_wr_ack), .sh_wr_free(sh_wr_free),
+    .sh_wr_req(sh_wr_req), .sh_wr_idx(sh_wr_idx), .sh_wr_data(sh_wr_data), .sh_wr_ack(sh_wr_ack),
     .sh_rd_idx(sh_rd_idx), .sh_rd_data(sh_rd_data), .sh_rd_valid(sh_rd_valid),
     .err_set(ex_err), .core_drain(core_drain), .cmd_valid(cmd_valid), .cmd_ready(cmd_ready), .cmd_op(cmd_op),
     .cmd_tri_mode(cmd_tri_mode), .cmd_tex_base(cmd_tex_base), .cmd_tex_fmt(cmd_tex_fmt), .cmd_scissor(cmd_scissor),
@@ -231,7 +230,7 @@ module spigpu_soc #(
             // with a load costs the most cells of the scanout's; docs/gateware.md fit-soc5)
             .CRC_BYTES(CRC_BYTES), .BUF_WORDS(SCAN_BUF), .BYTES_W(SCAN_BYTES_W),
             .DSP(PROFILE == 0 && DEPTH == 0 ? 1 : 0)) u_scan (
-    .clk(clk), .rst(rst), .soft_reset(soft_reset), .swap_in(swap_req), .swap_addr_in(swap_addr),
+    .clk(clk), .rst(rst), .soft_reset(soft_reset), .swap_req(swap_req), .swap_addr(swap_addr),
     .swap_format(cmd_fb_format), .swap_width(cmd_fb_width), .swap_height(cmd_fb_height), .swap_ready(swap_ready),
     .swap_pending(swap_pending_w), .err_range(scan_err), .vblank(vblank), .vsync(vsync),
     .req_valid(s_req_valid), .req_ready(s_req_ready), .req_addr(s_req_addr), .rsp_valid(s_rsp_valid),
@@ -251,7 +250,6 @@ module spigpu_soc #(
     .m_req_addr(m_req_addr), .m_req_wdata(m_req_wdata), .m_rsp_valid(m_rsp_valid), .s_req_valid(s_req_valid),
     .s_req_ready(s_req_ready), .s_req_addr(s_req_addr), .s_rsp_valid(s_rsp_valid), .c_req_valid(mem_req_valid),
     .c_req_ready(mem_req_ready), .c_req_we(mem_req_we), .c_req_addr(mem_req_addr), .c_req_wdata(mem_req_wdata),
-    .c_next_addr(mem_next_addr),
     .c_req_be(mem_req_be), .c_rsp_valid(mem_rsp_valid), .rsp_rdata(rsp_rdata), .c_range_err(core_range_err),
     .prot_active(prot_active), .prot_lo(prot_lo), .prot_hi(prot_hi), .b_req_valid(b_req_valid),
     .b_req_ready(b_req_ready), .b_req_we(b_req_we), .b_req_addr(b_req_addr), .b_req_wdata(b_req_wdata),
