@@ -51,9 +51,8 @@ using simd::u32x8;
 }
 
 // One instance per plane count, so the plane loops have constant bounds and the lanes stay in
-// registers (a run-time bound cost the untextured spans 5-15%). kMasked: tails through AVX-512's
-// masked moves (the AVX-512 instances only).
-template <bool kTextured, PixelFormat kFormat, bool kMasked>
+// registers (a run-time bound cost the untextured spans 5-15%).
+template <bool kTextured, PixelFormat kFormat>
 [[gnu::always_inline]] inline std::uint64_t shade_span(const SimdSpan& s) {
   constexpr std::size_t kBpp = protocol::bytes_per_pixel(kFormat);
   constexpr unsigned kUsed = kTextured ? 8 : 5;
@@ -82,8 +81,7 @@ template <bool kTextured, PixelFormat kFormat, bool kMasked>
     // lost 7% (cubes unchanged), while untextured 1,000-px spans gained 10%.
     const bool whole = !kTextured && i + 8 <= s.room;
     const u32x8 in_span = simd::mask(lane < static_cast<std::int32_t>(n));
-    passed -= simd::pixel8<kTextured, kFormat, simd::Chunk::Span, false, kMasked>(px, flags, q, in_span, cp, zp, n,
-                                                                                  whole, bayer);
+    passed -= simd::pixel8<kTextured, kFormat, simd::Chunk::Span>(px, flags, q, in_span, cp, zp, n, whole, bayer);
     cp += 8 * kBpp;
     if (flags.depth) zp += 8 * 4;  // s.depth is null without depth
     for (unsigned p = first; p < kUsed; ++p) {
@@ -97,16 +95,17 @@ template <bool kTextured, PixelFormat kFormat, bool kMasked>
   return total;
 }
 
-// The AVX-512 instance's untextured RGBA8888 spans in sixteen lanes (512-bit vectors): chunks of
-// sixteen while more than eight pixels remain, the last 1-8 in one chunk of eight lanes (the low
-// half of the sixteen), so that a span of 8 pixels, the commonest in thin triangles, never pays
-// for sixteen. Lanes 8..15 start one 8-pixel step (q8, r8) after lanes 0..7 and all advance by
-// twice that step, with one carry each: the same integers as eight lanes.
+// The AVX-512 instance's long untextured RGBA8888 spans in sixteen lanes (512-bit vectors): chunks
+// of sixteen while more than eight pixels remain, the last 1-8 in one chunk of eight lanes (the low
+// half of the sixteen) rather than a mostly empty sixteen. Lanes 8..15 start one 8-pixel step
+// (q8, r8) after lanes 0..7 and all advance by twice that step, with one carry each: the same
+// integers as eight lanes. kMasked: partial chunks through AVX-512's masked moves.
 [[gnu::always_inline]] inline simd::u32x16 join(u32x8 lo, u32x8 hi) {
   return __builtin_shufflevector(lo, hi, 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
 }
 [[gnu::always_inline]] inline u32x8 low_half(simd::u32x16 v) { return __builtin_shufflevector(v, v, 0, 1, 2, 3, 4, 5, 6, 7); }
 
+template <bool kMasked>
 [[gnu::always_inline]] inline std::uint64_t shade_span_wide(const SimdSpan& s) {
   using simd::u32x16;
   constexpr PixelFormat kFormat = PixelFormat::RGBA8888;
@@ -139,8 +138,8 @@ template <bool kTextured, PixelFormat kFormat, bool kMasked>
   for (; i + 8 < s.count; i += 16) {
     const unsigned n = s.count - i < 16 ? s.count - i : 16;
     const u32x16 in_span = simd::mask(lane < static_cast<std::int32_t>(n));
-    passed -= simd::pixel8<false, kFormat, simd::Chunk::Span, false, true>(px, flags, q, in_span, cp, zp, n, false,
-                                                                           u32x16{});
+    passed -= simd::pixel8<false, kFormat, simd::Chunk::Span, false, kMasked>(px, flags, q, in_span, cp, zp, n,
+                                                                              i + 16 <= s.room, u32x16{});
     cp += 16 * 4;
     if (flags.depth) zp += 16 * 4;  // s.depth is null without depth
     for (unsigned p = first; p < kUsed; ++p) {
@@ -156,8 +155,8 @@ template <bool kTextured, PixelFormat kFormat, bool kMasked>
     for (unsigned p = first; p < kUsed; ++p) qt[p] = low_half(q[p]);
     const i32x8 lane8 = {0, 1, 2, 3, 4, 5, 6, 7};
     const u32x8 in_span = simd::mask(lane8 < static_cast<std::int32_t>(n));
-    const u32x8 tail = simd::pixel8<false, kFormat, simd::Chunk::Span, false, true>(px, flags, qt, in_span, cp, zp, n,
-                                                                                    false, u32x8{});
+    const u32x8 tail = simd::pixel8<false, kFormat, simd::Chunk::Span, false, kMasked>(px, flags, qt, in_span, cp, zp,
+                                                                                       n, i + 8 <= s.room, u32x8{});
     for (unsigned k = 0; k < 8; ++k) total += tail[k] & 1;  // pass lanes are all ones (−1)
   }
   for (unsigned k = 0; k < 16; ++k) total += passed[k];  // pass lanes are all ones (−1)
@@ -169,27 +168,35 @@ namespace {
 // Each instance is the same source compiled for one ISA; all of them compute the same integers.
 std::uint64_t span_baseline(const SimdSpan& s) {
   return simd::dispatch(s.pixel, [&]<bool kTextured, PixelFormat kFormat>() __attribute__((always_inline)) {
-    return shade_span<kTextured, kFormat, false>(s);
+    return shade_span<kTextured, kFormat>(s);
   });
 }
 __attribute__((target("avx2"))) std::uint64_t span_avx2(const SimdSpan& s) {
   return simd::dispatch(s.pixel, [&]<bool kTextured, PixelFormat kFormat>() __attribute__((always_inline)) {
-    return shade_span<kTextured, kFormat, false>(s);
+    return shade_span<kTextured, kFormat>(s);
   });
 }
-// AVX-512 (F, VL, BW, DQ) in 256-bit vectors: the same eight lanes with 32 vector registers,
-// compares into mask registers and masked tails.
+// AVX-512 (F, VL, BW, DQ) in 256-bit vectors: the same eight lanes with 32 vector registers and
+// compares into mask registers. Tails as in AVX2 (whole loads where the row has room, stores of n
+// words): masked moves for them cost the road 15 % and the 1,000-px front rows a few per cent.
 #define SPAN_AVX512 __attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq")))
 SPAN_AVX512 std::uint64_t span_avx512_256(const SimdSpan& s) {
   return simd::dispatch(s.pixel, [&]<bool kTextured, PixelFormat kFormat>() __attribute__((always_inline)) {
-    return shade_span<kTextured, kFormat, true>(s);
+    return shade_span<kTextured, kFormat>(s);
   });
 }
-// AVX-512 with sixteen lanes for untextured RGBA8888 spans (shade_span_wide), eight for the rest.
+// Untextured RGBA8888 spans of at least kWideSpan pixels in sixteen lanes (shade_span_wide, tails
+// through masked moves: the 50,000-px front rows 108-113 → 101-102 ms a frame against unmasked
+// tails); every other span as span_avx512_256. Shorter spans stay in eight lanes: sixteen for
+// spans from 9 pixels on cost the 1,000-px front rows up to a tenth (spans of 20-40 pixels, where
+// the second set of lanes' start and the 8-lane tail are paid on every row).
+constexpr unsigned kWideSpan = 32;
 SPAN_AVX512 std::uint64_t span_avx512(const SimdSpan& s) {
   return simd::dispatch(s.pixel, [&]<bool kTextured, PixelFormat kFormat>() __attribute__((always_inline)) {
-    if constexpr (!kTextured && kFormat == PixelFormat::RGBA8888) return shade_span_wide(s);
-    else return shade_span<kTextured, kFormat, true>(s);
+    if constexpr (!kTextured && kFormat == PixelFormat::RGBA8888) {
+      if (s.count >= kWideSpan) return shade_span_wide<true>(s);
+    }
+    return shade_span<kTextured, kFormat>(s);
   });
 }
 #undef SPAN_AVX512
@@ -211,8 +218,8 @@ bool cpu_has(SpanIsa isa) {
   return true;
 }
 
-// The widest instance the CPU runs, capped by GPUBRIDGE_SIM_SPAN_ISA (avx2 or baseline) so that the
-// instances can be timed against each other in one binary.
+// The widest instance the CPU runs, capped by GPUBRIDGE_SIM_SPAN_ISA (avx512-256, avx2 or baseline)
+// so that the instances can be timed against each other in one binary.
 Instance pick_instance() {
   SpanIsa cap = SpanIsa::Avx512;
   if (const char* env = std::getenv("GPUBRIDGE_SIM_SPAN_ISA"); env && *env) {
