@@ -188,9 +188,10 @@ SPAN_AVX512 std::uint64_t span_avx512_256(const SimdSpan& s) {
 // Untextured RGBA8888 spans of at least kWideSpan pixels in sixteen lanes (shade_span_wide, tails
 // through masked moves: the 50,000-px front rows 108-113 → 101-102 ms a frame against unmasked
 // tails); every other span as span_avx512_256. Shorter spans stay in eight lanes: sixteen for
-// spans from 9 pixels on cost the 1,000-px front rows up to a tenth (spans of 20-40 pixels, where
-// the second set of lanes' start and the 8-lane tail are paid on every row).
-constexpr unsigned kWideSpan = 32;
+// spans from 9 or 32 pixels on cost the 1,000-px front rows a few per cent (spans of 20-45 pixels,
+// where the second set of lanes' start and the 8-lane tail are paid on every row); from 64 they
+// do not (docs/simulator.md, issue 17's AVX-512 part).
+constexpr unsigned kWideSpan = 64;
 SPAN_AVX512 std::uint64_t span_avx512(const SimdSpan& s) {
   return simd::dispatch(s.pixel, [&]<bool kTextured, PixelFormat kFormat>() __attribute__((always_inline)) {
     if constexpr (!kTextured && kFormat == PixelFormat::RGBA8888) {
