@@ -34,32 +34,41 @@ struct StageFlags {
 // lanes' planes (R, G, B, A when gouraud, Z when depth, S, T, Q when textured); `bayer` the lanes'
 // dither threshold indices (packed formats). Returns the lanes that passed the depth test.
 // kTexelLanes (the preview path): q[5] and q[6] hold the texel coordinates themselves.
-template <bool kTextured, PixelFormat kFormat, Chunk kChunk, bool kTexelLanes = false>
-[[gnu::always_inline]] inline u32x8 pixel8(const PixelLanes& px, StageFlags f, const u32x8* q, u32x8 pass,
-                                           std::uint8_t* cp, std::uint8_t* zp, unsigned n, bool whole, u32x8 bayer) {
-  bool none = false, all = n == 8;
+// V: u32x8, or u32x16 for untextured RGBA8888 spans (the span routine's AVX-512 instance); kMasked:
+// tails through AVX-512's masked moves (load_words).
+template <bool kTextured, PixelFormat kFormat, Chunk kChunk, bool kTexelLanes = false, bool kMasked = false, class V>
+[[gnu::always_inline]] inline V pixel8(const PixelLanes& px, StageFlags f, const V* q, V pass, std::uint8_t* cp,
+                                       std::uint8_t* zp, unsigned n, bool whole, V bayer) {
+  using S = signed_lanes<V>;
+  bool none = false, all = n == kLanesOf<V>;
   if (f.depth) {
-    const u32x8 z = q[4] & px.zmask;
-    const u32x8 old = load_words(zp, n, whole);  // lanes beyond n are masked off
-    if (px.z_test) pass = depth_test(px.z_func, pass, (i32x8)z, (i32x8)(bswap(old) & 0xFFFFFFu));  // both < 2^24
+    const V z = q[4] & px.zmask;
+    const V old = load_words<V, kMasked>(zp, n, whole);  // lanes beyond n are masked off
+    if (px.z_test) pass = depth_test(px.z_func, pass, (S)z, (S)(bswap(old) & 0xFFFFFFu));  // both < 2^24
     if constexpr (kChunk == Chunk::Span) {
-      std::uint64_t m[4];
+      constexpr unsigned kWords = sizeof(V) / 8;
+      std::uint64_t m[kWords];
       std::memcpy(m, &pass, sizeof m);
-      none = (m[0] | m[1] | m[2] | m[3]) == 0;
-      all = all && (m[0] & m[1] & m[2] & m[3]) == ~std::uint64_t{0};
+      std::uint64_t any = 0, every = ~std::uint64_t{0};
+      for (unsigned w = 0; w < kWords; ++w) {
+        any |= m[w];
+        every &= m[w];
+      }
+      none = any == 0;
+      all = all && every == ~std::uint64_t{0};
     }
-    if (px.z_write && !none) store_words(zp, (bswap(z) & pass) | (old & ~pass), n);
+    if (px.z_write && !none) store_words<kMasked>(zp, (bswap(z) & pass) | (old & ~pass), n);
   }
   if (none) return pass;  // rejected chunks touch no colour
-  u32x8 word = u32x8{} + px.flat;
+  V word = V{} + px.flat;
   if (px.gouraud) word = (q[0] & 255u) | ((q[1] & 255u) << 8) | ((q[2] & 255u) << 16) | (q[3] << 24);
   if constexpr (kTextured && kTexelLanes) word = texture8_lanes(px.texture, q[5], q[6], pass, n, word);
   else if constexpr (kTextured) word = texture8(px.texture, q[5], q[6], q[7], pass, n, word);
   if (kChunk == Chunk::Span && all && !f.reads_color) {  // a fully passing chunk of a plain store: no read
-    store_color<kFormat>(cp, pack_color<kFormat>(word, bayer, px.temporal), 8);
+    store_color<kFormat, kMasked>(cp, pack_color<kFormat>(word, bayer, px.temporal), kLanesOf<V>);
     return pass;
   }
-  write_color8<kFormat>(cp, n, word, pass, px.blend, bayer, px.temporal, px.keep, whole);
+  write_color8<kFormat, kMasked>(cp, n, word, pass, px.blend, bayer, px.temporal, px.keep, whole);
   return pass;
 }
 

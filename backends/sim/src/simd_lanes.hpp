@@ -1,11 +1,14 @@
 #pragma once
-// 8-lane GCC/Clang vector types and the lane operations of the vector routines (span_simd.cpp,
-// narrow_simd.cpp). Every helper is [[gnu::always_inline]]: that is what lets a function compiled
+// 8-lane (and, for the span routine's AVX-512 instance, 16-lane) GCC/Clang vector types and the
+// lane operations of the vector routines (span_simd.cpp, narrow_simd.cpp). The lane operations are
+// templates over the vector type V (u32x8 or u32x16), deduced from their arguments. Every helper is [[gnu::always_inline]]: that is what lets a function compiled
 // for the default target inline into the routines' AVX2 target clones (without it GCC keeps a call,
 // and a vector argument then crosses it in memory).
 #include <bit>
 #include <cstdint>
 #include <cstring>
+
+#include <immintrin.h>
 
 #include "gpubridge/protocol/registers.hpp"
 
@@ -17,9 +20,30 @@ namespace gpubridge::sim::simd {
 
 typedef std::uint32_t u32x8 __attribute__((vector_size(32)));
 typedef std::int32_t i32x8 __attribute__((vector_size(32)));
+typedef std::uint32_t u32x16 __attribute__((vector_size(64)));
+typedef std::int32_t i32x16 __attribute__((vector_size(64)));
+
+// The signed lanes of V's width (compares of V give them) and V's lane count.
+template <class V>
+struct LaneTraits;
+template <>
+struct LaneTraits<u32x8> {
+  using Signed = i32x8;
+  static constexpr unsigned kLanes = 8;
+};
+template <>
+struct LaneTraits<u32x16> {
+  using Signed = i32x16;
+  static constexpr unsigned kLanes = 16;
+};
+template <class V>
+using signed_lanes = typename LaneTraits<V>::Signed;
+template <class V>
+inline constexpr unsigned kLanesOf = LaneTraits<V>::kLanes;
 
 // A lane compare's result (0 or −1 per lane) as a mask of all-zero / all-one lanes.
 [[gnu::always_inline]] inline u32x8 mask(i32x8 m) { return (u32x8)m; }
+[[gnu::always_inline]] inline u32x16 mask(i32x16 m) { return (u32x16)m; }
 
 [[gnu::always_inline]] inline u32x8 load8(const void* p) {
   u32x8 v;
@@ -27,6 +51,29 @@ typedef std::int32_t i32x8 __attribute__((vector_size(32)));
   return v;
 }
 [[gnu::always_inline]] inline void store8(void* p, u32x8 v) { std::memcpy(p, &v, sizeof v); }
+template <class V>
+[[gnu::always_inline]] inline V load_lanes(const void* p) {
+  V v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+
+// The first n (< the lane count) words at p into lanes 0..n-1, 0 in the rest, and lanes 0..n-1 to n
+// words at p: AVX-512's masked moves (the masked-off words are neither read nor written, so no
+// fault and no stack copy). Only the AVX-512 instance calls them (kMasked below): their target
+// attribute lets them inline there and nowhere else.
+__attribute__((target("avx512f,avx512vl"))) inline u32x8 masked_load(const std::uint8_t* p, unsigned n, u32x8) {
+  return (u32x8)_mm256_maskz_loadu_epi32(static_cast<__mmask8>((1u << n) - 1), p);
+}
+__attribute__((target("avx512f,avx512vl"))) inline u32x16 masked_load(const std::uint8_t* p, unsigned n, u32x16) {
+  return (u32x16)_mm512_maskz_loadu_epi32(static_cast<__mmask16>((1u << n) - 1), p);
+}
+__attribute__((target("avx512f,avx512vl"))) inline void masked_store(std::uint8_t* p, u32x8 v, unsigned n) {
+  _mm256_mask_storeu_epi32(p, static_cast<__mmask8>((1u << n) - 1), (__m256i)v);
+}
+__attribute__((target("avx512f,avx512vl"))) inline void masked_store(std::uint8_t* p, u32x16 v, unsigned n) {
+  _mm512_mask_storeu_epi32(p, static_cast<__mmask16>((1u << n) - 1), (__m512i)v);
+}
 
 // n words from p into lanes 0..n-1; later lanes hold the next words of the row when `whole`
 // (eight words fit before the row ends: same row, so the same band and thread) or 0. Both are
@@ -34,35 +81,49 @@ typedef std::int32_t i32x8 __attribute__((vector_size(32)));
 // buffer stores it in pieces and reloads it as one 32-byte word, which defeats store-to-load
 // forwarding (a stall per chunk: 30% of random-Z span time for full chunks, and the tail chunk's
 // share of the rest).
-[[gnu::always_inline]] inline u32x8 load_words(const std::uint8_t* p, unsigned n, bool whole) {
-  if (n == 8 || whole) return load8(p);
-  std::uint32_t buf[8] = {};
-  std::memcpy(buf, p, std::size_t{n} * 4);
-  return load8(buf);
+// kMasked (AVX-512): a tail takes a masked load instead.
+template <class V = u32x8, bool kMasked = false>
+[[gnu::always_inline]] inline V load_words(const std::uint8_t* p, unsigned n, bool whole) {
+  constexpr unsigned kN = kLanesOf<V>;
+  if constexpr (kMasked) {
+    if (n == kN) return load_lanes<V>(p);
+    return masked_load(p, n, V{});
+  } else {
+    if (n == kN || whole) return load_lanes<V>(p);
+    std::uint32_t buf[kN] = {};
+    std::memcpy(buf, p, std::size_t{n} * 4);
+    return load_lanes<V>(buf);
+  }
 }
 // Lanes 0..n-1 to n words at p. Full chunks copy a constant 32 bytes (inlined); only the tail
-// copies n words.
-[[gnu::always_inline]] inline void store_words(std::uint8_t* p, u32x8 v, unsigned n) {
-  if (n == 8) std::memcpy(p, &v, 32);
+// copies n words (kMasked: a masked store).
+template <bool kMasked = false, class V>
+[[gnu::always_inline]] inline void store_words(std::uint8_t* p, V v, unsigned n) {
+  if (n == kLanesOf<V>) std::memcpy(p, &v, sizeof v);
+  else if constexpr (kMasked) masked_store(p, v, n);
   else std::memcpy(p, &v, std::size_t{n} * 4);
 }
 
 // Z is stored big-endian in video memory (docs/protocol.md): byte-swap each lane.
-[[gnu::always_inline]] inline u32x8 bswap(u32x8 w) {
+template <class V>
+[[gnu::always_inline]] inline V bswap(V w) {
   return (w >> 24) | ((w >> 8) & 0xFF00u) | ((w << 8) & 0xFF0000u) | (w << 24);
 }
 
 // One carry of an exact (q, r) stepper: r < 2·den < 2^31 before, r < den after (the signed
 // compare is exact); q counts the carry (carry lanes are all ones, −1).
-[[gnu::always_inline]] inline void carry(u32x8& q, u32x8& r, u32x8 den) {
-  const u32x8 c = mask((i32x8)r >= (i32x8)den);
+template <class V>
+[[gnu::always_inline]] inline void carry(V& q, V& r, V den) {
+  using S = signed_lanes<V>;
+  const V c = mask((S)r >= (S)den);
   r -= den & c;
   q -= c;
 }
 
 // `pass` narrowed to the lanes whose new depth z passes the test `f` against the stored depth d
 // (TRI_MODE.Z_FUNC), both < 2^24 in signed lanes.
-[[gnu::always_inline]] inline u32x8 depth_test(protocol::DepthFunc f, u32x8 pass, i32x8 z, i32x8 d) {
+template <class V>
+[[gnu::always_inline]] inline V depth_test(protocol::DepthFunc f, V pass, signed_lanes<V> z, signed_lanes<V> d) {
   using protocol::DepthFunc;
   switch (f) {
     case DepthFunc::Less: return pass & mask(z < d);
@@ -74,25 +135,27 @@ typedef std::int32_t i32x8 __attribute__((vector_size(32)));
     case DepthFunc::Always: return pass;
     case DepthFunc::Never: break;
   }
-  return u32x8{};
+  return V{};
 }
 
 // div255 of fixed_point.hpp in lanes: round(x / 255) for 0 <= x <= 65025.
-[[gnu::always_inline]] inline u32x8 div255(u32x8 x) { return (x + 128u + ((x + 128u) >> 8)) >> 8; }
+template <class V>
+[[gnu::always_inline]] inline V div255(V x) { return (x + 128u + ((x + 128u) >> 8)) >> 8; }
 
 // Section 11's blend (`mode` ALPHA, ADD or MULTIPLY) of eight source words with the eight stored
 // ones (byte c of a word is channel c: R, G, B, A), channel by channel in 32-bit lanes.
-[[gnu::always_inline]] inline u32x8 blend(protocol::BlendMode mode, u32x8 src, u32x8 dst) {
-  const u32x8 a = src >> 24, inv = 255u - a;
-  u32x8 out = {};
+template <class V>
+[[gnu::always_inline]] inline V blend(protocol::BlendMode mode, V src, V dst) {
+  const V a = src >> 24, inv = 255u - a;
+  V out = {};
   for (unsigned c = 0; c < 32; c += 8) {
-    const u32x8 s = (src >> c) & 255u, d = (dst >> c) & 255u;
-    u32x8 v;
+    const V s = (src >> c) & 255u, d = (dst >> c) & 255u;
+    V v;
     if (mode == protocol::BlendMode::Alpha) {
       v = div255(s * a + d * inv);
     } else if (mode == protocol::BlendMode::Add) {
       v = s + d;
-      const u32x8 over = mask((i32x8)v > 255);
+      const V over = mask((signed_lanes<V>)v > 255);
       v = (v & ~over) | (255u & over);
     } else {
       v = div255(s * d);

@@ -1,5 +1,8 @@
 #include "span_simd.hpp"
 
+#include <cstdlib>
+#include <cstring>
+
 #include "pixel8.hpp"
 
 namespace gpubridge::sim {
@@ -92,10 +95,154 @@ template <bool kTextured, PixelFormat kFormat>
   return total;
 }
 
-__attribute__((target_clones("avx2", "default"))) std::uint64_t shade_span_simd(const SimdSpan& s) {
+// The AVX-512 instance's long untextured RGBA8888 spans in sixteen lanes (512-bit vectors): chunks
+// of sixteen while more than eight pixels remain, the last 1-8 in one chunk of eight lanes (the low
+// half of the sixteen) rather than a mostly empty sixteen. Lanes 8..15 start one 8-pixel step
+// (q8, r8) after lanes 0..7 and all advance by twice that step, with one carry each: the same
+// integers as eight lanes. kMasked: partial chunks through AVX-512's masked moves.
+[[gnu::always_inline]] inline simd::u32x16 join(u32x8 lo, u32x8 hi) {
+  return __builtin_shufflevector(lo, hi, 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+}
+[[gnu::always_inline]] inline u32x8 low_half(simd::u32x16 v) { return __builtin_shufflevector(v, v, 0, 1, 2, 3, 4, 5, 6, 7); }
+
+template <bool kMasked>
+[[gnu::always_inline]] inline std::uint64_t shade_span_wide(const SimdSpan& s) {
+  using simd::u32x16;
+  constexpr PixelFormat kFormat = PixelFormat::RGBA8888;
+  constexpr unsigned kUsed = 5;  // untextured: R, G, B, A, Z
+  const PixelLanes& px = s.pixel;
+  const unsigned first = px.gouraud ? 0 : 4;
+  const u32x8 den8 = u32x8{} + s.den;
+  const u32x16 den = u32x16{} + s.den;
+  std::uint32_t q0[8], r0[8];
+  span_start(s, q0, r0);
+  u32x16 q[kUsed], r[kUsed];
+  std::uint32_t q16[kUsed], r16[kUsed];
+  for (unsigned p = first; p < kUsed; ++p) {
+    u32x8 ql = simd::load8(s.qk[p]) + q0[p], rl = simd::load8(s.rk[p]) + r0[p];
+    simd::carry(ql, rl, den8);
+    u32x8 qh = ql + s.q8[p], rh = rl + s.r8[p];
+    simd::carry(qh, rh, den8);
+    q[p] = join(ql, qh);
+    r[p] = join(rl, rh);
+    const bool over = 2 * s.r8[p] >= s.den;  // r8 < den < 2^30: no overflow
+    q16[p] = 2 * s.q8[p] + over;
+    r16[p] = 2 * s.r8[p] - (over ? s.den : 0);
+  }
+  const simd::i32x16 lane = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15};
+  const simd::StageFlags flags = simd::stage_flags(px);
+  u32x16 passed = {};
+  std::uint8_t* cp = s.color;
+  std::uint8_t* zp = s.depth;
+  unsigned i = 0;
+  for (; i + 8 < s.count; i += 16) {
+    const unsigned n = s.count - i < 16 ? s.count - i : 16;
+    const u32x16 in_span = simd::mask(lane < static_cast<std::int32_t>(n));
+    passed -= simd::pixel8<false, kFormat, simd::Chunk::Span, false, kMasked>(px, flags, q, in_span, cp, zp, n,
+                                                                              i + 16 <= s.room, u32x16{});
+    cp += 16 * 4;
+    if (flags.depth) zp += 16 * 4;  // s.depth is null without depth
+    for (unsigned p = first; p < kUsed; ++p) {
+      q[p] += q16[p];
+      r[p] += r16[p];
+      simd::carry(q[p], r[p], den);
+    }
+  }
+  std::uint64_t total = 0;
+  if (i < s.count) {
+    const unsigned n = s.count - i;  // 1..8
+    u32x8 qt[kUsed];
+    for (unsigned p = first; p < kUsed; ++p) qt[p] = low_half(q[p]);
+    const i32x8 lane8 = {0, 1, 2, 3, 4, 5, 6, 7};
+    const u32x8 in_span = simd::mask(lane8 < static_cast<std::int32_t>(n));
+    const u32x8 tail = simd::pixel8<false, kFormat, simd::Chunk::Span, false, kMasked>(px, flags, qt, in_span, cp, zp,
+                                                                                       n, i + 8 <= s.room, u32x8{});
+    for (unsigned k = 0; k < 8; ++k) total += tail[k] & 1;  // pass lanes are all ones (−1)
+  }
+  for (unsigned k = 0; k < 16; ++k) total += passed[k];  // pass lanes are all ones (−1)
+  return total;
+}
+
+namespace {
+
+// Each instance is the same source compiled for one ISA; all of them compute the same integers.
+std::uint64_t span_baseline(const SimdSpan& s) {
   return simd::dispatch(s.pixel, [&]<bool kTextured, PixelFormat kFormat>() __attribute__((always_inline)) {
     return shade_span<kTextured, kFormat>(s);
   });
 }
+__attribute__((target("avx2"))) std::uint64_t span_avx2(const SimdSpan& s) {
+  return simd::dispatch(s.pixel, [&]<bool kTextured, PixelFormat kFormat>() __attribute__((always_inline)) {
+    return shade_span<kTextured, kFormat>(s);
+  });
+}
+// AVX-512 (F, VL, BW, DQ) in 256-bit vectors: the same eight lanes with 32 vector registers and
+// compares into mask registers. Tails as in AVX2 (whole loads where the row has room, stores of n
+// words): masked moves for them cost the road 15 % and the 1,000-px front rows a few per cent.
+#define SPAN_AVX512 __attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq")))
+SPAN_AVX512 std::uint64_t span_avx512_256(const SimdSpan& s) {
+  return simd::dispatch(s.pixel, [&]<bool kTextured, PixelFormat kFormat>() __attribute__((always_inline)) {
+    return shade_span<kTextured, kFormat>(s);
+  });
+}
+// Untextured RGBA8888 spans of at least kWideSpan pixels in sixteen lanes (shade_span_wide, tails
+// through masked moves: the 50,000-px front rows 108-113 → 101-102 ms a frame against unmasked
+// tails); every other span as span_avx512_256. Shorter spans stay in eight lanes: sixteen for
+// spans from 9 or 32 pixels on cost the 1,000-px front rows a few per cent (spans of 20-45 pixels,
+// where the second set of lanes' start and the 8-lane tail are paid on every row); from 64 they
+// do not (docs/simulator.md, issue 17's AVX-512 part).
+constexpr unsigned kWideSpan = 64;
+SPAN_AVX512 std::uint64_t span_avx512(const SimdSpan& s) {
+  return simd::dispatch(s.pixel, [&]<bool kTextured, PixelFormat kFormat>() __attribute__((always_inline)) {
+    if constexpr (!kTextured && kFormat == PixelFormat::RGBA8888) {
+      if (s.count >= kWideSpan) return shade_span_wide<true>(s);
+    }
+    return shade_span<kTextured, kFormat>(s);
+  });
+}
+#undef SPAN_AVX512
+
+struct Instance {
+  SpanIsa isa;
+  std::uint64_t (*routine)(const SimdSpan&);
+};
+
+bool cpu_has(SpanIsa isa) {
+  switch (isa) {
+    case SpanIsa::Avx512:
+    case SpanIsa::Avx512x256:
+      return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
+             __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512dq");
+    case SpanIsa::Avx2: return __builtin_cpu_supports("avx2");
+    case SpanIsa::Baseline: break;
+  }
+  return true;
+}
+
+// The widest instance the CPU runs, capped by GPUBRIDGE_SIM_SPAN_ISA (avx512-256, avx2 or baseline)
+// so that the instances can be timed against each other in one binary.
+Instance pick_instance() {
+  SpanIsa cap = SpanIsa::Avx512;
+  if (const char* env = std::getenv("GPUBRIDGE_SIM_SPAN_ISA"); env && *env) {
+    if (std::strcmp(env, "avx512-256") == 0) cap = SpanIsa::Avx512x256;
+    else if (std::strcmp(env, "avx2") == 0) cap = SpanIsa::Avx2;
+    else if (std::strcmp(env, "baseline") == 0) cap = SpanIsa::Baseline;
+  }
+  if (cap == SpanIsa::Avx512 && cpu_has(SpanIsa::Avx512)) return {SpanIsa::Avx512, &span_avx512};
+  if (cap == SpanIsa::Avx512x256 && cpu_has(SpanIsa::Avx512)) return {SpanIsa::Avx512x256, &span_avx512_256};
+  if (cap != SpanIsa::Baseline && cpu_has(SpanIsa::Avx2)) return {SpanIsa::Avx2, &span_avx2};
+  return {SpanIsa::Baseline, &span_baseline};
+}
+
+const Instance& instance() {
+  static const Instance picked = pick_instance();
+  return picked;
+}
+
+}  // namespace
+
+SpanIsa span_simd_isa() { return instance().isa; }
+
+std::uint64_t shade_span_simd(const SimdSpan& s) { return instance().routine(s); }
 
 }  // namespace gpubridge::sim

@@ -33,7 +33,15 @@ struct SimdSpan {
   PixelLanes pixel;                        // the draw's depth, texture and colour stages
 };
 
-// Returns the number of pixels that passed the depth test (all of them without a test).
+// Returns the number of pixels that passed the depth test (all of them without a test). Runs the
+// widest instance the CPU has (span_simd_isa()); the environment variable GPUBRIDGE_SIM_SPAN_ISA
+// (avx512-256, avx2 or baseline; read once per process) caps it, to time the instances against
+// each other in one binary and to test each on a CPU that has a wider one.
 std::uint64_t shade_span_simd(const SimdSpan& span);
+
+// The instruction sets of the span routine's instances (all give the same bytes).
+enum class SpanIsa { Baseline, Avx2, Avx512x256, Avx512 };
+// The instance shade_span_simd() runs in this process.
+SpanIsa span_simd_isa();
 
 }  // namespace gpubridge::sim

@@ -1,0 +1,80 @@
+// The span routine's instruction-set instances (span_simd.cpp: AVX-512 with sixteen lanes, AVX-512
+// in 256-bit vectors, AVX2) against the scalar reference routines: random render states and
+// triangles rendered with DeviceOptions::vector_routines on and off, colour, depth and counters
+// identical. The process runs one instance, the widest the CPU has unless GPUBRIDGE_SIM_SPAN_ISA
+// caps it; tests/sim/CMakeLists.txt runs this test again under each cap, so that every instance
+// this CPU can run is checked (SimVectorRoutines.* checks only the widest).
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <cstring>
+#include <random>
+#include <string>
+
+#include "random_draws.hpp"
+#include "span_simd.hpp"
+
+namespace gpubridge::sim::test {
+namespace {
+
+bool cpu_has_avx512() {
+  return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
+         __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512dq");
+}
+
+// The instance this process should run, or an empty string when the CPU lacks it (skip).
+std::string expected_instance(SpanIsa& isa) {
+  const char* env = std::getenv("GPUBRIDGE_SIM_SPAN_ISA");
+  const std::string cap = env ? env : "";
+  if (cap == "baseline") {
+    isa = SpanIsa::Baseline;
+    return "baseline";
+  }
+  if (cap == "avx2") {
+    isa = SpanIsa::Avx2;
+    return __builtin_cpu_supports("avx2") ? "AVX2" : "";
+  }
+  isa = cap == "avx512-256" ? SpanIsa::Avx512x256 : SpanIsa::Avx512;
+  return cpu_has_avx512() ? (isa == SpanIsa::Avx512 ? "AVX-512 (16 lanes)" : "AVX-512 (256-bit)") : "";
+}
+
+DeviceOptions vector_options(bool vector) {
+  DeviceOptions o;
+  o.vector_routines = vector;
+  return o;
+}
+
+void expect_same(const Case& c, const Rendered& v, const Rendered& s, int i) {
+  ASSERT_EQ(v.memory, s.memory) << "case " << i << ": TRI_MODE 0x" << std::hex << c.tri_mode << " TEX_FMT 0x"
+                                << c.tex_fmt << " FB_FORMAT 0x" << c.fb_fmt;
+  EXPECT_TRUE(v.stats == s.stats) << i << ": the counters";
+}
+
+TEST(SimSpanIsa, SameBytesAndCountersAsScalar) {
+  SpanIsa isa{};
+  const std::string name = expected_instance(isa);
+  if (name.empty()) GTEST_SKIP() << "this CPU lacks the instruction set of the instance under test (AVX-512 F/VL/BW/DQ, or AVX2 under GPUBRIDGE_SIM_SPAN_ISA=avx2)";
+  ASSERT_EQ(span_simd_isa(), isa) << "the span routine does not run the " << name << " instance";
+  std::mt19937 rng(20261127);
+  unsigned wide = 0, narrow = 0;
+  for (int i = 0; i < 400; ++i) {
+    Case c = random_case(rng);
+    // Half the cases untextured RGBA8888, the states the sixteen-lane routine takes (every depth
+    // function, blend and write mask); the other half as drawn (eight lanes, masked tails).
+    if (i % 2 == 0) {
+      c.tri_mode &= ~std::uint64_t{2};
+      c.fb_fmt = fb_format(kW, kH, 0);
+    }
+    const Rendered v = render(c, vector_options(true)), s = render(c, vector_options(false));
+    expect_same(c, v, s, i);
+    if (::testing::Test::HasFatalFailure()) return;
+    const bool untextured_8888 = !(c.tri_mode & 2) && c.fb_fmt == fb_format(kW, kH, 0);
+    (untextured_8888 ? wide : narrow) += s.stats.pixels_depth_passed > 0;
+  }
+  // Both kinds of state drew pixels.
+  EXPECT_GT(wide, 150u);
+  EXPECT_GT(narrow, 100u);
+}
+
+}  // namespace
+}  // namespace gpubridge::sim::test
