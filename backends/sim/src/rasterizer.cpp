@@ -81,15 +81,36 @@ inline Divider edge_divider(const Edge& e) { return Divider(e.ex < 0 ? -e.ex : (
 
 // What drawing `rows` wide rows whose pixels all fail the depth test counts: every covered pixel
 // scanned and covered, none passed (Kernel::run's wide rows count exactly this). e: the edge
-// values at the first row, left at the row after the last.
+// values at the first row, left at the row after the last. The quotients solve_span divides out
+// are stepped from row to row instead, as the planes are: floor(e / d) with e += ey is (q, r)
+// advanced by floor_divmod(ey, d) and one carry (for a vertical edge d = 1: q is e itself).
 void count_covered(const Triangle& t, const Divider div[3], std::int64_t e[3], int rows, RasterCounters& c) {
   const std::int64_t w = t.x1 - t.x0;
+  std::int64_t q[3], r[3], qy[3], ry[3], d[3];
+  for (int i = 0; i < 3; ++i) {
+    const DivMod a = div[i](e[i]), s = div[i](t.edge[i].ey);
+    q[i] = a.q;
+    r[i] = a.r;
+    qy[i] = s.q;
+    ry[i] = s.r;
+    d[i] = div[i].divisor();
+    e[i] += rows * t.edge[i].ey;
+  }
   std::uint64_t n = 0;
-  for (int r = 0; r < rows; ++r) {
-    std::int64_t kl, kr;
-    solve_span(t, div, e, w, kl, kr);
+  for (int row = 0; row < rows; ++row) {
+    std::int64_t kl = 0, kr = w - 1;
+    for (int i = 0; i < 3; ++i) {
+      const std::int64_t ex = t.edge[i].ex;
+      if (ex > 0) kl = std::max(kl, -q[i]);
+      else if (ex < 0) kr = std::min(kr, q[i]);
+      else if (q[i] < 0) kr = -1;
+      q[i] += qy[i];
+      r[i] += ry[i];
+      const bool carry = r[i] >= d[i];
+      r[i] -= carry ? d[i] : 0;
+      q[i] += carry;
+    }
     n += kl <= kr ? static_cast<std::uint64_t>(kr - kl + 1) : 0u;
-    for (int i = 0; i < 3; ++i) e[i] += t.edge[i].ey;
   }
   c.scanned += n;
   c.covered += n;
@@ -193,7 +214,7 @@ class Kernel {
     const bool bands = kDepth && ctx_.hier_z && w >= kSpanSolveWidth;
     if (kDepth && ctx_.hier_z) {
       hz_run_ = HierZ::next_run(ctx_.hz_run);
-      hz_tries_ = HierZ::kTries - ((hz & kHzFirstAsked) ? 1 : 0);
+      hz_tries_ = HierZ::kTries;
       hz_rejected_ = (hz & kHzRejected) != 0;
     }
     const std::uint64_t passed_before = ctx_.counters.passed;
@@ -216,6 +237,7 @@ class Kernel {
         if ((y & ((1 << HierZ::kRowsLog) - 1)) == 0 && HierZ::band_asks_afresh(y >> HierZ::kRowsLog, hz_rejected_))
           hz_tries_ = HierZ::kTries;
         if (hz_tries_ != 0 && !(first && (hz & kHzFirstAsked))) {
+          // A band not rejected leaves the rows their tries: the band's bound is coarser than a row's.
           if (band_occluded(t_, st_, ctx_, zmask_, y, end - 1, hz_run_)) {
             hz_tries_ = HierZ::kTries;
             hz_rejected_ = true;
@@ -226,7 +248,6 @@ class Kernel {
             first = false;
             continue;
           }
-          --hz_tries_;
         }
       } else if (kDepth && ctx_.hier_z && (y & ((1 << HierZ::kRowsLog) - 1)) == 0 &&
                  HierZ::band_asks_afresh(y >> HierZ::kRowsLog, hz_rejected_)) {
