@@ -116,57 +116,70 @@ void count_covered(const Triangle& t, const Divider div[3], std::int64_t e[3], i
   c.covered += n;
 }
 
+// The triangle's edges as band_occluded clips them: edge i runs from its lower end (y0, x0, z0)
+// up to y1 (sample units), x and the interpolated depth changing by kx, kz per unit of y. Worked
+// out once per triangle (a division per edge) for all the bands it asks.
+struct BandClip {
+  double y0[3], y1[3], x0[3], z0[3], kx[3], kz[3];
+  explicit BandClip(const Triangle& t) {
+    for (int i = 0; i < 3; ++i) {
+      const Vertex* a = &t.v[i];
+      const Vertex* b = &t.v[i == 2 ? 0 : i + 1];
+      if (b->y < a->y) std::swap(a, b);
+      y0[i] = a->y;
+      y1[i] = b->y;
+      x0[i] = a->x;
+      z0[i] = a->z;
+      // A horizontal edge's ends are the ends of the other two edges: it adds nothing (y1 < y0 skips it).
+      if (b->y == a->y) {
+        y1[i] = y0[i] - 1;
+        kx[i] = kz[i] = 0;
+        continue;
+      }
+      const double inv = 1.0 / (static_cast<double>(b->y) - a->y);
+      kx[i] = (static_cast<double>(b->x) - a->x) * inv;
+      kz[i] = (static_cast<double>(b->z) - a->z) * inv;
+    }
+  }
+};
+
 // Whether the coarse depth bounds (hier_z.hpp) reject every covered pixel of t's rows ya..yb
 // (inclusive, inside one 16-row band of blocks), asked as Kernel run `run`. The depth plane is the
 // affine interpolation of the vertices' depths (section 9: the weights are the raw edge functions,
 // none negative at a covered sample point, rounded to nearest), so at a covered pixel of these rows
 // the depth is at least the floor of the plane's least value over the part of the triangle between
 // the rows' sample lines y = 16·ya + 8 and 16·yb + 8; that part is convex and its corners lie on
-// the edges clipped to those lines, so the least value is at an end of a clipped edge. Found in
-// double, with the clipping widened by 1e-9 of an edge (points slightly outside only lower the
-// bound and widen the columns) and a margin of one depth unit for rounding: a lower bound, masked
-// as the test masks (masking keeps order). The columns asked are those ends' pixel columns and one
-// more either side, inside the box. Every pixel of the rows then fails the test as in
-// Kernel::occluded. Asked before a Kernel is built, a rejected band costs its span solves only.
-bool band_occluded(const Triangle& t, const DrawState& st, RasterContext& ctx, std::uint32_t zmask, int ya, int yb,
-                   std::uint32_t run) {
+// the edges clipped to those lines, so the least value is at an end of a clipped edge (c). Found in
+// double, with a margin of one depth unit for rounding: a lower bound, masked as the test masks
+// (masking keeps order). The columns asked are those ends' pixel columns and one more either side,
+// inside the box. Every pixel of the rows then fails the test as in Kernel::occluded. Asked before
+// a Kernel is built, a rejected band costs its span solves only.
+bool band_occluded(const Triangle& t, const BandClip& c, const DrawState& st, RasterContext& ctx, std::uint32_t zmask,
+                   int ya, int yb, std::uint32_t run) {
   const double lo = 16.0 * ya + 8, hi = 16.0 * yb + 8;
   double zmin = HUGE_VAL, xmin = HUGE_VAL, xmax = -HUGE_VAL;
   for (int i = 0; i < 3; ++i) {
-    const Vertex& a = t.v[i];
-    const Vertex& b = t.v[i == 2 ? 0 : i + 1];
-    const double ay = a.y, dy = static_cast<double>(b.y) - a.y;
-    double s0 = 0, s1 = 1;
-    if (dy != 0) {
-      double sl = (lo - ay) / dy, sh = (hi - ay) / dy;
-      if (sl > sh) std::swap(sl, sh);
-      s0 = std::max(s0, sl - 1e-9);
-      s1 = std::min(s1, sh + 1e-9);
-      if (s0 > s1) continue;
-    } else if (ay < lo || ay > hi) {
-      continue;
-    }
-    const double ax = a.x, dx = static_cast<double>(b.x) - a.x, az = a.z, dz = static_cast<double>(b.z) - a.z;
-    for (const double s : {s0, s1}) {
-      const double x = ax + s * dx, z = az + s * dz;
-      zmin = std::min(zmin, z);
-      xmin = std::min(xmin, x);
-      xmax = std::max(xmax, x);
-    }
+    const double a = std::max(lo, c.y0[i]) - c.y0[i], b = std::min(hi, c.y1[i]) - c.y0[i];
+    if (a > b) continue;  // the edge does not reach these rows
+    const double xa = c.x0[i] + a * c.kx[i], xb = c.x0[i] + b * c.kx[i];
+    const double za = c.z0[i] + a * c.kz[i], zb = c.z0[i] + b * c.kz[i];
+    zmin = std::min(zmin, std::min(za, zb));
+    xmin = std::min(xmin, std::min(xa, xb));
+    xmax = std::max(xmax, std::max(xa, xb));
   }
   if (zmin == HUGE_VAL) return false;  // no part of the triangle in these rows (nothing to skip)
   const double zf = std::floor(zmin) - 1;
   const std::uint32_t z = zf <= 0 ? 0u : zf >= 0xFFFFFF ? 0xFFFFFFu : static_cast<std::uint32_t>(zf);
   // Pixel x's sample point is 16x + 8.
-  const int xa = std::max(t.x0, static_cast<int>(std::floor((xmin - 8) / 16)) - 1);
-  const int xb = std::min(t.x1 - 1, static_cast<int>(std::ceil((xmax - 8) / 16)) + 1);
+  const int xa = std::max(t.x0, static_cast<int>(std::floor((xmin - 8) * (1.0 / 16))) - 1);
+  const int xb = std::min(t.x1 - 1, static_cast<int>(std::ceil((xmax - 8) * (1.0 / 16))) + 1);
   if (xa > xb) return false;
   return ctx.hier_z->occludes(ctx.mem.data() + st.fb_z, ya, xa, xb, z & zmask, st.z_func == protocol::DepthFunc::Less,
                               ctx.hz_gen, run);
 }
 
 // What rasterize_rows's band tests found before the Kernel was built (Kernel::run's `hz`).
-constexpr unsigned kHzFirstAsked = 1;  // the first band of the run was asked and not rejected
+constexpr unsigned kHzFirstAsked = 1;  // the first band of the run was asked and not rejected (or let pass)
 constexpr unsigned kHzRejected = 2;    // bands before the run were rejected
 
 template <bool kGouraud, bool kTextured, bool kDepth, bool kSimple>
@@ -236,9 +249,12 @@ class Kernel {
         // A new 16-row band of blocks: its tries afresh (HierZ::band_asks_afresh).
         if ((y & ((1 << HierZ::kRowsLog) - 1)) == 0 && HierZ::band_asks_afresh(y >> HierZ::kRowsLog, hz_rejected_))
           hz_tries_ = HierZ::kTries;
-        if (hz_tries_ != 0 && !(first && (hz & kHzFirstAsked))) {
+        if (hz_tries_ != 0 && !(first && (hz & kHzFirstAsked)) && ctx_.hier_z->band_worth_asking(y >> HierZ::kRowsLog)) {
           // A band not rejected leaves the rows their tries: the band's bound is coarser than a row's.
-          if (band_occluded(t_, st_, ctx_, zmask_, y, end - 1, hz_run_)) {
+          if (!clip_) clip_.emplace(t_);
+          const bool rejected = band_occluded(t_, *clip_, st_, ctx_, zmask_, y, end - 1, hz_run_);
+          ctx_.hier_z->band_answered(y >> HierZ::kRowsLog, rejected);
+          if (rejected) {
             hz_tries_ = HierZ::kTries;
             hz_rejected_ = true;
             count_covered(t_, edge_div_, e, end - y, ctx_.counters);
@@ -548,6 +564,7 @@ class Kernel {
   std::uint32_t hz_run_ = 0;    // this run's number for the coarse depth bounds
   unsigned hz_tries_ = 0;       // rows left to ask them before giving up on this run (0: not asked)
   bool hz_rejected_ = false;    // they rejected a row of this run
+  std::optional<BandClip> clip_;  // for band_occluded, when a band is asked
 };
 
 template <bool G, bool T, bool Z, bool S>
@@ -759,9 +776,17 @@ void rasterize_rows(const Triangle& t, const DrawState& st, RasterContext& ctx, 
     const std::uint32_t run = HierZ::next_run(ctx.hz_run), zmask = z_mask(ctx);
     std::optional<std::array<Divider, 3>> div;
     std::int64_t e[3];
+    std::optional<BandClip> clip;
     for (;;) {
       const int end = std::min(yz, (ya | ((1 << HierZ::kRowsLog) - 1)) + 1);
-      if (!band_occluded(t, st, ctx, zmask, ya, end - 1, run)) {
+      if (!ctx.hier_z->band_worth_asking(ya >> HierZ::kRowsLog)) {
+        hz |= kHzFirstAsked;  // not asked this time (HierZ::band_worth_asking): the Kernel does not ask either
+        break;
+      }
+      if (!clip) clip.emplace(t);
+      const bool rejected = band_occluded(t, *clip, st, ctx, zmask, ya, end - 1, run);
+      ctx.hier_z->band_answered(ya >> HierZ::kRowsLog, rejected);
+      if (!rejected) {
         hz |= kHzFirstAsked;
         break;
       }
