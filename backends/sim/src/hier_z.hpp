@@ -3,7 +3,9 @@
 // random-Z scenes): per block of 16 rows × 32 pixels, an upper bound of the 24-bit depths stored
 // in it. A span whose smallest depth is not below its blocks' bounds (LESS; not at or below for
 // LEQUAL) fails the test at every pixel and is skipped; its pixels are still counted as scanned
-// and covered, so bytes, errors and DeviceStats stay those of drawing it.
+// and covered, so bytes, errors and DeviceStats stay those of drawing it. The exact kernel asks
+// a triangle's whole 16-row bands the same way first (rasterizer.cpp, band_occluded), with a
+// lower bound of the triangle's depth over the band's rows.
 //
 // Why the bound stays exact without watching every write to memory: a bound is only used within
 // one generation, which the renderer ends at every flush() (anything that reads or writes memory
