@@ -3,7 +3,9 @@
 // random-Z scenes): per block of 16 rows × 32 pixels, an upper bound of the 24-bit depths stored
 // in it. A span whose smallest depth is not below its blocks' bounds (LESS; not at or below for
 // LEQUAL) fails the test at every pixel and is skipped; its pixels are still counted as scanned
-// and covered, so bytes, errors and DeviceStats stay those of drawing it.
+// and covered, so bytes, errors and DeviceStats stay those of drawing it. The exact kernel asks
+// a triangle's whole 16-row bands the same way first (rasterizer.cpp, band_occluded), with a
+// lower bound of the triangle's depth over the band's rows.
 //
 // Why the bound stays exact without watching every write to memory: a bound is only used within
 // one generation, which the renderer ends at every flush() (anything that reads or writes memory
@@ -48,8 +50,32 @@ class HierZ {
     width_ = width;
     height_ = height;
     per_row_ = (width + (1u << kColsLog) - 1) >> kColsLog;
-    const std::size_t n = std::size_t{per_row_} * ((height + (1u << kRowsLog) - 1) >> kRowsLog);
+    const std::size_t bands = (height + (1u << kRowsLog) - 1) >> kRowsLog;
+    const std::size_t n = std::size_t{per_row_} * bands;
     if (blocks_.size() < n) blocks_.resize(n);
+    if (bands_.size() < bands) bands_.resize(bands);
+  }
+
+  // Whether a triangle's rows in 16-row band `band` are worth asking as a whole (the exact kernel's
+  // band test, before its rows are asked one by one). After kBandMisses band tests in a row in this
+  // band that did not reject, only every 2nd, 4th … 16th is asked: front-to-back scenes are never
+  // rejected and would pay a test a band for nothing. Kept per band, which one worker owns, so
+  // the workers share nothing here and the answers follow submission order at any thread count
+  // (a heuristic only: asking or not changes no byte).
+  bool band_worth_asking(int band) {
+    Band& b = bands_[static_cast<std::size_t>(band)];
+    if (b.skip == 0) return true;
+    --b.skip;
+    return false;
+  }
+  void band_answered(int band, bool rejected) {
+    Band& b = bands_[static_cast<std::size_t>(band)];
+    if (rejected) {
+      b.misses = 0;
+      return;
+    }
+    if (b.misses < kBandMisses + 4) ++b.misses;
+    if (b.misses >= kBandMisses) b.skip = static_cast<std::uint8_t>((2u << (b.misses - kBandMisses)) - 1);
   }
 
   // Whether every stored depth of row y's pixels xa..xb (inclusive) is at most `bound` (<= for
@@ -106,6 +132,11 @@ class HierZ {
 
  private:
   static constexpr unsigned kMaxLevel = 6;
+  static constexpr unsigned kBandMisses = 8;
+  struct Band {
+    std::uint8_t misses = 0;  // band tests in a row that did not reject (capped)
+    std::uint8_t skip = 0;    // band tests to let pass before asking again
+  };
   struct Block {
     std::uint64_t gen = 0;      // generation the bound was read in (0: never)
     std::uint32_t max = 0;      // upper bound of the block's depths
@@ -125,6 +156,7 @@ class HierZ {
 
   unsigned width_ = 0, height_ = 0, per_row_ = 0;
   std::vector<Block> blocks_;
+  std::vector<Band> bands_;
 };
 
 }  // namespace gpubridge::sim

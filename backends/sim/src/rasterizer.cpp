@@ -61,6 +61,127 @@ constexpr std::int64_t kStepJump = 4;
 // Rows this far ahead of the one being drawn are prefetched.
 constexpr int kPrefetchRows = 4;
 
+// The covered span kl..kr (box-relative; empty when kl > kr) of a wide row (box width w >=
+// kSpanSolveWidth) whose edge values are e, by division (div: the edges' |ex|).
+[[gnu::always_inline]] inline void solve_span(const Triangle& t, const Divider div[3], const std::int64_t e[3],
+                                              std::int64_t w, std::int64_t& kl, std::int64_t& kr) {
+  kl = 0;
+  kr = w - 1;
+  for (int i = 0; i < 3; ++i) {
+    const std::int64_t ex = t.edge[i].ex;
+    // E + k·ex >= 0  ⇔  k >= ceil(−E / ex) (ex > 0)  or  k <= floor(E / −ex) (ex < 0)
+    if (ex > 0) kl = std::max(kl, -div[i](e[i]).q);
+    else if (ex < 0) kr = std::min(kr, div[i](e[i]).q);
+    else if (e[i] < 0) kr = -1;
+  }
+}
+
+// The span solve's divisors: each edge's |ex| (1 for a vertical edge, never divided by).
+inline Divider edge_divider(const Edge& e) { return Divider(e.ex < 0 ? -e.ex : (e.ex == 0 ? 1 : e.ex)); }
+
+// What drawing `rows` wide rows whose pixels all fail the depth test counts: every covered pixel
+// scanned and covered, none passed (Kernel::run's wide rows count exactly this). e: the edge
+// values at the first row, left at the row after the last. The quotients solve_span divides out
+// are stepped from row to row instead, as the planes are: floor(e / d) with e += ey is (q, r)
+// advanced by floor_divmod(ey, d) and one carry (for a vertical edge d = 1: q is e itself).
+void count_covered(const Triangle& t, const Divider div[3], std::int64_t e[3], int rows, RasterCounters& c) {
+  const std::int64_t w = t.x1 - t.x0;
+  std::int64_t q[3], r[3], qy[3], ry[3], d[3];
+  for (int i = 0; i < 3; ++i) {
+    const DivMod a = div[i](e[i]), s = div[i](t.edge[i].ey);
+    q[i] = a.q;
+    r[i] = a.r;
+    qy[i] = s.q;
+    ry[i] = s.r;
+    d[i] = div[i].divisor();
+    e[i] += rows * t.edge[i].ey;
+  }
+  std::uint64_t n = 0;
+  for (int row = 0; row < rows; ++row) {
+    std::int64_t kl = 0, kr = w - 1;
+    for (int i = 0; i < 3; ++i) {
+      const std::int64_t ex = t.edge[i].ex;
+      if (ex > 0) kl = std::max(kl, -q[i]);
+      else if (ex < 0) kr = std::min(kr, q[i]);
+      else if (q[i] < 0) kr = -1;
+      q[i] += qy[i];
+      r[i] += ry[i];
+      const bool carry = r[i] >= d[i];
+      r[i] -= carry ? d[i] : 0;
+      q[i] += carry;
+    }
+    n += kl <= kr ? static_cast<std::uint64_t>(kr - kl + 1) : 0u;
+  }
+  c.scanned += n;
+  c.covered += n;
+}
+
+// The triangle's edges as band_occluded clips them: edge i runs from its lower end (y0, x0, z0)
+// up to y1 (sample units), x and the interpolated depth changing by kx, kz per unit of y. Worked
+// out once per triangle (a division per edge) for all the bands it asks.
+struct BandClip {
+  double y0[3], y1[3], x0[3], z0[3], kx[3], kz[3];
+  explicit BandClip(const Triangle& t) {
+    for (int i = 0; i < 3; ++i) {
+      const Vertex* a = &t.v[i];
+      const Vertex* b = &t.v[i == 2 ? 0 : i + 1];
+      if (b->y < a->y) std::swap(a, b);
+      y0[i] = a->y;
+      y1[i] = b->y;
+      x0[i] = a->x;
+      z0[i] = a->z;
+      // A horizontal edge's ends are the ends of the other two edges: it adds nothing (y1 < y0 skips it).
+      if (b->y == a->y) {
+        y1[i] = y0[i] - 1;
+        kx[i] = kz[i] = 0;
+        continue;
+      }
+      const double inv = 1.0 / (static_cast<double>(b->y) - a->y);
+      kx[i] = (static_cast<double>(b->x) - a->x) * inv;
+      kz[i] = (static_cast<double>(b->z) - a->z) * inv;
+    }
+  }
+};
+
+// Whether the coarse depth bounds (hier_z.hpp) reject every covered pixel of t's rows ya..yb
+// (inclusive, inside one 16-row band of blocks), asked as Kernel run `run`. The depth plane is the
+// affine interpolation of the vertices' depths (section 9: the weights are the raw edge functions,
+// none negative at a covered sample point, rounded to nearest), so at a covered pixel of these rows
+// the depth is at least the floor of the plane's least value over the part of the triangle between
+// the rows' sample lines y = 16·ya + 8 and 16·yb + 8; that part is convex and its corners lie on
+// the edges clipped to those lines, so the least value is at an end of a clipped edge (c). Found in
+// double, with a margin of one depth unit for rounding: a lower bound, masked as the test masks
+// (masking keeps order). The columns asked are those ends' pixel columns and one more either side,
+// inside the box. Every pixel of the rows then fails the test as in Kernel::occluded. Asked before
+// a Kernel is built, a rejected band costs its span solves only.
+bool band_occluded(const Triangle& t, const BandClip& c, const DrawState& st, RasterContext& ctx, std::uint32_t zmask,
+                   int ya, int yb, std::uint32_t run) {
+  const double lo = 16.0 * ya + 8, hi = 16.0 * yb + 8;
+  double zmin = HUGE_VAL, xmin = HUGE_VAL, xmax = -HUGE_VAL;
+  for (int i = 0; i < 3; ++i) {
+    const double a = std::max(lo, c.y0[i]) - c.y0[i], b = std::min(hi, c.y1[i]) - c.y0[i];
+    if (a > b) continue;  // the edge does not reach these rows
+    const double xa = c.x0[i] + a * c.kx[i], xb = c.x0[i] + b * c.kx[i];
+    const double za = c.z0[i] + a * c.kz[i], zb = c.z0[i] + b * c.kz[i];
+    zmin = std::min(zmin, std::min(za, zb));
+    xmin = std::min(xmin, std::min(xa, xb));
+    xmax = std::max(xmax, std::max(xa, xb));
+  }
+  if (zmin == HUGE_VAL) return false;  // no part of the triangle in these rows (nothing to skip)
+  const double zf = std::floor(zmin) - 1;
+  const std::uint32_t z = zf <= 0 ? 0u : zf >= 0xFFFFFF ? 0xFFFFFFu : static_cast<std::uint32_t>(zf);
+  // Pixel x's sample point is 16x + 8.
+  const int xa = std::max(t.x0, static_cast<int>(std::floor((xmin - 8) * (1.0 / 16))) - 1);
+  const int xb = std::min(t.x1 - 1, static_cast<int>(std::ceil((xmax - 8) * (1.0 / 16))) + 1);
+  if (xa > xb) return false;
+  return ctx.hier_z->occludes(ctx.mem.data() + st.fb_z, ya, xa, xb, z & zmask, st.z_func == protocol::DepthFunc::Less,
+                              ctx.hz_gen, run);
+}
+
+// What rasterize_rows's band tests found before the Kernel was built (Kernel::run's `hz`).
+constexpr unsigned kHzFirstAsked = 1;  // the first band of the run was asked and not rejected (or let pass)
+constexpr unsigned kHzRejected = 2;    // bands before the run were rejected
+
 template <bool kGouraud, bool kTextured, bool kDepth, bool kSimple>
 class Kernel {
  public:
@@ -88,10 +209,7 @@ class Kernel {
       flat_ = {t.flat[0], t.flat[1], t.flat[2], t.flat[3]};
     }
     if (t.x1 - t.x0 >= kSpanSolveWidth) {  // only wide rows solve their spans
-      for (int i = 0; i < 3; ++i) {
-        const std::int64_t ex = t.edge[i].ex;
-        edge_div_[i] = Divider(ex < 0 ? -ex : (ex == 0 ? 1 : ex));
-      }
+      for (int i = 0; i < 3; ++i) edge_div_[i] = edge_divider(t.edge[i]);
     }
     if (kTextured && t.plane[kQ].constant && t.plane[kQ].q != 0) {
       q_const_ = true;  // affine: the reciprocal is the same at every pixel
@@ -99,10 +217,18 @@ class Kernel {
     }
   }
 
-  void run(int ya, int yz) {
+  // Rows ya..yz-1. `hz` (kHzFirstAsked, kHzRejected) tells what the caller's band tests found before the Kernel was
+  // built (rasterize_rows): the first band was asked and not rejected, and whether bands before ya
+  // were rejected.
+  void run(int ya, int yz, unsigned hz) {
+    const int w = t_.x1 - t_.x0;
+    // Whole 16-row bands are asked first (band_occluded) in wide boxes; rows of a band that is not
+    // rejected are asked one by one (occluded), as before.
+    const bool bands = kDepth && ctx_.hier_z && w >= kSpanSolveWidth;
     if (kDepth && ctx_.hier_z) {
       hz_run_ = HierZ::next_run(ctx_.hz_run);
       hz_tries_ = HierZ::kTries;
+      hz_rejected_ = (hz & kHzRejected) != 0;
     }
     const std::uint64_t passed_before = ctx_.counters.passed;
     const std::int64_t k = ya - t_.y0;
@@ -113,65 +239,89 @@ class Kernel {
       if (!((kPlanes >> i) & 1)) continue;
       row.q[i] = t_.plane[i].q;
       row.r[i] = t_.plane[i].r;
-      if (k > 0) Plane::advance(row.q[i], row.r[i], t_.plane[i].qy, t_.plane[i].ry, k, t_.den);
     }
-    const int w = t_.x1 - t_.x0;
-    for (int y = ya; y < yz; ++y) {
-      // A new 16-row band of blocks: its tries afresh (HierZ::band_asks_afresh).
-      if (kDepth && (y & ((1 << HierZ::kRowsLog) - 1)) == 0 && ctx_.hier_z &&
-          HierZ::band_asks_afresh(y >> HierZ::kRowsLog, hz_rejected_))
+    std::int64_t lag = k;  // rows the planes in `row` are behind y (advanced when a row is drawn)
+    int mark_from = ya;    // the first row a pixel may have been written in
+    bool first = true;
+    for (int y = ya; y < yz;) {
+      const int end = std::min(yz, (y | ((1 << HierZ::kRowsLog) - 1)) + 1);  // this band's rows
+      if (bands) {
+        // A new 16-row band of blocks: its tries afresh (HierZ::band_asks_afresh).
+        if ((y & ((1 << HierZ::kRowsLog) - 1)) == 0 && HierZ::band_asks_afresh(y >> HierZ::kRowsLog, hz_rejected_))
+          hz_tries_ = HierZ::kTries;
+        if (hz_tries_ != 0 && !(first && (hz & kHzFirstAsked)) && ctx_.hier_z->band_worth_asking(y >> HierZ::kRowsLog)) {
+          // A band not rejected leaves the rows their tries: the band's bound is coarser than a row's.
+          if (!clip_) clip_.emplace(t_);
+          const bool rejected = band_occluded(t_, *clip_, st_, ctx_, zmask_, y, end - 1, hz_run_);
+          ctx_.hier_z->band_answered(y >> HierZ::kRowsLog, rejected);
+          if (rejected) {
+            hz_tries_ = HierZ::kTries;
+            hz_rejected_ = true;
+            count_covered(t_, edge_div_, e, end - y, ctx_.counters);
+            lag += end - y;
+            if (mark_from == y) mark_from = end;
+            y = end;
+            first = false;
+            continue;
+          }
+        }
+      } else if (kDepth && ctx_.hier_z && (y & ((1 << HierZ::kRowsLog) - 1)) == 0 &&
+                 HierZ::band_asks_afresh(y >> HierZ::kRowsLog, hz_rejected_)) {
         hz_tries_ = HierZ::kTries;
-      if (w >= kSpanSolveWidth) {
-        std::int64_t kl = 0, kr = w - 1;
-        for (int i = 0; i < 3; ++i) {
-          const std::int64_t ex = t_.edge[i].ex;
-          // E + k·ex >= 0  ⇔  k >= ceil(−E / ex) (ex > 0)  or  k <= floor(E / −ex) (ex < 0)
-          if (ex > 0) kl = std::max(kl, -edge_div_[i](e[i]).q);
-          else if (ex < 0) kr = std::min(kr, edge_div_[i](e[i]).q);
-          else if (e[i] < 0) kr = -1;
-        }
-        if (kl <= kr) {
-          if (simd_ && y + kPrefetchRows < yz) prefetch_row(y + kPrefetchRows, t_.x0 + static_cast<int>(kl), static_cast<int>(kr - kl + 1));
-          if (kr - kl + 1 >= kMinSimdSpan && simd_ready()) {
-            if (!occluded(row, kl, kr, y))
-              simd_span(row, kl, t_.x0 + static_cast<int>(kl), y, static_cast<unsigned>(kr - kl + 1));
-          } else {
-            Steppers s = row;
-            jump_x(s, kl);
-            for (std::int64_t kx = kl; kx <= kr; ++kx) {
-              pixel(t_.x0 + static_cast<int>(kx), y, s);
-              step_x(s);
-            }
-          }
-          ctx_.counters.scanned += static_cast<std::uint64_t>(kr - kl + 1);
-          ctx_.counters.covered += static_cast<std::uint64_t>(kr - kl + 1);
-        }
-      } else {
-        // Narrow rows (no span routine): every pixel of the box row is tested and stepped. The
-        // loop count is the same on every row of the triangle, so it predicts; stepping only along
-        // the covered run was tried and lost on tall slivers (its data-dependent loop exits
-        // mispredicted on every row).
-        Steppers s = row;
-        std::int64_t e0 = e[0], e1 = e[1], e2 = e[2];
-        const std::int64_t x0 = t_.edge[0].ex, x1 = t_.edge[1].ex, x2 = t_.edge[2].ex;
-        for (int kx = 0; kx < w; ++kx) {
-          if ((e0 | e1 | e2) >= 0) {
-            ++ctx_.counters.covered;
-            pixel(t_.x0 + kx, y, s);
-          }
-          e0 += x0;
-          e1 += x1;
-          e2 += x2;
-          step_x(s);
-        }
-        ctx_.counters.scanned += static_cast<std::uint64_t>(w);
       }
-      for (int i = 0; i < 3; ++i) e[i] += t_.edge[i].ey;
-      step_y(row);
+      first = false;
+      if (lag > 0) {
+        for (unsigned i = 0; i < kAttrCount; ++i)
+          if ((kPlanes >> i) & 1) Plane::advance(row.q[i], row.r[i], t_.plane[i].qy, t_.plane[i].ry, lag, t_.den);
+        lag = 0;
+      }
+      for (; y < end; ++y) {
+        if (w >= kSpanSolveWidth) {
+          std::int64_t kl, kr;
+          solve_span(t_, edge_div_, e, w, kl, kr);
+          if (kl <= kr) {
+            if (simd_ && y + kPrefetchRows < yz) prefetch_row(y + kPrefetchRows, t_.x0 + static_cast<int>(kl), static_cast<int>(kr - kl + 1));
+            if (kr - kl + 1 >= kMinSimdSpan && simd_ready()) {
+              if (!occluded(row, kl, kr, y))
+                simd_span(row, kl, t_.x0 + static_cast<int>(kl), y, static_cast<unsigned>(kr - kl + 1));
+            } else {
+              Steppers s = row;
+              jump_x(s, kl);
+              for (std::int64_t kx = kl; kx <= kr; ++kx) {
+                pixel(t_.x0 + static_cast<int>(kx), y, s);
+                step_x(s);
+              }
+            }
+            ctx_.counters.scanned += static_cast<std::uint64_t>(kr - kl + 1);
+            ctx_.counters.covered += static_cast<std::uint64_t>(kr - kl + 1);
+          }
+        } else {
+          // Narrow rows (no span routine): every pixel of the box row is tested and stepped. The
+          // loop count is the same on every row of the triangle, so it predicts; stepping only along
+          // the covered run was tried and lost on tall slivers (its data-dependent loop exits
+          // mispredicted on every row).
+          Steppers s = row;
+          std::int64_t e0 = e[0], e1 = e[1], e2 = e[2];
+          const std::int64_t x0 = t_.edge[0].ex, x1 = t_.edge[1].ex, x2 = t_.edge[2].ex;
+          for (int kx = 0; kx < w; ++kx) {
+            if ((e0 | e1 | e2) >= 0) {
+              ++ctx_.counters.covered;
+              pixel(t_.x0 + kx, y, s);
+            }
+            e0 += x0;
+            e1 += x1;
+            e2 += x2;
+            step_x(s);
+          }
+          ctx_.counters.scanned += static_cast<std::uint64_t>(w);
+        }
+        for (int i = 0; i < 3; ++i) e[i] += t_.edge[i].ey;
+        step_y(row);
+      }
     }
     // Blocks this run wrote into: read again when another run asks (their bounds only got looser).
     if (kDepth && ctx_.hier_z && st_.z_write && ctx_.counters.passed != passed_before)
-      ctx_.hier_z->mark(ya, yz, t_.x0, t_.x1 - 1, hz_run_);
+      ctx_.hier_z->mark(mark_from, yz, t_.x0, t_.x1 - 1, hz_run_);
     if constexpr (kTextured) {
       ctx_.counters.textured += textured_;
       ctx_.counters.texel_bytes += textured_ * (st_.tex.bilinear ? 4u : 1u) * protocol::bytes_per_pixel(st_.tex.format);
@@ -414,14 +564,15 @@ class Kernel {
   std::uint32_t hz_run_ = 0;    // this run's number for the coarse depth bounds
   unsigned hz_tries_ = 0;       // rows left to ask them before giving up on this run (0: not asked)
   bool hz_rejected_ = false;    // they rejected a row of this run
+  std::optional<BandClip> clip_;  // for band_occluded, when a band is asked
 };
 
 template <bool G, bool T, bool Z, bool S>
-void run_kernel(const Triangle& t, const DrawState& st, RasterContext& ctx, int ya, int yz) {
-  Kernel<G, T, Z, S>(t, st, ctx).run(ya, yz);
+void run_kernel(const Triangle& t, const DrawState& st, RasterContext& ctx, int ya, int yz, unsigned hz) {
+  Kernel<G, T, Z, S>(t, st, ctx).run(ya, yz, hz);
 }
 
-using KernelFn = void (*)(const Triangle&, const DrawState&, RasterContext&, int, int);
+using KernelFn = void (*)(const Triangle&, const DrawState&, RasterContext&, int, int, unsigned);
 
 // What a vector kernel drew, into the timing model's counters: `passed` pixels were blended when
 // `blended` and textured (their texel reads by the filter's footprint) when `textured`.
@@ -604,7 +755,8 @@ SmallDraw small_draw(const DrawState& st, VideoMemory& mem, unsigned z_bits) {
 }
 
 void rasterize_rows(const Triangle& t, const DrawState& st, RasterContext& ctx, int row_begin, int row_end) {
-  const int ya = std::max(row_begin, t.y0), yz = std::min(row_end, t.y1);
+  int ya = std::max(row_begin, t.y0);
+  const int yz = std::min(row_end, t.y1);
   if (ya >= yz) return;
   if (t.small) return rasterize_small(t, small_draw(st, ctx.mem, ctx.z_bits), ctx.counters, ya, yz);
   bool colors_differ = false;
@@ -616,8 +768,41 @@ void rasterize_rows(const Triangle& t, const DrawState& st, RasterContext& ctx, 
     return draw_preview(t, st, ctx, ya, yz, gouraud, depth);
   }
   if (ctx.vector && draw_narrow(t, st, ctx, ya, yz, gouraud, depth)) return;
+  // The run's leading 16-row bands are asked before a Kernel is built (Kernel::run asks the rest):
+  // a triangle whose bands are all rejected costs their span solves only, no Kernel set-up, plane
+  // advance or row loop.
+  unsigned hz = 0;
+  if (ctx.hier_z && depth && t.x1 - t.x0 >= kSpanSolveWidth) {
+    const std::uint32_t run = HierZ::next_run(ctx.hz_run), zmask = z_mask(ctx);
+    std::optional<std::array<Divider, 3>> div;
+    std::int64_t e[3];
+    std::optional<BandClip> clip;
+    for (;;) {
+      const int end = std::min(yz, (ya | ((1 << HierZ::kRowsLog) - 1)) + 1);
+      if (!ctx.hier_z->band_worth_asking(ya >> HierZ::kRowsLog)) {
+        hz |= kHzFirstAsked;  // not asked this time (HierZ::band_worth_asking): the Kernel does not ask either
+        break;
+      }
+      if (!clip) clip.emplace(t);
+      const bool rejected = band_occluded(t, *clip, st, ctx, zmask, ya, end - 1, run);
+      ctx.hier_z->band_answered(ya >> HierZ::kRowsLog, rejected);
+      if (!rejected) {
+        hz |= kHzFirstAsked;
+        break;
+      }
+      if (!div) {
+        div.emplace(std::array<Divider, 3>{edge_divider(t.edge[0]), edge_divider(t.edge[1]), edge_divider(t.edge[2])});
+        const std::int64_t k = ya - t.y0;
+        for (int i = 0; i < 3; ++i) e[i] = t.edge[i].e + k * t.edge[i].ey;
+      }
+      count_covered(t, div->data(), e, end - ya, ctx.counters);
+      hz |= kHzRejected;
+      ya = end;
+      if (ya >= yz) return;
+    }
+  }
   const unsigned key = (gouraud ? 1u : 0u) | (st.textured ? 2u : 0u) | (depth ? 4u : 0u) | (st.simple_color ? 8u : 0u);
-  kKernels[key](t, st, ctx, ya, yz);
+  kKernels[key](t, st, ctx, ya, yz, hz);
 }
 
 void observe_triangle(const Triangle& t, const DrawState& st, const PixelObserver& observer) {
