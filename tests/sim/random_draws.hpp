@@ -54,6 +54,27 @@ struct Rendered {
   DeviceStats stats;
 };
 
+// Device options with the vector routines on, or off (the reference routines they are compared with).
+inline DeviceOptions vector_options(bool vector) {
+  DeviceOptions o;
+  o.vector_routines = vector;
+  return o;
+}
+
+// The vector routines' rendering v of case c (number i) against the reference routines' s: the
+// bytes, then the counters the draws feed, then every counter.
+inline void expect_same(const Case& c, const Rendered& v, const Rendered& s, int i) {
+  ASSERT_EQ(v.memory, s.memory) << "case " << i << ": TRI_MODE 0x" << std::hex << c.tri_mode << " TEX_FMT 0x"
+                                << c.tex_fmt << " FB_FORMAT 0x" << c.fb_fmt << " FB_DRAW 0x" << c.fb_draw << " FB_Z 0x"
+                                << c.fb_z << " TEX_BASE 0x" << c.tex_base;
+  EXPECT_EQ(v.stats.pixels_covered, s.stats.pixels_covered) << i;
+  EXPECT_EQ(v.stats.pixels_depth_passed, s.stats.pixels_depth_passed) << i;
+  EXPECT_EQ(v.stats.pixels_textured, s.stats.pixels_textured) << i;
+  EXPECT_EQ(v.stats.pixels_blended, s.stats.pixels_blended) << i;
+  EXPECT_EQ(v.stats.texel_bytes, s.stats.texel_bytes) << i;
+  EXPECT_TRUE(v.stats == s.stats) << i << ": the timing counters too";
+}
+
 // Draws 24 random triangles of four size classes (narrow boxes, short and long spans, larger than
 // the target) in state c with device options o; the memory covers colour, depth and texture.
 // flat_z: each triangle's three vertices take its first vertex's Z, below 2^23 (so that Z + 0.5,

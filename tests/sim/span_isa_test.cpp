@@ -38,18 +38,6 @@ std::string expected_instance(SpanIsa& isa) {
   return cpu_has_avx512() ? (isa == SpanIsa::Avx512 ? "AVX-512 (16 lanes)" : "AVX-512 (256-bit)") : "";
 }
 
-DeviceOptions vector_options(bool vector) {
-  DeviceOptions o;
-  o.vector_routines = vector;
-  return o;
-}
-
-void expect_same(const Case& c, const Rendered& v, const Rendered& s, int i) {
-  ASSERT_EQ(v.memory, s.memory) << "case " << i << ": TRI_MODE 0x" << std::hex << c.tri_mode << " TEX_FMT 0x"
-                                << c.tex_fmt << " FB_FORMAT 0x" << c.fb_fmt;
-  EXPECT_TRUE(v.stats == s.stats) << i << ": the counters";
-}
-
 TEST(SimSpanIsa, SameBytesAndCountersAsScalar) {
   SpanIsa isa{};
   const std::string name = expected_instance(isa);

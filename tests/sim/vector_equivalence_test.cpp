@@ -12,24 +12,6 @@
 namespace gpubridge::sim::test {
 namespace {
 
-DeviceOptions vector_options(bool vector) {
-  DeviceOptions o;
-  o.vector_routines = vector;
-  return o;
-}
-
-void expect_same(const Case& c, const Rendered& v, const Rendered& s, int i) {
-  ASSERT_EQ(v.memory, s.memory) << "case " << i << ": TRI_MODE 0x" << std::hex << c.tri_mode << " TEX_FMT 0x"
-                                << c.tex_fmt << " FB_FORMAT 0x" << c.fb_fmt << " FB_DRAW 0x" << c.fb_draw << " FB_Z 0x"
-                                << c.fb_z << " TEX_BASE 0x" << c.tex_base;
-  EXPECT_EQ(v.stats.pixels_covered, s.stats.pixels_covered) << i;
-  EXPECT_EQ(v.stats.pixels_depth_passed, s.stats.pixels_depth_passed) << i;
-  EXPECT_EQ(v.stats.pixels_textured, s.stats.pixels_textured) << i;
-  EXPECT_EQ(v.stats.pixels_blended, s.stats.pixels_blended) << i;
-  EXPECT_EQ(v.stats.texel_bytes, s.stats.texel_bytes) << i;
-  EXPECT_TRUE(v.stats == s.stats) << i << ": the timing counters too";
-}
-
 TEST(SimVectorRoutines, SameBytesAndCountersAsScalar) {
   std::mt19937 rng(20261121);
   unsigned textured = 0, aliased = 0;

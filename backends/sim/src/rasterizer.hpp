@@ -62,8 +62,12 @@ struct SmallDraw {
 // For a state with st.preview_small != 0 (and preview_applies).
 SmallDraw small_draw(const DrawState& st, VideoMemory& mem, unsigned z_bits);
 // Draws the rows [row_begin, row_end) of a small triangle (clipped to its box) as rasterize_rows
-// does, counting into c. Inline: the renderer calls it once per small triangle.
-inline void rasterize_small(const Triangle& t, const SmallDraw& d, RasterCounters& c, int row_begin, int row_end) {
+// does, counting into c. Tri is the full Triangle or the batch's compact SmallTriangle record (both
+// have the box's y0, y1, x0), kernel the small routine for it. Inline: the renderer calls it once per
+// small triangle.
+template <class Tri, class SmallKernel>
+[[gnu::always_inline]] inline void rasterize_small(const Tri& t, const SmallDraw& d, SmallKernel kernel,
+                                                   RasterCounters& c, int row_begin, int row_end) {
   const int ya = row_begin > t.y0 ? row_begin : t.y0, yz = row_end < t.y1 ? row_end : t.y1;
   if (ya >= yz) return;
   SmallTarget s;
@@ -75,11 +79,14 @@ inline void rasterize_small(const Triangle& t, const SmallDraw& d, RasterCounter
   s.rows = yz - ya;
   s.zmask = d.zmask;
   s.z_write = d.z_write;
-  const PreviewCounts n = d.kernel(t, s);
+  const PreviewCounts n = kernel(t, s);
   c.scanned += n.scanned;  // count_drawn's counts
   c.covered += n.covered;
   c.passed += n.passed;
   if (d.blended) c.blended += n.passed;
+}
+inline void rasterize_small(const Triangle& t, const SmallDraw& d, RasterCounters& c, int row_begin, int row_end) {
+  rasterize_small(t, d, d.kernel, c, row_begin, row_end);
 }
 
 // Draws the rows [row_begin, row_end) of t (a preview triangle through the preview routine) (clipped to its bounding box) with state st.

@@ -29,28 +29,6 @@ bool hier_z_applies(const DrawState& st, bool vector) {
   return vector && st.z_test && (st.z_func == protocol::DepthFunc::Less || st.z_func == protocol::DepthFunc::LessEqual) &&
          st.z_in_vram && st.color_in_vram && st.buffers_disjoint;
 }
-
-// rasterize_small (rasterizer.hpp) for a compact record: the rows [row_begin, row_end) of a small
-// triangle, clipped to its box, counted into c.
-[[gnu::always_inline]] inline void draw_small(const SmallTriangle& t, const SmallDraw& d, SmallRecordKernel kernel,
-                                              RasterCounters& c, int row_begin, int row_end) {
-  const int ya = row_begin > t.y0 ? row_begin : t.y0, yz = row_end < t.y1 ? row_end : t.y1;
-  if (ya >= yz) return;
-  SmallTarget s;
-  const std::size_t pix = static_cast<std::size_t>(ya) * d.width + static_cast<std::size_t>(t.x0);
-  s.color = d.color + pix * 4;
-  if (d.depth) s.depth = d.depth + pix * 4;
-  s.pitch = d.pitch;
-  s.ky0 = ya - t.y0;
-  s.rows = yz - ya;
-  s.zmask = d.zmask;
-  s.z_write = d.z_write;
-  const PreviewCounts n = kernel(t, s);
-  c.scanned += n.scanned;  // count_drawn's counts
-  c.covered += n.covered;
-  c.passed += n.passed;
-  if (d.blended) c.blended += n.passed;
-}
 }  // namespace
 
 void Renderer::use_hier_z(RasterContext& ctx, const DrawState& st, std::uint64_t gen, unsigned w) {
@@ -122,7 +100,7 @@ Renderer::~Renderer() { wait_drawing(); }  // the workers read drawing_: stop th
   if (pending_is_small_) {  // no errors (both buffers inside memory), counters straight into the totals
     const SmallTriangle& s = small_slots_[pending_];
     const std::uint64_t covered = counters_.covered;
-    draw_small(s, pending_small_, pending_small_kernel_, counters_, s.y0, s.y1);
+    rasterize_small(s, pending_small_, pending_small_kernel_, counters_, s.y0, s.y1);
     modes_[pending_state_->mode_class].pixels += counters_.covered - covered;
     pending_ = -1;
     return;
@@ -297,7 +275,7 @@ void Renderer::draw_bands(unsigned worker) {
     unsigned ahead = worker + n - first % n;
     if (ahead >= n) ahead -= n;
     for (int band = static_cast<int>(first + ahead); band * kBandRows < r.y1; band += static_cast<int>(n)) {
-      if (r.small) draw_small(smalls[i], small, kernel, c.counters, band * kBandRows, (band + 1) * kBandRows);
+      if (r.small) rasterize_small(smalls[i], small, kernel, c.counters, band * kBandRows, (band + 1) * kBandRows);
       else rasterize_rows(full[i], st, c, band * kBandRows, (band + 1) * kBandRows);
     }
   }
