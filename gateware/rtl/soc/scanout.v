@@ -173,7 +173,7 @@ module scanout #(
   // the head word: from memory while there are answers; zeros once the reader left VRAM
   wire        mem_done  = !in_frame && outstanding == 3'd0 && buf_count == 3'd0;
   wire        have_word = buf_count != 3'd0 || mem_done;
-  wire [31:0] head_word = buf_count != 3'd0 ? buf_word[buf_rd] : 32'd0;
+  wire [31:0] head_word;        // the head buffer word, or 0 (g_head below)
 
   function automatic [31:0] crc_byte(input [31:0] c, input [7:0] b);
     integer i;
@@ -222,6 +222,25 @@ module scanout #(
   wire popping = folding && word_done && buf_count != 3'd0;
   assign issued = req_valid && req_ready;
   wire take    = rsp_valid && drop == 3'd0;
+  generate
+    if (CRC_BYTES == 4) begin : g_head
+      // ecp5: the head word is a register loaded a clock ahead (the word after the head while one is
+      // popped, the answer arriving into an emptied buffer, else 0), so the 4-byte CRC fold starts at a
+      // register, not at the buffer's LUT-RAM read (docs/gateware.md, branch ecp5-scan). The same value
+      // as the read below every clock: writes never land on the head's slot while the buffer holds it
+      wire [BAW-1:0] buf_rd1 = buf_rd + 1'b1;
+      wire [2:0]     kept    = buf_count - {2'd0, popping};
+      reg  [31:0]    head_q;
+      always @(posedge clk) begin
+        if (rst || soft_reset) head_q <= 32'd0;
+        else if (kept == 3'd0) head_q <= take ? rsp_rdata : 32'd0;
+        else if (popping) head_q <= buf_word[buf_rd1];
+      end
+      assign head_word = head_q;
+    end else begin : g_head
+      assign head_word = buf_count != 3'd0 ? buf_word[buf_rd] : 32'd0;
+    end
+  endgenerate
   wire last    = folding && bytes_left == BYTES_W'(n_fold);
   assign frame_valid  = folding;
   assign frame_word   = fold_word;
