@@ -194,6 +194,38 @@ Scene tie_scene(std::uint64_t mode, const DeviceOptions& o) {
   return finish(d);
 }
 
+// The band test's ties (issue 24, eleventh round): boxes 16 to 127 wide, which ask the bounds band
+// by band only. A grid of sloped triangles drawn and then drawn again over itself (LESS fails and
+// LEQUAL passes at every pixel) one LSB and two either side, and, in block columns of their own
+// (x from 96), flat triangles at the cleared depth and one LSB either side: there every block's
+// bound equals the band's smallest depth, so a band bound one LSB too high rejects the LEQUAL
+// redraws that pass.
+Scene band_tie_scene(std::uint64_t mode, const DeviceOptions& o) {
+  auto dev = make_device(o);
+  Device& d = *dev;
+  std::mt19937 rng(11);
+  const std::uint32_t cleared = 0x456789;
+  setup(d, cleared);
+  w(d, Reg::TRI_MODE, mode);
+  const auto cells = [&](int x0, int x1, int cw, int ch, auto&& z) {
+    for (int y = 0; y < static_cast<int>(kHeight); y += ch) {
+      for (int x = x0; x < x1; x += cw) {
+        const int xa = x * 16, ya = y * 16, xb = std::min(x + cw, x1) * 16, yb = std::min(y + ch, static_cast<int>(kHeight)) * 16;
+        triangle(d, rng, {xa, ya, xb, ya, xa, yb}, {z(xa, ya), z(xb, ya), z(xa, yb)});
+        triangle(d, rng, {xb, ya, xb, yb, xa, yb}, {z(xb, ya), z(xb, yb), z(xa, yb)});
+      }
+    }
+  };
+  for (const std::int32_t dz : {0, 0, 1, -1, 2, -2, 0}) {
+    cells(0, 96, 48, 40, [&](int x, int y) { return static_cast<std::uint32_t>(0x300000 + 7 * x - 5 * y + dz); });
+  }
+  for (const std::int32_t dz : {1, 0, -1, 0, -1}) {
+    const auto z = static_cast<std::uint32_t>(static_cast<std::int32_t>(cleared) + dz);
+    cells(96, static_cast<int>(kWidth), 52, 40, [&](int, int) { return z; });
+  }
+  return finish(d);
+}
+
 // `passed` gets the pixels that passed the depth test without the bounds, per mode (LESS, LEQUAL)
 // and z_bits (24, 13).
 template <class Draw>
@@ -235,6 +267,16 @@ TEST(SimPreviewBounds, TiesDrawAsWithoutTheBounds) {
   // flat one twice) pass under LEQUAL and fail under LESS.
   EXPECT_GT(passed[2], passed[0] + 3 * 100 * kHeight / 2) << "z_bits 24";
   EXPECT_GT(passed[3], passed[1] + 3 * 100 * kHeight / 2) << "z_bits 13";
+}
+
+TEST(SimPreviewBounds, BandTiesDrawAsWithoutTheBounds) {
+  std::vector<std::uint64_t> passed;
+  same_with_and_without_bounds(band_tie_scene, "band ties", passed);
+  ASSERT_EQ(passed.size(), 4u);
+  // The ties were there to decide: the coplanar grid redraw (96 columns, once) and the flat redraws
+  // at the stored depth (104 columns, twice) pass under LEQUAL and fail under LESS.
+  EXPECT_GT(passed[2], passed[0] + (96 + 2 * 104) * kHeight * 9 / 10) << "z_bits 24";
+  EXPECT_GT(passed[3], passed[1] + (96 + 2 * 104) * kHeight * 9 / 10) << "z_bits 13";
 }
 
 }  // namespace

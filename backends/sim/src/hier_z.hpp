@@ -5,7 +5,8 @@
 // LEQUAL) fails the test at every pixel and is skipped; its pixels are still counted as scanned
 // and covered, so bytes, errors and DeviceStats stay those of drawing it. The exact kernel asks
 // a triangle's whole 16-row bands the same way first (rasterizer.cpp, band_occluded), with a
-// lower bound of the triangle's depth over the band's rows.
+// lower bound of the triangle's depth over the band's rows; the preview's plain kernel too
+// (preview_plain_kernel.inc, band_occluded: the least of its spans' depths in its own integers).
 //
 // Why the bound stays exact without watching every write to memory: a bound is only used within
 // one generation, which the renderer ends at every flush() (anything that reads or writes memory
@@ -56,8 +57,8 @@ class HierZ {
     if (bands_.size() < bands) bands_.resize(bands);
   }
 
-  // Whether a triangle's rows in 16-row band `band` are worth asking as a whole (the exact kernel's
-  // band test, before its rows are asked one by one). After kBandMisses band tests in a row in this
+  // Whether a triangle's rows in 16-row band `band` are worth asking as a whole (the exact and the
+  // preview kernels' band tests, before their rows are asked one by one). After kBandMisses band tests in a row in this
   // band that did not reject, only every 2nd, 4th … 16th is asked: front-to-back scenes are never
   // rejected and would pay a test a band for nothing. Kept per band, which one worker owns, so
   // the workers share nothing here and the answers follow submission order at any thread count
