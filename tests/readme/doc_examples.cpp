@@ -258,6 +258,12 @@ std::vector<Example> make() {
       skip("ecppack --compress build/gateware/boards/ulx3s.config build/gateware/boards/ulx3s.bit",
            "ecppack is not in Debian 12; scripts/gateware.sh runs it when it is on PATH"),
   }});
+  all.push_back({"docs/gateware.md", "Building the bitstreams", 2, "docs_gateware_FlowOptions", {
+      skip("nextpnr-ice40 --up5k --package sg48 --pcf gateware/boards/icebreaker/icebreaker.pcf --freq 25.125 --json "
+           "build/gateware/boards/icebreaker.json --seed N --report r.json --timing-allow-fail OPTION",
+           "a template (a seed N and an option OPTION per run of the sweep), minutes of place and route each; "
+           "CTest gateware.icebreaker.pnr runs the board flow's own command"),
+  }});
   all.push_back({"docs/gateware.md", "Clock estimate (ULX3S, without nextpnr-ecp5)", 0, "docs_gateware_ClockEstimate", {
       skip("scripts/gateware.sh --board ulx3s --json build/gateware/boards/ulx3s-report.json",
            "minutes of yosys synth_ecp5; CTest gateware.ulx3s.synth runs it"),
