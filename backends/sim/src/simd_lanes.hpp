@@ -58,21 +58,24 @@ template <class V>
   return v;
 }
 
-// The first n (< the lane count) words at p into lanes 0..n-1, 0 in the rest, and lanes 0..n-1 to n
-// words at p: AVX-512's masked moves (the masked-off words are neither read nor written, so no
-// fault and no stack copy). Only the AVX-512 instance calls them (kMasked below): their target
-// attribute lets them inline there and nowhere else.
-__attribute__((target("avx512f,avx512vl"))) inline u32x8 masked_load(const std::uint8_t* p, unsigned n, u32x8) {
-  return (u32x8)_mm256_maskz_loadu_epi32(static_cast<__mmask8>((1u << n) - 1), p);
+// The first n (< the lane count) words at p into lanes 0..n-1 of *out, 0 in the rest, and lanes
+// 0..n-1 of *v to n words at p: AVX-512's masked moves (the masked-off words are neither read nor
+// written, so no fault and no stack copy). Only the AVX-512 instance calls them (kMasked below):
+// their target attribute lets them inline there and nowhere else. The vectors go by pointer because
+// a vector argument or result between a caller without AVX-512 (load_words / store_words, which are
+// inlined into the instance only afterwards) and a callee with it changes the calling convention,
+// which clang refuses.
+__attribute__((target("avx512f,avx512vl"))) inline void masked_load(const std::uint8_t* p, unsigned n, u32x8* out) {
+  *out = (u32x8)_mm256_maskz_loadu_epi32(static_cast<__mmask8>((1u << n) - 1), p);
 }
-__attribute__((target("avx512f,avx512vl"))) inline u32x16 masked_load(const std::uint8_t* p, unsigned n, u32x16) {
-  return (u32x16)_mm512_maskz_loadu_epi32(static_cast<__mmask16>((1u << n) - 1), p);
+__attribute__((target("avx512f,avx512vl"))) inline void masked_load(const std::uint8_t* p, unsigned n, u32x16* out) {
+  *out = (u32x16)_mm512_maskz_loadu_epi32(static_cast<__mmask16>((1u << n) - 1), p);
 }
-__attribute__((target("avx512f,avx512vl"))) inline void masked_store(std::uint8_t* p, u32x8 v, unsigned n) {
-  _mm256_mask_storeu_epi32(p, static_cast<__mmask8>((1u << n) - 1), (__m256i)v);
+__attribute__((target("avx512f,avx512vl"))) inline void masked_store(std::uint8_t* p, const u32x8* v, unsigned n) {
+  _mm256_mask_storeu_epi32(p, static_cast<__mmask8>((1u << n) - 1), (__m256i)*v);
 }
-__attribute__((target("avx512f,avx512vl"))) inline void masked_store(std::uint8_t* p, u32x16 v, unsigned n) {
-  _mm512_mask_storeu_epi32(p, static_cast<__mmask16>((1u << n) - 1), (__m512i)v);
+__attribute__((target("avx512f,avx512vl"))) inline void masked_store(std::uint8_t* p, const u32x16* v, unsigned n) {
+  _mm512_mask_storeu_epi32(p, static_cast<__mmask16>((1u << n) - 1), (__m512i)*v);
 }
 
 // n words from p into lanes 0..n-1; later lanes hold the next words of the row when `whole`
@@ -87,7 +90,9 @@ template <class V = u32x8, bool kMasked = false>
   constexpr unsigned kN = kLanesOf<V>;
   if constexpr (kMasked) {
     if (n == kN) return load_lanes<V>(p);
-    return masked_load(p, n, V{});
+    V v;
+    masked_load(p, n, &v);
+    return v;
   } else {
     if (n == kN || whole) return load_lanes<V>(p);
     std::uint32_t buf[kN] = {};
@@ -100,7 +105,7 @@ template <class V = u32x8, bool kMasked = false>
 template <bool kMasked = false, class V>
 [[gnu::always_inline]] inline void store_words(std::uint8_t* p, V v, unsigned n) {
   if (n == kLanesOf<V>) std::memcpy(p, &v, sizeof v);
-  else if constexpr (kMasked) masked_store(p, v, n);
+  else if constexpr (kMasked) masked_store(p, &v, n);
   else std::memcpy(p, &v, std::size_t{n} * 4);
 }
 
