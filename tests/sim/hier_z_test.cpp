@@ -77,10 +77,7 @@ void random_triangles(Device& d, std::mt19937& rng, int count, std::uint32_t zmi
   }
 }
 
-struct Scene {
-  std::vector<std::uint8_t> memory;
-  DeviceStats stats;
-};
+using Scene = DrawnScene;
 
 // Near depth everywhere, random triangles behind it (the bounds reject them), the depth buffer
 // raised in part of the screen by `raise`, then random triangles again, some in front of the
@@ -89,13 +86,7 @@ Scene render(Raise raise, std::uint64_t mode, const DeviceOptions& o) {
   auto dev = make_device(o);
   Device& d = *dev;
   std::mt19937 rng(20261127);
-  w(d, Reg::FB_FORMAT, fb_format(kWidth, kHeight));
-  w(d, Reg::FB_DRAW, 0);
-  w(d, Reg::FB_Z, Canvas::kZBase);
-  w(d, Reg::CLEAR_COLOR, 0);
-  w(d, Reg::CLEAR, 0);
-  w(d, Reg::CLEAR_DEPTH, 0xFFFFFF);
-  w(d, Reg::CLEAR_Z, 0);
+  clear_target(d, kWidth, kHeight, 0xFFFFFF);
   w(d, Reg::TRI_MODE, mode);
   w(d, Reg::PRIM, 0);
   const int x1 = kWidth * 16, y1 = kHeight * 16;
@@ -141,12 +132,7 @@ Scene render(Raise raise, std::uint64_t mode, const DeviceOptions& o) {
     }
   }
   random_triangles(d, rng, 200, 0x180000, 0xF00000);  // in front of the raised part only
-  d.drain();
-  const auto m = d.memory();
-  Scene s;
-  s.memory.assign(m.begin(), m.begin() + Canvas::kZBase + kWidth * kHeight * 4);
-  s.stats = d.stats();
-  return s;
+  return finish_scene(d, kWidth, kHeight);
 }
 
 TEST(SimHierZ, RaisedDepthBufferDrawsAsTheReferenceRoutines) {
@@ -184,13 +170,7 @@ Scene render_sloped(std::uint64_t mode, const DeviceOptions& o) {
   Device& d = *dev;
   std::mt19937 rng(20261128);
   constexpr std::uint32_t kStored = 0x400000;
-  w(d, Reg::FB_FORMAT, fb_format(kWidth, kHeight));
-  w(d, Reg::FB_DRAW, 0);
-  w(d, Reg::FB_Z, Canvas::kZBase);
-  w(d, Reg::CLEAR_COLOR, 0);
-  w(d, Reg::CLEAR, 0);
-  w(d, Reg::CLEAR_DEPTH, kStored);
-  w(d, Reg::CLEAR_Z, 0);
+  clear_target(d, kWidth, kHeight, kStored);
   w(d, Reg::TRI_MODE, mode);
   std::uniform_int_distribution<int> px(-20, kWidth + 20), py(-20, kHeight + 20), dv(-90, 90), sub(0, 15), pick(0, 3);
   for (int i = 0; i < 400; ++i) {
@@ -211,12 +191,7 @@ Scene render_sloped(std::uint64_t mode, const DeviceOptions& o) {
     w(d, Reg::COLOR, color(static_cast<std::uint32_t>(rng())));
     w(d, Reg::VERTEX, vtx(fx + 16 * dv(rng), fy + 16 * tall, kStored + 0x10000 * static_cast<std::uint32_t>(sub(rng))));
   }
-  d.drain();
-  const auto m = d.memory();
-  Scene s;
-  s.memory.assign(m.begin(), m.begin() + Canvas::kZBase + kWidth * kHeight * 4);
-  s.stats = d.stats();
-  return s;
+  return finish_scene(d, kWidth, kHeight);
 }
 
 TEST(SimHierZ, SlopedTrianglesBarelyInFrontDrawAsTheReferenceRoutines) {

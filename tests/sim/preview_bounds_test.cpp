@@ -82,29 +82,7 @@ constexpr unsigned kWidth = 200, kHeight = 120;  // 6.25 block columns, 7.5 bloc
 constexpr std::uint64_t kLess = 1 | 4 | (1u << 3) | (1u << 6), kLequal = 1 | 4 | (3u << 3) | (1u << 6);
 constexpr std::uint64_t kAlways = 1 | 4 | (7u << 3) | (1u << 6);
 
-struct Scene {
-  std::vector<std::uint8_t> memory;
-  DeviceStats stats;
-};
-
-Scene finish(Device& d) {
-  d.drain();
-  const auto m = d.memory();
-  Scene s;
-  s.memory.assign(m.begin(), m.begin() + Canvas::kZBase + kWidth * kHeight * 4);
-  s.stats = d.stats();
-  return s;
-}
-
-void setup(Device& d, std::uint32_t clear_depth) {
-  w(d, Reg::FB_FORMAT, fb_format(kWidth, kHeight));
-  w(d, Reg::FB_DRAW, 0);
-  w(d, Reg::FB_Z, Canvas::kZBase);
-  w(d, Reg::CLEAR_COLOR, 0);
-  w(d, Reg::CLEAR, 0);
-  w(d, Reg::CLEAR_DEPTH, clear_depth);
-  w(d, Reg::CLEAR_Z, 0);
-}
+using Scene = DrawnScene;
 
 void triangle(Device& d, std::mt19937& rng, const int (&xy)[6], const std::uint32_t (&z)[3]) {
   w(d, Reg::PRIM, 0);
@@ -135,7 +113,7 @@ Scene random_scene(std::uint64_t mode, const DeviceOptions& o) {
   auto dev = make_device(o);
   Device& d = *dev;
   std::mt19937 rng(20261127);
-  setup(d, 0xFFFFFF);
+  clear_target(d, kWidth, kHeight, 0xFFFFFF);
   w(d, Reg::TRI_MODE, mode);
   const int x1 = kWidth * 16, y1 = kHeight * 16;
   triangle(d, rng, {0, 0, x1, 0, 0, y1}, {0x100000, 0x100000, 0x100000});
@@ -154,7 +132,7 @@ Scene random_scene(std::uint64_t mode, const DeviceOptions& o) {
   triangle(d, rng, {130 * 16, 0, 200 * 16, 0, 130 * 16, 40 * 16}, {0xF00000, 0xF00000, 0xF00000});
   w(d, Reg::TRI_MODE, mode);
   random_triangles(d, rng, 200, 0x180000, 0xF00000);  // in front of the raised parts only
-  return finish(d);
+  return finish_scene(d, kWidth, kHeight);
 }
 
 // The ties: a sloped plane and a flat one written into the depth buffer, then drawn again over
@@ -166,7 +144,7 @@ Scene tie_scene(std::uint64_t mode, const DeviceOptions& o) {
   Device& d = *dev;
   std::mt19937 rng(7);
   const std::uint32_t cleared = 0x654321;
-  setup(d, cleared);
+  clear_target(d, kWidth, kHeight, cleared);
   w(d, Reg::TRI_MODE, mode);
   const int x1 = kWidth * 16, y1 = kHeight * 16;
   // The left half: sloped planes, the right half flat at the cleared depth (not drawn at first).
@@ -191,7 +169,7 @@ Scene tie_scene(std::uint64_t mode, const DeviceOptions& o) {
   for (int i = 0; i < 2; ++i) triangle(d, rng, {0, 70 * 16, x1, 90 * 16, 0, 110 * 16}, {0, 0xFFFFFF, 0});
   triangle(d, rng, {3, 100 * 16, x1, y1, 0, y1 - 3}, {0, 0, 0});
   triangle(d, rng, {3, 100 * 16, x1, y1, 0, y1 - 3}, {0xFFFFFF, 0xFFFFFF, 0xFFFFFF});
-  return finish(d);
+  return finish_scene(d, kWidth, kHeight);
 }
 
 // The band test's ties (issue 24, eleventh round): boxes 16 to 127 wide, which ask the bounds band
@@ -205,7 +183,7 @@ Scene band_tie_scene(std::uint64_t mode, const DeviceOptions& o) {
   Device& d = *dev;
   std::mt19937 rng(11);
   const std::uint32_t cleared = 0x456789;
-  setup(d, cleared);
+  clear_target(d, kWidth, kHeight, cleared);
   w(d, Reg::TRI_MODE, mode);
   const auto cells = [&](int x0, int x1, int cw, int ch, auto&& z) {
     for (int y = 0; y < static_cast<int>(kHeight); y += ch) {
@@ -223,7 +201,7 @@ Scene band_tie_scene(std::uint64_t mode, const DeviceOptions& o) {
     const auto z = static_cast<std::uint32_t>(static_cast<std::int32_t>(cleared) + dz);
     cells(96, static_cast<int>(kWidth), 52, 40, [&](int, int) { return z; });
   }
-  return finish(d);
+  return finish_scene(d, kWidth, kHeight);
 }
 
 // `passed` gets the pixels that passed the depth test without the bounds, per mode (LESS, LEQUAL)

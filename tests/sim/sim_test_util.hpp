@@ -98,4 +98,31 @@ struct Canvas {
   }
 };
 
+// What a scene drew on a clear_target: colour and depth bytes, and the whole DeviceStats (the
+// coarse depth bounds' tests compare both with the reference routines').
+struct DrawnScene {
+  std::vector<std::uint8_t> memory;
+  DeviceStats stats;
+};
+inline DrawnScene finish_scene(Device& d, unsigned width, unsigned height) {
+  d.drain();
+  const auto m = d.memory();
+  DrawnScene s;
+  s.memory.assign(m.begin(), m.begin() + Canvas::kZBase + std::size_t{width} * height * 4);
+  s.stats = d.stats();
+  return s;
+}
+
+// A width × height RGBA8888 target in Canvas's layout (colour at 0, depth at Canvas::kZBase) on a
+// device of the caller's options: the colour cleared to 0, the depth to `depth`.
+inline void clear_target(Device& d, unsigned width, unsigned height, std::uint32_t depth) {
+  w(d, Reg::FB_FORMAT, fb_format(width, height));
+  w(d, Reg::FB_DRAW, 0);
+  w(d, Reg::FB_Z, Canvas::kZBase);
+  w(d, Reg::CLEAR_COLOR, 0);
+  w(d, Reg::CLEAR, 0);
+  w(d, Reg::CLEAR_DEPTH, depth);
+  w(d, Reg::CLEAR_Z, 0);
+}
+
 }  // namespace gpubridge::sim::test

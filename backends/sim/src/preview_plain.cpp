@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstring>
 
+#include "cpu_features.hpp"
 #include "hier_z.hpp"
 #include "setup.hpp"
 #include "simd_lanes.hpp"
@@ -88,28 +89,14 @@ namespace plain_baseline {
 }  // namespace plain_baseline
 
 namespace {
-bool has_avx2() {
-  static const bool avx2 = __builtin_cpu_supports("avx2");
-  return avx2;
-}
-bool has_avx512() {
-  static const bool avx512 = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
-                             __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512dq");
-  return avx512;
-}
 const SmallKernel* small_kernel_table() {
-  return has_avx512() ? plain_avx512::kSmallKernels : has_avx2() ? plain_avx2::kSmallKernels : plain_baseline::kSmallKernels;
-}
-const SmallRecordKernel* small_record_table() {
-  return has_avx512() ? plain_avx512::kSmallRecordKernels
-         : has_avx2() ? plain_avx2::kSmallRecordKernels
-                      : plain_baseline::kSmallRecordKernels;
+  return cpu_has_avx512() ? plain_avx512::kSmallKernels : cpu_has_avx2() ? plain_avx2::kSmallKernels : plain_baseline::kSmallKernels;
 }
 }  // namespace
 
 PreviewCounts shade_preview_plain(const PreviewPlain& t) {
   // Not the AVX-512 instance: the span walk of thin triangles (the fan scene) was ~10 % slower in it.
-  return has_avx2() ? plain_avx2::shade(t) : plain_baseline::shade(t);
+  return cpu_has_avx2() ? plain_avx2::shade(t) : plain_baseline::shade(t);
 }
 
 SmallSetup setup_small_preview(const Vertex& a, const Vertex& b, const Vertex& c, const DrawState& st,
@@ -117,47 +104,19 @@ SmallSetup setup_small_preview(const Vertex& a, const Vertex& b, const Vertex& c
   return small_setup_routine()(a, b, c, st, subpixel_bits, t);
 }
 
-SmallSetup setup_small_preview(const Vertex& a, const Vertex& b, const Vertex& c, const DrawState& st,
-                               unsigned subpixel_bits, Triangle& t) {
-  SmallTriangle s;
-  const SmallSetup r = setup_small_preview(a, b, c, st, subpixel_bits, s);
-  if (r != SmallSetup::Drawn) return r;
-  for (int i = 0; i < 3; ++i) t.edge[i] = {s.e[i], s.ex[i], s.ey[i]};
-  t.x0 = s.x0;
-  t.y0 = s.y0;
-  t.x1 = s.x1;
-  t.y1 = s.y1;
-  t.den = s.den;
-  t.xplane = s.xplane;
-  std::memcpy(t.flat, a.c, sizeof t.flat);
-  t.preview = true;
-  t.small = s.small;
-  return r;
-}
-
-PreviewCounts shade_preview_small(const Triangle& t, const SmallTarget& d) {
-  return small_kernel_table()[t.small - 1](t, d);
-}
-
-PreviewCounts shade_preview_small(const SmallTriangle& t, const SmallTarget& d) {
-  return small_record_table()[t.small - 1](t, d);
-}
-
 SmallSetupRoutine small_setup_routine() {
-  return has_avx512() ? &plain_avx512::setup_small : has_avx2() ? &plain_avx2::setup_small : &plain_baseline::setup_small;
+  return cpu_has_avx512() ? &plain_avx512::setup_small : cpu_has_avx2() ? &plain_avx2::setup_small : &plain_baseline::setup_small;
 }
 
 SmallSetupRoutine small_setup_instance(unsigned isa) {
   switch (isa) {
     case 0: return &plain_baseline::setup_small;
-    case 1: return has_avx2() ? &plain_avx2::setup_small : nullptr;
-    case 2: return has_avx512() ? &plain_avx512::setup_small : nullptr;
+    case 1: return cpu_has_avx2() ? &plain_avx2::setup_small : nullptr;
+    case 2: return cpu_has_avx512() ? &plain_avx512::setup_small : nullptr;
     default: return nullptr;
   }
 }
 
 SmallKernel small_kernel(const DrawState& st) { return small_kernel_table()[st.preview_small - 1]; }
-
-SmallRecordKernel small_record_kernel(const DrawState& st) { return small_record_table()[st.preview_small - 1]; }
 
 }  // namespace gpubridge::sim

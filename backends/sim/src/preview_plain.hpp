@@ -26,7 +26,6 @@ namespace gpubridge::sim {
 struct FixedPlanes;
 struct FloatPlanes;
 struct SmallTriangle;
-struct Triangle;
 struct Vertex;
 
 // A textured plain draw's texture: an RGBA8888 texture inside VRAM, disjoint from both buffers.
@@ -118,11 +117,6 @@ enum class SmallSetup { Empty, Drawn, NotSmall };
 // then unspecified: set it up with setup_triangle_preview).
 SmallSetup setup_small_preview(const Vertex& a, const Vertex& b, const Vertex& c, const DrawState& st,
                                unsigned subpixel_bits, SmallTriangle& t);
-// The same into a Triangle (its edges, box, den, xplane, flat colour and `small`), for callers that
-// draw Triangles (setup_triangle_preview, rasterize_rows).
-SmallSetup setup_small_preview(const Vertex& a, const Vertex& b, const Vertex& c, const DrawState& st,
-                               unsigned subpixel_bits, Triangle& t);
-
 // Where a small triangle's rows [ky0, ky0 + rows) (from its box origin) are drawn.
 struct SmallTarget {
   std::uint8_t* color = nullptr;  // box origin column, first row drawn
@@ -132,20 +126,16 @@ struct SmallTarget {
   std::uint32_t zmask = 0xFFFFFF;  // the Z bits compared and stored (z_bits)
   bool z_write = false;
 };
-PreviewCounts shade_preview_small(const Triangle& t, const SmallTarget& d);
-PreviewCounts shade_preview_small(const SmallTriangle& t, const SmallTarget& d);
 
 // The same routines of this CPU (AVX2 or the baseline), looked up once per state by the renderer
 // instead of on every call (docs/simulator.md "Preview"): same routines, same bytes.
 using SmallSetupRoutine = SmallSetup (*)(const Vertex& a, const Vertex& b, const Vertex& c, const DrawState& st,
                                          unsigned subpixel_bits, SmallTriangle& t);
-using SmallKernel = PreviewCounts (*)(const Triangle& t, const SmallTarget& d);
-using SmallRecordKernel = PreviewCounts (*)(const SmallTriangle& t, const SmallTarget& d);
+using SmallKernel = PreviewCounts (*)(const SmallTriangle& t, const SmallTarget& d);
 SmallSetupRoutine small_setup_routine();
 // One instance of the small setup: 0 the baseline, 1 AVX2, 2 AVX-512; null when this CPU cannot run
 // it. For the tests that compare the instances (the renderer uses small_setup_routine).
 SmallSetupRoutine small_setup_instance(unsigned isa);
-SmallKernel small_kernel(const DrawState& st);                // st.preview_small != 0
-SmallRecordKernel small_record_kernel(const DrawState& st);   // st.preview_small != 0
+SmallKernel small_kernel(const DrawState& st);  // st.preview_small != 0
 
 }  // namespace gpubridge::sim

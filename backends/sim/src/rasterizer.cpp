@@ -178,6 +178,17 @@ bool band_occluded(const Triangle& t, const BandClip& c, const DrawState& st, Ra
                               ctx.hz_gen, run);
 }
 
+// Asks t's rows ya..yb (one 16-row band) as band_occluded does and gives the band's backoff the
+// answer (HierZ::band_answered); the edges are clipped (`clip`) the first time the triangle asks.
+// For rasterize_rows's leading bands and Kernel::run's later ones alike.
+bool ask_band(const Triangle& t, std::optional<BandClip>& clip, const DrawState& st, RasterContext& ctx,
+              std::uint32_t zmask, int ya, int yb, std::uint32_t run) {
+  if (!clip) clip.emplace(t);
+  const bool rejected = band_occluded(t, *clip, st, ctx, zmask, ya, yb, run);
+  ctx.hier_z->band_answered(ya >> HierZ::kRowsLog, rejected);
+  return rejected;
+}
+
 // What rasterize_rows's band tests found before the Kernel was built (Kernel::run's `hz`).
 constexpr unsigned kHzFirstAsked = 1;  // the first band of the run was asked and not rejected (or let pass)
 constexpr unsigned kHzRejected = 2;    // bands before the run were rejected
@@ -245,29 +256,22 @@ class Kernel {
     bool first = true;
     for (int y = ya; y < yz;) {
       const int end = std::min(yz, (y | ((1 << HierZ::kRowsLog) - 1)) + 1);  // this band's rows
-      if (bands) {
-        // A new 16-row band of blocks: its tries afresh (HierZ::band_asks_afresh).
-        if ((y & ((1 << HierZ::kRowsLog) - 1)) == 0 && HierZ::band_asks_afresh(y >> HierZ::kRowsLog, hz_rejected_))
-          hz_tries_ = HierZ::kTries;
-        if (hz_tries_ != 0 && !(first && (hz & kHzFirstAsked)) && ctx_.hier_z->band_worth_asking(y >> HierZ::kRowsLog)) {
-          // A band not rejected leaves the rows their tries: the band's bound is coarser than a row's.
-          if (!clip_) clip_.emplace(t_);
-          const bool rejected = band_occluded(t_, *clip_, st_, ctx_, zmask_, y, end - 1, hz_run_);
-          ctx_.hier_z->band_answered(y >> HierZ::kRowsLog, rejected);
-          if (rejected) {
-            hz_tries_ = HierZ::kTries;
-            hz_rejected_ = true;
-            count_covered(t_, edge_div_, e, end - y, ctx_.counters);
-            lag += end - y;
-            if (mark_from == y) mark_from = end;
-            y = end;
-            first = false;
-            continue;
-          }
-        }
-      } else if (kDepth && ctx_.hier_z && (y & ((1 << HierZ::kRowsLog) - 1)) == 0 &&
-                 HierZ::band_asks_afresh(y >> HierZ::kRowsLog, hz_rejected_)) {
+      // A new 16-row band of blocks: its tries afresh (HierZ::band_asks_afresh).
+      if (kDepth && ctx_.hier_z && (y & ((1 << HierZ::kRowsLog) - 1)) == 0 &&
+          HierZ::band_asks_afresh(y >> HierZ::kRowsLog, hz_rejected_))
         hz_tries_ = HierZ::kTries;
+      // A band not rejected leaves the rows their tries: the band's bound is coarser than a row's.
+      if (bands && hz_tries_ != 0 && !(first && (hz & kHzFirstAsked)) &&
+          ctx_.hier_z->band_worth_asking(y >> HierZ::kRowsLog) &&
+          ask_band(t_, clip_, st_, ctx_, zmask_, y, end - 1, hz_run_)) {
+        hz_tries_ = HierZ::kTries;
+        hz_rejected_ = true;
+        count_covered(t_, edge_div_, e, end - y, ctx_.counters);
+        lag += end - y;
+        if (mark_from == y) mark_from = end;
+        y = end;
+        first = false;
+        continue;
       }
       first = false;
       if (lag > 0) {
@@ -758,7 +762,6 @@ void rasterize_rows(const Triangle& t, const DrawState& st, RasterContext& ctx, 
   int ya = std::max(row_begin, t.y0);
   const int yz = std::min(row_end, t.y1);
   if (ya >= yz) return;
-  if (t.small) return rasterize_small(t, small_draw(st, ctx.mem, ctx.z_bits), ctx.counters, ya, yz);
   bool colors_differ = false;
   for (unsigned ch = 0; ch < 4; ++ch) colors_differ |= !t.plane[kR + ch].constant;
   const bool gouraud = st.gouraud && colors_differ;   // Gouraud only when colours differ
@@ -783,10 +786,7 @@ void rasterize_rows(const Triangle& t, const DrawState& st, RasterContext& ctx, 
         hz |= kHzFirstAsked;  // not asked this time (HierZ::band_worth_asking): the Kernel does not ask either
         break;
       }
-      if (!clip) clip.emplace(t);
-      const bool rejected = band_occluded(t, *clip, st, ctx, zmask, ya, end - 1, run);
-      ctx.hier_z->band_answered(ya >> HierZ::kRowsLog, rejected);
-      if (!rejected) {
+      if (!ask_band(t, clip, st, ctx, zmask, ya, end - 1, run)) {
         hz |= kHzFirstAsked;
         break;
       }

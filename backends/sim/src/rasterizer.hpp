@@ -48,7 +48,7 @@ struct RasterContext {
 // is not fully masked. Other draws take the exact path (setup_triangle) even in preview mode.
 bool preview_applies(const DrawState& st);
 
-// What drawing a small preview triangle (Triangle::small, preview_plain.hpp) needs from its state,
+// What drawing a small preview triangle (SmallTriangle, preview_plain.hpp) needs from its state,
 // worked out once per state (the renderer keeps it while the state lasts) instead of per triangle.
 struct SmallDraw {
   SmallKernel kernel = nullptr;   // small_kernel(st)
@@ -61,13 +61,11 @@ struct SmallDraw {
 };
 // For a state with st.preview_small != 0 (and preview_applies).
 SmallDraw small_draw(const DrawState& st, VideoMemory& mem, unsigned z_bits);
-// Draws the rows [row_begin, row_end) of a small triangle (clipped to its box) as rasterize_rows
-// does, counting into c. Tri is the full Triangle or the batch's compact SmallTriangle record (both
-// have the box's y0, y1, x0), kernel the small routine for it. Inline: the renderer calls it once per
+// Draws the rows [row_begin, row_end) of a small triangle's compact record (clipped to its box) as
+// rasterize_rows would draw the triangle, counting into c. Inline: the renderer calls it once per
 // small triangle.
-template <class Tri, class SmallKernel>
-[[gnu::always_inline]] inline void rasterize_small(const Tri& t, const SmallDraw& d, SmallKernel kernel,
-                                                   RasterCounters& c, int row_begin, int row_end) {
+[[gnu::always_inline]] inline void rasterize_small(const SmallTriangle& t, const SmallDraw& d, RasterCounters& c,
+                                                   int row_begin, int row_end) {
   const int ya = row_begin > t.y0 ? row_begin : t.y0, yz = row_end < t.y1 ? row_end : t.y1;
   if (ya >= yz) return;
   SmallTarget s;
@@ -79,14 +77,11 @@ template <class Tri, class SmallKernel>
   s.rows = yz - ya;
   s.zmask = d.zmask;
   s.z_write = d.z_write;
-  const PreviewCounts n = kernel(t, s);
+  const PreviewCounts n = d.kernel(t, s);
   c.scanned += n.scanned;  // count_drawn's counts
   c.covered += n.covered;
   c.passed += n.passed;
   if (d.blended) c.blended += n.passed;
-}
-inline void rasterize_small(const Triangle& t, const SmallDraw& d, RasterCounters& c, int row_begin, int row_end) {
-  rasterize_small(t, d, d.kernel, c, row_begin, row_end);
 }
 
 // Draws the rows [row_begin, row_end) of t (a preview triangle through the preview routine) (clipped to its bounding box) with state st.

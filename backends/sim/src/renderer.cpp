@@ -82,8 +82,7 @@ Renderer::~Renderer() { wait_drawing(); }  // the workers read drawing_: stop th
 [[gnu::always_inline]] inline Renderer::SetUp Renderer::setup(const Vertex& a, const Vertex& b, const Vertex& c,
                                                               const DrawState& st, bool observing, Triangle& t,
                                                               SmallTriangle& s) const {
-  // Small triangles of a plain untextured preview draw: their own setup (setup_triangle_preview's
-  // first step), entered directly, into the compact record.
+  // Small triangles of a plain untextured preview draw: their own setup, into the compact record.
   if (knobs_.preview && st.preview_small != 0 && !observing) {
     const SmallSetup r = small_setup_(a, b, c, st, knobs_.subpixel_bits, s);
     if (r != SmallSetup::NotSmall) return r == SmallSetup::Drawn ? SetUp::Small : SetUp::None;
@@ -100,7 +99,7 @@ Renderer::~Renderer() { wait_drawing(); }  // the workers read drawing_: stop th
   if (pending_is_small_) {  // no errors (both buffers inside memory), counters straight into the totals
     const SmallTriangle& s = small_slots_[pending_];
     const std::uint64_t covered = counters_.covered;
-    rasterize_small(s, pending_small_, pending_small_kernel_, counters_, s.y0, s.y1);
+    rasterize_small(s, pending_small_, counters_, s.y0, s.y1);
     modes_[pending_state_->mode_class].pixels += counters_.covered - covered;
     pending_ = -1;
     return;
@@ -189,10 +188,7 @@ void Renderer::draw(const Vertex& a, const Vertex& b, const Vertex& c, const std
   if (pending_state_ != state) {
     pending_state_ = state;
     pending_hz_ = hier_z_applies(st, vector_);
-    if (knobs_.preview && st.preview_small != 0) {
-      pending_small_ = small_draw(st, mem_, knobs_.z_bits);
-      pending_small_kernel_ = small_record_kernel(st);
-    }
+    if (knobs_.preview && st.preview_small != 0) pending_small_ = small_draw(st, mem_, knobs_.z_bits);
   }
 }
 
@@ -206,7 +202,7 @@ void Renderer::draw(const Vertex& a, const Vertex& b, const Vertex& c, const std
 
 void Renderer::count_rasterised(const Triangle& t, const DrawState& st) {
   count_box(t.x0, t.y0, t.x1, t.y1, st);
-  if (!count_rows_ || t.small || st.writes_nothing) return;
+  if (!count_rows_ || st.writes_nothing) return;
   const std::uint64_t covered = access_triangle_rows(sdram_, texel_cache_, t, st);
   if (st.mode_class & 4) texel_footprint_ += texel_footprint_bytes(t, st, covered);
   if (st.mode_class & 2) depth_tail_ += depth_tail_pixels(covered);
@@ -258,9 +254,7 @@ void Renderer::draw_bands(unsigned worker) {
   const DrawState& st = *drawing_state_;
   const unsigned n = pool_.workers();
   RasterContext& c = drawing_ctx_[worker];
-  const bool has_small = knobs_.preview && st.preview_small != 0;
-  const SmallDraw small = has_small ? small_draw(st, mem_, knobs_.z_bits) : SmallDraw{};
-  const SmallRecordKernel kernel = has_small ? small_record_kernel(st) : nullptr;
+  const SmallDraw small = knobs_.preview && st.preview_small != 0 ? small_draw(st, mem_, knobs_.z_bits) : SmallDraw{};
   // In locals: the kernels are called through pointers, so the compiler would load the batch's
   // fields again for every triangle.
   const BatchRows* const rows = drawing_.rows.data();
@@ -275,7 +269,7 @@ void Renderer::draw_bands(unsigned worker) {
     unsigned ahead = worker + n - first % n;
     if (ahead >= n) ahead -= n;
     for (int band = static_cast<int>(first + ahead); band * kBandRows < r.y1; band += static_cast<int>(n)) {
-      if (r.small) rasterize_small(smalls[i], small, kernel, c.counters, band * kBandRows, (band + 1) * kBandRows);
+      if (r.small) rasterize_small(smalls[i], small, c.counters, band * kBandRows, (band + 1) * kBandRows);
       else rasterize_rows(full[i], st, c, band * kBandRows, (band + 1) * kBandRows);
     }
   }

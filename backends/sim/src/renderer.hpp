@@ -134,7 +134,6 @@ class Renderer {
   bool pending_is_small_ = false;  // the pending triangle is small_slots_[pending_], not slots_[pending_]
   std::shared_ptr<const DrawState> pending_state_;
   SmallDraw pending_small_;  // for pending_state_ when it has small preview triangles
-  SmallRecordKernel pending_small_kernel_ = nullptr;
   SmallSetupRoutine small_setup_ = small_setup_routine();
   std::uint16_t errors_ = 0;
   std::uint64_t rasterised_ = 0;

@@ -1,7 +1,6 @@
 #include "setup.hpp"
 
 #include "color_planes.hpp"
-#include "preview_plain.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -151,7 +150,6 @@ bool setup_triangle(const Vertex& va, const Vertex& vb, const Vertex& vc, const 
   std::int64_t D = 0;
   if (!setup_coverage(va, vb, vc, state, subpixel_bits, t, e20, e01, D)) return false;
   t.preview = false;
-  t.small = 0;
   const Vertex* v = t.v;
   const Divider div(t.den);
   const bool color = all_attributes || state.gouraud;
@@ -176,12 +174,6 @@ bool setup_triangle(const Vertex& va, const Vertex& vb, const Vertex& vc, const 
 
 bool setup_triangle_preview(const Vertex& va, const Vertex& vb, const Vertex& vc, const DrawState& state,
                             unsigned subpixel_bits, bool observing, Triangle& t) {
-  // Small triangles of a plain untextured draw: a setup of their own (preview_plain.hpp).
-  if (state.preview_small != 0 && !observing) {
-    const SmallSetup s = setup_small_preview(va, vb, vc, state, subpixel_bits, t);
-    if (s != SmallSetup::NotSmall) return s == SmallSetup::Drawn;
-  }
-  t.small = 0;
   Edge e20, e01;  // the raw weights of vertices 1 and 2 at the box origin's sample point
   if (observing) {  // the observer reports the exact interpolants: set those up too
     if (!setup_triangle(va, vb, vc, state, subpixel_bits, true, t)) return false;

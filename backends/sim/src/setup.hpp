@@ -89,7 +89,6 @@ struct Triangle {
   std::uint8_t flat[4] = {0, 0, 0, 0};  // flat colour (first vertex as listed)
   std::uint64_t index = 0;              // kicked-triangle number
   bool preview = false;                 // set up by setup_triangle_preview: drawn from fplane
-  std::uint8_t small = 0;               // preview small-triangle kernel + 1 (preview_plain.hpp), 0: none
   FloatPlanes fplane;                   // preview only (the planes the state needs)
   FixedPlanes xplane;                   // preview of an untextured state: fplane in fixed point
 };
@@ -105,7 +104,7 @@ struct alignas(64) SmallTriangle {
   std::int32_t e[3], ex[3], ey[3];      // biased edge values at the box origin, steps (Triangle::edge)
   std::int32_t den = 0;                 // 2D
   std::int16_t x0 = 0, y0 = 0, x1 = 0, y1 = 0;  // clipped bounding box (a clip rectangle is below 2^11)
-  std::uint8_t small = 0;               // preview small-triangle kernel + 1 (Triangle::small)
+  std::uint8_t small = 0;               // preview small-triangle kernel + 1 (DrawState::preview_small)
 };
 static_assert(sizeof(SmallTriangle) == 128, "two cache lines");
 
@@ -118,6 +117,8 @@ bool setup_triangle(const Vertex& a, const Vertex& b, const Vertex& c, const Dra
 // The preview setup (`--accuracy preview`, preview.hpp): the same coverage (D, box, biased integer
 // edge functions) and float planes instead of exact ones, from one float reciprocal of D and no
 // exact division. With `observing` the exact planes are set up too (the observer reports them).
+// Small triangles of a plain untextured draw have a setup of their own, into a SmallTriangle
+// (setup_small_preview: the renderer tries it first).
 bool setup_triangle_preview(const Vertex& a, const Vertex& b, const Vertex& c, const DrawState& state,
                             unsigned subpixel_bits, bool observing, Triangle& out);
 

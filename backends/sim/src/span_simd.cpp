@@ -3,6 +3,8 @@
 #include <cstdlib>
 #include <cstring>
 
+#include "cpu_features.hpp"
+#include "gpubridge/common/log.hpp"
 #include "pixel8.hpp"
 
 namespace gpubridge::sim {
@@ -207,30 +209,23 @@ struct Instance {
   std::uint64_t (*routine)(const SimdSpan&);
 };
 
-bool cpu_has(SpanIsa isa) {
-  switch (isa) {
-    case SpanIsa::Avx512:
-    case SpanIsa::Avx512x256:
-      return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
-             __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512dq");
-    case SpanIsa::Avx2: return __builtin_cpu_supports("avx2");
-    case SpanIsa::Baseline: break;
-  }
-  return true;
-}
-
 // The widest instance the CPU runs, capped by GPUBRIDGE_SIM_SPAN_ISA (avx512-256, avx2 or baseline)
-// so that the instances can be timed against each other in one binary.
+// so that the instances can be timed against each other in one binary. Any other value is named
+// in a warning and caps nothing: a typo must not pass for a measurement of another instance.
 Instance pick_instance() {
   SpanIsa cap = SpanIsa::Avx512;
   if (const char* env = std::getenv("GPUBRIDGE_SIM_SPAN_ISA"); env && *env) {
     if (std::strcmp(env, "avx512-256") == 0) cap = SpanIsa::Avx512x256;
     else if (std::strcmp(env, "avx2") == 0) cap = SpanIsa::Avx2;
     else if (std::strcmp(env, "baseline") == 0) cap = SpanIsa::Baseline;
+    else
+      logger("sim")->warn("GPUBRIDGE_SIM_SPAN_ISA={} is not one of avx512-256, avx2, baseline: ignored, the span "
+                          "routine runs the widest instance this CPU has",
+                          env);
   }
-  if (cap == SpanIsa::Avx512 && cpu_has(SpanIsa::Avx512)) return {SpanIsa::Avx512, &span_avx512};
-  if (cap == SpanIsa::Avx512x256 && cpu_has(SpanIsa::Avx512)) return {SpanIsa::Avx512x256, &span_avx512_256};
-  if (cap != SpanIsa::Baseline && cpu_has(SpanIsa::Avx2)) return {SpanIsa::Avx2, &span_avx2};
+  if (cap == SpanIsa::Avx512 && cpu_has_avx512()) return {SpanIsa::Avx512, &span_avx512};
+  if (cap == SpanIsa::Avx512x256 && cpu_has_avx512()) return {SpanIsa::Avx512x256, &span_avx512_256};
+  if (cap != SpanIsa::Baseline && cpu_has_avx2()) return {SpanIsa::Avx2, &span_avx2};
   return {SpanIsa::Baseline, &span_baseline};
 }
 
