@@ -19,6 +19,7 @@ namespace {
 struct AccuracyArgs {
   bool quick = false;
   unsigned runs = 5;
+  unsigned min_ms = 250;
   unsigned scale = 1;
   unsigned peer_rounds = 3;
   bool no_llvmpipe = false;
@@ -99,6 +100,7 @@ int run_accuracy(const GlobalOptions& g, const AccuracyArgs& a) {
   bench::AccuracyBenchOptions opt;
   opt.quick = a.quick;
   opt.runs = a.runs;
+  opt.min_seconds = a.min_ms * 1e-3;
   opt.scale = a.scale;
   opt.llvmpipe = !a.no_llvmpipe;
   opt.peer_rounds = a.peer_rounds;
@@ -122,6 +124,7 @@ int run_accuracy(const GlobalOptions& g, const AccuracyArgs& a) {
   std::string command = "gpubridge bench accuracy";
   if (a.quick) command += " --quick";
   if (a.runs != 5) command += " --runs " + std::to_string(a.runs);
+  if (a.min_ms != 250) command += " --min-ms " + std::to_string(a.min_ms);
   if (a.scale != 1) command += " --scale " + std::to_string(a.scale);
   if (a.peer_rounds != 3) command += " --peer-rounds " + std::to_string(a.peer_rounds);
   for (const auto& name : a.scenes) command += " --scene " + name;
@@ -159,6 +162,11 @@ GPUBRIDGE_COMMAND("bench", 80, [](CLI::App& app, GlobalOptions& g, auto& runners
   sub->add_flag("--quick", args->quick, "small scenes and one timed run (smoke test; figures are not meaningful)");
   sub->add_option("--runs", args->runs, "timed runs per measurement after one warm-up; the best is reported")
       ->check(CLI::Range(1u, 100u))
+      ->capture_default_str();
+  sub->add_option("--min-ms", args->min_ms,
+                  "and more timed runs until this many milliseconds of frames have passed (the simulator, the "
+                  "llvmpipe peer and the minimal GL program alike; 0 = --runs only; --quick: 0)")
+      ->check(CLI::Range(0u, 60000u))
       ->capture_default_str();
   sub->add_option("--scale", args->scale, "divide the triangle counts of the scenes by this (1 = the full set)")
       ->check(CLI::Range(1u, 1000u))

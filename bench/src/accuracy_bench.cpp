@@ -87,6 +87,10 @@ Result<Report> run_accuracy_bench(const AccuracyBenchOptions& opt, const std::fu
     rep.scenes = std::move(chosen);
   }
   const unsigned runs = opt.quick ? 1 : std::max(1u, opt.runs);
+  // Every timed side (simulator, peer, minimal program) takes its best frame by this rule.
+  const FrameBudget budget{runs, opt.quick ? 0.0 : std::clamp(opt.min_seconds, 0.0, 60.0)};
+  rep.runs = budget.runs;
+  rep.min_seconds = budget.min_seconds;
   const unsigned rounds = opt.quick ? 1 : std::max(1u, opt.peer_rounds);
 
   progress("reference rasterisation of the error subsets");
@@ -109,7 +113,7 @@ Result<Report> run_accuracy_bench(const AccuracyBenchOptions& opt, const std::fu
       const unsigned lp_threads = t == 1 ? 0 : t;
       for (unsigned round = 0; round < rounds && !peer_failed; ++round) {
         progress("llvmpipe, " + std::to_string(t) + " thread(s), round " + std::to_string(round + 1));
-        auto r = run_llvmpipe(rep.scenes, refs, lp_threads, runs, t == 1 && round == 0);
+        auto r = run_llvmpipe(rep.scenes, refs, lp_threads, budget, t == 1 && round == 0);
         if (!r) {
           rep.llvmpipe = r.error().message;
           rep.llvmpipe_ok = false;
@@ -125,7 +129,7 @@ Result<Report> run_accuracy_bench(const AccuracyBenchOptions& opt, const std::fu
         for (std::size_t si = 0; minimal_exe && si < rep.scenes.size(); ++si) {
           if (!minimal_gl_draws(rep.scenes[si])) continue;
           progress("minimal GL program, " + std::to_string(t) + " thread(s), " + rep.scenes[si].name);
-          auto m = run_minimal_gl(*minimal_exe, rep.scenes[si], lp_threads, runs);
+          auto m = run_minimal_gl(*minimal_exe, rep.scenes[si], lp_threads, budget);
           if (!m) return m.error();  // llvmpipe ran a moment ago: a failure here is a bug to see
           if (!minimal[ti][si] || m->best_seconds < minimal[ti][si]->best_seconds) minimal[ti][si] = *m;
         }
@@ -168,17 +172,17 @@ Result<Report> run_accuracy_bench(const AccuracyBenchOptions& opt, const std::fu
       err = measure_error(s, refs[si], *frame);
       for (std::size_t ti = 0; ti < opt.threads.size(); ++ti) {
         const unsigned t = opt.threads[ti];
-        auto timing = time_sim(s, k, t, runs);
+        auto timing = time_sim(s, k, t, budget);
         if (!timing) return timing.error();
         if (k.preview) {
           // Exact, preview, exact, preview: each keeps its best frame of both rounds.
           double exact_best = 1e30;
           for (unsigned round = 0; round < 2; ++round) {
-            auto e = time_sim(s, configs.front(), t, runs);
+            auto e = time_sim(s, configs.front(), t, budget);
             if (!e) return e.error();
             exact_best = std::min(exact_best, e->best_seconds);
             if (round == 0) continue;
-            auto again = time_sim(s, k, t, runs);
+            auto again = time_sim(s, k, t, budget);
             if (!again) return again.error();
             timing->best_seconds = std::min(timing->best_seconds, again->best_seconds);
           }

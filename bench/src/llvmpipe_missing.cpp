@@ -3,8 +3,8 @@
 
 namespace gpubridge::bench {
 
-Result<LlvmpipeResult> run_llvmpipe(const std::vector<Scene>&, const std::vector<ReferenceFrame>&, unsigned, unsigned,
-                                    bool) {
+Result<LlvmpipeResult> run_llvmpipe(const std::vector<Scene>&, const std::vector<ReferenceFrame>&, unsigned,
+                                    const FrameBudget&, bool) {
   return make_error("llvmpipe peer not built: libEGL/libOpenGL development files were missing at configure time "
                     "(install libegl-dev libopengl-dev libgl1-mesa-dri and reconfigure)");
 }

@@ -82,7 +82,7 @@ ErrorStats llvmpipe_error(LlvmpipePeer& peer, const Scene& s, const ReferenceFra
 }  // namespace
 
 Result<LlvmpipeResult> run_llvmpipe(const std::vector<Scene>& scenes, const std::vector<ReferenceFrame>& refs,
-                                    unsigned lp_threads, unsigned runs, bool measure) {
+                                    unsigned lp_threads, const FrameBudget& budget, bool measure) {
   auto text = run_isolated(lp_threads, [&]() -> Result<std::string> {
     // The malloc thresholds of bench/llvmpipe/minimal_gl.c (see there): llvmpipe frees and
     // reallocates its binned scene every frame, and whether glibc trims and re-faults it each time
@@ -100,13 +100,11 @@ Result<LlvmpipeResult> run_llvmpipe(const std::vector<Scene>& scenes, const std:
       if (s.width != 640 || s.height != 480) return make_error("llvmpipe peer: scenes must be 640x480");
       const GlDrawState st = throughput_state(s);
       peer.set_vertices(vertices_of(s, s.triangles.size()), st.output);  // outside the timed frames
-      double best = 1e30;
-      for (unsigned r = 0; r <= runs; ++r) {
+      const double best = best_frame_seconds(budget, [&] {
         const auto t0 = std::chrono::steady_clock::now();
         peer.render(st);
-        const double sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        if (r > 0) best = std::min(best, sec);
-      }
+        return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      });
       unsigned long long sum = 0;  // compared with the minimal GL program's frame (same picture?)
       for (std::uint8_t b : peer.read_color()) sum += b;
       nlohmann::json js{{"seconds", best}, {"pixel_sum", sum}};

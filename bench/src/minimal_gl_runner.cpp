@@ -55,7 +55,8 @@ Result<std::string> find_minimal_gl() {
                        " (it is built with the llvmpipe peer: libegl-dev libopengl-dev)");
 }
 
-Result<MinimalGlRun> run_minimal_gl(const std::string& exe, const Scene& s, unsigned lp_threads, unsigned runs) {
+Result<MinimalGlRun> run_minimal_gl(const std::string& exe, const Scene& s, unsigned lp_threads,
+                                    const FrameBudget& budget) {
   std::string path = (fs::temp_directory_path() / "gpubridge-minimal-gl-XXXXXX").string();
   const int fd = mkstemp(path.data());
   if (fd < 0) return minimal_error(std::string("cannot create a temporary vertex file: ") + std::strerror(errno));
@@ -75,7 +76,8 @@ Result<MinimalGlRun> run_minimal_gl(const std::string& exe, const Scene& s, unsi
 
   int out[2];
   if (pipe(out) != 0) return minimal_error(std::string("pipe failed: ") + std::strerror(errno));
-  const std::string w = std::to_string(s.width), h = std::to_string(s.height), r = std::to_string(runs);
+  const std::string w = std::to_string(s.width), h = std::to_string(s.height), r = std::to_string(budget.runs);
+  const std::string min_ms = std::to_string(static_cast<unsigned>(budget.min_seconds * 1e3 + 0.5));
   const pid_t pid = fork();
   if (pid < 0) {
     close(out[0]);
@@ -87,7 +89,7 @@ Result<MinimalGlRun> run_minimal_gl(const std::string& exe, const Scene& s, unsi
     close(out[0]);
     close(out[1]);
     setenv("LP_NUM_THREADS", std::to_string(lp_threads).c_str(), 1);
-    const char* argv[] = {exe.c_str(), path.c_str(), w.c_str(), h.c_str(), r.c_str(), nullptr};
+    const char* argv[] = {exe.c_str(), path.c_str(), w.c_str(), h.c_str(), r.c_str(), min_ms.c_str(), nullptr};
     execv(exe.c_str(), const_cast<char* const*>(argv));
     _exit(127);
   }
@@ -108,9 +110,9 @@ Result<MinimalGlRun> run_minimal_gl(const std::string& exe, const Scene& s, unsi
                          "; its message is on stderr)");
   unsigned long long triangles = 0;
   MinimalGlRun run;
-  if (std::sscanf(text.c_str(), "triangles=%llu best_seconds=%lf pixel_sum=%llu", &triangles, &run.best_seconds,
-                  &run.pixel_sum) != 3 ||
-      triangles != s.triangles.size() || !(run.best_seconds > 0))
+  if (std::sscanf(text.c_str(), "triangles=%llu best_seconds=%lf pixel_sum=%llu frames=%u", &triangles,
+                  &run.best_seconds, &run.pixel_sum, &run.frames) != 4 ||
+      triangles != s.triangles.size() || !(run.best_seconds > 0) || run.frames < budget.runs)
     return minimal_error("unexpected output from " + exe + " on scene " + s.name + ": " + text);
   return run;
 }

@@ -78,22 +78,20 @@ std::vector<std::uint8_t> scene_frame_bytes(const Scene& s, const geometry::Rend
 }
 
 
-Result<Timing> time_sim(const Scene& scene, const sim::AccuracyKnobs& knobs, unsigned threads, unsigned runs) {
+Result<Timing> time_sim(const Scene& scene, const sim::AccuracyKnobs& knobs, unsigned threads, const FrameBudget& budget) {
   auto dev = make_scene_device(scene, knobs, threads);
   if (!dev) return dev.error();
   const auto bytes = scene_frame_bytes(scene, scene.state, scene.triangles.size());
   Timing t;
-  t.best_seconds = 1e30;
-  for (unsigned r = 0; r <= runs; ++r) {
+  t.best_seconds = best_frame_seconds(budget, [&] {
     (*dev)->reset_stats();
     const auto t0 = std::chrono::steady_clock::now();
     (*dev)->write(protocol::FrameView{bytes});
     (*dev)->drain();
     (void)(*dev)->memory();  // completes the triangles the band workers still hold
-    const double sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    if (r > 0) t.best_seconds = std::min(t.best_seconds, sec);  // run 0 is the warm-up
-    t.pixels_covered = (*dev)->stats().pixels_covered;
-  }
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  });
+  t.pixels_covered = (*dev)->stats().pixels_covered;
   return t;
 }
 

@@ -45,11 +45,24 @@ TEST(MinimalGl, DrawsTheBenchVerticesWithDepthLessAtOneAndTwoThreads) {
     for (bool near_first : {true, false}) {
       const Scene s = quads(near_first);
       ASSERT_TRUE(minimal_gl_draws(s));
-      auto run = run_minimal_gl(GPUBRIDGE_MINIMAL_GL, s, lp_threads, 2);
+      auto run = run_minimal_gl(GPUBRIDGE_MINIMAL_GL, s, lp_threads, {.runs = 2, .min_seconds = 0});
       ASSERT_TRUE(run) << run.error().message;
       EXPECT_EQ(run->pixel_sum, kRedFrameSum) << "LP_NUM_THREADS=" << lp_threads << ", near quad first: " << near_first;
       EXPECT_GT(run->best_seconds, 0.0);
     }
+}
+
+TEST(MinimalGl, TimesFramesUntilTheWindowIsFull) {
+  const Scene s = quads(true);
+  auto counted = run_minimal_gl(GPUBRIDGE_MINIMAL_GL, s, 0, {.runs = 3, .min_seconds = 0});
+  ASSERT_TRUE(counted) << counted.error().message;
+  EXPECT_EQ(counted->frames, 3u);  // no window: the count alone
+  // Two quads of 64 x 48 take well under 50 ms a frame, so a 150 ms window needs more than 3 frames.
+  auto windowed = run_minimal_gl(GPUBRIDGE_MINIMAL_GL, s, 0, {.runs = 3, .min_seconds = 0.15});
+  ASSERT_TRUE(windowed) << windowed.error().message;
+  EXPECT_GT(windowed->frames, 3u);
+  EXPECT_LE(windowed->frames, 2001u);
+  EXPECT_EQ(windowed->pixel_sum, kRedFrameSum);
 }
 
 TEST(MinimalGl, DrawsExactlyTheDepthLessGouraudScenes) {
@@ -63,7 +76,7 @@ TEST(MinimalGl, DrawsExactlyTheDepthLessGouraudScenes) {
 }
 
 TEST(MinimalGl, AMissingProgramIsAClearError) {
-  auto run = run_minimal_gl("/nonexistent/minimal_gl", quads(true), 0, 1);
+  auto run = run_minimal_gl("/nonexistent/minimal_gl", quads(true), 0, {.runs = 1});
   ASSERT_FALSE(run);
   EXPECT_NE(run.error().message.find("minimal GL program"), std::string::npos) << run.error().message;
 }

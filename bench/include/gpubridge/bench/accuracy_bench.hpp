@@ -20,6 +20,7 @@ struct AccuracyBenchOptions {
   bool quick = false;         // small scenes, 1 timed run: the smoke test of the test command
   unsigned scale = 1;         // divides the scene triangle counts (quick: 200)
   unsigned runs = 5;          // timed runs per measurement (best is reported), after 1 warm-up
+  double min_seconds = 0.25;  // ... and more runs until this much time is spent (both sides; quick: 0)
   bool llvmpipe = true;       // measure the llvmpipe peer (omitted with a reason when unavailable)
   unsigned peer_rounds = 3;   // the peer and the minimal GL program alternate this often (best of all; quick: 1)
   std::vector<unsigned> threads{1, 2};
@@ -74,6 +75,8 @@ struct Report {
   std::string llvmpipe;     // renderer string, or why the llvmpipe rows are missing
   bool llvmpipe_ok = false;
   std::string minimal_gl;   // the minimal GL program run beside the peer, or why it did not run
+  unsigned runs = 0;         // timed frames per measurement at least, after a warm-up ...
+  double min_seconds = 0;    // ... and more until this much time had been spent (every side alike)
   std::vector<Scene> scenes;  // descriptions only (triangles cleared after the run)
   std::vector<std::uint64_t> scene_pixels;  // covered pixels per frame (exact simulator)
   std::vector<std::size_t> scene_triangles;  // triangles per frame
