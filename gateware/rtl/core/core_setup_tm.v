@@ -275,7 +275,8 @@ module core_setup_tm #(
   // The fy half without fy's adder (A_BOX reads with box2 set, fy = (y + 8) >> 4):
   // box_y0 < floor((y + 8) / 16) <=> 16 (box_y0 + 1) <= y + 8 <=> y >= 16 box_y0 + 8, one
   // comparison of rd's Y with a concatenation, so the branch into the program ROM's address
-  // has one carry chain instead of two (fmax-setup, docs/gateware.md).
+  // has one carry chain instead of two (fmax-setup, docs/gateware.md); since fit10 the chain
+  // takes ~rc, one LUT after the RAM's output (shared with the X clamp's comparisons).
   reg         y0_in_clip;
   // rc >= 16 box_y0 + 8 <=> 16 box_y0 + 8 + ~rc < 0
   wire signed [17:0] s_rows = $signed({3'b0, box_y0, 4'b1000}) + $signed({nrc[15], nrc[15], nrc});
