@@ -13,13 +13,18 @@
 // below 2^NARROW: only its low NARROW bits are taken, read at bit NARROW - 1 of the shifting
 // register instead of its top (the bits above would give quotient bits beyond QW and leave the
 // remainder 0), so the division takes NARROW + 1 cycles; the quotient bits still enter at the
-// bottom, below what is left of the numerator.
+// bottom, below what is left of the numerator. With COMP, a `comp` pulse while idle replaces rem by
+// den - 1 - rem through the division's own subtractor (its trial is then {0, rem}, so diff =
+// rem - den and ~diff = den - 1 - rem): a caller that needs both remainders in turn complements
+// in place instead of keeping a second adder and a multiplexer for rem_c (fit10,
+// docs/gateware.md); the complement is its own inverse.
 module core_divider #(
     parameter integer NW = 72,  // numerator width (signed)
     parameter integer DW = 35,  // divisor / remainder width (unsigned)
     parameter integer QW = 32,  // quotient bits kept
     parameter integer SKIP = 1,
-    parameter integer NARROW = 0  // 0: none; else at least QW (not with SKIP)
+    parameter integer NARROW = 0, // 0: none; else at least QW (not with SKIP)
+    parameter integer COMP = 0    // 1: the `comp` input complements rem in place (above)
 ) (
     input  wire                 clk,
     input  wire                 rst,
@@ -27,6 +32,7 @@ module core_divider #(
     input  wire signed [NW-1:0] num,
     input  wire                 narrow, // with NARROW: |num| < 2^NARROW (num >= -2^NARROW)
     input  wire [DW-1:0]        den,    // held by the caller until rem_c is read (not copied)
+    input  wire                 comp,   // with COMP, while idle and not starting: rem <= den - 1 - rem
     output wire                 busy,
     output reg                  done,   // one-cycle pulse: quo / rem valid (held until next start)
     output wire [QW-1:0]        quo,
@@ -49,7 +55,8 @@ module core_divider #(
 
   assign busy = run;
 
-  wire [DW:0]   trial = {pr, (NARROW > 0 && nar) ? nq[NB] : nq[MW-1]};
+  wire          cmp = (COMP != 0) && comp;
+  wire [DW:0]   trial = cmp ? {1'b0, pr} : {pr, (NARROW > 0 && nar) ? nq[NB] : nq[MW-1]};
   wire [DW+1:0] diff = {1'b0, trial} - {2'b0, dv};
   wire          fits = !diff[DW+1];
   wire          skip = (SKIP != 0) && (pr < (dv >> 4)) && (left >= 4);
@@ -79,6 +86,8 @@ module core_divider #(
         nq   <= {nq[MW-2:0], fits ^ neg};
         left <= left - 1'b1;
       end
+    end else if (cmp) begin
+      pr <= ~diff[DW-1:0];
     end
   end
 

@@ -283,7 +283,7 @@ module core_setup #(
     for (gd = 0; gd < ND; gd = gd + 1) begin : dividers
       /* verilator lint_off PINCONNECTEMPTY */
       core_divider #(.NW(ACC_W), .DW(35), .QW(32), .SKIP(SKIP)) divider (
-          .clk(clk), .rst(rst), .start(dv_go[gd]), .num(acc_s), .narrow(1'b0), .den(den), .busy(), .done(dv_done[gd]),
+          .clk(clk), .rst(rst), .start(dv_go[gd]), .num(acc_s), .narrow(1'b0), .den(den), .comp(1'b0), .busy(), .done(dv_done[gd]),
           .quo(dv_q[gd*32 +: 32]), .rem(dv_r[gd*35 +: 35]), .rem_c(dv_rc[gd*35 +: 35]),
           .neg(dv_neg[gd]));
       /* verilator lint_on PINCONNECTEMPTY */

@@ -56,7 +56,7 @@ module core_setup_tm #(
     output wire signed [35:0] e_data,
     output reg  [10:0]  box_x0, box_y0, box_xl, box_y1, x_start,
     output reg  [IDX_W-1:0] origin_idx,
-    output reg  [34:0]  den,          // |2D|
+    output wire [34:0]  den,          // |2D| (held inverted, den_n below)
     output reg          pw_en,
     output reg  [2:0]   pw_attr,
     output reg  [1:0]   pw_field,
@@ -237,7 +237,7 @@ module core_setup_tm #(
   // Each clamped value goes straight into its output register when its vertex field is read
   // (A_FY0: the first row, rd the top vertex's Y; A_XT: the first column, rd its X; A_BOX: the
   // row end, rd the bottom vertex's Y), so no register holds the unclamped ones. by0 is in
-  // [0, 2048]: 2048 (by0_big) lies below every clip rectangle.
+  // [0, 2048]: 2048 lies below every clip rectangle (y0_in_clip is then 0).
   wire signed [12:0] xt = 13'(rc >>> 4);
   wire signed [12:0] cx0 = $signed({2'b0, clip_x0});
   wire signed [12:0] cy0 = $signed({2'b0, clip_y0}), cy1 = $signed({2'b0, clip_y1});
@@ -245,46 +245,80 @@ module core_setup_tm #(
   // start through the same registers' inputs: box_y0, x_start and box_y1 have one source each,
   // not a second one for clears (fit9, docs/gateware.md)
   wire        idle = (pc == 7'd0);
-  wire signed [12:0] by0 = (fy > cy0 && !idle) ? fy : cy0;
-  wire signed [12:0] by1 = (fy < cy1 && !idle) ? fy : cy1;
-  reg         by0_big;
-  wire        unused_by0 = by0[12];  // by0 >= 0
+  // The comparisons with fy and with rc are sign tests of sums with their complements (x - y - 1
+  // = x + ~y), ~fy and ~rc shared by all of them: written as x < y each one inverted its other
+  // operand (the clip rectangle, box_y0, box_xl: flip-flops, or clip_y1) into its carry chain
+  // through LUTs of its own, a logic cell per bit and comparison (fit10, docs/gateware.md).
+  // 14 and 18-bit sums: no overflow. Where a clamp's test becomes >= instead of >, the two
+  // values it chooses between are equal.
+  wire signed [12:0] nfy = ~fy;
+  wire signed [15:0] nrc = ~rc;
+  wire signed [12:0] nxt = 13'(nrc >>> 4);  // ~xt
+  wire signed [13:0] s_fy0 = $signed({cy0[12], cy0}) + $signed({nfy[12], nfy});  // cy0 - fy - 1
+  wire signed [13:0] s_fy1 = $signed({cy1[12], cy1}) + $signed({nfy[12], nfy});  // cy1 - fy - 1
+  wire signed [13:0] s_x0 = $signed({cx0[12], cx0}) + $signed({nxt[12], nxt});   // cx0 - xt - 1
+  wire signed [13:0] s_xl = $signed({3'b0, box_xl}) + $signed({nxt[12], nxt});   // xl - xt - 1
+  wire        fy_ge_cy0 = s_fy0[13];   // fy >= cy0
+  wire        fy_in_clip = !s_fy1[13]; // fy < cy1
+  wire        xt_lt_cx0 = !s_x0[13];   // xt < cx0
+  wire        xt_ge_xl = s_xl[13];     // xt >= box_xl
+  wire        unused_s = &{1'b0, xt[12:11], s_fy0[12:0], s_fy1[12:0], s_x0[12:0], s_xl[12:0]};
+  wire signed [12:0] by0 = (fy_ge_cy0 && !idle) ? fy : cy0;
+  wire signed [12:0] by1 = (fy_in_clip && !idle) ? fy : cy1;
+  wire        unused_by0 = &{1'b0, by0[12:11]};  // by0 >= 0; by0 = 2048 fails y0_in_clip
   wire        unused_by1 = &{1'b0, by1[12:11]};  // stored only when box_y0 < by1 <= cy1 < 2048
-  // A_BOX: some row to walk, box_y0 < min(fy, cy1). The clip half is compared a clock ahead
-  // (box_y0 is loaded at A_FY0, two instructions before A_BOX; the clip rectangle is the
-  // command's), so the branch does not wait for the scissor's clamp and the fy clamp in series.
+  // A_BOX: some row to walk, box_y0 < min(fy, cy1). The clip half is latched at A_FY0, two
+  // instructions before A_BOX, as the top's fy < cy1 (box_y0 = max(fy, cy0) < cy1 exactly then,
+  // cy0 < cy1 being a setup's condition; by0 = 2048 fails it too), by1's own comparator: no
+  // comparator of box_y0 with cy1 (fit10, docs/gateware.md), and the branch does not wait for
+  // the scissor's clamp and the fy clamp in series.
   // The fy half without fy's adder (A_BOX reads with box2 set, fy = (y + 8) >> 4):
   // box_y0 < floor((y + 8) / 16) <=> 16 (box_y0 + 1) <= y + 8 <=> y >= 16 box_y0 + 8, one
   // comparison of rd's Y with a concatenation, so the branch into the program ROM's address
-  // has one carry chain instead of two (fmax-setup, docs/gateware.md).
+  // has one carry chain instead of two (fmax-setup, docs/gateware.md); since fit10 the chain
+  // takes ~rc, one LUT after the RAM's output (shared with the X clamp's comparisons).
   reg         y0_in_clip;
-  always @(posedge clk) y0_in_clip <= $signed({2'b0, box_y0}) < cy1;
-  wire        rows = !by0_big && y0_in_clip &&
-                     $signed({rc[15], rc}) >= $signed({2'b0, box_y0, 4'b1000});
+  // rc >= 16 box_y0 + 8 <=> 16 box_y0 + 8 + ~rc < 0
+  wire signed [17:0] s_rows = $signed({3'b0, box_y0, 4'b1000}) + $signed({nrc[15], nrc[15], nrc});
+  wire        rows = y0_in_clip && s_rows[17];
+  wire        unused_rows = &{1'b0, s_rows[16:0]};
   // box_xl (the last column, clip_x1 - 1, loaded at the start) is the clamp's upper bound too
-  wire [10:0] xs = (xt < cx0 || idle) ? clip_x0 : (xt > $signed({2'b0, box_xl})) ? box_xl : xt[10:0];
+  wire [10:0] xs = (xt_lt_cx0 || idle) ? clip_x0 : xt_ge_xl ? box_xl : xt[10:0];
   wire [4:0] r_sel = (i_addr == R_YTOP) ? r_y(top) : (i_addr == R_XTOP) ? r_x(top) :
                      (i_addr == R_YBOT) ? r_y(bot) : i_addr;
 
   // ---------------------------------------------------------------- divider and plane writes
+  // den is held inverted: its readers (the divider's trial - den, the steppers' t - den) are
+  // subtractors, whose carry chains take it inverted. Held as it is, every bit cost an inverter
+  // LUT beside a flip-flop without one (two logic cells); inverted, the inverter is the
+  // flip-flop's own LUT, and the readers' inversion of ~den_n cancels (fit10, docs/gateware.md).
+  reg  [34:0] den_n;
+  assign den = ~den_n;
   reg         dv_pend, dv_rdy, xl_next;
   reg  [1:0]  dv_field;
   reg  [2:0]  dv_attr;
   wire        dv_done, dv_neg;
   wire [31:0] dv_q;
-  wire [34:0] dv_r, dv_rc;
+  wire [34:0] dv_r;
+  // The steps right and left need r and den - 1 - r (the other one for a negative numerator,
+  // core_divider): the divider complements its remainder in place, through its own subtractor,
+  // in the clock before the write that needs the other one (dv_rdy with a negative numerator:
+  // before the first write; xl_next: between the step right and the step left), so pw_r is the
+  // remainder register itself, without an adder and a multiplexer for rem_c (fit10,
+  // docs/gateware.md)
+  wire        dv_comp = (dv_rdy && dv_neg) || xl_next;
   /* verilator lint_off PINCONNECTEMPTY */
   // colour numerators: |d| < 2^8, |e| < 2^33, |D| < 2^33, a0 < 2^8, so |M0| = |2(d1 e1 + d2 e2 + a0
   // |D|) + ...| < 2^44 and the steps |32(d1 dy + d2 dy)| < 2^31: 45 numerator bits, 46 cycles a
   // division instead of 62 (Z's need all 62). Without a depth buffer every numerator is a
   // colour's: the divider is 46 bits wide and always takes 46 cycles.
-  core_divider #(.NW(ACC_W), .DW(35), .QW(32), .SKIP(0), .NARROW((DEPTH != 0) ? 45 : 0)) divider (
-      .clk(clk), .rst(rst), .start(dv2), .num(acc_s), .narrow(dv_attr != 3'd4), .den(den), .busy(), .done(dv_done),
-      .quo(dv_q), .rem(dv_r), .rem_c(dv_rc), .neg(dv_neg));
+  core_divider #(.NW(ACC_W), .DW(35), .QW(32), .SKIP(0), .NARROW((DEPTH != 0) ? 45 : 0), .COMP(1)) divider (
+      .clk(clk), .rst(rst), .start(dv2), .num(acc_s), .narrow(dv_attr != 3'd4), .den(den), .comp(dv_comp),
+      .busy(), .done(dv_done), .quo(dv_q), .rem(dv_r), .rem_c(), .neg(dv_neg));
   /* verilator lint_on PINCONNECTEMPTY */
   wire unused_q = &{1'b0, dv_q[31:24]};
   assign pw_q = (pw_field == 2'd2) ? ~dv_q[23:0] : dv_q[23:0];
-  assign pw_r = ((pw_field == 2'd2) ^ dv_neg) ? dv_rc : dv_r;
+  assign pw_r = dv_r;
 
   // ---------------------------------------------------------------- sequencer
   reg  [4:0] todo;
@@ -302,7 +336,7 @@ module core_setup_tm #(
   always @(*) begin
     case (i_act)
       A_JMP, A_DONE, A_NODRAW: taken = 1'b1;
-      A_BRZERO: taken = (acc == {ACC_W{1'b0}});
+      A_BRZERO: taken = (acc[35:0] == 36'd0);  // D: |D| < 2^34, so its low 36 bits say D == 0
       A_BRNNEG: taken = !acc[ACC_W-1];
       A_BOX:    taken = !rows;
       A_BRRECT: taken = rect;
@@ -340,7 +374,7 @@ module core_setup_tm #(
         R_DY1: begin dy1 <= acc[16:0]; dyz[1] <= (acc[16:0] == 17'd0); end
         R_DX2: dx2 <= acc[16:0];
         R_DY2: begin dy2 <= acc[16:0]; dyz[2] <= (acc[16:0] == 17'd0); end
-        R_ABSD: den <= {acc[33:0], 1'b0};
+        R_ABSD: den_n <= ~{acc[33:0], 1'b0};
         default: ;
       endcase
     end
@@ -403,9 +437,9 @@ module core_setup_tm #(
         case (i_act)
           A_FLIP: flip <= 1'b1;
           A_FY0: begin
-            box_y0  <= by0[10:0];
-            by0_big <= by0[11];
-            box2    <= 1'b1;
+            box_y0     <= by0[10:0];
+            y0_in_clip <= fy_in_clip;
+            box2       <= 1'b1;
           end
           A_XT: x_start <= xs;
           A_BOX: begin
