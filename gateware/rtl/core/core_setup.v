@@ -100,20 +100,25 @@ module core_setup #(
   function [1:0] argmax(input signed [16:0] d10, input signed [16:0] d21, input signed [16:0] d02);
     argmax = (d10 <= 0 && d02 >= 0) ? 2'd0 : (d10 > 0 && d21 <= 0) ? 2'd1 : 2'd2;
   endfunction
-  // One vertex multiplexer (xa, ya) serves the box (S_BOX: the top vertex, S_BOX2: the bottom
-  // one) and the edge values (the edge's start vertex), selected by `pv`.
+  // One vertex multiplexer (xa, ya) serves the box (S_BOX: the top vertex) and the edge values
+  // (the edge's start vertex), selected by `pv`.
   reg  [1:0] pv;
   wire signed [15:0] xa = pick3(pv, x0, x1, x2);
   wire signed [15:0] ya = pick3(pv, y0, y1, y2);
-  reg        box2;   // S_BOX2: ya is the bottom vertex's
   // samples 16p + 8 inside [min, max]: p from (min + 7) >> 4 to (max + 8) >> 4, exclusive
-  wire signed [12:0] fy = 13'(($signed({ya[15], ya}) + (box2 ? 17'sd8 : 17'sd7)) >>> 4);
-  reg  signed [12:0] fy0, xt;  // the top vertex's first row and column (S_BOX)
-  wire signed [12:0] fy1 = fy;
+  wire signed [12:0] fy = 13'(($signed({ya[15], ya}) + 17'sd7) >>> 4);
+  reg  signed [12:0] xt;  // the top vertex's first column (S_BOX)
   wire signed [12:0] cx0 = $signed({2'b0, r_clip_x0}), cx1 = $signed({2'b0, r_clip_x1});
   wire signed [12:0] cy0 = $signed({2'b0, r_clip_y0}), cy1 = $signed({2'b0, r_clip_y1});
-  wire signed [12:0] by0 = (fy0 > cy0) ? fy0 : cy0;
-  wire signed [12:0] by1 = (fy1 < cy1) ? fy1 : cy1;
+  // The rows to walk, registered in S_BOX: the top vertex's first row through `pv` (the top
+  // vertex there), the bottom vertex's last through a multiplexer of its own (argmax of the
+  // edges, there since S_DELTA), so S_BOX2's decision starts at registers. It took the bottom
+  // vertex through `pv`, the adder and the clamp before the decision and the box registers'
+  // enables (`ek` / `pv` -> `raster.box_y0`, 18.5 ns by the ULX3S clock estimate, docs/gateware.md
+  // "The texture cache's fill target"). No clock added.
+  wire signed [15:0] yb = pick3(argmax(dy2, dy0, dy1), y0, y1, y2);
+  wire signed [12:0] fyb = 13'(($signed({yb[15], yb}) + 17'sd8) >>> 4);
+  reg  signed [12:0] by0, by1;
   // Columns: with XREJECT a triangle wholly beside the clip rectangle is dropped here; without
   // (the small profile) it costs its empty rows, about two cycles each, and its setup.
   wire x_out;
@@ -164,8 +169,8 @@ module core_setup #(
   localparam [3:0] O_DX0 = 4'd0, O_DY0 = 4'd1, O_DX1 = 4'd2, O_DY1 = 4'd3, O_DX2 = 4'd4,
                    O_DY2 = 4'd5, O_W = 4'd6, O_XS = 4'd7, O_E1 = 4'd8, O_E2 = 4'd9, O_D1 = 4'd10,
                    O_D2 = 4'd11, O_D = 4'd12, O_ONE = 4'd13;
-  // Two m operand buses: `osel` (the first product's, or a single addition's) and `osel2` (the
-  // second product's), so that a multiply registers all its operands in one clock.
+  // Two m operand buses: `osel` (the first product's) and `osel2` (the second product's), so that
+  // a multiply registers all its operands in one clock (a single addition's operand is `aop`).
   reg  [3:0] osel;
   reg        sh5;   // the delta operands times 32
   function signed [35:0] moper(input [3:0] k, input s5, input signed [35:0] ea, input signed [35:0] eb,
@@ -210,8 +215,13 @@ module core_setup #(
   wire signed [ACC_W-1:0] acc_s = $signed(acc);
   assign e_data = acc_s[35:0];
   reg        c_dbl, c_neg, c_en;  // this cycle's accumulator operation
-  wire [ACC_W-1:0] bop = ACC_W'(mop);
-  wire [ACC_W-1:0] acc_sum = (c_dbl ? acc << 1 : acc) + (bop ^ {ACC_W{c_neg}}) + {{(ACC_W-1){1'b0}}, c_neg};
+  // A single addition's operand, complemented when it subtracts, is registered by the sequencer
+  // as it asks for the addition (its sources, d1, d2, den and 1, hold from there to the addition),
+  // so the addition starts at a register: through the operand multiplexer (`moper`, shared with
+  // the multiply's operands) it was the ULX3S clock estimate's worst cone (`add_osel` -> `acc`,
+  // 18.7 ns, docs/gateware.md "The texture cache's fill target").
+  reg  [ACC_W-1:0] aop;
+  wire [ACC_W-1:0] acc_sum = (c_dbl ? acc << 1 : acc) + aop + {{(ACC_W-1){1'b0}}, c_neg};
 
   // multiply: osel1/osel2 sources, negate (mneg), subtract the second (msub)
   reg  [3:0] osel1, osel2;
@@ -220,7 +230,7 @@ module core_setup #(
   reg        mac_run, ph;
   // single additions requested by the sequencer
   reg        add_go, add_dbl, add_neg;
-  reg  [3:0] add_osel;
+  wire signed [35:0] aop_b = moper(O_ONE, sh5, e1, e2, d1, d2);   // S_BIAS's
 
   // A multiply in three clocks, each ending in registers (the ULX3S clock, docs/gateware.md
   // "Clock estimate"): the mac_go clock takes the operands (the sequencer set their selects with
@@ -231,7 +241,7 @@ module core_setup #(
   reg signed [ACC_W-1:0] p1, p2;   // |a| < 2^(AW-1), |m| < 2^35
   wire signed [ACC_W-1:0] s12 = p1 + (msub ? -p2 : p2);
   always @(*) begin
-    osel  = mac_go ? osel1 : add_osel;
+    osel  = osel1;
     c_en  = add_go && !mac_run;
     c_dbl = add_dbl;
     c_neg = add_neg;
@@ -321,6 +331,7 @@ module core_setup #(
                    S_WAIT = 5'd15, S_GX_W = 5'd16, S_BOX2 = 5'd17, S_DELTA = 5'd18;
   reg [4:0]  st, ret;   // S_WAIT: until the multiply is done, then ret
   reg [1:0]  cstep;     // M0 corrections
+  wire signed [35:0] aop_c = moper((cstep == 2'd1) ? O_D1 : (cstep == 2'd2) ? O_D2 : O_D, sh5, e1, e2, d1, d2);  // S_M0_C's
   reg [7:0]  todo;
 
   assign busy = (st != S_IDLE);
@@ -373,7 +384,6 @@ module core_setup #(
           box_xl <= clip_x1 - 11'd1;  // clip_x1 > clip_x0 >= 0: a setup starts only then
           flip  <= 1'b0;
           sh5   <= 1'b0;
-          box2  <= 1'b0;
           cstep <= 2'd0;
           r_v0 <= v0; r_v1 <= v1; r_v2 <= v2;
           r_clip_x0 <= clip_x0; r_clip_y0 <= clip_y0;
@@ -419,14 +429,12 @@ module core_setup #(
         end
         S_BOX: begin
           x_out_r <= x_out;
-          fy0  <= fy;
+          by0  <= (fy > cy0) ? fy : cy0;
+          by1  <= (fyb < cy1) ? fyb : cy1;
           xt   <= 13'(xa >>> 4);
-          pv   <= argmax(dy2, dy0, dy1);   // the bottom vertex
-          box2 <= 1'b1;
           st   <= S_BOX2;
         end
         S_BOX2: begin
-          box2 <= 1'b0;
           if (box_empty) begin
             draw <= 1'b0;
             st   <= S_END;
@@ -461,7 +469,7 @@ module core_setup #(
         end
         S_BIAS: begin  // -1 unless the edge (as drawn) is top or left; then into the rasteriser
           if (!cstep[0] && !((ek == 2'd0) ? tl0 : (ek == 2'd1) ? tl1 : tl2)) begin
-            add_go <= 1'b1; add_osel <= O_ONE; add_neg <= 1'b1; add_dbl <= 1'b0;
+            add_go <= 1'b1; aop <= ~(ACC_W'(aop_b)); add_neg <= 1'b1; add_dbl <= 1'b0;
             cstep[0] <= 1'b1;
           end else if (!add_go) begin
             cstep[0] <= 1'b0;
@@ -515,7 +523,7 @@ module core_setup #(
             cstep  <= 2'd1;
           end else if (!mac_busy && !add_go) begin
             add_go   <= (cstep == 2'd1) ? !tl1 : (cstep == 2'd2) ? !tl2 : 1'b1;
-            add_osel <= (cstep == 2'd1) ? O_D1 : (cstep == 2'd2) ? O_D2 : O_D;
+            aop      <= ACC_W'(aop_c);
             add_neg  <= 1'b0;
             add_dbl  <= (cstep == 2'd3);
             cstep    <= cstep + 2'd1;

@@ -91,8 +91,19 @@ module core_texture #(
 
   wire [31:0] in_m = in_q << in_n;
 
-  wire [31:0] y0;
-  core_recip_rom rom (.clk(clk), .en(en), .addr(in_m[30:21]), .y(y0));
+  // The block RAMs (this table, the texel cache) are read on every clock, not on `en`: `en` ends
+  // the memory port's grant cone, and as the block RAMs' clock enables it took that cone through
+  // a 2 ns net into a block (`disp_frame_addr` -> the cache's banks, 18.4 ns by the ULX3S clock
+  // estimate, docs/gateware.md "The texture cache's fill target"). While the pipeline stands the
+  // read answers the next pixel's address, so the word the standing pixel read is kept in a
+  // register (`hu`: the pipeline stood last clock, the kept word is the one to use).
+  reg         hu;
+  always @(posedge clk) hu <= !en;
+  wire [31:0] y0r, y0;
+  reg  [31:0] y0h;
+  core_recip_rom rom (.clk(clk), .en(1'b1), .addr(in_m[30:21]), .y(y0r));
+  assign y0 = hu ? y0h : y0r;
+  always @(posedge clk) y0h <= y0;
 
   // stage 1: normalised q; the table entry arrives with it
   reg        v1, qz1;
@@ -248,9 +259,11 @@ module core_texture #(
   // the texel read queue's size, and the response's target (defined with the queue below)
   localparam integer QA = (AW < 1) ? 1 : AW;  // at least two pixels in flight
   localparam integer N = 1 << QA;
-  localparam integer IW = PAY + 8 + 8 + 8 + 1 + 40;
-  wire [1:0] fslot;
-  wire [9:0] f_ia, f_ib, f_ja, f_jb;
+  localparam integer IW = PAY + 8 + 8 + 8 + 1;
+  wire [1:0]  fslot;
+  wire [1:0]  f_bank;  // the response's texel: its bank, entry in the bank and tag
+  wire [10:0] f_idx;
+  wire [6:0]  f_tag;
 
   // ---------------------------------------------------------------- texel cache (CACHE = 1)
   // Four banks by texel parity ({j & 1, i & 1}: the four texels of a bilinear sample are in four
@@ -290,23 +303,22 @@ module core_texture #(
       // entry of texel (i, j) in its bank: {j[2:1], i[9:1]}
       wire [10:0] x0 = {lj0[2:1], li0[9:1]}, x1 = {lj0[2:1], li1[9:1]};
       wire [10:0] x2 = {lj2[2:1], li0[9:1]}, x3 = {lj2[2:1], li1[9:1]};
-      // fill: the response's slot of the filling entry
-      wire [9:0] fi_i = slot_i(fslot[0], f_ia, f_ib), fi_j = slot_j(fslot[1], f_ja, f_jb);
-      wire [1:0] fbank = {fi_j[0], fi_i[0]};
-      wire [10:0] fidx = sweeping ? sweep[10:0] : {fi_j[2:1], fi_i[9:1]};
-      wire [46:0] fword = sweeping ? {epoch - 8'd1, 39'd0} : {epoch, fi_j[9:3], rsp_data};
+      // fill: the response's texel, from the request-order queue's head (a register)
+      wire [1:0] fbank = f_bank;
+      wire [10:0] fidx = sweeping ? sweep[10:0] : f_idx;
+      wire [46:0] fword = sweeping ? {epoch - 8'd1, 39'd0} : {epoch, f_tag, rsp_data};
       wire        fill = (rsp_valid && cache_en) || sweeping;
-      wire unused_parity = &{1'b0, li0[0], lj0[0], li1[0], lj2[0], fi_i[0], fi_j[0]};
+      wire unused_parity = &{1'b0, li0[0], lj0[0], li1[0], lj2[0]};
       always @(posedge clk) begin
         if (fill && (sweeping || fbank == 2'd0)) bank0[fidx] <= fword;
         if (fill && (sweeping || fbank == 2'd1)) bank1[fidx] <= fword;
         if (fill && (sweeping || fbank == 2'd2)) bank2[fidx] <= fword;
         if (fill && (sweeping || fbank == 2'd3)) bank3[fidx] <= fword;
+        rd0 <= bank0[x0];  // every clock (`hu`, above)
+        rd1 <= bank1[x1];
+        rd2 <= bank2[x2];
+        rd3 <= bank3[x3];
         if (en) begin
-          rd0 <= bank0[x0];
-          rd1 <= bank1[x1];
-          rd2 <= bank2[x2];
-          rd3 <= bank3[x3];
           tg0 <= lj0[9:3];
           tg1 <= lj0[9:3];
           tg2 <= lj2[9:3];
@@ -317,26 +329,25 @@ module core_texture #(
       // that land between the read and stage 5 (the responses of the pixel ahead, the texels it
       // shares with this one) are caught here, or it would miss them (bilinear, 0.636 -> 0.566
       // px/clk on the core bench without this).
+      // The entries as the pixel in stage 4w sees them: read as it entered (rd_k), then kept in
+      // h_k with the fills since (the block RAM reads the next pixel's entries meanwhile).
       reg [10:0]  xr0, xr1, xr2, xr3;   // the entries read
-      reg [3:0]   snv;                  // entry k filled since its read: sn_k holds it
-      reg [46:0]  sn0, sn1, sn2, sn3;
+      reg [46:0]  h0, h1, h2, h3;
       // (compared with the entries read, registered: a fill in the clock of the read itself is
       // not caught, as before)
       wire [3:0]  snp = {4{fill && !sweeping}} & {fbank == 2'd3 && fidx == xr3, fbank == 2'd2 && fidx == xr2,
                                                  fbank == 2'd1 && fidx == xr1, fbank == 2'd0 && fidx == xr0};
+      wire [46:0] e0 = hu ? h0 : rd0, e1 = hu ? h1 : rd1;
+      wire [46:0] e2 = hu ? h2 : rd2, e3 = hu ? h3 : rd3;
       always @(posedge clk) begin
         if (en) begin
           xr0 <= x0; xr1 <= x1; xr2 <= x2; xr3 <= x3;
         end
-        if (rst || en) snv <= 4'd0;
-        else snv <= snv | snp;
-        if (snp[0]) sn0 <= fword;
-        if (snp[1]) sn1 <= fword;
-        if (snp[2]) sn2 <= fword;
-        if (snp[3]) sn3 <= fword;
+        h0 <= snp[0] ? fword : e0;
+        h1 <= snp[1] ? fword : e1;
+        h2 <= snp[2] ? fword : e2;
+        h3 <= snp[3] ? fword : e3;
       end
-      wire [46:0] e0 = snv[0] ? sn0 : rd0, e1 = snv[1] ? sn1 : rd1;
-      wire [46:0] e2 = snv[2] ? sn2 : rd2, e3 = snv[3] ? sn3 : rd3;
       always @(posedge clk) begin
         if (rst) begin
           epoch <= 8'd1;
@@ -375,7 +386,7 @@ module core_texture #(
       assign hit5 = 4'd0;
       assign hdata5 = 128'd0;
       assign sweeping = 1'b0;
-      wire unused_cache = &{1'b0, inval, cache_en, f_ia, f_ib, f_ja, f_jb};
+      wire unused_cache = &{1'b0, inval, cache_en, f_bank, f_idx, f_tag};
     end
   endgenerate
 
@@ -485,20 +496,39 @@ module core_texture #(
   assign shr_now = {4{adj5}} & miss5 & {sh0[QA+2], sh1[QA+2], sh2[QA+2], sh3[QA+2]};
   assign shr_src = {sh3[QA+1:0], sh2[QA+1:0], sh1[QA+1:0], sh0[QA+1:0]};
   wire          pop;
-  // the entry the next response belongs to: the oldest with slots outstanding
-  reg  [QA-1:0] fe;
-  integer qk;
-  always @(*) begin
-    fe = rp[QA-1:0];
-    for (qk = N - 1; qk >= 0; qk = qk - 1)
-      if ((QA+1)'(qk) < (wp - rp) && miss[QA'(rp[QA-1:0] + QA'(qk))] != 4'd0) fe = QA'(rp[QA-1:0] + QA'(qk));
+  // The reads asked for, in request order: the responses come in that order, so the queue's head
+  // names the next response's entry and slot and the texel it fills in the cache. The head is a
+  // register (rq[rqr], written a clock ahead), so the cache's fill snoop compares a flip-flop with
+  // the entries read; it was the oldest entry with slots outstanding, searched through the read
+  // queue's pointers and misses in the response's clock (`wp` -> the snoop `sn0`, 19.3 ns by the
+  // ULX3S clock estimate, docs/gateware.md "The texture cache's fill target"). An entry's reads are
+  // its slots in order 00 10 01 11, all asked for before the next entry's, so the head is that
+  // search's answer. At most four reads an entry are in flight: 4N entries never overflow.
+  localparam integer RA = QA + 2;
+  localparam integer RW = QA + 2 + 2 + 11 + 7;  // {entry, slot, bank, index in the bank, tag}
+  reg  [RW-1:0] rq[0:(1 << RA)-1];
+  reg  [RA-1:0] rqw, rqr;
+  reg  [RW-1:0] rqh;  // rq[rqr]
+  wire          rq_push = rd_valid && rd_ready;
+  wire [9:0]    rq_i = slot_i(slot[0], ia5, ib5), rq_j = slot_j(slot[1], ja5, jb5);
+  wire [QA-1:0] rq_e = pushed ? QA'(wp[QA-1:0] - 1'b1) : wp[QA-1:0];  // stage 5's entry
+  wire [RW-1:0] rq_d = {rq_e, slot, rq_j[0], rq_i[0], rq_j[2:1], rq_i[9:1], rq_j[9:3]};
+  wire [RA-1:0] rqr1 = rqr + 1'b1;
+  always @(posedge clk) begin
+    if (rst) begin
+      rqw <= 0; rqr <= 0;
+    end else begin
+      if (rq_push) rqw <= rqw + 1'b1;
+      if (rsp_valid) rqr <= rqr1;
+    end
+    if (rq_push) rq[rqw] <= rq_d;
+    // the head of the next clock: the entry written now when it lands there
+    rqh <= (rq_push && rqw == (rsp_valid ? rqr1 : rqr)) ? rq_d : rsp_valid ? rq[rqr1] : rq[rqr];
   end
+  wire [QA-1:0] fe = rqh[RW-1:RW-QA];
   wire [3:0] fmiss = miss[fe];
-  assign fslot = fmiss[3] ? 2'd0 : fmiss[2] ? 2'd1 : fmiss[1] ? 2'd2 : 2'd3;
-  assign f_ia = items[fe][IW-1:IW-10];
-  assign f_ib = items[fe][IW-11:IW-20];
-  assign f_ja = items[fe][IW-21:IW-30];
-  assign f_jb = items[fe][IW-31:IW-40];
+  assign fslot = rqh[21:20];
+  assign {f_bank, f_idx, f_tag} = rqh[19:0];
   // the response of this clock: {entry, slot}
   wire [QA+1:0] rsrc = {fe, fslot};
   integer qe, qs, pk;
@@ -538,7 +568,7 @@ module core_texture #(
             end
       end
       if (push) begin
-        items[wp[QA-1:0]] <= {ia5, ib5, ja5, jb5, bil5, lanes5, fu5, fv5, pay5};
+        items[wp[QA-1:0]] <= {bil5, lanes5, fu5, fv5, pay5};
         words[wp[QA-1:0]] <= pw;
         miss[wp[QA-1:0]]  <= need;
         cp[wp[QA-1:0]]    <= pcp;
