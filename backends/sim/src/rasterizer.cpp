@@ -546,10 +546,11 @@ class Kernel {
   // A span whose first pixel is x (the cursor's planes).
   void simd_span(int x, int y, unsigned count) {
     SimdSpan& sp = simd_tpl_;
+    // Planes the draw does not use keep the template's zeros (simd_tpl_ is value-initialised).
     for (unsigned p = 0; p < SimdSpan::kPlanes; ++p) {
-      const bool used = simd_plane_used(p);
-      sp.q0[p] = used ? static_cast<std::uint32_t>(cur_.q[kR + p]) : 0;
-      sp.r0[p] = used ? static_cast<std::uint32_t>(cur_.r[kR + p]) : 0;
+      if (!simd_plane_used(p)) continue;
+      sp.q0[p] = static_cast<std::uint32_t>(cur_.q[kR + p]);
+      sp.r0[p] = static_cast<std::uint32_t>(cur_.r[kR + p]);
     }
     const std::size_t pix = static_cast<std::size_t>(y) * width_ + static_cast<std::size_t>(x);
     sp.color = color_ + pix * st_.bpp;
