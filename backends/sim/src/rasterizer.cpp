@@ -276,9 +276,9 @@ class Kernel {
     return ya;
   }
 
-  // Wide boxes: each row's covered span kl..kr from the edge walk (EdgeWalk: no division a row),
+  // Wide boxes: each row's covered span kl..kr from the edge walk (walk_, start_walk: no division a row),
   // the planes kept at the span's first pixel by a cursor that one combined step a row carries to
-  // the next row's first pixel (Cursor), spans of kMinSimdSpan pixels or more through the span
+  // the next row's first pixel (cur_, move), spans of kMinSimdSpan pixels or more through the span
   // routine, shorter ones pixel by pixel. Whole 16-row bands are asked first (band_occluded); rows
   // of a band that is not rejected are asked one by one (occluded). Returns the first row a pixel
   // may have been written in.
@@ -390,7 +390,7 @@ class Kernel {
   // The cursor from (y − 1, col_) to (y, col_ + d): one row and d pixels (d of either sign) in one
   // step, (qy + d·qx + f, ry + d·rx − f·den) with f = floor((ry + d·rx) / den), and one carry. A
   // straight edge moves the span's start by one of two distances a row, so the last two steps are
-  // kept (Cursor::step) and a division is paid only when the distance changes (at a vertex).
+  // kept (steps_) and a division is paid only when the distance changes (at a vertex).
   void move(std::int64_t d) {
     unsigned slot = steps_[1].d == d ? 1u : 0u;
     if (steps_[slot].d != d) {
