@@ -54,34 +54,21 @@ inline void set_pixel_lanes(PixelLanes& px, const DrawState& st, const RasterCon
   px.z_write = depth && st.z_write;
 }
 
-// Rows this long or longer find their covered span by division instead of testing every pixel.
+// Rows this long or longer find their covered span from the edge walk instead of testing every pixel.
 constexpr int kSpanSolveWidth = 16;
-// Jumps along a span shorter than this are stepped instead of divided.
+// Jumps along a row shorter than this are stepped instead of divided (the cursor's anchor).
 constexpr std::int64_t kStepJump = 4;
 // Rows this far ahead of the one being drawn are prefetched.
 constexpr int kPrefetchRows = 4;
 
-// The covered span kl..kr (box-relative; empty when kl > kr) of a wide row (box width w >=
-// kSpanSolveWidth) whose edge values are e, by division (div: the edges' |ex|).
-[[gnu::always_inline]] inline void solve_span(const Triangle& t, const Divider div[3], const std::int64_t e[3],
-                                              std::int64_t w, std::int64_t& kl, std::int64_t& kr) {
-  kl = 0;
-  kr = w - 1;
-  for (int i = 0; i < 3; ++i) {
-    const std::int64_t ex = t.edge[i].ex;
-    // E + k·ex >= 0  ⇔  k >= ceil(−E / ex) (ex > 0)  or  k <= floor(E / −ex) (ex < 0)
-    if (ex > 0) kl = std::max(kl, -div[i](e[i]).q);
-    else if (ex < 0) kr = std::min(kr, div[i](e[i]).q);
-    else if (e[i] < 0) kr = -1;
-  }
-}
-
-// The span solve's divisors: each edge's |ex| (1 for a vertical edge, never divided by).
+// The edge walk's divisors: each edge's |ex| (1 for a vertical edge, never divided by). A wide
+// row's covered span kl..kr (box-relative) is where E + k·ex >= 0 for all three edges:
+// k >= ceil(−E / ex) = −floor(E / ex) for ex > 0, k <= floor(E / −ex) for ex < 0.
 inline Divider edge_divider(const Edge& e) { return Divider(e.ex < 0 ? -e.ex : (e.ex == 0 ? 1 : e.ex)); }
 
 // What drawing `rows` wide rows whose pixels all fail the depth test counts: every covered pixel
 // scanned and covered, none passed (Kernel::run's wide rows count exactly this). e: the edge
-// values at the first row, left at the row after the last. The quotients solve_span divides out
+// values at the first row, left at the row after the last. The quotients of the span bounds
 // are stepped from row to row instead, as the planes are: floor(e / d) with e += ey is (q, r)
 // advanced by floor_divmod(ey, d) and one carry (for a vertical edge d = 1: q is e itself).
 void count_covered(const Triangle& t, const Divider div[3], std::int64_t e[3], int rows, RasterCounters& c) {
@@ -219,8 +206,14 @@ class Kernel {
     } else {
       flat_ = {t.flat[0], t.flat[1], t.flat[2], t.flat[3]};
     }
-    if (t.x1 - t.x0 >= kSpanSolveWidth) {  // only wide rows solve their spans
-      for (int i = 0; i < 3; ++i) edge_div_[i] = edge_divider(t.edge[i]);
+    if (t.x1 - t.x0 >= kSpanSolveWidth) {  // only wide rows walk their span ends
+      for (int i = 0; i < 3; ++i) {
+        edge_div_[i] = edge_divider(t.edge[i]);
+        const DivMod s = edge_div_[i](t.edge[i].ey);
+        walk_.qy[i] = s.q;
+        walk_.ry[i] = s.r;
+        walk_.d[i] = edge_div_[i].divisor();
+      }
     }
     if (kTextured && t.plane[kQ].constant && t.plane[kQ].q != 0) {
       q_const_ = true;  // affine: the reciprocal is the same at every pixel
@@ -233,27 +226,69 @@ class Kernel {
   // were rejected.
   void run(int ya, int yz, unsigned hz) {
     const int w = t_.x1 - t_.x0;
-    // Whole 16-row bands are asked first (band_occluded) in wide boxes; rows of a band that is not
-    // rejected are asked one by one (occluded), as before.
-    const bool bands = kDepth && ctx_.hier_z && w >= kSpanSolveWidth;
     if (kDepth && ctx_.hier_z) {
       hz_run_ = HierZ::next_run(ctx_.hz_run);
       hz_tries_ = HierZ::kTries;
       hz_rejected_ = (hz & kHzRejected) != 0;
     }
     const std::uint64_t passed_before = ctx_.counters.passed;
-    const std::int64_t k = ya - t_.y0;
-    std::int64_t e[3];
-    for (int i = 0; i < 3; ++i) e[i] = t_.edge[i].e + k * t_.edge[i].ey;
-    Steppers row;
-    for (unsigned i = 0; i < kAttrCount; ++i) {
-      if (!((kPlanes >> i) & 1)) continue;
-      row.q[i] = t_.plane[i].q;
-      row.r[i] = t_.plane[i].r;
+    const int mark_from = w >= kSpanSolveWidth ? run_wide(ya, yz, hz) : run_narrow(ya, yz);
+    // Blocks this run wrote into: read again when another run asks (their bounds only got looser).
+    if (kDepth && ctx_.hier_z && st_.z_write && ctx_.counters.passed != passed_before)
+      ctx_.hier_z->mark(mark_from, yz, t_.x0, t_.x1 - 1, hz_run_);
+    if constexpr (kTextured) {
+      ctx_.counters.textured += textured_;
+      ctx_.counters.texel_bytes += textured_ * (st_.tex.bilinear ? 4u : 1u) * protocol::bytes_per_pixel(st_.tex.format);
     }
-    std::int64_t lag = k;  // rows the planes in `row` are behind y (advanced when a row is drawn)
-    int mark_from = ya;    // the first row a pixel may have been written in
+  }
+
+ private:
+  // Narrow boxes (no span routine): every pixel of the box row is tested and stepped. The loop
+  // count is the same on every row of the triangle, so it predicts; stepping only along the
+  // covered run was tried and lost on tall slivers (its data-dependent loop exits mispredicted on
+  // every row). Returns the first row a pixel may have been written in.
+  int run_narrow(int ya, int yz) {
+    const int w = t_.x1 - t_.x0;
+    const std::int64_t k = ya - t_.y0;
+    std::int64_t e0 = t_.edge[0].e + k * t_.edge[0].ey, e1 = t_.edge[1].e + k * t_.edge[1].ey,
+                 e2 = t_.edge[2].e + k * t_.edge[2].ey;
+    const std::int64_t x0 = t_.edge[0].ex, x1 = t_.edge[1].ex, x2 = t_.edge[2].ex;
+    Steppers row = anchor(ya, 0);
+    for (int y = ya; y < yz; ++y) {
+      Steppers s = row;
+      std::int64_t f0 = e0, f1 = e1, f2 = e2;
+      for (int kx = 0; kx < w; ++kx) {
+        if ((f0 | f1 | f2) >= 0) {
+          ++ctx_.counters.covered;
+          pixel(t_.x0 + kx, y, s);
+        }
+        f0 += x0;
+        f1 += x1;
+        f2 += x2;
+        step_x(s);
+      }
+      ctx_.counters.scanned += static_cast<std::uint64_t>(w);
+      e0 += t_.edge[0].ey;
+      e1 += t_.edge[1].ey;
+      e2 += t_.edge[2].ey;
+      step_y(row);
+    }
+    return ya;
+  }
+
+  // Wide boxes: each row's covered span kl..kr from the edge walk (walk_, start_walk: no division a row),
+  // the planes kept at the span's first pixel by a cursor that one combined step a row carries to
+  // the next row's first pixel (cur_, move), spans of kMinSimdSpan pixels or more through the span
+  // routine, shorter ones pixel by pixel. Whole 16-row bands are asked first (band_occluded); rows
+  // of a band that is not rejected are asked one by one (occluded). Returns the first row a pixel
+  // may have been written in.
+  int run_wide(int ya, int yz, unsigned hz) {
+    const int w = t_.x1 - t_.x0;
+    const bool bands = kDepth && ctx_.hier_z;
+    int mark_from = ya;
     bool first = true;
+    bool walking = false;  // walk_ holds row y's quotients (false after a rejected band)
+    bool anchored = false;  // cur_ holds the planes at (y - 1, col_) (false before the first drawn row and after a rejected band)
     for (int y = ya; y < yz;) {
       const int end = std::min(yz, (y | ((1 << HierZ::kRowsLog) - 1)) + 1);  // this band's rows
       // A new 16-row band of blocks: its tries afresh (HierZ::band_asks_afresh).
@@ -266,73 +301,122 @@ class Kernel {
           ask_band(t_, clip_, st_, ctx_, zmask_, y, end - 1, hz_run_)) {
         hz_tries_ = HierZ::kTries;
         hz_rejected_ = true;
+        std::int64_t e[3];
+        edges_at(y, e);
         count_covered(t_, edge_div_, e, end - y, ctx_.counters);
-        lag += end - y;
         if (mark_from == y) mark_from = end;
         y = end;
         first = false;
+        walking = anchored = false;
         continue;
       }
       first = false;
-      if (lag > 0) {
-        for (unsigned i = 0; i < kAttrCount; ++i)
-          if ((kPlanes >> i) & 1) Plane::advance(row.q[i], row.r[i], t_.plane[i].qy, t_.plane[i].ry, lag, t_.den);
-        lag = 0;
+      if (!walking) {
+        start_walk(y);
+        walking = true;
       }
       for (; y < end; ++y) {
-        if (w >= kSpanSolveWidth) {
-          std::int64_t kl, kr;
-          solve_span(t_, edge_div_, e, w, kl, kr);
-          if (kl <= kr) {
-            if (simd_ && y + kPrefetchRows < yz) prefetch_row(y + kPrefetchRows, t_.x0 + static_cast<int>(kl), static_cast<int>(kr - kl + 1));
-            if (kr - kl + 1 >= kMinSimdSpan && simd_ready()) {
-              if (!occluded(row, kl, kr, y))
-                simd_span(row, kl, t_.x0 + static_cast<int>(kl), y, static_cast<unsigned>(kr - kl + 1));
-            } else {
-              Steppers s = row;
-              jump_x(s, kl);
-              for (std::int64_t kx = kl; kx <= kr; ++kx) {
-                pixel(t_.x0 + static_cast<int>(kx), y, s);
-                step_x(s);
-              }
-            }
-            ctx_.counters.scanned += static_cast<std::uint64_t>(kr - kl + 1);
-            ctx_.counters.covered += static_cast<std::uint64_t>(kr - kl + 1);
-          }
+        std::int64_t kl = 0, kr = w - 1;
+        for (int i = 0; i < 3; ++i) {
+          const std::int64_t ex = t_.edge[i].ex;
+          if (ex > 0) kl = std::max(kl, -walk_.q[i]);
+          else if (ex < 0) kr = std::min(kr, walk_.q[i]);
+          else if (walk_.q[i] < 0) kr = -1;
+          walk_.q[i] += walk_.qy[i];
+          walk_.r[i] += walk_.ry[i];
+          const bool carry = walk_.r[i] >= walk_.d[i];
+          walk_.r[i] -= carry ? walk_.d[i] : 0;
+          walk_.q[i] += carry;
+        }
+        if (kl > kr) {  // no sample covered: the cursor stays in its column
+          if (anchored) step_y(cur_);
+          continue;
+        }
+        if (!anchored) {
+          cur_ = anchor(y, kl);
+          anchored = true;
         } else {
-          // Narrow rows (no span routine): every pixel of the box row is tested and stepped. The
-          // loop count is the same on every row of the triangle, so it predicts; stepping only along
-          // the covered run was tried and lost on tall slivers (its data-dependent loop exits
-          // mispredicted on every row).
-          Steppers s = row;
-          std::int64_t e0 = e[0], e1 = e[1], e2 = e[2];
-          const std::int64_t x0 = t_.edge[0].ex, x1 = t_.edge[1].ex, x2 = t_.edge[2].ex;
-          for (int kx = 0; kx < w; ++kx) {
-            if ((e0 | e1 | e2) >= 0) {
-              ++ctx_.counters.covered;
-              pixel(t_.x0 + kx, y, s);
-            }
-            e0 += x0;
-            e1 += x1;
-            e2 += x2;
+          move(kl - col_);
+        }
+        col_ = kl;
+        if (simd_ && y + kPrefetchRows < yz) prefetch_row(y + kPrefetchRows, t_.x0 + static_cast<int>(kl), static_cast<int>(kr - kl + 1));
+        if (kr - kl + 1 >= kMinSimdSpan && simd_ready()) {
+          if (!occluded(kl, kr, y)) simd_span(t_.x0 + static_cast<int>(kl), y, static_cast<unsigned>(kr - kl + 1));
+        } else {
+          Steppers s = cur_;
+          for (std::int64_t kx = kl; kx <= kr; ++kx) {
+            pixel(t_.x0 + static_cast<int>(kx), y, s);
             step_x(s);
           }
-          ctx_.counters.scanned += static_cast<std::uint64_t>(w);
         }
-        for (int i = 0; i < 3; ++i) e[i] += t_.edge[i].ey;
-        step_y(row);
+        ctx_.counters.scanned += static_cast<std::uint64_t>(kr - kl + 1);
+        ctx_.counters.covered += static_cast<std::uint64_t>(kr - kl + 1);
       }
     }
-    // Blocks this run wrote into: read again when another run asks (their bounds only got looser).
-    if (kDepth && ctx_.hier_z && st_.z_write && ctx_.counters.passed != passed_before)
-      ctx_.hier_z->mark(mark_from, yz, t_.x0, t_.x1 - 1, hz_run_);
-    if constexpr (kTextured) {
-      ctx_.counters.textured += textured_;
-      ctx_.counters.texel_bytes += textured_ * (st_.tex.bilinear ? 4u : 1u) * protocol::bytes_per_pixel(st_.tex.format);
+    return mark_from;
+  }
+
+  // The biased edge values at the box's column 0 in row y.
+  void edges_at(int y, std::int64_t e[3]) const {
+    const std::int64_t k = y - t_.y0;
+    for (int i = 0; i < 3; ++i) e[i] = t_.edge[i].e + k * t_.edge[i].ey;
+  }
+  // The edge walk from row y: (q, r) = floor-divmod of each edge value by |ex| (the span
+  // bounds' quotients), stepped a row at a time by floor-divmod(ey, |ex|) and one carry, as count_covered
+  // steps them: the same integers as dividing on every row.
+  void start_walk(int y) {
+    std::int64_t e[3];
+    edges_at(y, e);
+    for (int i = 0; i < 3; ++i) {
+      const DivMod a = edge_div_[i](e[i]);
+      walk_.q[i] = a.q;
+      walk_.r[i] = a.r;
+    }
+  }
+  // The planes at (y, kx): the triangle's planes advanced y − y0 rows (exact, 128-bit) and jumped
+  // kx pixels. Once per run and after a rejected band; every other row moves the cursor.
+  Steppers anchor(int y, std::int64_t kx) const {
+    Steppers s;
+    const std::int64_t k = y - t_.y0;
+    for (unsigned i = 0; i < kAttrCount; ++i) {
+      if (!((kPlanes >> i) & 1)) continue;
+      s.q[i] = t_.plane[i].q;
+      s.r[i] = t_.plane[i].r;
+      if (k > 0) Plane::advance(s.q[i], s.r[i], t_.plane[i].qy, t_.plane[i].ry, k, t_.den);
+    }
+    jump_x(s, kx);
+    return s;
+  }
+  // The cursor from (y − 1, col_) to (y, col_ + d): one row and d pixels (d of either sign) in one
+  // step, (qy + d·qx + f, ry + d·rx − f·den) with f = floor((ry + d·rx) / den), and one carry. A
+  // straight edge moves the span's start by one of two distances a row, so the last two steps are
+  // kept (steps_) and a division is paid only when the distance changes (at a vertex).
+  void move(std::int64_t d) {
+    unsigned slot = steps_[1].d == d ? 1u : 0u;
+    if (steps_[slot].d != d) {
+      slot = victim_;
+      victim_ ^= 1u;
+      CursorStep& c = steps_[slot];
+      c.d = d;
+      for (unsigned i = 0; i < kAttrCount; ++i) {
+        if (!((kPlanes >> i) & 1)) continue;
+        const Plane& p = t_.plane[i];
+        const DivMod f = den_div_(p.ry + d * p.rx);  // |d·rx| < 2^11 · 2^36: exact in the Divider
+        c.q[i] = p.qy + d * p.qx + f.q;
+        c.r[i] = f.r;
+      }
+    }
+    const CursorStep& c = steps_[slot];
+    for (unsigned i = 0; i < kAttrCount; ++i) {
+      if (!((kPlanes >> i) & 1)) continue;
+      cur_.q[i] += c.q[i];
+      cur_.r[i] += c.r[i];
+      const bool carry = cur_.r[i] >= t_.den;
+      cur_.r[i] -= carry ? t_.den : 0;
+      cur_.q[i] += carry;
     }
   }
 
- private:
   void step_x(Steppers& s) const {
     for (unsigned i = 0; i < kAttrCount; ++i) {
       if (!((kPlanes >> i) & 1)) continue;
@@ -393,11 +477,9 @@ class Kernel {
       const Plane& pl = t_.plane[kR + p];
       if (!simd_plane_used(p)) {
         simd_tpl_.q8[p] = simd_tpl_.r8[p] = simd_tpl_.qx[p] = 0;
-        simd_tpl_.rx[p] = 0;
         for (unsigned k = 0; k < 8; ++k) simd_tpl_.qk[p][k] = simd_tpl_.rk[p][k] = 0;
         continue;
       }
-      simd_tpl_.rx[p] = static_cast<double>(pl.rx);
       simd_tpl_.qx[p] = static_cast<std::uint32_t>(pl.qx);
       const DivMod d = den_div_(8 * pl.rx);
       const std::int64_t q8 = 8 * pl.qx + d.q;
@@ -434,19 +516,20 @@ class Kernel {
   // (hier_z.hpp): its smallest depth, masked as the test masks it, is not below (LESS) or not at
   // or below (LEQUAL) the largest depth stored in the blocks it crosses. Depth is linear along the
   // row, so its smallest value over the span is at one end, and both ends are covered pixels
-  // (depths within the vertices' 24-bit range). Only with the span routine (den < 2^30).
-  bool occluded(const Steppers& row, std::int64_t kl, std::int64_t kr, int y) {
+  // (depths within the vertices' 24-bit range). The cursor holds the planes at kl. Only with the
+  // span routine (den < 2^30).
+  bool occluded(std::int64_t kl, std::int64_t kr, int y) {
     if constexpr (!kDepth) {
       return false;
     } else {
       if (hz_tries_ == 0) return false;
       const Plane& p = t_.plane[kZ];
-      const std::int64_t k = p.qx >= 0 ? kl : kr;  // the slope qx + rx/den has the sign of qx (0 <= rx < den)
-      const std::int64_t n = row.r[kZ] + k * p.rx;  // 0 <= n < 2^41: exact in double
+      const std::int64_t k = p.qx >= 0 ? 0 : kr - kl;  // the slope qx + rx/den has the sign of qx (0 <= rx < den)
+      const std::int64_t n = cur_.r[kZ] + k * p.rx;  // 0 <= n < 2^41: exact in double
       std::int64_t f = static_cast<std::int64_t>(static_cast<double>(n) * simd_tpl_.inv_den);  // off by at most one
       f -= f * t_.den > n;
       f += (f + 1) * t_.den <= n;
-      const std::int64_t z = row.q[kZ] + k * p.qx + f;  // the exact depth at pixel k
+      const std::int64_t z = cur_.q[kZ] + k * p.qx + f;  // the exact depth at pixel kl + k
       if (z < 0 || z > 0xFFFFFF) return false;  // not a covered depth: never rejects
       const std::uint32_t zm = static_cast<std::uint32_t>(z) & zmask_;
       if (ctx_.hier_z->occludes(zbuf_, y, t_.x0 + static_cast<int>(kl), t_.x0 + static_cast<int>(kr), zm,
@@ -460,16 +543,15 @@ class Kernel {
     }
   }
 
-  // A span `skip` pixels from the box row's start, whose planes are `row`: the routine does the
-  // jump itself (SimdSpan::skip).
-  void simd_span(const Steppers& row, std::int64_t skip, int x, int y, unsigned count) {
+  // A span whose first pixel is x (the cursor's planes).
+  void simd_span(int x, int y, unsigned count) {
     SimdSpan& sp = simd_tpl_;
+    // Planes the draw does not use keep the template's zeros (simd_tpl_ is value-initialised).
     for (unsigned p = 0; p < SimdSpan::kPlanes; ++p) {
-      const bool used = simd_plane_used(p);
-      sp.q0[p] = used ? static_cast<std::uint32_t>(row.q[kR + p]) : 0;
-      sp.r0[p] = used ? static_cast<std::uint32_t>(row.r[kR + p]) : 0;
+      if (!simd_plane_used(p)) continue;
+      sp.q0[p] = static_cast<std::uint32_t>(cur_.q[kR + p]);
+      sp.r0[p] = static_cast<std::uint32_t>(cur_.r[kR + p]);
     }
-    sp.skip = static_cast<std::uint32_t>(skip);
     const std::size_t pix = static_cast<std::size_t>(y) * width_ + static_cast<std::size_t>(x);
     sp.color = color_ + pix * st_.bpp;
     if (st_.dither.on && st_.fb_format != protocol::PixelFormat::RGBA8888)
@@ -569,6 +651,18 @@ class Kernel {
   unsigned hz_tries_ = 0;       // rows left to ask them before giving up on this run (0: not asked)
   bool hz_rejected_ = false;    // they rejected a row of this run
   std::optional<BandClip> clip_;  // for band_occluded, when a band is asked
+  // Wide rows: the edge walk (start_walk), the cursor (the planes at the last drawn span's first
+  // pixel, column col_) and its last two combined steps (move).
+  struct EdgeWalk {
+    std::int64_t q[3], r[3], qy[3], ry[3], d[3];
+  } walk_{};
+  Steppers cur_{};
+  std::int64_t col_ = 0;
+  struct CursorStep {
+    std::int64_t d = INT64_MIN;  // the distance it moves the span's start (INT64_MIN: none yet)
+    std::int64_t q[kAttrCount], r[kAttrCount];
+  } steps_[2];
+  unsigned victim_ = 0;  // the step to replace next
 };
 
 template <bool G, bool T, bool Z, bool S>

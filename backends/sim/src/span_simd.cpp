@@ -13,45 +13,6 @@ using protocol::PixelFormat;
 using simd::i32x8;
 using simd::u32x8;
 
-// (q0, r0) of every plane advanced s.skip pixels: the floor-divmod of r0 + rx·skip by den for all
-// eight planes at once in double lanes, without branches. With den < 2^30 and skip < 2^11 the
-// numerator is below 2^41, exact in double; the truncated estimate of its (non-negative) quotient
-// is off by at most one, and one select each way corrects it. Done here rather than in the
-// rasteriser's row loop, where five scalar divisions and their correction loops were a quarter of
-// its per-row time (1,000-px triangles; perf).
-[[gnu::always_inline]] inline void span_start(const SimdSpan& s, std::uint32_t* q0, std::uint32_t* r0) {
-  // Four lanes at a time, corrections as masks (GCC splits 8-lane double selects into scalars).
-  using f64x4 = double __attribute__((vector_size(32)));
-  using i64x4 = std::int64_t __attribute__((vector_size(32)));
-  using i32x4 = std::int32_t __attribute__((vector_size(16)));
-  const f64x4 den = f64x4{} + static_cast<double>(s.den), one = f64x4{} + 1.0;
-  const double skip = static_cast<double>(s.skip);
-  i32x4 qd[2], rd[2];
-  for (unsigned h = 0; h < 2; ++h) {
-    i32x4 ri;
-    f64x4 rx;
-    std::memcpy(&ri, s.r0 + 4 * h, sizeof ri);
-    std::memcpy(&rx, s.rx + 4 * h, sizeof rx);
-    const f64x4 num = __builtin_convertvector(ri, f64x4) + rx * skip;
-    f64x4 q = __builtin_convertvector(__builtin_convertvector(num * s.inv_den, i32x4), f64x4);
-    f64x4 r = num - q * den;
-    i64x4 low = r < 0;  // estimate one too high
-    q -= (f64x4)((i64x4)one & low);
-    r += (f64x4)((i64x4)den & low);
-    const i64x4 high = r >= den;  // one too low
-    q += (f64x4)((i64x4)one & high);
-    r -= (f64x4)((i64x4)den & high);
-    qd[h] = __builtin_convertvector(q, i32x4);
-    rd[h] = __builtin_convertvector(r, i32x4);
-  }
-  u32x8 qv, rv;
-  std::memcpy(&qv, qd, sizeof qv);
-  std::memcpy(&rv, rd, sizeof rv);
-  const u32x8 qs = simd::load8(s.q0) + simd::load8(s.qx) * s.skip + qv;  // modulo 2^32
-  std::memcpy(q0, &qs, sizeof qs);
-  std::memcpy(r0, &rv, sizeof rv);
-}
-
 // One instance per plane count, so the plane loops have constant bounds and the lanes stay in
 // registers (a run-time bound cost the untextured spans 5-15%).
 template <bool kTextured, PixelFormat kFormat>
@@ -62,11 +23,12 @@ template <bool kTextured, PixelFormat kFormat>
   const PixelLanes& px = s.pixel;
   const unsigned first = px.gouraud ? 0 : 4;
   const u32x8 den = u32x8{} + s.den;
-  std::uint32_t q0[8], r0[8];
-  span_start(s, q0, r0);
+  // The rasteriser hands over the planes at the span's first pixel (its cursor): lane k adds k
+  // steps. (The routine used to jump from the box row's start itself, a double-vector division
+  // per span; the cursor made that jump unnecessary.)
   for (unsigned p = first; p < kUsed; ++p) {
-    q[p] = simd::load8(s.qk[p]) + q0[p];
-    r[p] = simd::load8(s.rk[p]) + r0[p];
+    q[p] = simd::load8(s.qk[p]) + s.q0[p];
+    r[p] = simd::load8(s.rk[p]) + s.r0[p];
     simd::carry(q[p], r[p], den);
   }
   const i32x8 lane = {0, 1, 2, 3, 4, 5, 6, 7};
@@ -116,12 +78,10 @@ template <bool kMasked>
   const unsigned first = px.gouraud ? 0 : 4;
   const u32x8 den8 = u32x8{} + s.den;
   const u32x16 den = u32x16{} + s.den;
-  std::uint32_t q0[8], r0[8];
-  span_start(s, q0, r0);
   u32x16 q[kUsed], r[kUsed];
   std::uint32_t q16[kUsed], r16[kUsed];
   for (unsigned p = first; p < kUsed; ++p) {
-    u32x8 ql = simd::load8(s.qk[p]) + q0[p], rl = simd::load8(s.rk[p]) + r0[p];
+    u32x8 ql = simd::load8(s.qk[p]) + s.q0[p], rl = simd::load8(s.rk[p]) + s.r0[p];
     simd::carry(ql, rl, den8);
     u32x8 qh = ql + s.q8[p], rh = rl + s.r8[p];
     simd::carry(qh, rh, den8);

@@ -16,11 +16,9 @@ namespace gpubridge::sim {
 
 struct SimdSpan {
   static constexpr unsigned kPlanes = 8;  // R, G, B, A, Z, S, T, Q (setup.hpp's attribute order)
-  std::uint32_t q0[kPlanes], r0[kPlanes];      // (q, r) `skip` pixels before the span's first pixel
-  unsigned skip = 0;                           // < 2^11: pixels from (q0, r0) to the span (the routine jumps)
-  double rx[kPlanes];                          // per-pixel remainder step of each plane (< den, exact)
+  std::uint32_t q0[kPlanes], r0[kPlanes];      // (q, r) at the span's first pixel (r0 < den)
   std::uint32_t qx[kPlanes];                   // per-pixel quotient step of each plane, modulo 2^32
-  double inv_den = 1;                          // 1 / den
+  double inv_den = 1;                          // 1 / den (the rasteriser's depth bound query)
   std::uint32_t qk[kPlanes][8], rk[kPlanes][8];  // offsets of lane k: divmod(k·step), rk < den
   std::uint32_t q8[kPlanes], r8[kPlanes];  // advance per 8 pixels (r8 < den)
   std::uint32_t den = 1;                   // < 2^30, so r + r8 < 2^31
