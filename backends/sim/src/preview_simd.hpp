@@ -88,6 +88,16 @@ class SpanWalk {
     kr = static_cast<int>(hi);
     return true;
   }
+  // The covered pixels of the next `rows` rows (what drawing them counts as scanned and covered),
+  // leaving the walk after them.
+  [[gnu::always_inline]] std::uint64_t count(int width, int rows) {
+    std::uint64_t n = 0;
+    for (int r = 0; r < rows; ++r, next_row()) {
+      int kl = 0, kr = 0;
+      if (span(width, kl, kr)) n += static_cast<unsigned>(kr - kl + 1);
+    }
+    return n;
+  }
   [[gnu::always_inline]] void next_row() {
     for (int i = 0; i < 3; ++i) {
       f_[i] += qy_[i];
