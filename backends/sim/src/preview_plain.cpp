@@ -1,6 +1,7 @@
 #include "preview_plain.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 
 #include "cpu_features.hpp"

@@ -88,6 +88,29 @@ class SpanWalk {
     kr = static_cast<int>(hi);
     return true;
   }
+  // The covered pixels of the next `rows` rows (what drawing them counts as scanned and covered),
+  // leaving the walk after them. A triangle's edges are two left ones and a right one, a left one
+  // and two right ones, or a left, a right and a horizontal one (their ex sum to 0): the edges are
+  // put in that order once, so the row loop has no branch on an edge's kind (about half the
+  // instructions of span() and next_row() per row).
+  std::uint64_t count(int width, int rows) {
+    int order[3], n_left = 0, n_right = 0;
+    for (int i = 0; i < 3; ++i)
+      if (kind_[i] > 0) order[n_left++] = i;
+    for (int i = 0; i < 3; ++i)
+      if (kind_[i] < 0) order[n_left + n_right++] = i;
+    for (int i = 0; i < 3; ++i)
+      if (kind_[i] == 0) order[n_left + n_right] = i;
+    if (n_left == 2 && n_right == 1) return count_as<2, 1>(order, width, rows);
+    if (n_left == 1 && n_right == 2) return count_as<1, 2>(order, width, rows);
+    if (n_left == 1 && n_right == 1) return count_as<1, 1>(order, width, rows);
+    std::uint64_t n = 0;  // no other kinds for a triangle of D != 0: kept general all the same
+    for (int r = 0; r < rows; ++r, next_row()) {
+      int kl = 0, kr = 0;
+      if (span(width, kl, kr)) n += static_cast<unsigned>(kr - kl + 1);
+    }
+    return n;
+  }
   [[gnu::always_inline]] void next_row() {
     for (int i = 0; i < 3; ++i) {
       f_[i] += qy_[i];
@@ -106,6 +129,37 @@ class SpanWalk {
       --q;
       r += d;
     }
+  }
+  // count() with kLeft left edges first, then kRight right ones, then (when they are 1 + 1) the
+  // horizontal one, which empties every row while its value is negative.
+  template <int kLeft, int kRight>
+  std::uint64_t count_as(const int* order, int width, int rows) {
+    std::int64_t f[3], m[3], a[3], qy[3], ry[3];
+    for (int j = 0; j < 3; ++j) {
+      const int i = order[j];
+      f[j] = f_[i], m[j] = m_[i], a[j] = a_[i], qy[j] = qy_[i], ry[j] = ry_[i];
+    }
+    std::uint64_t n = 0;
+    const std::int64_t last = width - 1;
+    for (int r = 0; r < rows; ++r) {
+      std::int64_t lo = 0, hi = last;
+      for (int j = 0; j < kLeft; ++j) lo = -f[j] > lo ? -f[j] : lo;
+      for (int j = kLeft; j < kLeft + kRight; ++j) hi = f[j] < hi ? f[j] : hi;
+      if constexpr (kLeft + kRight == 2) hi = f[2] < 0 ? -1 : hi;
+      n += lo <= hi ? static_cast<std::uint64_t>(hi - lo + 1) : 0u;
+      for (int j = 0; j < 3; ++j) {
+        f[j] += qy[j];
+        m[j] += ry[j];
+        const bool carry = m[j] >= a[j];
+        m[j] -= carry ? a[j] : 0;
+        f[j] += carry;
+      }
+    }
+    for (int j = 0; j < 3; ++j) {
+      const int i = order[j];
+      f_[i] = f[j], m_[i] = m[j];
+    }
+    return n;
   }
   std::int64_t f_[3] = {}, m_[3] = {}, a_[3] = {1, 1, 1}, qy_[3] = {}, ry_[3] = {};
   int kind_[3] = {};
