@@ -309,7 +309,11 @@ struct Device::State {
 
   void kick(const Vertex& a, const Vertex& b, const Vertex& c) {
     ++stats.triangles_kicked;
-    draw_state();
+    const DrawState& st = draw_state();
+    if (mem.shadows().outdated(st, opt.accuracy.preview)) {  // shadows change only while the renderer is idle
+      renderer.flush();
+      mem.shadows().update(st, mem.data(), opt.accuracy.preview);
+    }
     renderer.draw(a, b, c, state, triangles++);
   }
 
