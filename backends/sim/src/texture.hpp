@@ -73,9 +73,10 @@ class TextureUnit {
 
   // The texels sample() filters, for the vector routines: the four neighbours as colour words
   // (byte c = channel c: R, G, B, A, as the framebuffer stores them) and the bilinear weights
-  // (nearest: c00 only, fu = fv = 0). The texture must lie inside VRAM (direct_).
+  // (nearest: c00 only, fu = fv = 0). The texture must lie inside VRAM (direct_). `pairs`: read
+  // the row-pair shadow when there is one (the caller's choice per chunk; the bytes are the same).
   [[gnu::always_inline]] void quad(TexelCoords c, std::uint32_t& c00, std::uint32_t& c10, std::uint32_t& c01,
-                                   std::uint32_t& c11, std::uint32_t& fu, std::uint32_t& fv) const {
+                                   std::uint32_t& c11, std::uint32_t& fu, std::uint32_t& fv, bool pairs = true) const {
     if (!bilinear_) {
       c00 = word(address(c.tu >> 12, wrap_s_, wl_), address(c.tv >> 12, wrap_t_, hl_));
       c10 = c01 = c11 = fu = fv = 0;
@@ -90,7 +91,7 @@ class TextureUnit {
     // The row-pair shadow holds rows b0 and b0 + 1 (mod height) side by side: two loads, mostly
     // from one cache line. Other row pairs (CLAMP's and MIRROR's edges, MIRROR's descending half)
     // read the linear texture.
-    if (pairs_ && b1 == ((b0 + 1) & ((std::int64_t{1} << hl_) - 1))) {
+    if (pairs && pairs_ && b1 == ((b0 + 1) & ((std::int64_t{1} << hl_) - 1))) {
       const std::uint64_t* row = pairs_ + (static_cast<std::uint64_t>(b0) << wl_);
       const std::uint64_t p0 = row[a0], p1 = row[a1];
       c00 = static_cast<std::uint32_t>(p0);
@@ -105,6 +106,7 @@ class TextureUnit {
     c11 = word(a1, b1);
   }
   bool direct() const { return direct_ != nullptr; }
+  bool shadowed() const { return pairs_ != nullptr; }
   bool bilinear() const { return bilinear_; }
 
   // Texel (i, j) of an addressed (in-range) index pair, expanded to 8 bits per channel.
