@@ -4,6 +4,7 @@
 #include "gpubridge/sim/device.hpp"
 
 #include <algorithm>
+#include <utility>
 #include <array>
 #include <deque>
 
@@ -621,7 +622,7 @@ std::span<std::uint8_t> Device::memory() {
 }
 std::span<const std::uint8_t> Device::memory() const {
   s_->renderer.flush();
-  return s_->mem.span();
+  return std::as_const(s_->mem).span();  // the const view: the writable one drops the texture shadows
 }
 void Device::set_scanout_callback(backends::ScanoutCallback cb) { s_->scanout_cb = std::move(cb); }
 void Device::set_pixel_observer(PixelObserver observer) {
