@@ -4,7 +4,6 @@
 #include "gpubridge/sim/device.hpp"
 
 #include <algorithm>
-#include <utility>
 #include <array>
 #include <deque>
 
@@ -310,11 +309,7 @@ struct Device::State {
 
   void kick(const Vertex& a, const Vertex& b, const Vertex& c) {
     ++stats.triangles_kicked;
-    const DrawState& st = draw_state();
-    if (mem.shadows().outdated(st, opt.accuracy.preview)) {  // shadows change only while the renderer is idle
-      renderer.flush();
-      mem.shadows().update(st, mem.data(), opt.accuracy.preview);
-    }
+    draw_state();
     renderer.draw(a, b, c, state, triangles++);
   }
 
@@ -622,7 +617,7 @@ std::span<std::uint8_t> Device::memory() {
 }
 std::span<const std::uint8_t> Device::memory() const {
   s_->renderer.flush();
-  return std::as_const(s_->mem).span();  // the const view: the writable one drops the texture shadows
+  return s_->mem.span();
 }
 void Device::set_scanout_callback(backends::ScanoutCallback cb) { s_->scanout_cb = std::move(cb); }
 void Device::set_pixel_observer(PixelObserver observer) {

@@ -43,7 +43,6 @@ class TextureUnit {
       : mem_(mem),
         base_(tex.base),
         direct_(tex.in_vram ? mem.data() + tex.base : nullptr),
-        pairs_(mem.shadows().find(tex)),
         wl_(tex.wl),
         hl_(tex.hl),
         bpp_(protocol::bytes_per_pixel(tex.format)),
@@ -73,10 +72,9 @@ class TextureUnit {
 
   // The texels sample() filters, for the vector routines: the four neighbours as colour words
   // (byte c = channel c: R, G, B, A, as the framebuffer stores them) and the bilinear weights
-  // (nearest: c00 only, fu = fv = 0). The texture must lie inside VRAM (direct_). `pairs`: read
-  // the row-pair shadow when there is one (the caller's choice per chunk; the bytes are the same).
+  // (nearest: c00 only, fu = fv = 0). The texture must lie inside VRAM (direct_).
   [[gnu::always_inline]] void quad(TexelCoords c, std::uint32_t& c00, std::uint32_t& c10, std::uint32_t& c01,
-                                   std::uint32_t& c11, std::uint32_t& fu, std::uint32_t& fv, bool pairs = true) const {
+                                   std::uint32_t& c11, std::uint32_t& fu, std::uint32_t& fv) const {
     if (!bilinear_) {
       c00 = word(address(c.tu >> 12, wrap_s_, wl_), address(c.tv >> 12, wrap_t_, hl_));
       c10 = c01 = c11 = fu = fv = 0;
@@ -88,25 +86,12 @@ class TextureUnit {
     fv = static_cast<std::uint32_t>((v >> 4) & 255);
     const std::int64_t a0 = address(i0, wrap_s_, wl_), a1 = address(i0 + 1, wrap_s_, wl_);
     const std::int64_t b0 = address(j0, wrap_t_, hl_), b1 = address(j0 + 1, wrap_t_, hl_);
-    // The row-pair shadow holds rows b0 and b0 + 1 (mod height) side by side: two loads, mostly
-    // from one cache line. Other row pairs (CLAMP's and MIRROR's edges, MIRROR's descending half)
-    // read the linear texture.
-    if (pairs && pairs_ && b1 == ((b0 + 1) & ((std::int64_t{1} << hl_) - 1))) {
-      const std::uint64_t* row = pairs_ + (static_cast<std::uint64_t>(b0) << wl_);
-      const std::uint64_t p0 = row[a0], p1 = row[a1];
-      c00 = static_cast<std::uint32_t>(p0);
-      c01 = static_cast<std::uint32_t>(p0 >> 32);
-      c10 = static_cast<std::uint32_t>(p1);
-      c11 = static_cast<std::uint32_t>(p1 >> 32);
-      return;
-    }
     c00 = word(a0, b0);
     c10 = word(a1, b0);
     c01 = word(a0, b1);
     c11 = word(a1, b1);
   }
   bool direct() const { return direct_ != nullptr; }
-  bool shadowed() const { return pairs_ != nullptr; }
   bool bilinear() const { return bilinear_; }
 
   // Texel (i, j) of an addressed (in-range) index pair, expanded to 8 bits per channel.
@@ -140,7 +125,6 @@ class TextureUnit {
   const VideoMemory& mem_;
   std::uint32_t base_;
   const std::uint8_t* direct_;  // the texture's first byte when it lies wholly inside VRAM
-  const std::uint64_t* pairs_;  // its row-pair shadow (texture_shadow.hpp) when one is current
   unsigned wl_, hl_, bpp_;
   protocol::PixelFormat format_;
   protocol::Wrap wrap_s_, wrap_t_;

@@ -16,21 +16,8 @@ namespace gpubridge::sim {
   std::uint32_t pv[8];
   simd::store8(pv, pass);
   alignas(32) std::uint32_t c00[8] = {}, c10[8] = {}, c01[8] = {}, c11[8] = {}, fu[8] = {}, fv[8] = {};
-  // The row-pair shadow (texture_shadow.hpp) when the chunk's lanes lie on different texel rows
-  // (its first and last lane at least kPairRows rows apart): their footprints share no line, and
-  // the shadow reads one line a footprint instead of two. Where lanes share texel rows (the road's
-  // magnified rows) the linear texture's lines serve the neighbouring lanes and the next screen
-  // row too, and the shadow (twice the bytes a texel) would miss more (docs/simulator.md).
-  constexpr std::int64_t kPairRows = 2;
-  const std::int64_t dv = n > 1 ? tc[n - 1].tv - tc[0].tv : 0;
-  const bool pairs = s.tex->shadowed() && (dv >= (kPairRows << 12) || dv <= -(kPairRows << 12));
-  if (pairs) {
-    for (unsigned k = 0; k < n; ++k)
-      if (pv[k]) s.tex->quad(tc[k], c00[k], c10[k], c01[k], c11[k], fu[k], fv[k], true);  // rejected lanes: never sampled
-  } else {
-    for (unsigned k = 0; k < n; ++k)
-      if (pv[k]) s.tex->quad(tc[k], c00[k], c10[k], c01[k], c11[k], fu[k], fv[k], false);
-  }
+  for (unsigned k = 0; k < n; ++k)
+    if (pv[k]) s.tex->quad(tc[k], c00[k], c10[k], c01[k], c11[k], fu[k], fv[k]);  // rejected lanes: never sampled
   u32x8 texel = simd::load8(c00);
   if (s.tex->bilinear()) {
     const u32x8 t10 = simd::load8(c10), t01 = simd::load8(c01), t11 = simd::load8(c11);

@@ -10,8 +10,6 @@
 
 #include <sys/mman.h>
 
-#include "texture_shadow.hpp"
-
 namespace gpubridge::sim {
 
 class VideoMemory {
@@ -22,20 +20,10 @@ class VideoMemory {
   explicit VideoMemory(std::uint64_t size) : size_(size), bytes_(allocate(size)) {}
 
   std::uint64_t size() const { return size_; }
-  // The renderer's own writes through data() are its draws, whose buffers the device checks
-  // against the texture shadows before queueing them (TextureShadows::outdated).
   std::uint8_t* data() { return bytes_.get(); }
   const std::uint8_t* data() const { return bytes_.get(); }
-  // The writable view may be written anywhere: it drops every texture shadow.
-  std::span<std::uint8_t> span() {
-    shadows_.invalidate_all();
-    return {bytes_.get(), size_};
-  }
+  std::span<std::uint8_t> span() { return {bytes_.get(), size_}; }
   std::span<const std::uint8_t> span() const { return {bytes_.get(), size_}; }
-
-  // Copies of textures for the texture unit (texture_shadow.hpp); writes above drop the ones under them.
-  TextureShadows& shadows() { return shadows_; }
-  const TextureShadows& shadows() const { return shadows_; }
 
   // True when [address, address + length) lies inside memory (64-bit math: never wraps).
   bool contains(std::uint64_t address, std::uint64_t length) const {
@@ -54,7 +42,6 @@ class VideoMemory {
   }
   // Writes the bytes that fall inside memory; returns false when any byte was dropped.
   bool write(std::uint64_t address, const std::uint8_t* in, std::size_t length) {
-    shadows_.invalidate(address, length);
     if (contains(address, length)) {
       std::memcpy(bytes_.get() + address, in, length);
       return true;
@@ -85,7 +72,6 @@ class VideoMemory {
   }
   std::uint64_t size_;
   std::unique_ptr<std::uint8_t[], Free> bytes_;
-  TextureShadows shadows_;
 };
 
 }  // namespace gpubridge::sim
