@@ -253,25 +253,6 @@ module scanout #(
   assign frame_end    = last;
   assign frame_done   = folding && last;
 
-  // end_vram, mul_step and mul_acc matter only while a swap is computed, pending or read, so they are set
-  // while none is (swap_ready) instead of on swap_req, which always comes in such a clock (the
-  // executor waits for swap_ready): their enables are then registers only, not the executor's `go`
-  // (the FIFO head's decode, the core's and the register file's acknowledgements) nor a RESET
-  // frame's decode (docs/gateware.md fmax-soc11). In the clock after swap_req end_vram and mul_step
-  // hold VRAM_END and 0 as before (mul_acc is first read after its first product); a RESET leaves
-  // them to the next swap_ready clock, before any later swap_req.
-  always @(posedge clk) begin
-    if (swap_ready) begin
-      end_vram <= VRAM_END;
-      mul_step <= 4'd0;
-    end else if (computing) begin
-      if (mul_step != 4'd11) begin
-        mul_acc <= product[BYTES_W-1:0];
-        mul_step <= mul_step + 4'd1;
-      end else end_vram <= end_beyond ? VRAM_END : end_in[VAW:0];
-    end
-  end
-
   always @(posedge clk) begin
     err_range <= 1'b0;
     if (rst || soft_reset) begin
@@ -298,16 +279,22 @@ module scanout #(
 
       if (swap_req) begin
         computing <= 1'b1;
+        end_vram <= VRAM_END;
         above <= swap_addr[27:VAW-2] != {(30 - VAW){1'b0}};
         frame_format <= swap_format;
         frame_width <= swap_width;
         frame_height <= swap_height;
+        mul_step <= 4'd0;
       end else if (computing) begin
         // mul_acc = width x height, on a multiplier; the swap keeps its 12 clocks
         // (no frame is being read while a swap is computed, so bytes_left is free)
-        if (mul_step == 4'd11) begin
+        if (mul_step != 4'd11) begin
+          mul_acc <= product[BYTES_W-1:0];
+          mul_step <= mul_step + 4'd1;
+        end else begin
           computing <= 1'b0;
           pending <= 1'b1;
+          end_vram <= end_beyond ? VRAM_END : end_in[VAW:0];
           if (end_beyond) err_range <= 1'b1;
         end
       end
