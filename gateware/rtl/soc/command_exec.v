@@ -310,9 +310,13 @@ module command_exec #(
   wire   mem_offer    = in_valid && core_quiet;
   assign mem_set_addr = mem_offer && is_memaddr;
   assign mem_write    = mem_offer && is_memdata;
-  assign mem_op_data  = d;
+  // MEM_DATA has no reserved, enumerated or clamped bit and MEM_ADDR none in the pointer's bits
+  // [31:3], the only ones the unit reads of it, so the validated value is the entry's there: the
+  // write data and the pointer come from the FIFO's output without the validation's multiplexer on
+  // the index (in the clock of the SPRAM's write, docs/gateware.md fmax-soc11)
+  assign mem_op_data  = raw;
   assign swap_req     = go && is_display;
-  assign swap_addr    = d[31:4];
+  assign swap_addr    = raw[31:4];   // FB_DISPLAY reserves [3:0] and [63:32] only: [31:4] as received
   assign waiting_vsync = in_valid && is_display && quiet && !swap_ready;
 
   // the shadow write happens in the cycle the entry executes (or, for a kick, before it is offered)

@@ -164,7 +164,17 @@ module register_file #(
   reg  [63:0] shadow_q;
   reg         seq_active;
   reg  [4:0]  seq_idx;
-  wire        imm_wr = wr_imm && (is_host_tag || link_ctrl_strobe);
+  // The immediate writes reach the RAM a clock after their frame (imm_wr): their decode (LINK_CTRL's
+  // CLEAR_KEY compare on the frame's data) then no longer lies in the executor's clock through
+  // ex_wr_ack, which gated `go` and from there the swap request and the FIFO's pop (docs/gateware.md
+  // fmax-soc11). The frame's index and data are the SPI slave's shift register, which holds them until
+  // the next SCK rising edge: at least two clocks after frame_valid (the synchronisers and T/2 > Tc),
+  // so they are unchanged in that clock. No host sees the clock: a read of HOST_TAG or LINK_CTRL
+  // reaches the RAM at bit 64 of a later frame, and the error flags and the link's own state
+  // (link_ctrl_strobe) still act in the frame's clock.
+  wire        imm_wr_now = wr_imm && (is_host_tag || link_ctrl_strobe);
+  reg         imm_wr;
+  always @(posedge clk) imm_wr <= imm_wr_now && !rst;
   wire        sh_we  = seq_active || imm_wr || ex_wr_req;
   wire [4:0]  sh_wa  = seq_active ? seq_idx : imm_wr ? frame_idx[4:0] : ex_wr_idx;
   // The immediate writes that reach the RAM are HOST_TAG's (no reserved bits: its data as received,
