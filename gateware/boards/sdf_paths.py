@@ -8,9 +8,8 @@ and prints the endpoints slower than the period: grouped by start and end regist
 prefix before yosys's _SB_* suffix), by the start's module, the N worst with the registers they
 pass, and the nets of >= 8 sinks that the most failing paths cross. The worst agrees with
 nextpnr's own figure (the same delays).
-usage: sdf_paths.py FILE.sdf [N [period_ns [end_substring [start_substring]]]]
-(with end_substring: the full path into the first failing endpoint whose cell name contains it)"""
-import re, sys, collections
+Written by: nextpnr-ice40 ... --sdf FILE.sdf (scripts/gateware.sh's command line plus --sdf)."""
+import argparse, re, sys, collections
 
 def tokens(text):
     for m in re.finditer(r'\(|\)|"[^"]*"|(?:\\.|[^\s()"])+', text):
@@ -49,11 +48,37 @@ def split_pin(s):
     i = s.rfind('/')
     return s[:i], s[i + 1:]
 
-def main():
-    sdf = open(sys.argv[1]).read()
-    n_top = int(sys.argv[2]) if len(sys.argv) > 2 else 40
-    period = float(sys.argv[3]) * 1000 if len(sys.argv) > 3 else 39800.0
-    tree = parse(sdf)
+def arguments(argv):
+    ap = argparse.ArgumentParser(
+        prog='sdf_paths.py', description=__doc__.split('\n\n')[0],
+        epilog='Example: python3 gateware/boards/sdf_paths.py r.sdf 30 --period 39.8 --end swap')
+    ap.add_argument('sdf', help='the SDF file nextpnr-ice40 wrote with --sdf')
+    ap.add_argument('top', nargs='?', type=int, default=40, help='how many worst endpoints to list (40)')
+    ap.add_argument('--period', type=float, default=39.8,
+                    help='the clock period in ns; endpoints slower than it fail (39.8: 25.125 MHz)')
+    ap.add_argument('--end', help='print the whole path into the worst failing endpoint whose cell name '
+                    'contains this')
+    ap.add_argument('--start', help='with --end: only a path whose first cell name contains this')
+    a = ap.parse_args(argv)
+    if a.top < 0 or not (a.period > 0):
+        ap.error('N must be >= 0 and --period a positive number of ns')
+    return a
+
+def main(argv):
+    opt = arguments(argv)
+    try:
+        with open(opt.sdf) as f:
+            sdf = f.read()
+    except OSError as e:
+        sys.exit(f"sdf_paths.py: cannot read {opt.sdf}: {e.strerror} (write it with nextpnr-ice40 ... --sdf {opt.sdf})")
+    n_top = opt.top
+    period = opt.period * 1000
+    try:
+        tree = parse(sdf)
+    except (IndexError, ValueError):
+        tree = None
+    if not isinstance(tree, list) or not tree or tree[0] != 'DELAYFILE':
+        sys.exit(f"sdf_paths.py: {opt.sdf} is not an SDF file (no balanced (DELAYFILE ...) at its start)")
     comb = collections.defaultdict(list)      # (cell, inport) -> [(outport, d)]
     clk2q = {}                                # (cell, outport) -> d
     setup = {}                                # (cell, inport) -> setup
@@ -150,6 +175,8 @@ def main():
             k = pred.get(k)
         return p[::-1]
 
+    if not ends:
+        sys.exit(f"sdf_paths.py: {opt.sdf} has no timed endpoint (no register input with a setup time is reached)")
     print(f"# {len(ends)} timed endpoints; worst {ends[0][0]/1000:.2f} ns ({1e6/ends[0][0]:.2f} MHz); "
           f"endpoints over {period/1000:.1f} ns: {sum(1 for t, _ in ends if t > period)}")
     groups = collections.defaultdict(lambda: [0, 0.0, None])
@@ -184,9 +211,9 @@ def main():
     print("## failing endpoints by the start's module: count, worst ns, its end")
     for key, (n, t, e) in sorted(cat.items(), key=lambda x: -x[1][1]):
         print(f"CAT {key:24s} x{n:4d} {t/1000:6.2f} ns -> {e}")
-    if len(sys.argv) > 4:
+    if opt.end:
         for t, k, p in rows:
-            if sys.argv[4] in k[0] and (len(sys.argv) < 6 or sys.argv[5] in p[0][0]):
+            if opt.end in k[0] and (not opt.start or opt.start in p[0][0]):
                 print(f"## path into {k}: {t/1000:.2f} ns")
                 for n in p:
                     print(f"   {arr[n]/1000:6.2f}  fo {fanout.get(n, 0):3d}  {n[0].replace('u_gpu.', '')}.{n[1]}")
@@ -209,4 +236,5 @@ def main():
     for n, c in cnt.most_common(25):
         print(f"x{c:4d}  fanout {fanout[n]:3d}  {n[0].replace('u_gpu.', '')}.{n[1]}")
 
-main()
+if __name__ == '__main__':
+    main(sys.argv[1:])
