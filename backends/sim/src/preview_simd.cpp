@@ -144,23 +144,22 @@ __attribute__((target_clones("avx2", "default"))) PreviewCounts shade_preview_si
 // width − 1 and the right edges' E_j(r)/a_j (E = f·a + m, the walk's state), the row empty while a
 // horizontal edge is negative. The walk's span is [ceil L, floor R] (ceil and floor are monotone,
 // so ceil of the largest is the largest ceil), and it has floor R − ceil L + 1 pixels exactly when
-// R >= L in the reals (otherwise none: floor R < ceil L). Every comparison used (which line is the
-// largest, the smallest, R >= L) is the sign of an affine function of r (the lines cross-multiplied,
-// in 128 bits), so it changes at most once: between consecutive sign changes the count is
-// Σ floor R(r) + Σ floor(−L(r)) + rows, each a floor_sum. No rounding anywhere, so this is the
-// walk's count for every input; the walk stays the fallback where the floor sums' 64-bit steps
-// could overflow (edge steps wider than 32 bits, which setup.hpp's 32-bit edges never give).
+// R >= L in the reals (otherwise none: floor R < ceil L). L is convex in r and R concave (a largest
+// and a smallest of lines), so a line that is the largest at a run's first and last rows is the
+// largest all along it (likewise the smallest), and then R − L is one line, >= 0 on rows found by
+// one division: the run's count is Σ floor R(r) + Σ floor(−L(r)) + its rows, two floor sums
+// (Euclid's steps). A run whose ends disagree is split where their lines cross. No rounding anywhere (the lines are
+// compared cross-multiplied, in 64 bits under the bound checked first), so this is the walk's count
+// for every input; the walk stays the fallback for values past that bound.
 namespace {
 
-using i128 = __int128;
-
-// x(r) = (p + r·q) / d, d > 0.
+// x(r) = (p + r·q) / d, d > 0, with r counted from the walk's row.
 struct CountLine {
   std::int64_t p, q, d;
 };
 
 std::int64_t floor_quotient(std::int64_t n, std::int64_t d) {  // d > 0
-  std::int64_t q = n / d;
+  const std::int64_t q = n / d;
   return q - (n % d < 0);
 }
 
@@ -188,96 +187,93 @@ std::uint64_t floor_sum_unsigned(std::uint64_t n, std::uint64_t m, std::uint64_t
   return sum;
 }
 
-// Σ_{r=s}^{e−1} floor(x(r)), exactly (in 128 bits: the terms are 64-bit).
-i128 floor_sum(const CountLine& x, int s, int e) {
+// Σ_{r=s}^{e−1} floor(x(r)) (x, s, e inside count's bound).
+std::int64_t floor_sum(const CountLine& x, int s, int e) {
   const std::int64_t n = e - s, b = x.p + s * x.q;
+  if (x.d == 1) return b * n + x.q * (n * (n - 1) / 2);
   const std::int64_t qb = floor_quotient(b, x.d), qa = floor_quotient(x.q, x.d);
-  const i128 whole = static_cast<i128>(qb) * n + static_cast<i128>(qa) * (n * (n - 1) / 2);
-  return whole + static_cast<i128>(floor_sum_unsigned(static_cast<std::uint64_t>(n), static_cast<std::uint64_t>(x.d),
+  return qb * n + qa * (n * (n - 1) / 2) +
+         static_cast<std::int64_t>(floor_sum_unsigned(static_cast<std::uint64_t>(n), static_cast<std::uint64_t>(x.d),
                                                       static_cast<std::uint64_t>(x.q - qa * x.d),
                                                       static_cast<std::uint64_t>(b - qb * x.d)));
 }
 
-// u(r) − v(r) has the sign of A + B·r.
+// u(r) − v(r) has the sign of A + B·r (cross-multiplied).
 struct CountCross {
-  i128 a, b;
+  std::int64_t a, b;
 };
 CountCross cross(const CountLine& u, const CountLine& v) {
-  return {static_cast<i128>(u.p) * v.d - static_cast<i128>(v.p) * u.d,
-          static_cast<i128>(u.q) * v.d - static_cast<i128>(v.q) * u.d};
+  return {u.p * v.d - v.p * u.d, u.q * v.d - v.q * u.d};
 }
-bool at_least(const CountCross& c, int r) { return c.a + c.b * r >= 0; }
+bool at_least(const CountCross& c, std::int64_t r) { return c.a + c.b * r >= 0; }
 
-// The first row in (s, e) where A + B·r >= 0 changes, or −1.
-int sign_change(const CountCross& c, int s, int e) {
-  if (c.b == 0 || at_least(c, s) == at_least(c, e - 1)) return -1;
-  i128 r;
-  if (c.b > 0) {  // first r with A + B·r >= 0: ceil(−A / B)
-    const i128 n = -c.a;
-    r = n / c.b + (n % c.b > 0);
-  } else {  // first r with A + B·r < 0: floor(A / −B) + 1
-    const i128 d = -c.b;
-    r = c.a / d - (c.a % d < 0) + 1;
+struct CountLines {
+  CountLine left[4], right[4];  // the clip line (0, width − 1) first
+  int n_left = 1, n_right = 1;
+  // The largest left line and the smallest right one at row r (ties: either, the values are equal).
+  int largest(int r) const {
+    int lo = 0;
+    for (int i = 1; i < n_left; ++i) lo = at_least(cross(left[lo], left[i]), r) ? lo : i;
+    return lo;
   }
-  return static_cast<int>(r);  // inside (s, e): the signs at s and e − 1 differ
+  int smallest(int r) const {
+    int hi = 0;
+    for (int j = 1; j < n_right; ++j) hi = at_least(cross(right[j], right[hi]), r) ? hi : j;
+    return hi;
+  }
+};
+
+// The covered pixels of rows [s, e), s < e.
+std::int64_t count_run(const CountLines& t, int s, int e) {
+  const int lo = t.largest(s), hi = t.smallest(s);
+  if (e - s > 1) {
+    // Ends that disagree: split where the last row's line overtakes the first row's (one division;
+    // any split would do, the runs are counted independently, this one usually leaves two runs
+    // whose ends agree where halving took four or five levels around a vertex's row).
+    const int lo_e = t.largest(e - 1), hi_e = t.smallest(e - 1);
+    if (lo_e != lo || hi_e != hi) {
+      const CountCross g = lo_e != lo ? cross(t.left[lo_e], t.left[lo]) : cross(t.right[hi], t.right[hi_e]);
+      std::int64_t mid = g.b > 0 ? -floor_quotient(g.a, g.b) : s + (e - s) / 2;  // first row with g >= 0
+      mid = std::min<std::int64_t>(std::max<std::int64_t>(mid, s + 1), e - 1);
+      return count_run(t, s, static_cast<int>(mid)) + count_run(t, static_cast<int>(mid), e);
+    }
+  }
+  // One pair of lines all along [s, e): R − L >= 0 on the rows where A + B·r >= 0.
+  const CountLine &left = t.left[lo], &right = t.right[hi];
+  const CountCross c = cross(right, left);
+  if (c.b > 0) s = static_cast<int>(std::max<std::int64_t>(s, std::min<std::int64_t>(e, -floor_quotient(c.a, c.b))));
+  else if (c.b < 0) e = static_cast<int>(std::min<std::int64_t>(e, std::max<std::int64_t>(s, floor_quotient(c.a, -c.b) + 1)));
+  else if (c.a < 0) return 0;
+  if (s >= e) return 0;
+  return floor_sum(right, s, e) + floor_sum({-left.p, -left.q, left.d}, s, e) + (e - s);
 }
 
 }  // namespace
 
 std::uint64_t SpanWalk::count(int width, int rows) {
-  constexpr std::int64_t kLimit = std::int64_t{1} << 31;  // steps, denominators (setup.hpp: 32-bit edges)
+  // Lines in 64-bit cross-multiplications: values below 2^33 over the rows, denominators below
+  // 2^29 (setup.hpp's 32-bit edges keep a box's values well inside).
+  constexpr std::int64_t kValues = std::int64_t{1} << 33, kDenominators = std::int64_t{1} << 29;
+  if (rows <= 0) return 0;
+  if (rows >= (1 << 20)) return count_walk(width, rows);
+  CountLines t;
+  t.left[0] = {0, 0, 1};
+  t.right[0] = {width - 1, 0, 1};
   int r0 = 0, r1 = rows;
-  CountLine left[4], right[4];
-  int n_left = 0, n_right = 0;
-  left[n_left++] = {0, 0, 1};
-  right[n_right++] = {width - 1, 0, 1};
-  bool narrow = rows < (1 << 20);
   for (int i = 0; i < 3; ++i) {
-    const i128 e = static_cast<i128>(f_[i]) * a_[i] + m_[i], ey = static_cast<i128>(qy_[i]) * a_[i] + ry_[i];
-    narrow = narrow && a_[i] < kLimit && ey < kLimit && ey > -kLimit && e < kLimit * kLimit / 4 &&
-             e > -kLimit * kLimit / 4;
-  }
-  if (!narrow) return count_walk(width, rows);
-  for (int i = 0; i < 3; ++i) {
+    if (a_[i] >= kDenominators || f_[i] >= kValues || f_[i] <= -kValues || qy_[i] >= kValues / rows ||
+        qy_[i] <= -kValues / rows)
+      return count_walk(width, rows);
     const std::int64_t e = f_[i] * a_[i] + m_[i], ey = qy_[i] * a_[i] + ry_[i];
-    if (kind_[i] > 0) left[n_left++] = {-e, -ey, a_[i]};
-    else if (kind_[i] < 0) right[n_right++] = {e, ey, a_[i]};
+    const std::int64_t far = e + (rows - 1) * ey;
+    if (e >= kValues || e <= -kValues || far >= kValues || far <= -kValues) return count_walk(width, rows);
+    if (kind_[i] > 0) t.left[t.n_left++] = {-e, -ey, a_[i]};
+    else if (kind_[i] < 0) t.right[t.n_right++] = {e, ey, a_[i]};
     else if (ey == 0) r1 = e < 0 ? r0 : r1;  // horizontal (a = 1): the rows where E >= 0
     else if (ey > 0) r0 = static_cast<int>(std::max<std::int64_t>(r0, std::min<std::int64_t>(r1, -floor_quotient(e, ey))));
     else r1 = static_cast<int>(std::min<std::int64_t>(r1, std::max<std::int64_t>(r0, floor_quotient(e, -ey) + 1)));
   }
-  i128 n = 0;
-  if (r0 < r1) {
-    // The rows where some comparison changes sign split [r0, r1) into runs of one formula each.
-    int cuts[24], n_cuts = 0;
-    CountLine all[8];
-    int n_all = 0;
-    for (int j = 0; j < n_right; ++j) all[n_all++] = right[j];
-    for (int i = 0; i < n_left; ++i) all[n_all++] = left[i];
-    for (int u = 0; u < n_all; ++u)
-      for (int v = u + 1; v < n_all; ++v) {
-        const int c = sign_change(cross(all[u], all[v]), r0, r1);
-        if (c >= 0) cuts[n_cuts++] = c;
-      }
-    cuts[n_cuts++] = r1;
-    std::sort(cuts, cuts + n_cuts);
-    int s = r0;
-    for (int k = 0; k < n_cuts; s = cuts[k++]) {
-      const int e = cuts[k];
-      if (e == s) continue;
-      // The largest left line and the smallest right one over the run, from their comparisons at
-      // row s. Only the cut comparisons (u − v >= 0, u before v in `all`: rights first) are
-      // constant over a run (v − u >= 0 is not where they tie), so only those are asked.
-      int lo = 0, hi = 0;
-      for (int i = 1; i < n_left; ++i)
-        if (!at_least(cross(left[lo], left[i]), s)) lo = i;  // left[i] > left[lo] over the run
-      for (int j = 1; j < n_right; ++j)
-        if (at_least(cross(right[hi], right[j]), s)) hi = j;  // right[j] <= right[hi] over the run
-      if (!at_least(cross(right[hi], left[lo]), s)) continue;  // R < L over the run: no pixel
-      const CountLine neg_left = {-left[lo].p, -left[lo].q, left[lo].d};
-      n += floor_sum(right[hi], s, e) + floor_sum(neg_left, s, e) + (e - s);
-    }
-  }
+  const std::int64_t n = r0 < r1 ? count_run(t, r0, r1) : 0;
   // Leave the walk after the rows (as count_walk does): E(r + rows) = f·a + m + rows·ey.
   for (int i = 0; i < 3; ++i) {
     m_[i] += rows * ry_[i];
