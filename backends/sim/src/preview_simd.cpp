@@ -158,7 +158,7 @@ struct CountLine {
   std::int64_t p, q, d;
 };
 
-std::int64_t floor_quotient(std::int64_t n, std::int64_t d) {  // d > 0
+[[gnu::always_inline]] inline std::int64_t floor_quotient(std::int64_t n, std::int64_t d) {  // d > 0
   const std::int64_t q = n / d;
   return q - (n % d < 0);
 }
@@ -188,7 +188,7 @@ std::uint64_t floor_sum_unsigned(std::uint64_t n, std::uint64_t m, std::uint64_t
 }
 
 // Σ_{r=s}^{e−1} floor(x(r)) (x, s, e inside count's bound).
-std::int64_t floor_sum(const CountLine& x, int s, int e) {
+[[gnu::always_inline]] inline std::int64_t floor_sum(const CountLine& x, int s, int e) {
   const std::int64_t n = e - s, b = x.p + s * x.q;
   if (x.d == 1) return b * n + x.q * (n * (n - 1) / 2);
   const std::int64_t qb = floor_quotient(b, x.d), qa = floor_quotient(x.q, x.d);
@@ -202,21 +202,21 @@ std::int64_t floor_sum(const CountLine& x, int s, int e) {
 struct CountCross {
   std::int64_t a, b;
 };
-CountCross cross(const CountLine& u, const CountLine& v) {
+[[gnu::always_inline]] inline CountCross cross(const CountLine& u, const CountLine& v) {
   return {u.p * v.d - v.p * u.d, u.q * v.d - v.q * u.d};
 }
-bool at_least(const CountCross& c, std::int64_t r) { return c.a + c.b * r >= 0; }
+[[gnu::always_inline]] inline bool at_least(const CountCross& c, std::int64_t r) { return c.a + c.b * r >= 0; }
 
 struct CountLines {
   CountLine left[4], right[4];  // the clip line (0, width − 1) first
   int n_left = 1, n_right = 1;
   // The largest left line and the smallest right one at row r (ties: either, the values are equal).
-  int largest(int r) const {
+  [[gnu::always_inline]] int largest(int r) const {
     int lo = 0;
     for (int i = 1; i < n_left; ++i) lo = at_least(cross(left[lo], left[i]), r) ? lo : i;
     return lo;
   }
-  int smallest(int r) const {
+  [[gnu::always_inline]] int smallest(int r) const {
     int hi = 0;
     for (int j = 1; j < n_right; ++j) hi = at_least(cross(right[j], right[hi]), r) ? hi : j;
     return hi;
