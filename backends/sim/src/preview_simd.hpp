@@ -89,18 +89,11 @@ class SpanWalk {
     return true;
   }
   // The covered pixels of the next `rows` rows (what drawing them counts as scanned and covered),
-  // leaving the walk after them, without walking them (preview_simd.cpp, docs/simulator.md
-  // "Preview"): a row's span is [ceil(max of the left edges' crossings, 0), floor(min of the right
-  // ones', width − 1)] and ceil and floor are monotone, so which crossing bounds it changes only
-  // where two lines cross; between those rows the count is sums of floors of affine functions
-  // (floor_sum, Euclid's steps). Equal to count_walk for every input (the walk is its fallback when
-  // the values are too wide for 64-bit steps).
-  std::uint64_t count(int width, int rows);
-  // The same count by walking the rows (the reference; tests compare the two). A triangle's edges
-  // are two left ones and a right one, a left one and two right ones, or a left, a right and a
-  // horizontal one (their ex sum to 0): the edges are put in that order once, so the row loop has
-  // no branch on an edge's kind.
-  std::uint64_t count_walk(int width, int rows) {
+  // leaving the walk after them. A triangle's edges are two left ones and a right one, a left one
+  // and two right ones, or a left, a right and a horizontal one (their ex sum to 0): the edges are
+  // put in that order once, so the row loop has no branch on an edge's kind (about half the
+  // instructions of span() and next_row() per row).
+  std::uint64_t count(int width, int rows) {
     int order[3], n_left = 0, n_right = 0;
     for (int i = 0; i < 3; ++i)
       if (kind_[i] > 0) order[n_left++] = i;
