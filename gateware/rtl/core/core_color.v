@@ -19,9 +19,7 @@ module core_color #(
     input  wire        temporal,   // TRI_MODE.TEMPORAL (with DITHER)
     input  wire [3:0]  phase,      // TRI_MODE.DITHER_PHASE
     input  wire [3:0]  keep,       // 1 = keep the stored channel: bit 0 R .. bit 3 A
-    input  wire        need_dst,   // read the destination (blend, or mask on a packed format;
-                                   // PACKQ: never for RGBA8888, which the caller decodes when the
-                                   // draw starts, below)
+    input  wire        need_dst,   // read the destination (blend, or mask on a packed format)
     // pixels in: {yl[1:0], xl[1:0], idx, rgba[31:0]}
     input  wire        in_valid,
     output wire        in_ready,
@@ -58,11 +56,8 @@ module core_color #(
   wire [67:0] in_item = {in_pix[IDX_W+35:IDX_W+32], in_addr, in_pix[31:0]};
 
   // ---- destination read queue ----
-  // PACKQ: RGBA8888 has nothing to merge (a read would only feed a blend), so the caller's
-  // need_dst is already 0 for it: decoded from the format into a flip-flop when the draw starts,
-  // not here, where it was the first LUT of every stall decision back to the rasteriser's walk
-  // (in_ready -> the depth stage -> pipe_ok -> adv; fmax-core12, docs/gateware.md)
-  wire        need_rd = need_dst;
+  // PACKQ: RGBA8888 has nothing to merge (a read would only feed a blend)
+  wire        need_rd = (PACKQ != 0) ? (need_dst && fmt != 2'd0) : need_dst;
   wire        q_full, q_empty, q_head;
   wire [QIW-1:0] q_item, push_item;
   wire [QDW-1:0] q_data, rsp_kept;

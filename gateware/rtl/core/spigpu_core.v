@@ -62,7 +62,7 @@ module spigpu_core #(
     output reg  [31:0]  perf_setup,       // cycles in triangle setup
     output reg  [31:0]  perf_raster       // cycles the rasteriser walked
 );
-  localparam F_BILINEAR = 0, F_BLEND = 1, F_TEXTURE = 7;
+  localparam F_BILINEAR = 0, F_TEXTURE = 7;
   localparam integer TEX    = FEATURES[F_TEXTURE] ? 1 : 0;
   localparam integer SMALL  = (PROFILE == 0) ? 1 : 0;
   localparam integer IDX_W  = $clog2(MAX_WIDTH * MAX_HEIGHT);     // pixel index bits
@@ -70,9 +70,6 @@ module spigpu_core #(
   localparam integer Q_AW   = (SMALL != 0) ? 0 : 2;                      // log2 reads in flight per stage
   localparam integer PW     = IDX_W + 60 + ((TEX != 0) ? 96 : 0);        // pixel record
   localparam integer CW     = IDX_W + 36;                         // colour stage record
-  // core_color's packed read queue (no blend, one read in flight: up5k): it reads the
-  // destination only to merge a packed format's masked channels, never for RGBA8888
-  localparam integer PACKQ  = (!FEATURES[F_BLEND] && Q_AW == 0) ? 1 : 0;
   localparam [1:0] OP_TRI = 2'd0, OP_CLEAR = 2'd1, OP_CLEAR_Z = 2'd2;
   // up5k: the rasteriser's column and row bits. The soc's FB_FORMAT holds a width and height of
   // at most MAX_WIDTH x MAX_HEIGHT or its reset value 640 x 480 (command_exec's WB, HB bits), and
@@ -505,8 +502,7 @@ module spigpu_core #(
             r_flat      <= (SMALL != 0) ? vp_data : cmd_v0[87:56];
             r_serial    <= serial_n;
             r_need      <= need;
-            r_need_dst  <= ((cmd_tri_mode[8:7] != 2'd0) || (some_masked && !all_masked && cmd_fb_format != 2'd0)) &&
-                           (PACKQ == 0 || cmd_fb_format != 2'd0);
+            r_need_dst  <= (cmd_tri_mode[8:7] != 2'd0) || (some_masked && !all_masked && cmd_fb_format != 2'd0);
             colour_on_r <= colour_on;
           end else begin
             // a clear drawn as a rectangle: CLEAR_COLOR truncated (no dither, blend or mask), or
