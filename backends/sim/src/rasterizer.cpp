@@ -66,26 +66,33 @@ constexpr int kPrefetchRows = 4;
 // k >= ceil(−E / ex) = −floor(E / ex) for ex > 0, k <= floor(E / −ex) for ex < 0.
 inline Divider edge_divider(const Edge& e) { return Divider(e.ex < 0 ? -e.ex : (e.ex == 0 ? 1 : e.ex)); }
 
-// What drawing `rows` wide rows whose pixels all fail the depth test counts: every covered pixel
-// scanned and covered, none passed (Kernel::run's wide rows count exactly this). e: the edge
-// values at the first row, left at the row after the last. The quotients of the span bounds
-// are stepped from row to row instead, as the planes are: floor(e / d) with e += ey is (q, r)
-// advanced by floor_divmod(ey, d) and one carry (for a vertical edge d = 1: q is e itself).
-void count_covered(const Triangle& t, const Divider div[3], std::int64_t e[3], int rows, RasterCounters& c) {
-  const std::int64_t w = t.x1 - t.x0;
+// The edge walk of a wide box (w >= kSpanSolveWidth): (q, r) = floor-divmod of each edge value by
+// its |ex| (the span bounds' quotients), stepped a row at a time by floor-divmod(ey, |ex|) and one
+// carry: the same integers as dividing on every row, with no division a row.
+struct EdgeWalk {
   std::int64_t q[3], r[3], qy[3], ry[3], d[3];
-  for (int i = 0; i < 3; ++i) {
-    const DivMod a = div[i](e[i]), s = div[i](t.edge[i].ey);
-    q[i] = a.q;
-    r[i] = a.r;
-    qy[i] = s.q;
-    ry[i] = s.r;
-    d[i] = div[i].divisor();
-    e[i] += rows * t.edge[i].ey;
+  // The row steps (once per triangle; div: the edges' dividers, edge_divider).
+  void prepare(const Triangle& t, const Divider div[3]) {
+    for (int i = 0; i < 3; ++i) {
+      const DivMod s = div[i](t.edge[i].ey);
+      qy[i] = s.q;
+      ry[i] = s.r;
+      d[i] = div[i].divisor();
+    }
   }
-  std::uint64_t n = 0;
-  for (int row = 0; row < rows; ++row) {
-    std::int64_t kl = 0, kr = w - 1;
+  // The quotients of box row y (absolute).
+  void start(const Triangle& t, const Divider div[3], int y) {
+    const std::int64_t k = y - t.y0;
+    for (int i = 0; i < 3; ++i) {
+      const DivMod a = div[i](t.edge[i].e + k * t.edge[i].ey);
+      q[i] = a.q;
+      r[i] = a.r;
+    }
+  }
+  // This row's covered span kl..kr (box-relative; empty when kl > kr), then on to the next row.
+  [[gnu::always_inline]] void span_and_step(const Triangle& t, std::int64_t w, std::int64_t& kl, std::int64_t& kr) {
+    kl = 0;
+    kr = w - 1;
     for (int i = 0; i < 3; ++i) {
       const std::int64_t ex = t.edge[i].ex;
       if (ex > 0) kl = std::max(kl, -q[i]);
@@ -97,11 +104,21 @@ void count_covered(const Triangle& t, const Divider div[3], std::int64_t e[3], i
       r[i] -= carry ? d[i] : 0;
       q[i] += carry;
     }
-    n += kl <= kr ? static_cast<std::uint64_t>(kr - kl + 1) : 0u;
   }
-  c.scanned += n;
-  c.covered += n;
-}
+  // What drawing the next `rows` rows counts when all their pixels fail the depth test: every
+  // covered pixel scanned and covered, none passed. Leaves the walk after them.
+  void count(const Triangle& t, int rows, RasterCounters& c) {
+    const std::int64_t w = t.x1 - t.x0;
+    std::uint64_t n = 0;
+    for (int row = 0; row < rows; ++row) {
+      std::int64_t kl, kr;
+      span_and_step(t, w, kl, kr);
+      n += kl <= kr ? static_cast<std::uint64_t>(kr - kl + 1) : 0u;
+    }
+    c.scanned += n;
+    c.covered += n;
+  }
+};
 
 // The triangle's edges as band_occluded clips them: edge i runs from its lower end (y0, x0, z0)
 // up to y1 (sample units), x and the interpolated depth changing by kx, kz per unit of y. Worked
@@ -209,11 +226,8 @@ class Kernel {
     if (t.x1 - t.x0 >= kSpanSolveWidth) {  // only wide rows walk their span ends
       for (int i = 0; i < 3; ++i) {
         edge_div_[i] = edge_divider(t.edge[i]);
-        const DivMod s = edge_div_[i](t.edge[i].ey);
-        walk_.qy[i] = s.q;
-        walk_.ry[i] = s.r;
-        walk_.d[i] = edge_div_[i].divisor();
       }
+      walk_.prepare(t, edge_div_);
     }
     if (kTextured && t.plane[kQ].constant && t.plane[kQ].q != 0) {
       q_const_ = true;  // affine: the reciprocal is the same at every pixel
@@ -276,7 +290,7 @@ class Kernel {
     return ya;
   }
 
-  // Wide boxes: each row's covered span kl..kr from the edge walk (walk_, start_walk: no division a row),
+  // Wide boxes: each row's covered span kl..kr from the edge walk (walk_, an EdgeWalk: no division a row; a rejected band is counted through it and the walk goes on),
   // the planes kept at the span's first pixel by a cursor that one combined step a row carries to
   // the next row's first pixel (cur_, move), spans of kMinSimdSpan pixels or more through the span
   // routine, shorter ones pixel by pixel. Whole 16-row bands are asked first (band_occluded); rows
@@ -287,7 +301,7 @@ class Kernel {
     const bool bands = kDepth && ctx_.hier_z;
     int mark_from = ya;
     bool first = true;
-    bool walking = false;  // walk_ holds row y's quotients (false after a rejected band)
+    bool walking = false;  // walk_ holds row y's quotients
     bool anchored = false;  // cur_ holds the planes at (y - 1, col_) (false before the first drawn row and after a rejected band)
     for (int y = ya; y < yz;) {
       const int end = std::min(yz, (y | ((1 << HierZ::kRowsLog) - 1)) + 1);  // this band's rows
@@ -301,33 +315,23 @@ class Kernel {
           ask_band(t_, clip_, st_, ctx_, zmask_, y, end - 1, hz_run_)) {
         hz_tries_ = HierZ::kTries;
         hz_rejected_ = true;
-        std::int64_t e[3];
-        edges_at(y, e);
-        count_covered(t_, edge_div_, e, end - y, ctx_.counters);
+        if (!walking) walk_.start(t_, edge_div_, y);
+        walking = true;
+        walk_.count(t_, end - y, ctx_.counters);  // the walk goes on after the band
         if (mark_from == y) mark_from = end;
         y = end;
         first = false;
-        walking = anchored = false;
+        anchored = false;
         continue;
       }
       first = false;
       if (!walking) {
-        start_walk(y);
+        walk_.start(t_, edge_div_, y);
         walking = true;
       }
       for (; y < end; ++y) {
-        std::int64_t kl = 0, kr = w - 1;
-        for (int i = 0; i < 3; ++i) {
-          const std::int64_t ex = t_.edge[i].ex;
-          if (ex > 0) kl = std::max(kl, -walk_.q[i]);
-          else if (ex < 0) kr = std::min(kr, walk_.q[i]);
-          else if (walk_.q[i] < 0) kr = -1;
-          walk_.q[i] += walk_.qy[i];
-          walk_.r[i] += walk_.ry[i];
-          const bool carry = walk_.r[i] >= walk_.d[i];
-          walk_.r[i] -= carry ? walk_.d[i] : 0;
-          walk_.q[i] += carry;
-        }
+        std::int64_t kl, kr;
+        walk_.span_and_step(t_, w, kl, kr);
         if (kl > kr) {  // no sample covered: the cursor stays in its column
           if (anchored) step_y(cur_);
           continue;
@@ -356,23 +360,6 @@ class Kernel {
     return mark_from;
   }
 
-  // The biased edge values at the box's column 0 in row y.
-  void edges_at(int y, std::int64_t e[3]) const {
-    const std::int64_t k = y - t_.y0;
-    for (int i = 0; i < 3; ++i) e[i] = t_.edge[i].e + k * t_.edge[i].ey;
-  }
-  // The edge walk from row y: (q, r) = floor-divmod of each edge value by |ex| (the span
-  // bounds' quotients), stepped a row at a time by floor-divmod(ey, |ex|) and one carry, as count_covered
-  // steps them: the same integers as dividing on every row.
-  void start_walk(int y) {
-    std::int64_t e[3];
-    edges_at(y, e);
-    for (int i = 0; i < 3; ++i) {
-      const DivMod a = edge_div_[i](e[i]);
-      walk_.q[i] = a.q;
-      walk_.r[i] = a.r;
-    }
-  }
   // The planes at (y, kx): the triangle's planes advanced y − y0 rows (exact, 128-bit) and jumped
   // kx pixels. Once per run and after a rejected band; every other row moves the cursor.
   Steppers anchor(int y, std::int64_t kx) const {
@@ -651,11 +638,9 @@ class Kernel {
   unsigned hz_tries_ = 0;       // rows left to ask them before giving up on this run (0: not asked)
   bool hz_rejected_ = false;    // they rejected a row of this run
   std::optional<BandClip> clip_;  // for band_occluded, when a band is asked
-  // Wide rows: the edge walk (start_walk), the cursor (the planes at the last drawn span's first
+  // Wide rows: the edge walk, the cursor (the planes at the last drawn span's first
   // pixel, column col_) and its last two combined steps (move).
-  struct EdgeWalk {
-    std::int64_t q[3], r[3], qy[3], ry[3], d[3];
-  } walk_{};
+  EdgeWalk walk_{};
   Steppers cur_{};
   std::int64_t col_ = 0;
   struct CursorStep {
@@ -872,7 +857,7 @@ void rasterize_rows(const Triangle& t, const DrawState& st, RasterContext& ctx, 
   if (ctx.hier_z && depth && t.x1 - t.x0 >= kSpanSolveWidth) {
     const std::uint32_t run = HierZ::next_run(ctx.hz_run), zmask = z_mask(ctx);
     std::optional<std::array<Divider, 3>> div;
-    std::int64_t e[3];
+    EdgeWalk walk;  // from row ya once a band is rejected
     std::optional<BandClip> clip;
     for (;;) {
       const int end = std::min(yz, (ya | ((1 << HierZ::kRowsLog) - 1)) + 1);
@@ -886,10 +871,10 @@ void rasterize_rows(const Triangle& t, const DrawState& st, RasterContext& ctx, 
       }
       if (!div) {
         div.emplace(std::array<Divider, 3>{edge_divider(t.edge[0]), edge_divider(t.edge[1]), edge_divider(t.edge[2])});
-        const std::int64_t k = ya - t.y0;
-        for (int i = 0; i < 3; ++i) e[i] = t.edge[i].e + k * t.edge[i].ey;
+        walk.prepare(t, div->data());
+        walk.start(t, div->data(), ya);
       }
-      count_covered(t, div->data(), e, end - ya, ctx.counters);
+      walk.count(t, end - ya, ctx.counters);
       hz |= kHzRejected;
       ya = end;
       if (ya >= yz) return;
