@@ -44,6 +44,11 @@ template <bool kTextured, PixelFormat kFormat, Chunk kChunk, bool kTexelLanes = 
                                        std::uint8_t* zp, unsigned n, bool whole, V bayer) {
   using S = signed_lanes<V>;
   bool none = false, all = n == kLanesOf<V>;
+  // A chunk that loaded whole (the row has room for every lane) stores every lane: the lanes beyond
+  // n write back the words just loaded from the same addresses (same row, so the same band and
+  // thread, and nothing writes them in between), one vector store where n words were a call to
+  // memcpy. Not with masked loads (those lanes hold 0) nor on the preview path (kTexelLanes).
+  const unsigned stored = !kMasked && !kTexelLanes && whole ? kLanesOf<V> : n;
   if (f.depth) {
     const V z = q[4] & px.zmask;
     const V old = load_words<V, kMasked>(zp, n, whole);  // lanes beyond n are masked off
@@ -64,7 +69,7 @@ template <bool kTextured, PixelFormat kFormat, Chunk kChunk, bool kTexelLanes = 
       none = any == 0;
       all = all && every == ~std::uint64_t{0};
     }
-    if (px.z_write && !none) store_words<kMasked>(zp, (bswap<kAvx2>(z) & pass) | (old & ~pass), n);
+    if (px.z_write && !none) store_words<kMasked>(zp, (bswap<kAvx2>(z) & pass) | (old & ~pass), stored);
   }
   if (none) return pass;  // rejected chunks touch no colour
   V word = V{} + px.flat;
@@ -75,7 +80,7 @@ template <bool kTextured, PixelFormat kFormat, Chunk kChunk, bool kTexelLanes = 
     store_color<kFormat, kMasked>(cp, pack_color<kFormat>(word, bayer, px.temporal), kLanesOf<V>);
     return pass;
   }
-  write_color8<kFormat, kMasked>(cp, n, word, pass, px.blend, bayer, px.temporal, px.keep, whole);
+  write_color8<kFormat, kMasked>(cp, n, stored, word, pass, px.blend, bayer, px.temporal, px.keep, whole);
   return pass;
 }
 

@@ -22,6 +22,7 @@ typedef std::uint32_t u32x8 __attribute__((vector_size(32)));
 typedef std::int32_t i32x8 __attribute__((vector_size(32)));
 typedef std::uint32_t u32x16 __attribute__((vector_size(64)));
 typedef std::int32_t i32x16 __attribute__((vector_size(64)));
+typedef std::uint32_t u32x4 __attribute__((vector_size(16)));
 
 // The signed lanes of V's width (compares of V give them) and V's lane count.
 template <class V>
@@ -107,12 +108,30 @@ template <class V = u32x8, bool kMasked = false>
   }
 }
 // Lanes 0..n-1 to n words at p. Full chunks copy a constant 32 bytes (inlined); only the tail
-// copies n words (kMasked: a masked store).
+// copies n words (kMasked: a masked store), eight lanes' tails in pieces of 4, 2 and 1 words with
+// constant sizes (inlined: a copy of n words was a call to memcpy, its vector spilled around it).
 template <bool kMasked = false, class V>
 [[gnu::always_inline]] inline void store_words(std::uint8_t* p, V v, unsigned n) {
-  if (n == kLanesOf<V>) std::memcpy(p, &v, sizeof v);
-  else if constexpr (kMasked) masked_store(p, &v, n);
-  else std::memcpy(p, &v, std::size_t{n} * 4);
+  if (n == kLanesOf<V>) {
+    std::memcpy(p, &v, sizeof v);
+  } else if constexpr (kMasked) {
+    masked_store(p, &v, n);
+  } else if constexpr (kLanesOf<V> == 8) {
+    u32x4 part = __builtin_shufflevector(v, v, 0, 1, 2, 3);
+    if (n & 4) {
+      std::memcpy(p, &part, 16);
+      part = __builtin_shufflevector(v, v, 4, 5, 6, 7);
+      p += 16;
+    }
+    if (n & 2) {
+      std::memcpy(p, &part, 8);
+      part = __builtin_shufflevector(part, part, 2, 3, 2, 3);
+      p += 8;
+    }
+    if (n & 1) std::memcpy(p, &part, 4);
+  } else {
+    std::memcpy(p, &v, std::size_t{n} * 4);
+  }
 }
 
 typedef std::uint8_t u8x32 __attribute__((vector_size(32)));
@@ -137,8 +156,6 @@ template <bool kShuffle = false, class V>
 }
 #undef GPUBRIDGE_BSWAP16
 #undef GPUBRIDGE_BSWAP4
-
-typedef std::uint32_t u32x4 __attribute__((vector_size(16)));
 
 // The sum of the lanes (each lane's count of passes: the total stays far below 2^32), halves
 // folded onto each other: a few adds and shuffles where eight extracts and 64-bit adds were.
