@@ -116,9 +116,9 @@ template <PixelFormat kFormat, class V>
 
 // The colour write of n pixels at p merged with the stored ones: blend (`mode`), the bits the
 // write mask keeps (`keep_bits`) and the lanes that do not pass keep what is stored. `whole`: as
-// for load_color.
+// for load_color; `stored` (n, or every lane when `whole`) pixels are written back.
 template <PixelFormat kFormat, bool kMasked = false, class V>
-[[gnu::always_inline]] inline void write_color8(std::uint8_t* p, unsigned n, V word, V pass,
+[[gnu::always_inline]] inline void write_color8(std::uint8_t* p, unsigned n, unsigned stored, V word, V pass,
                                                 protocol::BlendMode mode, V bayer, bool temporal,
                                                 std::uint32_t keep_bits, bool whole) {
   const V old = load_color<kFormat, V, kMasked>(p, n, whole);
@@ -126,7 +126,7 @@ template <PixelFormat kFormat, bool kMasked = false, class V>
   V out = pack_color<kFormat>(word, bayer, temporal);
   out = (out & ~keep_bits) | (old & keep_bits);
   out = (out & pass) | (old & ~pass);
-  store_color<kFormat, kMasked>(p, out, n);
+  store_color<kFormat, kMasked>(p, out, stored);
 }
 
 }  // namespace gpubridge::sim::simd

@@ -35,17 +35,29 @@ struct StageFlags {
 // dither threshold indices (packed formats). Returns the lanes that passed the depth test.
 // kTexelLanes (the preview path): q[5] and q[6] hold the texel coordinates themselves.
 // V: u32x8, or u32x16 for untextured RGBA8888 spans (the span routine's AVX-512 instance); kMasked:
-// tails through AVX-512's masked moves (load_words).
-template <bool kTextured, PixelFormat kFormat, Chunk kChunk, bool kTexelLanes = false, bool kMasked = false, class V>
+// tails through AVX-512's masked moves (load_words); kAvx2 (the span routine's instances with AVX2 or
+// AVX-512): the depth words' byte order by one byte shuffle (bswap) and a chunk's pass mask as lane
+// bits (lane_bits: one vmovmskps where four extracts, ors and ands were).
+template <bool kTextured, PixelFormat kFormat, Chunk kChunk, bool kTexelLanes = false, bool kMasked = false,
+          bool kAvx2 = false, class V>
 [[gnu::always_inline]] inline V pixel8(const PixelLanes& px, StageFlags f, const V* q, V pass, std::uint8_t* cp,
                                        std::uint8_t* zp, unsigned n, bool whole, V bayer) {
   using S = signed_lanes<V>;
   bool none = false, all = n == kLanesOf<V>;
+  // A chunk that loaded whole (the row has room for every lane) stores every lane: the lanes beyond
+  // n write back the words just loaded from the same addresses (same row, so the same band and
+  // thread, and nothing writes them in between), one vector store where n words were a call to
+  // memcpy. Not with masked loads (those lanes hold 0) nor on the preview path (kTexelLanes).
+  const unsigned stored = !kMasked && !kTexelLanes && whole ? kLanesOf<V> : n;
   if (f.depth) {
     const V z = q[4] & px.zmask;
     const V old = load_words<V, kMasked>(zp, n, whole);  // lanes beyond n are masked off
-    if (px.z_test) pass = depth_test(px.z_func, pass, (S)z, (S)(bswap(old) & 0xFFFFFFu));  // both < 2^24
-    if constexpr (kChunk == Chunk::Span) {
+    if (px.z_test) pass = depth_test(px.z_func, pass, (S)z, (S)(bswap<kAvx2>(old) & 0xFFFFFFu));  // both < 2^24
+    if constexpr (kChunk == Chunk::Span && kAvx2 && kLanesOf<V> == 8) {
+      const unsigned bits = lane_bits(&pass);
+      none = bits == 0;
+      all = all && bits == 0xFFu;
+    } else if constexpr (kChunk == Chunk::Span) {
       constexpr unsigned kWords = sizeof(V) / 8;
       std::uint64_t m[kWords];
       std::memcpy(m, &pass, sizeof m);
@@ -57,7 +69,7 @@ template <bool kTextured, PixelFormat kFormat, Chunk kChunk, bool kTexelLanes = 
       none = any == 0;
       all = all && every == ~std::uint64_t{0};
     }
-    if (px.z_write && !none) store_words<kMasked>(zp, (bswap(z) & pass) | (old & ~pass), n);
+    if (px.z_write && !none) store_words<kMasked>(zp, (bswap<kAvx2>(z) & pass) | (old & ~pass), stored);
   }
   if (none) return pass;  // rejected chunks touch no colour
   V word = V{} + px.flat;
@@ -68,7 +80,7 @@ template <bool kTextured, PixelFormat kFormat, Chunk kChunk, bool kTexelLanes = 
     store_color<kFormat, kMasked>(cp, pack_color<kFormat>(word, bayer, px.temporal), kLanesOf<V>);
     return pass;
   }
-  write_color8<kFormat, kMasked>(cp, n, word, pass, px.blend, bayer, px.temporal, px.keep, whole);
+  write_color8<kFormat, kMasked>(cp, n, stored, word, pass, px.blend, bayer, px.temporal, px.keep, whole);
   return pass;
 }
 

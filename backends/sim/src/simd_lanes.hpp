@@ -22,6 +22,7 @@ typedef std::uint32_t u32x8 __attribute__((vector_size(32)));
 typedef std::int32_t i32x8 __attribute__((vector_size(32)));
 typedef std::uint32_t u32x16 __attribute__((vector_size(64)));
 typedef std::int32_t i32x16 __attribute__((vector_size(64)));
+typedef std::uint32_t u32x4 __attribute__((vector_size(16)));
 
 // The signed lanes of V's width (compares of V give them) and V's lane count.
 template <class V>
@@ -78,6 +79,12 @@ __attribute__((target("avx512f,avx512vl"))) inline void masked_store(std::uint8_
   _mm512_mask_storeu_epi32(p, static_cast<__mmask16>((1u << n) - 1), (__m512i)*v);
 }
 
+// Bit k set when lane k of the mask *m (0 or all ones per lane) is set: one vmovmskps. Only the
+// instances with AVX2 call it (pixel8's kAvx2); by pointer for the reason given above.
+__attribute__((target("avx2"))) inline unsigned lane_bits(const u32x8* m) {
+  return static_cast<unsigned>(_mm256_movemask_ps((__m256)*m));
+}
+
 // n words from p into lanes 0..n-1; later lanes hold the next words of the row when `whole`
 // (eight words fit before the row ends: same row, so the same band and thread) or 0. Both are
 // masked off by the caller. Loads straight into the vector where possible: going through a stack
@@ -101,18 +108,66 @@ template <class V = u32x8, bool kMasked = false>
   }
 }
 // Lanes 0..n-1 to n words at p. Full chunks copy a constant 32 bytes (inlined); only the tail
-// copies n words (kMasked: a masked store).
+// copies n words (kMasked: a masked store), eight lanes' tails in pieces of 4, 2 and 1 words with
+// constant sizes (inlined: a copy of n words was a call to memcpy, its vector spilled around it).
 template <bool kMasked = false, class V>
 [[gnu::always_inline]] inline void store_words(std::uint8_t* p, V v, unsigned n) {
-  if (n == kLanesOf<V>) std::memcpy(p, &v, sizeof v);
-  else if constexpr (kMasked) masked_store(p, &v, n);
-  else std::memcpy(p, &v, std::size_t{n} * 4);
+  if (n == kLanesOf<V>) {
+    std::memcpy(p, &v, sizeof v);
+  } else if constexpr (kMasked) {
+    masked_store(p, &v, n);
+  } else if constexpr (kLanesOf<V> == 8) {
+    u32x4 part = __builtin_shufflevector(v, v, 0, 1, 2, 3);
+    if (n & 4) {
+      std::memcpy(p, &part, 16);
+      part = __builtin_shufflevector(v, v, 4, 5, 6, 7);
+      p += 16;
+    }
+    if (n & 2) {
+      std::memcpy(p, &part, 8);
+      part = __builtin_shufflevector(part, part, 2, 3, 2, 3);
+      p += 8;
+    }
+    if (n & 1) std::memcpy(p, &part, 4);
+  } else {
+    std::memcpy(p, &v, std::size_t{n} * 4);
+  }
 }
 
-// Z is stored big-endian in video memory (docs/protocol.md): byte-swap each lane.
-template <class V>
+typedef std::uint8_t u8x32 __attribute__((vector_size(32)));
+typedef std::uint8_t u8x64 __attribute__((vector_size(64)));
+
+// Z is stored big-endian in video memory (docs/protocol.md): byte-swap each lane. kShuffle (the
+// instances with AVX2 or AVX-512BW): one byte shuffle (vpshufb), as the preview kernel does, for
+// the nine shifts, masks and ors; without it (baseline x86-64, which has no byte shuffle, where
+// GCC spells a generic shuffle byte by byte through the stack) the shifts.
+#define GPUBRIDGE_BSWAP4(b) b + 3, b + 2, b + 1, b
+#define GPUBRIDGE_BSWAP16(b) GPUBRIDGE_BSWAP4(b), GPUBRIDGE_BSWAP4(b + 4), GPUBRIDGE_BSWAP4(b + 8), GPUBRIDGE_BSWAP4(b + 12)
+template <bool kShuffle = false, class V>
 [[gnu::always_inline]] inline V bswap(V w) {
-  return (w >> 24) | ((w >> 8) & 0xFF00u) | ((w << 8) & 0xFF0000u) | (w << 24);
+  if constexpr (kShuffle && kLanesOf<V> == 8) {
+    return (V)__builtin_shufflevector((u8x32)w, (u8x32)w, GPUBRIDGE_BSWAP16(0), GPUBRIDGE_BSWAP16(16));
+  } else if constexpr (kShuffle) {
+    return (V)__builtin_shufflevector((u8x64)w, (u8x64)w, GPUBRIDGE_BSWAP16(0), GPUBRIDGE_BSWAP16(16),
+                                      GPUBRIDGE_BSWAP16(32), GPUBRIDGE_BSWAP16(48));
+  } else {
+    return (w >> 24) | ((w >> 8) & 0xFF00u) | ((w << 8) & 0xFF0000u) | (w << 24);
+  }
+}
+#undef GPUBRIDGE_BSWAP16
+#undef GPUBRIDGE_BSWAP4
+
+// The sum of the lanes (each lane's count of passes: the total stays far below 2^32), halves
+// folded onto each other: a few adds and shuffles where eight extracts and 64-bit adds were.
+[[gnu::always_inline]] inline std::uint32_t lane_sum(u32x8 v) {
+  u32x4 a = __builtin_shufflevector(v, v, 0, 1, 2, 3) + __builtin_shufflevector(v, v, 4, 5, 6, 7);
+  a += __builtin_shufflevector(a, a, 2, 3, 0, 1);
+  a += __builtin_shufflevector(a, a, 1, 0, 3, 2);
+  return a[0];
+}
+[[gnu::always_inline]] inline std::uint32_t lane_sum(u32x16 v) {
+  return lane_sum(u32x8(__builtin_shufflevector(v, v, 0, 1, 2, 3, 4, 5, 6, 7) +
+                        __builtin_shufflevector(v, v, 8, 9, 10, 11, 12, 13, 14, 15)));
 }
 
 // One carry of an exact (q, r) stepper: r < 2·den < 2^31 before, r < den after (the signed

@@ -13,15 +13,22 @@ using protocol::PixelFormat;
 using simd::i32x8;
 using simd::u32x8;
 
-// One instance per plane count, so the plane loops have constant bounds and the lanes stay in
-// registers (a run-time bound cost the untextured spans 5-15%).
-template <bool kTextured, PixelFormat kFormat>
+// One instance per plane count and colour source, so the plane loops have constant bounds and the
+// lanes stay in registers (a run-time bound cost the untextured spans 5-15%; a run-time first
+// plane, Gouraud or not, kept every plane's lanes on the stack, loaded and stored on every chunk).
+// kAvx2: the instance has AVX2 or AVX-512 (pixel8's byte shuffle and lane bits).
+template <bool kTextured, PixelFormat kFormat, bool kGouraud, bool kAvx2>
 [[gnu::always_inline]] inline std::uint64_t shade_span(const SimdSpan& s) {
   constexpr std::size_t kBpp = protocol::bytes_per_pixel(kFormat);
   constexpr unsigned kUsed = kTextured ? 8 : 5;
-  u32x8 q[kUsed], r[kUsed];
-  const PixelLanes& px = s.pixel;
-  const unsigned first = px.gouraud ? 0 : 4;
+  constexpr unsigned first = kGouraud ? 0 : 4;
+  // Local copies of what the loop reads of the span: the colour and depth stores go through
+  // std::uint8_t pointers, which may alias `s`, so its fields would be read again on every chunk.
+  // (The copy's gouraud is this instance's constant, so the colour's source is no branch either.)
+  PixelLanes px = s.pixel;
+  px.gouraud = kGouraud;
+  const unsigned count = s.count, room = s.room;
+  u32x8 q[kUsed] = {}, r[kUsed] = {}, q8[kUsed] = {}, r8[kUsed] = {};  // unused planes: zeros, never read
   const u32x8 den = u32x8{} + s.den;
   // The rasteriser hands over the planes at the span's first pixel (its cursor): lane k adds k
   // steps. (The routine used to jump from the box row's start itself, a double-vector division
@@ -30,33 +37,50 @@ template <bool kTextured, PixelFormat kFormat>
     q[p] = simd::load8(s.qk[p]) + s.q0[p];
     r[p] = simd::load8(s.rk[p]) + s.r0[p];
     simd::carry(q[p], r[p], den);
+    q8[p] = u32x8{} + s.q8[p];
+    r8[p] = u32x8{} + s.r8[p];
   }
-  const i32x8 lane = {0, 1, 2, 3, 4, 5, 6, 7};
   const simd::StageFlags flags = simd::stage_flags(px);
   u32x8 bayer = {};
   if constexpr (kFormat != PixelFormat::RGBA8888) bayer = simd::load8(s.bayer);
   u32x8 passed = {};
   std::uint8_t* cp = s.color;
   std::uint8_t* zp = s.depth;
-  for (unsigned i = 0; i < s.count; i += 8) {
-    const unsigned n = s.count - i < 8 ? s.count - i : 8;
-    // A tail chunk loads a full vector when the row has room. Not for textured spans: their short
-    // spans (2-7 pixels) then reach into another cache line more often, and the perspective road
-    // lost 7% (cubes unchanged), while untextured 1,000-px spans gained 10%.
-    const bool whole = !kTextured && i + 8 <= s.room;
-    const u32x8 in_span = simd::mask(lane < static_cast<std::int32_t>(n));
-    passed -= simd::pixel8<kTextured, kFormat, simd::Chunk::Span>(px, flags, q, in_span, cp, zp, n, whole, bayer);
+  // Whole chunks of eight: every lane a pixel (n = 8 is a constant, so no lane mask and no tail
+  // branch in the loads and stores); the planes step only when another chunk follows.
+  unsigned i = 0;
+  for (; i + 8 <= count; i += 8) {
+    if (i != 0) {
+      for (unsigned p = first; p < kUsed; ++p) {
+        q[p] += q8[p];
+        r[p] += r8[p];
+        simd::carry(q[p], r[p], den);
+      }
+    }
+    passed -= simd::pixel8<kTextured, kFormat, simd::Chunk::Span, false, false, kAvx2>(
+        px, flags, q, ~u32x8{}, cp, zp, 8, true, bayer);
     cp += 8 * kBpp;
     if (flags.depth) zp += 8 * 4;  // s.depth is null without depth
-    for (unsigned p = first; p < kUsed; ++p) {
-      q[p] += s.q8[p];
-      r[p] += s.r8[p];
-      simd::carry(q[p], r[p], den);
-    }
   }
-  std::uint64_t total = 0;
-  for (unsigned k = 0; k < 8; ++k) total += passed[k];  // pass lanes are all ones (−1)
-  return total;
+  if (i < count) {  // the last 1-7 pixels
+    if (i != 0) {
+      for (unsigned p = first; p < kUsed; ++p) {
+        q[p] += q8[p];
+        r[p] += r8[p];
+        simd::carry(q[p], r[p], den);
+      }
+    }
+    const unsigned n = count - i;
+    const i32x8 lane = {0, 1, 2, 3, 4, 5, 6, 7};
+    const u32x8 in_span = simd::mask(lane < static_cast<std::int32_t>(n));
+    // The tail loads a full vector when the row has room. Not for textured spans: their short
+    // spans (2-7 pixels) then reach into another cache line more often, and the perspective road
+    // lost 7% (cubes unchanged), while untextured 1,000-px spans gained 10%.
+    const bool whole = !kTextured && i + 8 <= room;
+    passed -= simd::pixel8<kTextured, kFormat, simd::Chunk::Span, false, false, kAvx2>(px, flags, q, in_span, cp, zp,
+                                                                                       n, whole, bayer);
+  }
+  return simd::lane_sum(passed);  // pass lanes are all ones (−1)
 }
 
 // The AVX-512 instance's long untextured RGBA8888 spans in sixteen lanes (512-bit vectors): chunks
@@ -69,17 +93,19 @@ template <bool kTextured, PixelFormat kFormat>
 }
 [[gnu::always_inline]] inline u32x8 low_half(simd::u32x16 v) { return __builtin_shufflevector(v, v, 0, 1, 2, 3, 4, 5, 6, 7); }
 
-template <bool kMasked>
+template <bool kMasked, bool kGouraud>
 [[gnu::always_inline]] inline std::uint64_t shade_span_wide(const SimdSpan& s) {
   using simd::u32x16;
   constexpr PixelFormat kFormat = PixelFormat::RGBA8888;
   constexpr unsigned kUsed = 5;  // untextured: R, G, B, A, Z
-  const PixelLanes& px = s.pixel;
-  const unsigned first = px.gouraud ? 0 : 4;
+  constexpr unsigned first = kGouraud ? 0 : 4;
+  PixelLanes px = s.pixel;  // local copies, as in shade_span
+  px.gouraud = kGouraud;
+  const unsigned count = s.count, room = s.room;
   const u32x8 den8 = u32x8{} + s.den;
   const u32x16 den = u32x16{} + s.den;
-  u32x16 q[kUsed], r[kUsed];
-  std::uint32_t q16[kUsed], r16[kUsed];
+  u32x16 q[kUsed] = {}, r[kUsed] = {};
+  std::uint32_t q16[kUsed] = {}, r16[kUsed] = {};
   for (unsigned p = first; p < kUsed; ++p) {
     u32x8 ql = simd::load8(s.qk[p]) + s.q0[p], rl = simd::load8(s.rk[p]) + s.r0[p];
     simd::carry(ql, rl, den8);
@@ -97,11 +123,11 @@ template <bool kMasked>
   std::uint8_t* cp = s.color;
   std::uint8_t* zp = s.depth;
   unsigned i = 0;
-  for (; i + 8 < s.count; i += 16) {
-    const unsigned n = s.count - i < 16 ? s.count - i : 16;
+  for (; i + 8 < count; i += 16) {
+    const unsigned n = count - i < 16 ? count - i : 16;
     const u32x16 in_span = simd::mask(lane < static_cast<std::int32_t>(n));
-    passed -= simd::pixel8<false, kFormat, simd::Chunk::Span, false, kMasked>(px, flags, q, in_span, cp, zp, n,
-                                                                              i + 16 <= s.room, u32x16{});
+    passed -= simd::pixel8<false, kFormat, simd::Chunk::Span, false, kMasked, true>(px, flags, q, in_span, cp, zp, n,
+                                                                                    i + 16 <= room, u32x16{});
     cp += 16 * 4;
     if (flags.depth) zp += 16 * 4;  // s.depth is null without depth
     for (unsigned p = first; p < kUsed; ++p) {
@@ -111,18 +137,17 @@ template <bool kMasked>
     }
   }
   std::uint64_t total = 0;
-  if (i < s.count) {
-    const unsigned n = s.count - i;  // 1..8
+  if (i < count) {
+    const unsigned n = count - i;  // 1..8
     u32x8 qt[kUsed];
     for (unsigned p = first; p < kUsed; ++p) qt[p] = low_half(q[p]);
     const i32x8 lane8 = {0, 1, 2, 3, 4, 5, 6, 7};
     const u32x8 in_span = simd::mask(lane8 < static_cast<std::int32_t>(n));
-    const u32x8 tail = simd::pixel8<false, kFormat, simd::Chunk::Span, false, kMasked>(px, flags, qt, in_span, cp, zp,
-                                                                                       n, i + 8 <= s.room, u32x8{});
-    for (unsigned k = 0; k < 8; ++k) total += tail[k] & 1;  // pass lanes are all ones (−1)
+    const u32x8 tail = simd::pixel8<false, kFormat, simd::Chunk::Span, false, kMasked, true>(
+        px, flags, qt, in_span, cp, zp, n, i + 8 <= room, u32x8{});
+    total = simd::lane_sum(u32x8{} - tail);  // pass lanes are all ones (−1)
   }
-  for (unsigned k = 0; k < 16; ++k) total += passed[k];  // pass lanes are all ones (−1)
-  return total;
+  return total + simd::lane_sum(passed);
 }
 
 namespace {
@@ -130,12 +155,14 @@ namespace {
 // Each instance is the same source compiled for one ISA; all of them compute the same integers.
 std::uint64_t span_baseline(const SimdSpan& s) {
   return simd::dispatch(s.pixel, [&]<bool kTextured, PixelFormat kFormat>() __attribute__((always_inline)) {
-    return shade_span<kTextured, kFormat>(s);
+    return s.pixel.gouraud ? shade_span<kTextured, kFormat, true, false>(s)
+                           : shade_span<kTextured, kFormat, false, false>(s);
   });
 }
 __attribute__((target("avx2"))) std::uint64_t span_avx2(const SimdSpan& s) {
   return simd::dispatch(s.pixel, [&]<bool kTextured, PixelFormat kFormat>() __attribute__((always_inline)) {
-    return shade_span<kTextured, kFormat>(s);
+    return s.pixel.gouraud ? shade_span<kTextured, kFormat, true, true>(s)
+                           : shade_span<kTextured, kFormat, false, true>(s);
   });
 }
 // AVX-512 (F, VL, BW, DQ) in 256-bit vectors: the same eight lanes with 32 vector registers and
@@ -144,7 +171,8 @@ __attribute__((target("avx2"))) std::uint64_t span_avx2(const SimdSpan& s) {
 #define SPAN_AVX512 __attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq")))
 SPAN_AVX512 std::uint64_t span_avx512_256(const SimdSpan& s) {
   return simd::dispatch(s.pixel, [&]<bool kTextured, PixelFormat kFormat>() __attribute__((always_inline)) {
-    return shade_span<kTextured, kFormat>(s);
+    return s.pixel.gouraud ? shade_span<kTextured, kFormat, true, true>(s)
+                           : shade_span<kTextured, kFormat, false, true>(s);
   });
 }
 // Untextured RGBA8888 spans of at least kWideSpan pixels in sixteen lanes (shade_span_wide, tails
@@ -157,9 +185,11 @@ constexpr unsigned kWideSpan = 64;
 SPAN_AVX512 std::uint64_t span_avx512(const SimdSpan& s) {
   return simd::dispatch(s.pixel, [&]<bool kTextured, PixelFormat kFormat>() __attribute__((always_inline)) {
     if constexpr (!kTextured && kFormat == PixelFormat::RGBA8888) {
-      if (s.count >= kWideSpan) return shade_span_wide<true>(s);
+      if (s.count >= kWideSpan)
+        return s.pixel.gouraud ? shade_span_wide<true, true>(s) : shade_span_wide<true, false>(s);
     }
-    return shade_span<kTextured, kFormat>(s);
+    return s.pixel.gouraud ? shade_span<kTextured, kFormat, true, true>(s)
+                           : shade_span<kTextured, kFormat, false, true>(s);
   });
 }
 #undef SPAN_AVX512
