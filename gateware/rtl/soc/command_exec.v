@@ -33,14 +33,13 @@ module command_exec #(
   input  wire         rst,           // power-on or RESET
   // command FIFO
   input  wire         in_valid,
-  input  wire [6:0]   in_class,      // the entry's class, decoded at the push (command_class.vh)
   input  wire [70:0]  in_entry,
   output wire         in_pop,
   // shadow RAM of the register file
   output wire         sh_wr_req,
   output wire [4:0]   sh_wr_idx,
   output wire [63:0]  sh_wr_data,
-  input  wire         sh_wr_free,    // sh_wr_req is taken this clock if made (register file)
+  input  wire         sh_wr_ack,
   output wire [4:0]   sh_rd_idx,     // VPORT: COLOR, read from the shadow RAM (no copy here)
   input  wire [63:0]  sh_rd_data,
   input  wire         sh_rd_valid,
@@ -67,12 +66,11 @@ module command_exec #(
   input  wire [3:0]   vp_addr,       // {triangle vertex 0-2, word 0-2} (VPORT = 1)
   output reg  [31:0]  vp_data,       // the word, a clock later
   input  wire         core_idle,
-  // memory-access unit: the operation's data stays in the FIFO head until acknowledged
+  // memory-access unit: the operation's data stays in the FIFO head until mem_op_ack
   output wire         mem_set_addr,  // MEM_ADDR offered
   output wire         mem_write,     // MEM_DATA write offered
   output wire [63:0]  mem_op_data,
-  input  wire         mem_ack_set,   // an offered MEM_ADDR is taken this clock
-  input  wire         mem_ack_write, // an offered MEM_DATA is taken this clock (both words written)
+  input  wire         mem_op_ack,    // taken (MEM_ADDR: at once; MEM_DATA: both words written)
   input  wire         mem_idle,      // no MEM_ADDR / MEM_DATA operation of the executor in progress
   // scanout
   output wire         swap_req,      // FB_DISPLAY executes
@@ -83,7 +81,6 @@ module command_exec #(
 );
 `include "spigpu_regs.vh"
 `include "const_compare.vh"
-`include "command_class.vh"
 
   // --- validation (section 5) ---
   wire [6:0]  idx = in_entry[70:64];
@@ -203,36 +200,26 @@ module command_exec #(
 
   wire [183:0] vertex = {texcoord[31:0], texcoord[63:32], color[63:32], color[31:0], d[55:32], d[31:16], d[15:0]};
 
-  // The classes `go` tests come with the entry (decoded at the push: the FIFO's output bits, not a
-  // decode of the index behind the block RAM's clock-to-out, docs/gateware.md fmax-soc13); the
-  // core's operation is decoded here (the command is offered with it, not in `go`'s clock).
-  wire is_vertex  = in_class[CLS_VERTEX];
+  wire is_vertex  = idx == `SPIGPU_REG_VERTEX;
   wire is_clear   = idx == `SPIGPU_REG_CLEAR;
   wire is_clear_z = idx == `SPIGPU_REG_CLEAR_Z && DEPTH != 0;
-  wire is_display = in_class[CLS_DISPLAY];
-  wire is_memaddr = in_class[CLS_MEMADDR];
-  wire is_memdata = in_class[CLS_MEMDATA];
-  wire is_fence   = in_class[CLS_FENCE];
+  wire is_display = idx == `SPIGPU_REG_FB_DISPLAY;
+  wire is_memaddr = idx == `SPIGPU_REG_MEM_ADDR;
+  wire is_memdata = idx == `SPIGPU_REG_MEM_DATA;
+  wire is_fence   = idx == `SPIGPU_REG_FENCE;
   wire kick       = is_vertex && vcount == 2'd2;
-  wire to_core    = kick || in_class[CLS_CLEAR];
-  wire to_shadow  = in_class[CLS_SHADOW];
+  wire to_core    = kick || is_clear || is_clear_z;
+  wire to_shadow  = idx[6:5] == 2'b00 && reg_is_rw(idx);
 
   // Conditions for executing the entry now.
   wire core_quiet = core_idle && !core_drain;                  // every earlier core command completed
   wire quiet      = core_quiet && mem_idle;                    // ... and every earlier memory operation
   wire is_mem     = is_memaddr || is_memdata;
   wire core_ok    = !to_core || (cmd_ready && mem_idle && !core_drain && (!to_shadow || kick_shadowed));
-  // the unit's acknowledgement of the offer (mem_offer below) for the entry's class: go and
-  // sh_wr_req hold the offer's own terms (in_valid, wait_ok's core_quiet)
-  wire mem_ok     = is_memaddr ? mem_ack_set : is_memdata ? mem_ack_write : 1'b1;
+  wire mem_ok     = !is_mem || mem_op_ack;                     // the unit waits for its own idle
   wire wait_ok    = is_mem ? core_quiet : (is_display || is_fence) ? quiet : 1'b1;
   wire swap_ok    = !is_display || swap_ready;
-  // sh_wr_ack is sh_wr_req && sh_wr_free, and sh_wr_req's conditions are all go's own (the entry,
-  // core_ok, wait_ok, swap_ok, mem_ok; a kick's mem_idle && !core_drain, which its core_ok holds,
-  // and core_ok needs kick_shadowed where a kick writes the shadow RAM): go reads sh_wr_free
-  // without the loop through the request (docs/gateware.md fmax-soc13)
-  wire sh_wr_ack  = sh_wr_req && sh_wr_free;
-  wire shadow_ok  = !to_shadow || sh_wr_free || kick_shadowed;
+  wire shadow_ok  = !to_shadow || sh_wr_ack || kick_shadowed;
   wire vert_ok;                                                // VPORT: the vertex's words are written
   wire go         = in_valid && core_ok && wait_ok && swap_ok && shadow_ok && mem_ok && vert_ok;
 

@@ -12,14 +12,13 @@
 module command_fifo #(
   parameter DEPTH = 64,     // CAPS.FIFO_DEPTH
   parameter AW = 7,         // storage address bits, 2^AW > DEPTH
-  parameter HEAD = 0,       // 1: the executor's entry is a flip-flop copy of the RAM's output
-  parameter W = 71          // entry bits: {index[6:0], data[63:0]} and what the soc stores with them
+  parameter HEAD = 0        // 1: the executor's entry is a flip-flop copy of the RAM's output
 ) (
   input  wire        clk,
   input  wire        rst,            // power-on or RESET: empty
   input  wire        push,
   input  wire        push_held,      // strict mode: the pushed entry waits for a LINK_CHECK
-  input  wire [W-1:0] push_entry,    // {.., index[6:0], data[63:0]}
+  input  wire [70:0] push_entry,     // {index[6:0], data[63:0]}
   input  wire        release_held,
   input  wire        discard_held,
   output wire        full,
@@ -27,12 +26,12 @@ module command_fifo #(
   output wire [10:0] level,          // entries not yet taken by the executor, held ones included
   output wire        held,           // some entries wait for a LINK_CHECK
   output wire        out_valid,
-  output wire [W-1:0] out_entry,
+  output wire [70:0] out_entry,
   output wire        read_any,       // an entry is read from the RAM (in q or h): work is waiting
   input  wire        pop
 );
-  (* no_rw_check *) reg [W-1:0] mem [0:(1 << AW) - 1];   // an entry is never read in the clock it is written
-  reg [W-1:0] q;
+  (* no_rw_check *) reg [70:0] mem [0:(1 << AW) - 1];   // an entry is never read in the clock it is written
+  reg [70:0] q;
   reg        q_valid;       // q holds an entry not yet taken (by the executor, or by h)
   reg [AW-1:0] wr, rel, rd;
   // entries not yet taken, 0..DEPTH (DEPTH <= 1023): in the bits DEPTH needs (7 on up5k, not 11).
@@ -54,7 +53,7 @@ module command_fifo #(
     if (HEAD != 0) begin : g_head
       // h and its valid depend on registers only: h loads when it is empty (the executor's pop,
       // which empties it, is a clock earlier), q then takes the next entry in the same clock
-      reg [W-1:0] h;
+      reg [70:0] h;
       reg        hv;
       assign q_take    = q_valid && !hv;
       assign h_valid   = hv;

@@ -7,7 +7,7 @@
 //     the highest memory priority and complete within a few clocks (SPRAM: 3; SDRAM: a refresh and a
 //     row miss at worst), long before the next frame's bit 64 at any SCK the SPI slave allows.
 // Accesses beyond VRAM never reach the memory: writes are dropped (ERR_MEM_RANGE), loads give 0.
-// The executor offers an operation with its data (the head of the command FIFO) until it is acknowledged; a
+// The executor offers an operation with its data (the head of the command FIFO) until op_ack; a
 // read is taken first. A reload started while another is in flight discards the older responses.
 module mem_access #(
   parameter        UNITS_L2 = 14            // VRAM size / 8 bytes = 2^UNITS_L2
@@ -19,8 +19,7 @@ module mem_access #(
   input  wire        set_addr,
   input  wire        write,
   input  wire [63:0] op_data,
-  output wire        ack_set,      // the acknowledgement if a MEM_ADDR were offered now
-  output wire        ack_write,    // the acknowledgement if a MEM_DATA write were offered now
+  output wire        op_ack,
   output wire        ex_idle,      // no executor operation (write or its reload) in progress
   // SPI: a MEM_DATA read reached bit 64
   input  wire        read_strobe,
@@ -59,11 +58,8 @@ module mem_access #(
   wire issued   = req_valid && req_ready;
   wire reading  = issued && !req_we;
   wire writing  = phase == WR0 || phase == WR1;
-  // VRAM is a power of two: "below it" is a test of the pointer's upper bits, no comparator; kept
-  // as a flip-flop loaded with the pointer (in_vram_r: the pointer's own test, which the executor's
-  // `go` reads through the acknowledgement, then starts at a flip-flop, docs/gateware.md fmax-soc13)
-  reg  in_vram_r;
-  wire in_vram  = in_vram_r;
+  // VRAM is a power of two: "below it" is a test of the pointer's upper bits, no comparator
+  wire in_vram  = addr[28:UNITS_L2] == 0;
   wire [1:0] outstanding_next = outstanding + {1'b0, reading} - {1'b0, rsp_valid};
   wire [1:0] discard_next = discard - {1'b0, rsp_valid && discard != 2'd0};
 
@@ -72,12 +68,7 @@ module mem_access #(
   wire do_set   = !writing && !pend_read && set_addr && ex_idle;
   wire do_write = !writing && !pend_read && !set_addr && write && ex_idle;
   wire wr_done  = phase == WR1 && issued;
-  // The acknowledgement (do_set || (do_write && !in_vram) || wr_done) for each offer, without it: the executor tests its entry's class against these
-  // (its `go` already holds the offer's other terms, the entry and core_quiet), so the pointer's
-  // and the unit's state reach `go` without the offer's decode (docs/gateware.md fmax-soc13)
-  wire        unit_free = !writing && !pend_read && ex_idle;
-  assign ack_set   = unit_free || wr_done;
-  assign ack_write = (unit_free && !in_vram) || wr_done;
+  assign op_ack = do_set || (do_write && !in_vram) || wr_done;
   wire        do_load   = do_read || do_set || (do_write && !in_vram) || wr_done;
   wire [28:0] load_addr = do_set ? op_data[31:3] : addr + 29'd1;
   wire        load_in_vram = load_addr[28:UNITS_L2] == 0;
@@ -98,7 +89,6 @@ module mem_access #(
     err_range <= 1'b0;
     if (rst || soft_reset) begin
       addr <= 29'd0;
-      in_vram_r <= 1'b1;
       mem_ready <= 1'b0;
       phase <= IDLE;
       pend_read <= 1'b0;
@@ -140,7 +130,6 @@ module mem_access #(
       end
       if (do_load) begin
         addr <= load_addr;
-        in_vram_r <= load_in_vram;
         mem_ready <= 1'b0;
         got_first <= 1'b0;
         discard <= outstanding_next;

@@ -95,10 +95,7 @@ module mem_arbiter #(
   // and its memory requests done, so no core request meets a window in the clock it starts; one
   // that ends is seen a clock late (a write may wait a clock longer, never less).
   wire        c_act;
-  // the window compares as !(a < b), not a >= b: yosys builds >= as the carry chain's less-than OR
-  // an equality of the chain's XOR bits, a LUT tree after the chain (docs/gateware.md fmax-soc9);
-  // the less-than alone is the chain's carry out
-  wire        c_prot   = c_act && !(c_vram < prot_lo) && c_vram < prot_hi;
+  wire        c_prot   = c_act && c_vram >= prot_lo && c_vram < prot_hi;
   // The memory-access unit's write is compared a clock before it is granted (issue 19, 25.125 MHz
   // on the UP5K: the compare on its address, whose low bit is the unit's phase, led through its
   // grant into the executor's FIFO pop in one clock). m_out_r: last clock the window was active
@@ -113,10 +110,10 @@ module mem_arbiter #(
   // was granted and a clock before it can start another, so no unit write meets a window in the
   // clock it starts (checked in the co-simulation); one that ends is seen a clock late.
   reg         m_wait_r, m_out_r, m_act_r;
-  wire        m_in_win = !(m_vram < prot_lo) && m_vram < prot_hi;
+  wire        m_in_win = m_vram >= prot_lo && m_vram < prot_hi;
   wire m_block = m_writes && m_act_r && !(m_wait_r && m_out_r);
   assign c_act = m_act_r;
-  (* keep *) wire c_block = c_req_we && c_prot;   // (no core request while the unit writes: see pick_c)
+  wire c_block = c_req_we && c_prot;   // (no core request while the unit writes: see pick_c)
   wire c_oor   = c_req_addr[29:AW] != 0;   // beyond VRAM: an upper bit, no comparator
   wire v_oor   = v_req_addr[29:AW] != 0;
   wire v_hold  = v_req_valid && v_oor;       // the scanout and the core wait while it drains the reads
@@ -124,8 +121,7 @@ module mem_arbiter #(
   wire m_ok  = m_req_valid && !m_block && (m_req_we || tags_room);
   wire s_ok  = s_req_valid && tags_room;
   wire c_zero = c_req_valid && c_oor && (c_req_we || (tags_empty && !b_rsp_valid));
-  wire c_cand = c_req_valid && !c_oor && (c_req_we || tags_room);   // c_ok but for the window
-  wire c_ok  = c_cand && !c_block;
+  wire c_ok  = c_req_valid && !c_oor && !c_block && (c_req_we || tags_room);
 
   // choice (independent of b_req_ready)
   wire pick_m = m_ok;
@@ -138,26 +134,13 @@ module mem_arbiter #(
   wire mc_ok  = m_req_valid && (m_req_we || tags_room);
   wire vc_pick = !mc_ok && v_req_valid && (v_oor ? tags_empty && !b_rsp_valid : tags_room);
   wire sc_pick = !vc_pick && !v_hold && !mc_ok && s_ok && (scan_wait == 4'd15 || !(c_ok || c_zero));
+  wire pick_c = !vc_pick && !v_hold && !mc_ok && !sc_pick && c_ok;
   wire pick_z = !vc_pick && !v_hold && !mc_ok && !sc_pick && !c_ok && c_zero;
-  // The window's compare (two carry chains on the core's address and the scanout's bounds) decides
-  // only whether the core's request goes now, so it enters the back end's address, chip select
-  // and write enable last, in one LUT each (issue 19, fmax-soc13): c_sel is the core's grant but
-  // for the window (with c_ok, sc_pick is the scanout's 16th clock alone), and the address of every
-  // other grant (`other`: the unit's, the video output's, else the scanout's, which is also the
-  // address when nothing is granted) and the request's valid with the core blocked (`valid_blk`)
-  // or not (`valid_go`) are taken without it. `keep` holds those nets as the compare's last inputs
-  // (ABC sees the chains' carry outs as early as a flip-flop and would put the compare first).
-  (* keep *) wire c_sel = !vc_pick && !v_hold && !mc_ok && !(s_ok && scan_wait == 4'd15) && c_cand;
-  wire pick_c = c_sel && !c_block;
-  wire v_back = pick_v && !v_oor;
-  wire s_base = !pick_v && !v_hold && !pick_m && s_ok;
-  (* keep *) wire valid_go  = v_back || pick_m || (s_base && (scan_wait == 4'd15 || !(c_cand || c_zero))) || c_sel;
-  (* keep *) wire valid_blk = v_back || pick_m || (s_base && (scan_wait == 4'd15 || !c_zero));
-  (* keep *) wire [AW-1:0] other = pick_m ? m_req_addr[AW-1:0] : pick_v ? v_req_addr[AW-1:0] : s_req_addr[AW-1:0];
 
-  assign b_req_valid = c_block ? valid_blk : valid_go;
-  assign b_req_we    = pick_m ? m_req_we : pick_c && c_req_we;
-  assign b_req_addr  = pick_c ? c_req_addr[AW-1:0] : other;
+  assign b_req_valid = (pick_v && !v_oor) || pick_m || pick_s || pick_c;
+  assign b_req_we    = pick_m ? m_req_we : pick_c ? c_req_we : 1'b0;
+  wire [29:0] addr   = pick_m ? m_req_addr : pick_v ? v_req_addr : pick_s ? s_req_addr : c_req_addr;
+  assign b_req_addr  = addr[AW-1:0];
   assign b_req_wdata = pick_m ? m_req_wdata : c_req_wdata;
   assign b_req_be    = pick_c ? c_req_be : 4'hF;
 
@@ -228,5 +211,5 @@ module mem_arbiter #(
   end
 `endif
 
-  wire unused_ok = &{1'b0, m_req_addr[29:AW], s_req_addr[29:AW]};
+  wire unused_ok = &{1'b0, addr[29:AW]};
 endmodule

@@ -59,7 +59,7 @@ module register_file #(
   input  wire        ex_wr_req,
   input  wire [4:0]  ex_wr_idx,
   input  wire [63:0] ex_wr_data,
-  output wire        ex_wr_free,     // ex_wr_req would be taken this clock (the executor's ack)
+  output wire        ex_wr_ack,
   // executor reads (EX_READ = 1): the shadow RAM's read port is the SPI side's only in the bit-64
   // cycle of a read of a shadowed register; in every other clock it reads ex_rd_idx, and
   // ex_rd_valid says the clock before was such a clock (ex_rd_data is then that entry)
@@ -166,7 +166,7 @@ module register_file #(
   reg  [4:0]  seq_idx;
   // The immediate writes reach the RAM a clock after their frame (imm_wr): their decode (LINK_CTRL's
   // CLEAR_KEY compare on the frame's data) then no longer lies in the executor's clock through
-  // the executor's shadow write, which gated `go` and from there the swap request and the FIFO's pop (docs/gateware.md
+  // ex_wr_ack, which gated `go` and from there the swap request and the FIFO's pop (docs/gateware.md
   // fmax-soc11). The frame's index and data are the SPI slave's shift register, which holds them until
   // the next SCK rising edge: at least two clocks after frame_valid (the synchronisers and T/2 > Tc),
   // so they are unchanged in that clock. No host sees the clock: a read of HOST_TAG or LINK_CTRL
@@ -186,10 +186,7 @@ module register_file #(
   wire        sel_ex  = !seq_active && !imm_wr;
   wire [63:0] sh_wd  = ({64{sel_tag}} & frame_data & ~RSV_HOST_TAG)
                      | {63'd0, sel_lc && link_ctrl_strict} | ({64{sel_ex}} & ex_wr_data);
-  // the executor's write is taken when it asks and neither the reset sequencer nor an immediate
-  // write has the RAM: the executor forms the ack (sh_wr_req && ex_wr_free), and its `go` reads
-  // ex_wr_free alone (docs/gateware.md fmax-soc13)
-  assign ex_wr_free = !seq_active && !imm_wr;
+  assign ex_wr_ack = ex_wr_req && !seq_active && !imm_wr;
   // at_reset[i]: register i (in RESET_NZ) has not been written since the last reset, so its value is
   // entry 32 + i. A read in the clock of the first write still sees the reset value there, the old
   // value, as a read of entry i would; the sequencer's zeros do not count as writes

@@ -100,7 +100,6 @@ module spigpu_soc #(
   output wire [31:0]  perf_refreshes      // SDRAM auto refreshes
 );
 `include "spigpu_regs.vh"
-`include "command_class.vh"
   localparam [9:0]  FIFO_D10 = FIFO_DEPTH;
   localparam [10:0] MAXW11 = MAX_WIDTH, MAXH11 = MAX_HEIGHT;
   localparam [23:0] VRAM24 = VRAM_KIB;
@@ -134,16 +133,13 @@ module spigpu_soc #(
   wire        rst_any = rst || soft_reset;
   wire        fifo_push, fifo_push_held, fifo_full, fifo_nearly_full, fifo_held, fifo_out_valid, fifo_pop;
   wire        fifo_read_any;   // an entry waits in the FIFO's output (HEAD: in either of its two registers)
-  wire [70:0] fifo_entry;
-  // the entry's class (command_class.vh) decoded at the push and stored with it
-  wire [CLS_W+70:0] fifo_out;
-  wire [CLS_W-1:0]  fifo_class = cmd_class(fifo_entry[70:64], DEPTH != 0);
+  wire [70:0] fifo_entry, fifo_out;
   wire [10:0] fifo_level;
   wire        link_strict, link_discarding, link_release, link_discard, err_link_crc, drop_overflow;
   wire        check_strobe, ctrl_strobe, ctrl_strict;
   wire [31:0] check_crc;
   wire [63:0] link_status;
-  wire        sh_wr_req, sh_wr_free;
+  wire        sh_wr_req, sh_wr_ack;
   wire [4:0]  sh_wr_idx;
   wire [63:0] sh_wr_data;
   wire [6:0]  ex_err;
@@ -173,7 +169,7 @@ module spigpu_soc #(
     .err_link_crc(err_link_crc), .drop_overflow(drop_overflow), .link_check_strobe(check_strobe),
     .link_check_crc(check_crc), .link_ctrl_strobe(ctrl_strobe), .link_ctrl_strict(ctrl_strict),
     .soft_reset(soft_reset), .ex_wr_req(sh_wr_req), .ex_wr_idx(sh_wr_idx), .ex_wr_data(sh_wr_data),
-    .ex_wr_free(sh_wr_free), .ex_rd_idx(sh_rd_idx), .ex_rd_data(sh_rd_data), .ex_rd_valid(sh_rd_valid),
+    .ex_wr_ack(sh_wr_ack), .ex_rd_idx(sh_rd_idx), .ex_rd_data(sh_rd_data), .ex_rd_valid(sh_rd_valid),
     .err_set(ex_err | {mem_err || scan_err, 6'd0}), .core_range_err(core_range_err),
     .core_idle(core_idle && !cmd_valid), .core_drain(core_drain), .busy(device_busy), .vblank(vblank),
     .swap_pending(swap_pending_w), .frame_count(frame_count), .frame_crc(frame_crc), .mem_ready(mem_ready),
@@ -186,23 +182,22 @@ module spigpu_soc #(
     .strict(link_strict), .discarding(link_discarding), .release_held(link_release), .discard_held(link_discard),
     .err_link_crc(err_link_crc), .link_status(link_status));
 
-  command_fifo #(.DEPTH(FIFO_DEPTH), .AW(FIFO_AW), .HEAD(PROFILE == 1 ? 1 : 0), .W(CLS_W + 71)) u_fifo (
-    .clk(clk), .rst(rst_any), .push(fifo_push), .push_held(fifo_push_held), .push_entry({fifo_class, fifo_entry}),
+  command_fifo #(.DEPTH(FIFO_DEPTH), .AW(FIFO_AW), .HEAD(PROFILE == 1 ? 1 : 0)) u_fifo (
+    .clk(clk), .rst(rst_any), .push(fifo_push), .push_held(fifo_push_held), .push_entry(fifo_entry),
     .release_held(link_release), .discard_held(link_discard), .full(fifo_full), .nearly_full(fifo_nearly_full),
     .level(fifo_level), .held(fifo_held), .out_valid(fifo_out_valid), .out_entry(fifo_out), .read_any(fifo_read_any),
     .pop(fifo_pop));
   assign busy_pin = fifo_nearly_full;
 
   // --- executor ---
-  wire        mem_set_addr, mem_write, mem_ack_set, mem_ack_write, executed, core_stall;
+  wire        mem_set_addr, mem_write, mem_op_ack, executed, core_stall;
   wire [63:0] mem_op_data;
   wire        swap_req, swap_ready, waiting_vsync;
   wire [27:0] swap_addr;
   command_exec #(.FEATURES(FEATURES), .MAX_WIDTH(MAX_WIDTH), .MAX_HEIGHT(MAX_HEIGHT), .VRAM_KIB(VRAM_KIB), .DEPTH(DEPTH),
                  .VPORT(PROFILE == 0 ? 1 : 0)) u_exec (
-    .clk(clk), .rst(rst_any), .in_valid(fifo_out_valid), .in_class(fifo_out[CLS_W+70:71]), .in_entry(fifo_out[70:0]),
-    .in_pop(fifo_pop),
-    .sh_wr_req(sh_wr_req), .sh_wr_idx(sh_wr_idx), .sh_wr_data(sh_wr_data), .sh_wr_free(sh_wr_free),
+    .clk(clk), .rst(rst_any), .in_valid(fifo_out_valid), .in_entry(fifo_out), .in_pop(fifo_pop),
+    .sh_wr_req(sh_wr_req), .sh_wr_idx(sh_wr_idx), .sh_wr_data(sh_wr_data), .sh_wr_ack(sh_wr_ack),
     .sh_rd_idx(sh_rd_idx), .sh_rd_data(sh_rd_data), .sh_rd_valid(sh_rd_valid),
     .err_set(ex_err), .core_drain(core_drain), .cmd_valid(cmd_valid), .cmd_ready(cmd_ready), .cmd_op(cmd_op),
     .cmd_tri_mode(cmd_tri_mode), .cmd_tex_base(cmd_tex_base), .cmd_tex_fmt(cmd_tex_fmt), .cmd_scissor(cmd_scissor),
@@ -210,8 +205,7 @@ module spigpu_soc #(
     .cmd_fb_height(cmd_fb_height), .cmd_clear_color(cmd_clear_color), .cmd_clear_depth(cmd_clear_depth),
     .cmd_v0(cmd_v0), .cmd_v1(cmd_v1), .cmd_v2(cmd_v2), .vp_addr(vp_addr), .vp_data(vp_data),
     .core_idle(core_idle), .mem_set_addr(mem_set_addr),
-    .mem_write(mem_write), .mem_op_data(mem_op_data), .mem_ack_set(mem_ack_set),
-    .mem_ack_write(mem_ack_write), .mem_idle(mem_ex_idle),
+    .mem_write(mem_write), .mem_op_data(mem_op_data), .mem_op_ack(mem_op_ack), .mem_idle(mem_ex_idle),
     .swap_req(swap_req), .swap_addr(swap_addr), .swap_ready(swap_ready), .waiting_vsync(waiting_vsync),
     .executed(executed));
 
@@ -226,7 +220,7 @@ module spigpu_soc #(
   wire [VAW:0] prot_lo, prot_hi;
   mem_access #(.UNITS_L2(VAW - 1)) u_mem (
     .clk(clk), .rst(rst), .soft_reset(soft_reset), .set_addr(mem_set_addr), .write(mem_write),
-    .op_data(mem_op_data), .ack_set(mem_ack_set), .ack_write(mem_ack_write), .ex_idle(mem_ex_idle), .read_strobe(mem_read_strobe), .addr(mem_addr),
+    .op_data(mem_op_data), .op_ack(mem_op_ack), .ex_idle(mem_ex_idle), .read_strobe(mem_read_strobe), .addr(mem_addr),
     .prefetch(prefetch), .mem_ready(mem_ready), .err_range(mem_err), .req_valid(m_req_valid),
     .req_ready(m_req_ready), .req_we(m_req_we), .req_addr(m_req_addr), .req_wdata(m_req_wdata),
     .rsp_valid(m_rsp_valid), .rsp_rdata(rsp_rdata));
