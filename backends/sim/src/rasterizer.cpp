@@ -3,9 +3,11 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <optional>
 #include <utility>
 
+#include "color_cursor.hpp"
 #include "narrow_simd.hpp"
 #include "pixel.hpp"
 #include "preview_plain.hpp"
@@ -246,7 +248,10 @@ class Kernel {
       hz_rejected_ = (hz & kHzRejected) != 0;
     }
     const std::uint64_t passed_before = ctx_.counters.passed;
-    const int mark_from = w >= kSpanSolveWidth ? run_wide(ya, yz, hz) : run_narrow(ya, yz);
+    int mark_from;
+    if (w < kSpanSolveWidth) mark_from = run_narrow(ya, yz);
+    else if (kGouraud && ctx_.vector && t_.den < (std::int64_t{1} << 30)) mark_from = run_wide<true>(ya, yz, hz);
+    else mark_from = run_wide<false>(ya, yz, hz);
     // Blocks this run wrote into: read again when another run asks (their bounds only got looser).
     if (kDepth && ctx_.hier_z && st_.z_write && ctx_.counters.passed != passed_before)
       ctx_.hier_z->mark(mark_from, yz, t_.x0, t_.x1 - 1, hz_run_);
@@ -274,7 +279,7 @@ class Kernel {
       for (int kx = 0; kx < w; ++kx) {
         if ((f0 | f1 | f2) >= 0) {
           ++ctx_.counters.covered;
-          pixel(t_.x0 + kx, y, s);
+          pixel(t_.x0 + kx, y, s, rgba_of(s));
         }
         f0 += x0;
         f1 += x1;
@@ -295,8 +300,12 @@ class Kernel {
   // the next row's first pixel (cur_, move), spans of kMinSimdSpan pixels or more through the span
   // routine, shorter ones pixel by pixel. Whole 16-row bands are asked first (band_occluded); rows
   // of a band that is not rejected are asked one by one (occluded). Returns the first row a pixel
-  // may have been written in.
+  // may have been written in. kLanes: the colour planes of the cursor and of short spans step in one
+  // 4-lane vector (color_cursor.hpp; Gouraud draws with den < 2^30), the other planes as scalars.
+  template <bool kLanes>
   int run_wide(int ya, int yz, unsigned hz) {
+    constexpr unsigned kScalar = scalar_planes<kLanes>();
+    if constexpr (kLanes) prepare_lanes();
     const int w = t_.x1 - t_.x0;
     const bool bands = kDepth && ctx_.hier_z;
     int mark_from = ya;
@@ -333,23 +342,35 @@ class Kernel {
         std::int64_t kl, kr;
         walk_.span_and_step(t_, w, kl, kr);
         if (kl > kr) {  // no sample covered: the cursor stays in its column
-          if (anchored) step_y(cur_);
+          if (anchored) {
+            step_y<kScalar>(cur_);
+            if constexpr (kLanes) ccur_.step(cy_, cden_);
+          }
           continue;
         }
         if (!anchored) {
           cur_ = anchor(y, kl);
+          if constexpr (kLanes) ccur_ = color_lanes(cur_.q, cur_.r);
           anchored = true;
         } else {
-          move(kl - col_);
+          move<kLanes>(kl - col_);
         }
         col_ = kl;
         if (simd_ && y + kPrefetchRows < yz) prefetch_row(y + kPrefetchRows, t_.x0 + static_cast<int>(kl), static_cast<int>(kr - kl + 1));
         if (kr - kl + 1 >= kMinSimdSpan && simd_ready()) {
-          if (!occluded(kl, kr, y)) simd_span(t_.x0 + static_cast<int>(kl), y, static_cast<unsigned>(kr - kl + 1));
+          if (!occluded(kl, kr, y)) simd_span<kLanes>(t_.x0 + static_cast<int>(kl), y, static_cast<unsigned>(kr - kl + 1));
+        } else if constexpr (kLanes) {
+          Steppers s = cur_;  // the planes other than colour
+          ColorLanes c = ccur_;
+          for (std::int64_t kx = kl; kx <= kr; ++kx) {
+            pixel(t_.x0 + static_cast<int>(kx), y, s, c.rgba());
+            step_x<kScalar>(s);
+            c.step(cx_, cden_);
+          }
         } else {
           Steppers s = cur_;
           for (std::int64_t kx = kl; kx <= kr; ++kx) {
-            pixel(t_.x0 + static_cast<int>(kx), y, s);
+            pixel(t_.x0 + static_cast<int>(kx), y, s, rgba_of(s));
             step_x(s);
           }
         }
@@ -378,6 +399,7 @@ class Kernel {
   // step, (qy + d·qx + f, ry + d·rx − f·den) with f = floor((ry + d·rx) / den), and one carry. A
   // straight edge moves the span's start by one of two distances a row, so the last two steps are
   // kept (steps_) and a division is paid only when the distance changes (at a vertex).
+  template <bool kLanes>
   void move(std::int64_t d) {
     unsigned slot = steps_[1].d == d ? 1u : 0u;
     if (steps_[slot].d != d) {
@@ -392,10 +414,12 @@ class Kernel {
         c.q[i] = p.qy + d * p.qx + f.q;
         c.r[i] = f.r;
       }
+      if constexpr (kLanes) c.c = color_lanes(c.q, c.r);
     }
     const CursorStep& c = steps_[slot];
+    if constexpr (kLanes) ccur_.step(c.c, cden_);
     for (unsigned i = 0; i < kAttrCount; ++i) {
-      if (!((kPlanes >> i) & 1)) continue;
+      if (!((scalar_planes<kLanes>() >> i) & 1)) continue;
       cur_.q[i] += c.q[i];
       cur_.r[i] += c.r[i];
       const bool carry = cur_.r[i] >= t_.den;
@@ -404,9 +428,48 @@ class Kernel {
     }
   }
 
+  // The planes stepped as scalars: all but the colour planes when they step in lanes.
+  template <bool kLanes>
+  static constexpr unsigned scalar_planes() { return kLanes ? kPlanes & ~0xFu : kPlanes; }
+  // The colour planes of (q, r) in lanes: quotients modulo 2^32, remainders below den < 2^30.
+  static ColorLanes color_lanes(const std::int64_t* q, const std::int64_t* r) {
+    ColorLanes c;
+    for (unsigned i = 0; i < 4; ++i) {
+      c.q[i] = static_cast<std::int32_t>(static_cast<std::uint32_t>(q[kR + i]));
+      c.r[i] = static_cast<std::int32_t>(r[kR + i]);
+    }
+    return c;
+  }
+  // The lanes' x and y steps and den (run_wide<true>, once per run).
+  void prepare_lanes() {
+    std::int64_t q[kAttrCount], r[kAttrCount];
+    for (unsigned i = 0; i < 4; ++i) {
+      q[kR + i] = t_.plane[kR + i].qx;
+      r[kR + i] = t_.plane[kR + i].rx;
+    }
+    cx_ = color_lanes(q, r);
+    for (unsigned i = 0; i < 4; ++i) {
+      q[kR + i] = t_.plane[kR + i].qy;
+      r[kR + i] = t_.plane[kR + i].ry;
+    }
+    cy_ = color_lanes(q, r);
+    const std::int32_t den = static_cast<std::int32_t>(t_.den);
+    cden_ = i32x4{den, den, den, den};
+  }
+  // A pixel's Gouraud colour (pixel()) from scalar planes.
+  static std::uint32_t rgba_of(const Steppers& s) {
+    if constexpr (kGouraud) {
+      return pack_rgba(static_cast<std::uint32_t>(s.q[kR]), static_cast<std::uint32_t>(s.q[kG]),
+                       static_cast<std::uint32_t>(s.q[kB]), static_cast<std::uint32_t>(s.q[kA]));
+    } else {
+      return 0;
+    }
+  }
+
+  template <unsigned kMask = kPlanes>
   void step_x(Steppers& s) const {
     for (unsigned i = 0; i < kAttrCount; ++i) {
-      if (!((kPlanes >> i) & 1)) continue;
+      if (!((kMask >> i) & 1)) continue;
       s.q[i] += t_.plane[i].qx;
       s.r[i] += t_.plane[i].rx;
       const bool carry = s.r[i] >= t_.den;
@@ -414,9 +477,10 @@ class Kernel {
       s.q[i] += carry;
     }
   }
+  template <unsigned kMask = kPlanes>
   void step_y(Steppers& s) const {
     for (unsigned i = 0; i < kAttrCount; ++i) {
-      if (!((kPlanes >> i) & 1)) continue;
+      if (!((kMask >> i) & 1)) continue;
       s.q[i] += t_.plane[i].qy;
       s.r[i] += t_.plane[i].ry;
       const bool carry = s.r[i] >= t_.den;
@@ -531,10 +595,15 @@ class Kernel {
   }
 
   // A span whose first pixel is x (the cursor's planes).
+  template <bool kLanes>
   void simd_span(int x, int y, unsigned count) {
     SimdSpan& sp = simd_tpl_;
+    if constexpr (kLanes) {
+      std::memcpy(sp.q0, &ccur_.q, sizeof ccur_.q);
+      std::memcpy(sp.r0, &ccur_.r, sizeof ccur_.r);
+    }
     // Planes the draw does not use keep the template's zeros (simd_tpl_ is value-initialised).
-    for (unsigned p = 0; p < SimdSpan::kPlanes; ++p) {
+    for (unsigned p = kLanes ? 4 : 0; p < SimdSpan::kPlanes; ++p) {
       if (!simd_plane_used(p)) continue;
       sp.q0[p] = static_cast<std::uint32_t>(cur_.q[kR + p]);
       sp.r0[p] = static_cast<std::uint32_t>(cur_.r[kR + p]);
@@ -552,7 +621,8 @@ class Kernel {
     if (kTextured) textured_ += passed;
   }
 
-  [[gnu::always_inline]] void pixel(int x, int y, const Steppers& s) {
+  // The pixel at (x, y) with the planes s (colour, when Gouraud, as the word rgba: pack_rgba).
+  [[gnu::always_inline]] void pixel(int x, int y, const Steppers& s, std::uint32_t rgba) {
     const std::size_t pix = static_cast<std::size_t>(y) * width_ + static_cast<std::size_t>(x);
     if constexpr (kDepth) {
       const std::uint32_t z = static_cast<std::uint32_t>(s.q[kZ]) & zmask_;
@@ -571,10 +641,16 @@ class Kernel {
     }
     ++ctx_.counters.passed;
     if (skip_color_) return;
+    if constexpr (kSimple && kGouraud && !kTextured) {
+      if (st_.color_in_vram) {
+        store_rgba(color_ + pix * 4, rgba);
+        return;
+      }
+    }
     Rgba8 c = flat_;
     if constexpr (kGouraud) {
-      c = {static_cast<std::uint8_t>(s.q[kR]), static_cast<std::uint8_t>(s.q[kG]), static_cast<std::uint8_t>(s.q[kB]),
-           static_cast<std::uint8_t>(s.q[kA])};
+      c = {static_cast<std::uint8_t>(rgba), static_cast<std::uint8_t>(rgba >> 8), static_cast<std::uint8_t>(rgba >> 16),
+           static_cast<std::uint8_t>(rgba >> 24)};
     }
     if constexpr (kTextured) {
       ++textured_;  // counted here, added to the context once per run (no per-pixel store through ctx_)
@@ -643,9 +719,13 @@ class Kernel {
   EdgeWalk walk_{};
   Steppers cur_{};
   std::int64_t col_ = 0;
+  // run_wide<true>: the cursor's colour planes (cur_'s are then stale), their x and y steps, den.
+  ColorLanes ccur_{}, cx_{}, cy_{};
+  i32x4 cden_{};
   struct CursorStep {
     std::int64_t d = INT64_MIN;  // the distance it moves the span's start (INT64_MIN: none yet)
     std::int64_t q[kAttrCount], r[kAttrCount];
+    ColorLanes c;  // the colour planes' step in lanes (run_wide<true>)
   } steps_[2];
   unsigned victim_ = 0;  // the step to replace next
 };
