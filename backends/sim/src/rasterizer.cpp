@@ -262,6 +262,7 @@ class Kernel {
     if constexpr (kTextured) {
       ctx_.counters.textured += textured_;
       ctx_.counters.texel_bytes += textured_ * (st_.tex.bilinear ? 4u : 1u) * protocol::bytes_per_pixel(st_.tex.format);
+      textured_ = 0;  // the next run (a later band of the same Kernel) counts afresh
     }
   }
 
@@ -737,12 +738,38 @@ class Kernel {
   unsigned victim_ = 0;  // the step to replace next
 };
 
+// The rows [ya, yz) of a wide triangle: rasterize_rows's leading band tests (the triangle's
+// first 16-row bands of blocks asked before a Kernel is built: a triangle whose bands are all
+// rejected costs their span solves only, no Kernel set-up, plane advance or row loop). Moves ya past
+// the rejected bands and says what was found in hz (Kernel::run's); false when no row is left.
+bool ask_leading_bands(const Triangle& t, const DrawState& st, RasterContext& ctx, int& ya, int yz, unsigned& hz);
+bool draw_narrow(const Triangle& t, const DrawState& st, RasterContext& ctx, int ya, int yz, bool gouraud, bool depth);
+
+// Rows [ya, yz), then [ya + stride, yz + stride) and so on while ya < end (stride 0: one run), all
+// clipped to the box: one Kernel for all of them (a band worker's 16-row bands of one triangle),
+// built when the first run needs it, so its set-up (edge dividers, lane steps, the span template,
+// the cursor's cached steps) is paid once per triangle, not once per band. Boxes up to 8 wide try
+// the small-triangle routine per run first (its edge range check depends on the rows).
 template <bool G, bool T, bool Z, bool S>
-void run_kernel(const Triangle& t, const DrawState& st, RasterContext& ctx, int ya, int yz, unsigned hz) {
-  Kernel<G, T, Z, S>(t, st, ctx).run(ya, yz, hz);
+void run_kernel(const Triangle& t, const DrawState& st, RasterContext& ctx, int ya, int yz, int stride, int end) {
+  std::optional<Kernel<G, T, Z, S>> kernel;
+  for (;; ya += stride, yz += stride) {
+    int a = std::max(ya, t.y0);
+    const int z = std::min(yz, t.y1);
+    if (a < z) {
+      unsigned hz = 0;
+      if (ctx.vector && t.x1 - t.x0 <= 8 && draw_narrow(t, st, ctx, a, z, G, Z)) {
+        // drawn by the small-triangle routine
+      } else if (ask_leading_bands(t, st, ctx, a, z, hz)) {
+        if (!kernel) kernel.emplace(t, st, ctx);
+        kernel->run(a, z, hz);
+      }
+    }
+    if (stride == 0 || ya + stride >= end) return;
+  }
 }
 
-using KernelFn = void (*)(const Triangle&, const DrawState&, RasterContext&, int, int, unsigned);
+using KernelFn = void (*)(const Triangle&, const DrawState&, RasterContext&, int, int, int, int);
 
 // What a vector kernel drew, into the timing model's counters: `passed` pixels were blended when
 // `blended` and textured (their texel reads by the filter's footprint) when `textured`.
@@ -924,51 +951,72 @@ SmallDraw small_draw(const DrawState& st, VideoMemory& mem, unsigned z_bits) {
   return d;
 }
 
-void rasterize_rows(const Triangle& t, const DrawState& st, RasterContext& ctx, int row_begin, int row_end) {
-  int ya = std::max(row_begin, t.y0);
-  const int yz = std::min(row_end, t.y1);
-  if (ya >= yz) return;
+namespace {
+
+bool ask_leading_bands(const Triangle& t, const DrawState& st, RasterContext& ctx, int& ya, int yz, unsigned& hz) {
+  if (!ctx.hier_z || !(st.z_test || st.z_write) || t.x1 - t.x0 < kSpanSolveWidth) return true;
+  const std::uint32_t run = HierZ::next_run(ctx.hz_run), zmask = z_mask(ctx);
+  std::optional<std::array<Divider, 3>> div;
+  EdgeWalk walk;  // from row ya once a band is rejected
+  std::optional<BandClip> clip;
+  for (;;) {
+    const int end = std::min(yz, (ya | ((1 << HierZ::kRowsLog) - 1)) + 1);
+    if (!ctx.hier_z->band_worth_asking(ya >> HierZ::kRowsLog)) {
+      hz |= kHzFirstAsked;  // not asked this time (HierZ::band_worth_asking): the Kernel does not ask either
+      return true;
+    }
+    if (!ask_band(t, clip, st, ctx, zmask, ya, end - 1, run)) {
+      hz |= kHzFirstAsked;
+      return true;
+    }
+    if (!div) {
+      div.emplace(std::array<Divider, 3>{edge_divider(t.edge[0]), edge_divider(t.edge[1]), edge_divider(t.edge[2])});
+      walk.prepare(t, div->data());
+      walk.start(t, div->data(), ya);
+    }
+    walk.count(t, end - ya, ctx.counters);
+    hz |= kHzRejected;
+    ya = end;
+    if (ya >= yz) return false;
+  }
+}
+
+// The exact kernel for t's state (rasterize_rows, rasterize_bands).
+KernelFn kernel_for(const Triangle& t, const DrawState& st) {
   bool colors_differ = false;
   for (unsigned ch = 0; ch < 4; ++ch) colors_differ |= !t.plane[kR + ch].constant;
-  const bool gouraud = st.gouraud && colors_differ;   // Gouraud only when colours differ
+  const bool gouraud = st.gouraud && colors_differ;  // Gouraud only when colours differ
   const bool depth = st.z_test || st.z_write;
-  if (t.preview) {
-    if (st.preview_plain) return draw_preview_plain(t, st, ctx, ya, yz, depth);
-    return draw_preview(t, st, ctx, ya, yz, gouraud, depth);
-  }
-  if (ctx.vector && draw_narrow(t, st, ctx, ya, yz, gouraud, depth)) return;
-  // The run's leading 16-row bands are asked before a Kernel is built (Kernel::run asks the rest):
-  // a triangle whose bands are all rejected costs their span solves only, no Kernel set-up, plane
-  // advance or row loop.
-  unsigned hz = 0;
-  if (ctx.hier_z && depth && t.x1 - t.x0 >= kSpanSolveWidth) {
-    const std::uint32_t run = HierZ::next_run(ctx.hz_run), zmask = z_mask(ctx);
-    std::optional<std::array<Divider, 3>> div;
-    EdgeWalk walk;  // from row ya once a band is rejected
-    std::optional<BandClip> clip;
-    for (;;) {
-      const int end = std::min(yz, (ya | ((1 << HierZ::kRowsLog) - 1)) + 1);
-      if (!ctx.hier_z->band_worth_asking(ya >> HierZ::kRowsLog)) {
-        hz |= kHzFirstAsked;  // not asked this time (HierZ::band_worth_asking): the Kernel does not ask either
-        break;
-      }
-      if (!ask_band(t, clip, st, ctx, zmask, ya, end - 1, run)) {
-        hz |= kHzFirstAsked;
-        break;
-      }
-      if (!div) {
-        div.emplace(std::array<Divider, 3>{edge_divider(t.edge[0]), edge_divider(t.edge[1]), edge_divider(t.edge[2])});
-        walk.prepare(t, div->data());
-        walk.start(t, div->data(), ya);
-      }
-      walk.count(t, end - ya, ctx.counters);
-      hz |= kHzRejected;
-      ya = end;
-      if (ya >= yz) return;
-    }
-  }
   const unsigned key = (gouraud ? 1u : 0u) | (st.textured ? 2u : 0u) | (depth ? 4u : 0u) | (st.simple_color ? 8u : 0u);
-  kKernels[key](t, st, ctx, ya, yz, hz);
+  return kKernels[key];
+}
+
+}  // namespace
+
+void rasterize_rows(const Triangle& t, const DrawState& st, RasterContext& ctx, int row_begin, int row_end) {
+  const int ya = std::max(row_begin, t.y0);
+  const int yz = std::min(row_end, t.y1);
+  if (ya >= yz) return;
+  if (t.preview) {
+    bool colors_differ = false;
+    for (unsigned ch = 0; ch < 4; ++ch) colors_differ |= !t.plane[kR + ch].constant;
+    const bool depth = st.z_test || st.z_write;
+    if (st.preview_plain) return draw_preview_plain(t, st, ctx, ya, yz, depth);
+    return draw_preview(t, st, ctx, ya, yz, st.gouraud && colors_differ, depth);
+  }
+  kernel_for(t, st)(t, st, ctx, ya, yz, 0, yz);
+}
+
+void rasterize_bands(const Triangle& t, const DrawState& st, RasterContext& ctx, int row_begin, int row_end, int stride) {
+  if (t.preview || stride <= 0) {
+    for (; row_begin < t.y1; row_begin += stride, row_end += stride) {
+      rasterize_rows(t, st, ctx, row_begin, row_end);
+      if (stride <= 0) return;
+    }
+    return;
+  }
+  if (row_begin >= t.y1) return;
+  kernel_for(t, st)(t, st, ctx, row_begin, row_end, stride, t.y1);
 }
 
 void observe_triangle(const Triangle& t, const DrawState& st, const PixelObserver& observer) {
