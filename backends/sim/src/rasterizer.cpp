@@ -318,6 +318,27 @@ class Kernel {
     bool first = true;
     bool walking = false;  // walk_ holds row y's quotients
     bool anchored = false;  // cur_ holds the planes at (y - 1, col_) (false before the first drawn row and after a rejected band)
+    bool resumed = false;   // the cursor was carried over a gap and has not moved since
+    if (walk_ok_ && ya > ended_at_) {
+      // A later band of the same triangle (rasterize_bands): the walk and the cursor where the last
+      // run left them, carried over the rows between (other workers' bands) in one step each.
+      const int gap = ya - ended_at_;
+      if (gap != gap_) prepare_gap(gap);
+      for (int i = 0; i < 3; ++i) {
+        walk_.q[i] += gap_walk_.q[i];
+        walk_.r[i] += gap_walk_.r[i];
+        const bool carry = walk_.r[i] >= walk_.d[i];
+        walk_.r[i] -= carry ? walk_.d[i] : 0;
+        walk_.q[i] += carry;
+      }
+      walking = true;
+      if (cursor_ok_) {
+        carry_step<kScalar>(cur_, gap_cursor_);
+        if constexpr (kLanes) ccur_.step(gap_color_, cden_);
+        anchored = true;
+        resumed = true;
+      }
+    }
     for (int y = ya; y < yz;) {
       const int end = std::min(yz, (y | ((1 << HierZ::kRowsLog) - 1)) + 1);  // this band's rows
       // A new 16-row band of blocks: its tries afresh (HierZ::band_asks_afresh).
@@ -359,7 +380,8 @@ class Kernel {
           if constexpr (kLanes) ccur_ = color_lanes(cur_.q, cur_.r);
           anchored = true;
         } else {
-          move<kLanes>(kl - col_);
+          move<kLanes>(kl - col_, !resumed);
+          resumed = false;
         }
         col_ = kl;
         if (simd_ && y + kPrefetchRows < yz) prefetch_row(y + kPrefetchRows, t_.x0 + static_cast<int>(kl), static_cast<int>(kr - kl + 1));
@@ -386,7 +408,41 @@ class Kernel {
         ctx_.counters.covered += static_cast<std::uint64_t>(kr - kl + 1);
       }
     }
+    walk_ok_ = walking;  // the walk at row yz, the cursor at (yz - 1, col_)
+    cursor_ok_ = anchored;
+    ended_at_ = yz;
     return mark_from;
+  }
+
+  // The steps over `gap` rows between two runs: each edge's floor-divmod(gap·ey, |ex|) and each
+  // plane's (gap·qy + f, gap·ry − f·den), f = floor(gap·ry / den) (the cursor stays in its column).
+  void prepare_gap(int gap) {
+    gap_ = gap;
+    for (int i = 0; i < 3; ++i) {
+      const DivMod g = edge_div_[i](gap * t_.edge[i].ey);
+      gap_walk_.q[i] = g.q;
+      gap_walk_.r[i] = g.r;
+    }
+    for (unsigned i = 0; i < kAttrCount; ++i) {
+      if (!((kPlanes >> i) & 1)) continue;
+      const Plane& p = t_.plane[i];
+      const DivMod f = den_div_(gap * p.ry);  // gap < 2^16, ry < 2^36
+      gap_cursor_.q[i] = gap * p.qy + f.q;
+      gap_cursor_.r[i] = f.r;
+    }
+    if constexpr (kGouraud) gap_color_ = color_lanes(gap_cursor_.q, gap_cursor_.r);
+  }
+  // s advanced by the step (q, r) of each plane in kMask (r in [0, den)) and one carry.
+  template <unsigned kMask>
+  void carry_step(Steppers& s, const Steppers& step) const {
+    for (unsigned i = 0; i < kAttrCount; ++i) {
+      if (!((kMask >> i) & 1)) continue;
+      s.q[i] += step.q[i];
+      s.r[i] += step.r[i];
+      const bool carry = s.r[i] >= t_.den;
+      s.r[i] -= carry ? t_.den : 0;
+      s.q[i] += carry;
+    }
   }
 
   // The planes at (y, kx): the triangle's planes advanced y − y0 rows (exact, 128-bit) and jumped
@@ -407,13 +463,20 @@ class Kernel {
   // step, (qy + d·qx + f, ry + d·rx − f·den) with f = floor((ry + d·rx) / den), and one carry. A
   // straight edge moves the span's start by one of two distances a row, so the last two steps are
   // kept (steps_) and a division is paid only when the distance changes (at a vertex).
+  // `keep` false: a step not among the last two is used once and not kept (the first drawn row
+  // after a gap between runs moves by a distance of its own, which would evict a row's step).
   template <bool kLanes>
-  void move(std::int64_t d) {
+  void move(std::int64_t d, bool keep = true) {
     unsigned slot = steps_[1].d == d ? 1u : 0u;
+    CursorStep once;
+    const CursorStep* step = &steps_[slot];
     if (steps_[slot].d != d) {
-      slot = victim_;
-      victim_ ^= 1u;
-      CursorStep& c = steps_[slot];
+      if (keep) {
+        slot = victim_;
+        victim_ ^= 1u;
+      }
+      CursorStep& c = keep ? steps_[slot] : once;
+      step = &c;
       c.d = d;
       for (unsigned i = 0; i < kAttrCount; ++i) {
         if (!((kPlanes >> i) & 1)) continue;
@@ -424,7 +487,7 @@ class Kernel {
       }
       if constexpr (kLanes) c.c = color_lanes(c.q, c.r);
     }
-    const CursorStep& c = steps_[slot];
+    const CursorStep& c = *step;
     if constexpr (kLanes) ccur_.step(c.c, cden_);
     for (unsigned i = 0; i < kAttrCount; ++i) {
       if (!((scalar_planes<kLanes>() >> i) & 1)) continue;
@@ -736,6 +799,15 @@ class Kernel {
     ColorLanes c;  // the colour planes' step in lanes (run_wide<true>)
   } steps_[2];
   unsigned victim_ = 0;  // the step to replace next
+  // Between runs of one Kernel (rasterize_bands): whether the walk (at row ended_at_) and the cursor
+  // (at row ended_at_ − 1) are valid, and the steps over the last gap (prepare_gap).
+  bool walk_ok_ = false, cursor_ok_ = false;
+  int ended_at_ = 0, gap_ = 0;
+  struct {
+    std::int64_t q[3], r[3];
+  } gap_walk_{};
+  Steppers gap_cursor_{};
+  ColorLanes gap_color_{};
 };
 
 // The rows [ya, yz) of a wide triangle: rasterize_rows's leading band tests (the triangle's
