@@ -56,12 +56,18 @@ inline void set_pixel_lanes(PixelLanes& px, const DrawState& st, const RasterCon
   px.z_write = depth && st.z_write;
 }
 
-// Rows this long or longer find their covered span from the edge walk instead of testing every pixel
-// (boxes up to 8 wide take the small-triangle routine, narrow_simd.hpp). It was 16 while a row's
-// span ends cost divisions; with the edge walk's steps, boxes of 9-15 pixels (tall slivers: the
-// fan's near-vertical ones) cost less walked than tested pixel by pixel (fan 0.400 -> 0.350 G
-// instructions, tri10-front 1.481 -> 1.463 G; docs/simulator.md, "sim-narrow").
-constexpr int kSpanSolveWidth = 9;
+// Boxes this wide or wider find each row's covered span from the edge walk instead of testing every
+// pixel of the box row (boxes up to 8 wide take the small-triangle routine, narrow_simd.hpp).
+constexpr int kSpanSolveWidth = 16;
+// So do boxes of 9-15 pixels at least this tall (tall slivers: the fan's near-vertical ones), which
+// cost less walked than tested pixel by pixel (fan 0.400 -> 0.350 G instructions). Short ones keep
+// the pixel test: walked, the 10-px triangles lost 10 % CPU time for 1 % fewer instructions.
+constexpr int kSpanSolveTall = 24;
+// Whether t's rows take the edge walk (Kernel::run_wide).
+inline bool walks_rows(const Triangle& t) {
+  const int w = t.x1 - t.x0;
+  return w >= kSpanSolveWidth || (w > 8 && t.y1 - t.y0 >= kSpanSolveTall);
+}
 // Jumps along a row shorter than this are stepped instead of divided (the cursor's anchor).
 constexpr std::int64_t kStepJump = 4;
 // Rows this far ahead of the one being drawn are prefetched.
@@ -229,7 +235,7 @@ class Kernel {
     } else {
       flat_ = {t.flat[0], t.flat[1], t.flat[2], t.flat[3]};
     }
-    if (t.x1 - t.x0 >= kSpanSolveWidth) {  // only wide rows walk their span ends
+    if (walks_rows(t)) {  // only walked rows need the edge steps
       for (int i = 0; i < 3; ++i) {
         edge_div_[i] = edge_divider(t.edge[i]);
       }
@@ -245,7 +251,6 @@ class Kernel {
   // built (rasterize_rows): the first band was asked and not rejected, and whether bands before ya
   // were rejected.
   void run(int ya, int yz, unsigned hz) {
-    const int w = t_.x1 - t_.x0;
     if (kDepth && ctx_.hier_z) {
       hz_run_ = HierZ::next_run(ctx_.hz_run);
       hz_tries_ = HierZ::kTries;
@@ -253,7 +258,7 @@ class Kernel {
     }
     const std::uint64_t passed_before = ctx_.counters.passed;
     int mark_from;
-    if (w < kSpanSolveWidth) mark_from = run_narrow(ya, yz);
+    if (!walks_rows(t_)) mark_from = run_narrow(ya, yz);
     else if (kGouraud && ctx_.vector && t_.den < (std::int64_t{1} << 30)) mark_from = run_wide<true>(ya, yz, hz);
     else mark_from = run_wide<false>(ya, yz, hz);
     // Blocks this run wrote into: read again when another run asks (their bounds only got looser).
@@ -815,13 +820,12 @@ class Kernel {
 // rejected costs their span solves only, no Kernel set-up, plane advance or row loop). Moves ya past
 // the rejected bands and says what was found in hz (Kernel::run's); false when no row is left.
 bool ask_leading_bands(const Triangle& t, const DrawState& st, RasterContext& ctx, int& ya, int yz, unsigned& hz);
-bool draw_narrow(const Triangle& t, const DrawState& st, RasterContext& ctx, int ya, int yz, bool gouraud, bool depth);
 
 // Rows [ya, yz), then [ya + stride, yz + stride) and so on while ya < end (stride 0: one run), all
 // clipped to the box: one Kernel for all of them (a band worker's 16-row bands of one triangle),
 // built when the first run needs it, so its set-up (edge dividers, lane steps, the span template,
-// the cursor's cached steps) is paid once per triangle, not once per band. Boxes up to 8 wide try
-// the small-triangle routine per run first (its edge range check depends on the rows).
+// the cursor's cached steps) is paid once per triangle, not once per band. The caller has tried
+// the small-triangle routine (draw_narrow) where it applies.
 template <bool G, bool T, bool Z, bool S>
 void run_kernel(const Triangle& t, const DrawState& st, RasterContext& ctx, int ya, int yz, int stride, int end) {
   std::optional<Kernel<G, T, Z, S>> kernel;
@@ -830,9 +834,7 @@ void run_kernel(const Triangle& t, const DrawState& st, RasterContext& ctx, int 
     const int z = std::min(yz, t.y1);
     if (a < z) {
       unsigned hz = 0;
-      if (ctx.vector && t.x1 - t.x0 <= 8 && draw_narrow(t, st, ctx, a, z, G, Z)) {
-        // drawn by the small-triangle routine
-      } else if (ask_leading_bands(t, st, ctx, a, z, hz)) {
+      if (ask_leading_bands(t, st, ctx, a, z, hz)) {
         if (!kernel) kernel.emplace(t, st, ctx);
         kernel->run(a, z, hz);
       }
@@ -1026,7 +1028,7 @@ SmallDraw small_draw(const DrawState& st, VideoMemory& mem, unsigned z_bits) {
 namespace {
 
 bool ask_leading_bands(const Triangle& t, const DrawState& st, RasterContext& ctx, int& ya, int yz, unsigned& hz) {
-  if (!ctx.hier_z || !(st.z_test || st.z_write) || t.x1 - t.x0 < kSpanSolveWidth) return true;
+  if (!ctx.hier_z || !(st.z_test || st.z_write) || !walks_rows(t)) return true;
   const std::uint32_t run = HierZ::next_run(ctx.hz_run), zmask = z_mask(ctx);
   std::optional<std::array<Divider, 3>> div;
   EdgeWalk walk;  // from row ya once a band is rejected
@@ -1069,18 +1071,20 @@ void rasterize_rows(const Triangle& t, const DrawState& st, RasterContext& ctx, 
   const int ya = std::max(row_begin, t.y0);
   const int yz = std::min(row_end, t.y1);
   if (ya >= yz) return;
+  bool colors_differ = false;
+  for (unsigned ch = 0; ch < 4; ++ch) colors_differ |= !t.plane[kR + ch].constant;
+  const bool gouraud = st.gouraud && colors_differ;  // Gouraud only when colours differ
+  const bool depth = st.z_test || st.z_write;
   if (t.preview) {
-    bool colors_differ = false;
-    for (unsigned ch = 0; ch < 4; ++ch) colors_differ |= !t.plane[kR + ch].constant;
-    const bool depth = st.z_test || st.z_write;
     if (st.preview_plain) return draw_preview_plain(t, st, ctx, ya, yz, depth);
-    return draw_preview(t, st, ctx, ya, yz, st.gouraud && colors_differ, depth);
+    return draw_preview(t, st, ctx, ya, yz, gouraud, depth);
   }
+  if (ctx.vector && draw_narrow(t, st, ctx, ya, yz, gouraud, depth)) return;
   kernel_for(t, st)(t, st, ctx, ya, yz, 0, yz);
 }
 
 void rasterize_bands(const Triangle& t, const DrawState& st, RasterContext& ctx, int row_begin, int row_end, int stride) {
-  if (t.preview || stride <= 0) {
+  if (t.preview || stride <= 0 || t.x1 - t.x0 <= 8) {  // preview and small triangles: band by band
     for (; row_begin < t.y1; row_begin += stride, row_end += stride) {
       rasterize_rows(t, st, ctx, row_begin, row_end);
       if (stride <= 0) return;
