@@ -1058,11 +1058,15 @@ bool ask_leading_bands(const Triangle& t, const DrawState& st, RasterContext& ct
   }
 }
 
-// The exact kernel for t's state (rasterize_rows, rasterize_bands).
-KernelFn kernel_for(const Triangle& t, const DrawState& st) {
+// Gouraud only when the state asks for it and the triangle's colours differ.
+bool draws_gouraud(const Triangle& t, const DrawState& st) {
   bool colors_differ = false;
   for (unsigned ch = 0; ch < 4; ++ch) colors_differ |= !t.plane[kR + ch].constant;
-  const bool gouraud = st.gouraud && colors_differ;  // Gouraud only when colours differ
+  return st.gouraud && colors_differ;
+}
+
+// The exact kernel for a draw (rasterize_rows, rasterize_bands).
+KernelFn kernel_for(const DrawState& st, bool gouraud) {
   const bool depth = st.z_test || st.z_write;
   const unsigned key = (gouraud ? 1u : 0u) | (st.textured ? 2u : 0u) | (depth ? 4u : 0u) | (st.simple_color ? 8u : 0u);
   return kKernels[key];
@@ -1074,16 +1078,14 @@ void rasterize_rows(const Triangle& t, const DrawState& st, RasterContext& ctx, 
   const int ya = std::max(row_begin, t.y0);
   const int yz = std::min(row_end, t.y1);
   if (ya >= yz) return;
-  bool colors_differ = false;
-  for (unsigned ch = 0; ch < 4; ++ch) colors_differ |= !t.plane[kR + ch].constant;
-  const bool gouraud = st.gouraud && colors_differ;  // Gouraud only when colours differ
+  const bool gouraud = draws_gouraud(t, st);
   const bool depth = st.z_test || st.z_write;
   if (t.preview) {
     if (st.preview_plain) return draw_preview_plain(t, st, ctx, ya, yz, depth);
     return draw_preview(t, st, ctx, ya, yz, gouraud, depth);
   }
   if (ctx.vector && draw_narrow(t, st, ctx, ya, yz, gouraud, depth)) return;
-  kernel_for(t, st)(t, st, ctx, ya, yz, 0, yz);
+  kernel_for(st, gouraud)(t, st, ctx, ya, yz, 0, yz);
 }
 
 void rasterize_bands(const Triangle& t, const DrawState& st, RasterContext& ctx, int row_begin, int row_end, int stride) {
@@ -1095,7 +1097,7 @@ void rasterize_bands(const Triangle& t, const DrawState& st, RasterContext& ctx,
     return;
   }
   if (row_begin >= t.y1) return;
-  kernel_for(t, st)(t, st, ctx, row_begin, row_end, stride, t.y1);
+  kernel_for(st, draws_gouraud(t, st))(t, st, ctx, row_begin, row_end, stride, t.y1);
 }
 
 void observe_triangle(const Triangle& t, const DrawState& st, const PixelObserver& observer) {
