@@ -3,9 +3,11 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <optional>
 #include <utility>
 
+#include "color_cursor.hpp"
 #include "narrow_simd.hpp"
 #include "pixel.hpp"
 #include "preview_plain.hpp"
@@ -54,8 +56,18 @@ inline void set_pixel_lanes(PixelLanes& px, const DrawState& st, const RasterCon
   px.z_write = depth && st.z_write;
 }
 
-// Rows this long or longer find their covered span from the edge walk instead of testing every pixel.
+// Boxes this wide or wider find each row's covered span from the edge walk instead of testing every
+// pixel of the box row (boxes up to 8 wide take the small-triangle routine, narrow_simd.hpp).
 constexpr int kSpanSolveWidth = 16;
+// So do boxes of 9-15 pixels at least this tall (tall slivers: the fan's near-vertical ones), which
+// cost less walked than tested pixel by pixel (fan 0.400 -> 0.350 G instructions). Short ones keep
+// the pixel test: walked, the 10-px triangles lost 10 % CPU time for 1 % fewer instructions.
+constexpr int kSpanSolveTall = 24;
+// Whether t's rows take the edge walk (Kernel::run_wide).
+inline bool walks_rows(const Triangle& t) {
+  const int w = t.x1 - t.x0;
+  return w >= kSpanSolveWidth || (w > 8 && t.y1 - t.y0 >= kSpanSolveTall);
+}
 // Jumps along a row shorter than this are stepped instead of divided (the cursor's anchor).
 constexpr std::int64_t kStepJump = 4;
 // Rows this far ahead of the one being drawn are prefetched.
@@ -223,7 +235,7 @@ class Kernel {
     } else {
       flat_ = {t.flat[0], t.flat[1], t.flat[2], t.flat[3]};
     }
-    if (t.x1 - t.x0 >= kSpanSolveWidth) {  // only wide rows walk their span ends
+    if (walks_rows(t)) {  // only walked rows need the edge steps
       for (int i = 0; i < 3; ++i) {
         edge_div_[i] = edge_divider(t.edge[i]);
       }
@@ -239,20 +251,23 @@ class Kernel {
   // built (rasterize_rows): the first band was asked and not rejected, and whether bands before ya
   // were rejected.
   void run(int ya, int yz, unsigned hz) {
-    const int w = t_.x1 - t_.x0;
     if (kDepth && ctx_.hier_z) {
       hz_run_ = HierZ::next_run(ctx_.hz_run);
       hz_tries_ = HierZ::kTries;
       hz_rejected_ = (hz & kHzRejected) != 0;
     }
     const std::uint64_t passed_before = ctx_.counters.passed;
-    const int mark_from = w >= kSpanSolveWidth ? run_wide(ya, yz, hz) : run_narrow(ya, yz);
+    int mark_from;
+    if (!walks_rows(t_)) mark_from = run_narrow(ya, yz);
+    else if (kGouraud && ctx_.vector && t_.den < (std::int64_t{1} << 30)) mark_from = run_wide<true>(ya, yz, hz);
+    else mark_from = run_wide<false>(ya, yz, hz);
     // Blocks this run wrote into: read again when another run asks (their bounds only got looser).
     if (kDepth && ctx_.hier_z && st_.z_write && ctx_.counters.passed != passed_before)
       ctx_.hier_z->mark(mark_from, yz, t_.x0, t_.x1 - 1, hz_run_);
     if constexpr (kTextured) {
       ctx_.counters.textured += textured_;
       ctx_.counters.texel_bytes += textured_ * (st_.tex.bilinear ? 4u : 1u) * protocol::bytes_per_pixel(st_.tex.format);
+      textured_ = 0;  // the next run (a later band of the same Kernel) counts afresh
     }
   }
 
@@ -274,7 +289,8 @@ class Kernel {
       for (int kx = 0; kx < w; ++kx) {
         if ((f0 | f1 | f2) >= 0) {
           ++ctx_.counters.covered;
-          pixel(t_.x0 + kx, y, s);
+          if constexpr (!kDepth) ++ctx_.counters.passed;  // pixel() counts only depth-tested passes
+          pixel(t_.x0 + kx, y, s, rgba_of(s));
         }
         f0 += x0;
         f1 += x1;
@@ -295,14 +311,39 @@ class Kernel {
   // the next row's first pixel (cur_, move), spans of kMinSimdSpan pixels or more through the span
   // routine, shorter ones pixel by pixel. Whole 16-row bands are asked first (band_occluded); rows
   // of a band that is not rejected are asked one by one (occluded). Returns the first row a pixel
-  // may have been written in.
+  // may have been written in. kLanes: the colour planes of the cursor and of short spans step in one
+  // 4-lane vector (color_cursor.hpp; Gouraud draws with den < 2^30), the other planes as scalars.
+  template <bool kLanes>
   int run_wide(int ya, int yz, unsigned hz) {
+    constexpr unsigned kScalar = scalar_planes<kLanes>();
+    if constexpr (kLanes) prepare_lanes();
     const int w = t_.x1 - t_.x0;
     const bool bands = kDepth && ctx_.hier_z;
     int mark_from = ya;
     bool first = true;
     bool walking = false;  // walk_ holds row y's quotients
     bool anchored = false;  // cur_ holds the planes at (y - 1, col_) (false before the first drawn row and after a rejected band)
+    bool resumed = false;   // the cursor was carried over a gap and has not moved since
+    if (walk_ok_ && ya > ended_at_) {
+      // A later band of the same triangle (rasterize_bands): the walk and the cursor where the last
+      // run left them, carried over the rows between (other workers' bands) in one step each.
+      const int gap = ya - ended_at_;
+      if (gap != gap_) prepare_gap(gap);
+      for (int i = 0; i < 3; ++i) {
+        walk_.q[i] += gap_walk_.q[i];
+        walk_.r[i] += gap_walk_.r[i];
+        const bool carry = walk_.r[i] >= walk_.d[i];
+        walk_.r[i] -= carry ? walk_.d[i] : 0;
+        walk_.q[i] += carry;
+      }
+      walking = true;
+      if (cursor_ok_) {
+        carry_step<kScalar>(cur_, gap_cursor_);
+        if constexpr (kLanes) ccur_.step(gap_color_, cden_);
+        anchored = true;
+        resumed = true;
+      }
+    }
     for (int y = ya; y < yz;) {
       const int end = std::min(yz, (y | ((1 << HierZ::kRowsLog) - 1)) + 1);  // this band's rows
       // A new 16-row band of blocks: its tries afresh (HierZ::band_asks_afresh).
@@ -333,23 +374,38 @@ class Kernel {
         std::int64_t kl, kr;
         walk_.span_and_step(t_, w, kl, kr);
         if (kl > kr) {  // no sample covered: the cursor stays in its column
-          if (anchored) step_y(cur_);
+          if (anchored) {
+            step_y<kScalar>(cur_);
+            if constexpr (kLanes) ccur_.step(cy_, cden_);
+          }
           continue;
         }
         if (!anchored) {
           cur_ = anchor(y, kl);
+          if constexpr (kLanes) ccur_ = color_lanes(cur_.q, cur_.r);
           anchored = true;
         } else {
-          move(kl - col_);
+          move<kLanes>(kl - col_, !resumed);
+          resumed = false;
         }
         col_ = kl;
         if (simd_ && y + kPrefetchRows < yz) prefetch_row(y + kPrefetchRows, t_.x0 + static_cast<int>(kl), static_cast<int>(kr - kl + 1));
         if (kr - kl + 1 >= kMinSimdSpan && simd_ready()) {
-          if (!occluded(kl, kr, y)) simd_span(t_.x0 + static_cast<int>(kl), y, static_cast<unsigned>(kr - kl + 1));
+          if (!occluded(kl, kr, y)) simd_span<kLanes>(t_.x0 + static_cast<int>(kl), y, static_cast<unsigned>(kr - kl + 1));
+        } else if constexpr (kLanes) {
+          if constexpr (!kDepth) ctx_.counters.passed += static_cast<std::uint64_t>(kr - kl + 1);
+          Steppers s = cur_;  // the planes other than colour
+          ColorLanes c = ccur_;
+          for (std::int64_t kx = kl; kx <= kr; ++kx) {
+            pixel(t_.x0 + static_cast<int>(kx), y, s, c.rgba());
+            step_x<kScalar>(s);
+            c.step(cx_, cden_);
+          }
         } else {
+          if constexpr (!kDepth) ctx_.counters.passed += static_cast<std::uint64_t>(kr - kl + 1);
           Steppers s = cur_;
           for (std::int64_t kx = kl; kx <= kr; ++kx) {
-            pixel(t_.x0 + static_cast<int>(kx), y, s);
+            pixel(t_.x0 + static_cast<int>(kx), y, s, rgba_of(s));
             step_x(s);
           }
         }
@@ -357,7 +413,41 @@ class Kernel {
         ctx_.counters.covered += static_cast<std::uint64_t>(kr - kl + 1);
       }
     }
+    walk_ok_ = walking;  // the walk at row yz, the cursor at (yz - 1, col_)
+    cursor_ok_ = anchored;
+    ended_at_ = yz;
     return mark_from;
+  }
+
+  // The steps over `gap` rows between two runs: each edge's floor-divmod(gap·ey, |ex|) and each
+  // plane's (gap·qy + f, gap·ry − f·den), f = floor(gap·ry / den) (the cursor stays in its column).
+  void prepare_gap(int gap) {
+    gap_ = gap;
+    for (int i = 0; i < 3; ++i) {
+      const DivMod g = edge_div_[i](gap * t_.edge[i].ey);
+      gap_walk_.q[i] = g.q;
+      gap_walk_.r[i] = g.r;
+    }
+    for (unsigned i = 0; i < kAttrCount; ++i) {
+      if (!((kPlanes >> i) & 1)) continue;
+      const Plane& p = t_.plane[i];
+      const DivMod f = den_div_(gap * p.ry);  // gap < 2^16, ry < 2^36
+      gap_cursor_.q[i] = gap * p.qy + f.q;
+      gap_cursor_.r[i] = f.r;
+    }
+    if constexpr (kGouraud) gap_color_ = color_lanes(gap_cursor_.q, gap_cursor_.r);
+  }
+  // s advanced by the step (q, r) of each plane in kMask (r in [0, den)) and one carry.
+  template <unsigned kMask>
+  void carry_step(Steppers& s, const Steppers& step) const {
+    for (unsigned i = 0; i < kAttrCount; ++i) {
+      if (!((kMask >> i) & 1)) continue;
+      s.q[i] += step.q[i];
+      s.r[i] += step.r[i];
+      const bool carry = s.r[i] >= t_.den;
+      s.r[i] -= carry ? t_.den : 0;
+      s.q[i] += carry;
+    }
   }
 
   // The planes at (y, kx): the triangle's planes advanced y − y0 rows (exact, 128-bit) and jumped
@@ -378,12 +468,20 @@ class Kernel {
   // step, (qy + d·qx + f, ry + d·rx − f·den) with f = floor((ry + d·rx) / den), and one carry. A
   // straight edge moves the span's start by one of two distances a row, so the last two steps are
   // kept (steps_) and a division is paid only when the distance changes (at a vertex).
-  void move(std::int64_t d) {
+  // `keep` false: a step not among the last two is used once and not kept (the first drawn row
+  // after a gap between runs moves by a distance of its own, which would evict a row's step).
+  template <bool kLanes>
+  void move(std::int64_t d, bool keep = true) {
     unsigned slot = steps_[1].d == d ? 1u : 0u;
+    CursorStep once;
+    const CursorStep* step = &steps_[slot];
     if (steps_[slot].d != d) {
-      slot = victim_;
-      victim_ ^= 1u;
-      CursorStep& c = steps_[slot];
+      if (keep) {
+        slot = victim_;
+        victim_ ^= 1u;
+      }
+      CursorStep& c = keep ? steps_[slot] : once;
+      step = &c;
       c.d = d;
       for (unsigned i = 0; i < kAttrCount; ++i) {
         if (!((kPlanes >> i) & 1)) continue;
@@ -392,10 +490,12 @@ class Kernel {
         c.q[i] = p.qy + d * p.qx + f.q;
         c.r[i] = f.r;
       }
+      if constexpr (kLanes) c.c = color_lanes(c.q, c.r);
     }
-    const CursorStep& c = steps_[slot];
+    const CursorStep& c = *step;
+    if constexpr (kLanes) ccur_.step(c.c, cden_);
     for (unsigned i = 0; i < kAttrCount; ++i) {
-      if (!((kPlanes >> i) & 1)) continue;
+      if (!((scalar_planes<kLanes>() >> i) & 1)) continue;
       cur_.q[i] += c.q[i];
       cur_.r[i] += c.r[i];
       const bool carry = cur_.r[i] >= t_.den;
@@ -404,9 +504,48 @@ class Kernel {
     }
   }
 
+  // The planes stepped as scalars: all but the colour planes when they step in lanes.
+  template <bool kLanes>
+  static constexpr unsigned scalar_planes() { return kLanes ? kPlanes & ~0xFu : kPlanes; }
+  // The colour planes of (q, r) in lanes: quotients modulo 2^32, remainders below den < 2^30.
+  static ColorLanes color_lanes(const std::int64_t* q, const std::int64_t* r) {
+    ColorLanes c;
+    for (unsigned i = 0; i < 4; ++i) {
+      c.q[i] = static_cast<std::int32_t>(static_cast<std::uint32_t>(q[kR + i]));
+      c.r[i] = static_cast<std::int32_t>(r[kR + i]);
+    }
+    return c;
+  }
+  // The lanes' x and y steps and den (run_wide<true>, once per run).
+  void prepare_lanes() {
+    std::int64_t q[kAttrCount], r[kAttrCount];
+    for (unsigned i = 0; i < 4; ++i) {
+      q[kR + i] = t_.plane[kR + i].qx;
+      r[kR + i] = t_.plane[kR + i].rx;
+    }
+    cx_ = color_lanes(q, r);
+    for (unsigned i = 0; i < 4; ++i) {
+      q[kR + i] = t_.plane[kR + i].qy;
+      r[kR + i] = t_.plane[kR + i].ry;
+    }
+    cy_ = color_lanes(q, r);
+    const std::int32_t den = static_cast<std::int32_t>(t_.den);
+    cden_ = i32x4{den, den, den, den};
+  }
+  // A pixel's Gouraud colour (pixel()) from scalar planes.
+  static std::uint32_t rgba_of(const Steppers& s) {
+    if constexpr (kGouraud) {
+      return pack_rgba(static_cast<std::uint32_t>(s.q[kR]), static_cast<std::uint32_t>(s.q[kG]),
+                       static_cast<std::uint32_t>(s.q[kB]), static_cast<std::uint32_t>(s.q[kA]));
+    } else {
+      return 0;
+    }
+  }
+
+  template <unsigned kMask = kPlanes>
   void step_x(Steppers& s) const {
     for (unsigned i = 0; i < kAttrCount; ++i) {
-      if (!((kPlanes >> i) & 1)) continue;
+      if (!((kMask >> i) & 1)) continue;
       s.q[i] += t_.plane[i].qx;
       s.r[i] += t_.plane[i].rx;
       const bool carry = s.r[i] >= t_.den;
@@ -414,9 +553,10 @@ class Kernel {
       s.q[i] += carry;
     }
   }
+  template <unsigned kMask = kPlanes>
   void step_y(Steppers& s) const {
     for (unsigned i = 0; i < kAttrCount; ++i) {
-      if (!((kPlanes >> i) & 1)) continue;
+      if (!((kMask >> i) & 1)) continue;
       s.q[i] += t_.plane[i].qy;
       s.r[i] += t_.plane[i].ry;
       const bool carry = s.r[i] >= t_.den;
@@ -531,10 +671,15 @@ class Kernel {
   }
 
   // A span whose first pixel is x (the cursor's planes).
+  template <bool kLanes>
   void simd_span(int x, int y, unsigned count) {
     SimdSpan& sp = simd_tpl_;
+    if constexpr (kLanes) {
+      std::memcpy(sp.q0, &ccur_.q, sizeof ccur_.q);
+      std::memcpy(sp.r0, &ccur_.r, sizeof ccur_.r);
+    }
     // Planes the draw does not use keep the template's zeros (simd_tpl_ is value-initialised).
-    for (unsigned p = 0; p < SimdSpan::kPlanes; ++p) {
+    for (unsigned p = kLanes ? 4 : 0; p < SimdSpan::kPlanes; ++p) {
       if (!simd_plane_used(p)) continue;
       sp.q0[p] = static_cast<std::uint32_t>(cur_.q[kR + p]);
       sp.r0[p] = static_cast<std::uint32_t>(cur_.r[kR + p]);
@@ -552,7 +697,8 @@ class Kernel {
     if (kTextured) textured_ += passed;
   }
 
-  [[gnu::always_inline]] void pixel(int x, int y, const Steppers& s) {
+  // The pixel at (x, y) with the planes s (colour, when Gouraud, as the word rgba: pack_rgba).
+  [[gnu::always_inline]] void pixel(int x, int y, const Steppers& s, std::uint32_t rgba) {
     const std::size_t pix = static_cast<std::size_t>(y) * width_ + static_cast<std::size_t>(x);
     if constexpr (kDepth) {
       const std::uint32_t z = static_cast<std::uint32_t>(s.q[kZ]) & zmask_;
@@ -569,12 +715,18 @@ class Kernel {
         if (!direct && !ctx_.mem.write(std::uint64_t{st_.fb_z} + pix * 4, tmp, 4)) ctx_.errors |= protocol::ERR_MEM_RANGE;
       }
     }
-    ++ctx_.counters.passed;
+    if constexpr (kDepth) ++ctx_.counters.passed;  // without depth the caller counts every pixel
     if (skip_color_) return;
+    if constexpr (kSimple && kGouraud && !kTextured) {
+      if (st_.color_in_vram) {
+        store_rgba(color_ + pix * 4, rgba);
+        return;
+      }
+    }
     Rgba8 c = flat_;
     if constexpr (kGouraud) {
-      c = {static_cast<std::uint8_t>(s.q[kR]), static_cast<std::uint8_t>(s.q[kG]), static_cast<std::uint8_t>(s.q[kB]),
-           static_cast<std::uint8_t>(s.q[kA])};
+      c = {static_cast<std::uint8_t>(rgba), static_cast<std::uint8_t>(rgba >> 8), static_cast<std::uint8_t>(rgba >> 16),
+           static_cast<std::uint8_t>(rgba >> 24)};
     }
     if constexpr (kTextured) {
       ++textured_;  // counted here, added to the context once per run (no per-pixel store through ctx_)
@@ -643,19 +795,55 @@ class Kernel {
   EdgeWalk walk_{};
   Steppers cur_{};
   std::int64_t col_ = 0;
+  // run_wide<true>: the cursor's colour planes (cur_'s are then stale), their x and y steps, den.
+  ColorLanes ccur_{}, cx_{}, cy_{};
+  i32x4 cden_{};
   struct CursorStep {
     std::int64_t d = INT64_MIN;  // the distance it moves the span's start (INT64_MIN: none yet)
     std::int64_t q[kAttrCount], r[kAttrCount];
+    ColorLanes c;  // the colour planes' step in lanes (run_wide<true>)
   } steps_[2];
   unsigned victim_ = 0;  // the step to replace next
+  // Between runs of one Kernel (rasterize_bands): whether the walk (at row ended_at_) and the cursor
+  // (at row ended_at_ − 1) are valid, and the steps over the last gap (prepare_gap).
+  bool walk_ok_ = false, cursor_ok_ = false;
+  int ended_at_ = 0, gap_ = 0;
+  struct {
+    std::int64_t q[3], r[3];
+  } gap_walk_{};
+  Steppers gap_cursor_{};
+  ColorLanes gap_color_{};
 };
 
+// The rows [ya, yz) of a wide triangle: rasterize_rows's leading band tests (the triangle's
+// first 16-row bands of blocks asked before a Kernel is built: a triangle whose bands are all
+// rejected costs their span solves only, no Kernel set-up, plane advance or row loop). Moves ya past
+// the rejected bands and says what was found in hz (Kernel::run's); false when no row is left.
+bool ask_leading_bands(const Triangle& t, const DrawState& st, RasterContext& ctx, int& ya, int yz, unsigned& hz);
+
+// Rows [ya, yz), then [ya + stride, yz + stride) and so on while ya < end (stride 0: one run), all
+// clipped to the box: one Kernel for all of them (a band worker's 16-row bands of one triangle),
+// built when the first run needs it, so its set-up (edge dividers, lane steps, the span template,
+// the cursor's cached steps) is paid once per triangle, not once per band. The caller has tried
+// the small-triangle routine (draw_narrow) where it applies.
 template <bool G, bool T, bool Z, bool S>
-void run_kernel(const Triangle& t, const DrawState& st, RasterContext& ctx, int ya, int yz, unsigned hz) {
-  Kernel<G, T, Z, S>(t, st, ctx).run(ya, yz, hz);
+void run_kernel(const Triangle& t, const DrawState& st, RasterContext& ctx, int ya, int yz, int stride, int end) {
+  std::optional<Kernel<G, T, Z, S>> kernel;
+  for (;; ya += stride, yz += stride) {
+    int a = std::max(ya, t.y0);
+    const int z = std::min(yz, t.y1);
+    if (a < z) {
+      unsigned hz = 0;
+      if (ask_leading_bands(t, st, ctx, a, z, hz)) {
+        if (!kernel) kernel.emplace(t, st, ctx);
+        kernel->run(a, z, hz);
+      }
+    }
+    if (stride == 0 || ya + stride >= end) return;
+  }
 }
 
-using KernelFn = void (*)(const Triangle&, const DrawState&, RasterContext&, int, int, unsigned);
+using KernelFn = void (*)(const Triangle&, const DrawState&, RasterContext&, int, int, int, int);
 
 // What a vector kernel drew, into the timing model's counters: `passed` pixels were blended when
 // `blended` and textured (their texel reads by the filter's footprint) when `textured`.
@@ -689,7 +877,10 @@ constexpr auto make_table(std::integer_sequence<unsigned, I...>) {
 constexpr auto kKernels = make_table(std::make_integer_sequence<unsigned, 16>{});
 
 // The small-triangle vector routine (narrow_simd.hpp) when its conditions hold; false otherwise.
-bool draw_narrow(const Triangle& t, const DrawState& st, RasterContext& ctx, int ya, int yz, bool gouraud, bool depth) {
+// Inlined into rasterize_rows, its one caller, as it was before rasterize_bands (a call cost the
+// 10-px triangles 4 % more instructions).
+[[gnu::always_inline]] inline bool draw_narrow(const Triangle& t, const DrawState& st, RasterContext& ctx, int ya, int yz,
+                                               bool gouraud, bool depth) {
   const int w = t.x1 - t.x0;
   if (w > 8 || t.x0 + 8 > static_cast<int>(st.fb_width) || !st.color_in_vram) return false;
   if (depth && (!st.z_in_vram || !st.buffers_disjoint)) return false;
@@ -837,51 +1028,76 @@ SmallDraw small_draw(const DrawState& st, VideoMemory& mem, unsigned z_bits) {
   return d;
 }
 
-void rasterize_rows(const Triangle& t, const DrawState& st, RasterContext& ctx, int row_begin, int row_end) {
-  int ya = std::max(row_begin, t.y0);
-  const int yz = std::min(row_end, t.y1);
-  if (ya >= yz) return;
+namespace {
+
+bool ask_leading_bands(const Triangle& t, const DrawState& st, RasterContext& ctx, int& ya, int yz, unsigned& hz) {
+  if (!ctx.hier_z || !(st.z_test || st.z_write) || !walks_rows(t)) return true;
+  const std::uint32_t run = HierZ::next_run(ctx.hz_run), zmask = z_mask(ctx);
+  std::optional<std::array<Divider, 3>> div;
+  EdgeWalk walk;  // from row ya once a band is rejected
+  std::optional<BandClip> clip;
+  for (;;) {
+    const int end = std::min(yz, (ya | ((1 << HierZ::kRowsLog) - 1)) + 1);
+    if (!ctx.hier_z->band_worth_asking(ya >> HierZ::kRowsLog)) {
+      hz |= kHzFirstAsked;  // not asked this time (HierZ::band_worth_asking): the Kernel does not ask either
+      return true;
+    }
+    if (!ask_band(t, clip, st, ctx, zmask, ya, end - 1, run)) {
+      hz |= kHzFirstAsked;
+      return true;
+    }
+    if (!div) {
+      div.emplace(std::array<Divider, 3>{edge_divider(t.edge[0]), edge_divider(t.edge[1]), edge_divider(t.edge[2])});
+      walk.prepare(t, div->data());
+      walk.start(t, div->data(), ya);
+    }
+    walk.count(t, end - ya, ctx.counters);
+    hz |= kHzRejected;
+    ya = end;
+    if (ya >= yz) return false;
+  }
+}
+
+// Gouraud only when the state asks for it and the triangle's colours differ.
+bool draws_gouraud(const Triangle& t, const DrawState& st) {
   bool colors_differ = false;
   for (unsigned ch = 0; ch < 4; ++ch) colors_differ |= !t.plane[kR + ch].constant;
-  const bool gouraud = st.gouraud && colors_differ;   // Gouraud only when colours differ
+  return st.gouraud && colors_differ;
+}
+
+// The exact kernel for a draw (rasterize_rows, rasterize_bands).
+KernelFn kernel_for(const DrawState& st, bool gouraud) {
+  const bool depth = st.z_test || st.z_write;
+  const unsigned key = (gouraud ? 1u : 0u) | (st.textured ? 2u : 0u) | (depth ? 4u : 0u) | (st.simple_color ? 8u : 0u);
+  return kKernels[key];
+}
+
+}  // namespace
+
+void rasterize_rows(const Triangle& t, const DrawState& st, RasterContext& ctx, int row_begin, int row_end) {
+  const int ya = std::max(row_begin, t.y0);
+  const int yz = std::min(row_end, t.y1);
+  if (ya >= yz) return;
+  const bool gouraud = draws_gouraud(t, st);
   const bool depth = st.z_test || st.z_write;
   if (t.preview) {
     if (st.preview_plain) return draw_preview_plain(t, st, ctx, ya, yz, depth);
     return draw_preview(t, st, ctx, ya, yz, gouraud, depth);
   }
   if (ctx.vector && draw_narrow(t, st, ctx, ya, yz, gouraud, depth)) return;
-  // The run's leading 16-row bands are asked before a Kernel is built (Kernel::run asks the rest):
-  // a triangle whose bands are all rejected costs their span solves only, no Kernel set-up, plane
-  // advance or row loop.
-  unsigned hz = 0;
-  if (ctx.hier_z && depth && t.x1 - t.x0 >= kSpanSolveWidth) {
-    const std::uint32_t run = HierZ::next_run(ctx.hz_run), zmask = z_mask(ctx);
-    std::optional<std::array<Divider, 3>> div;
-    EdgeWalk walk;  // from row ya once a band is rejected
-    std::optional<BandClip> clip;
-    for (;;) {
-      const int end = std::min(yz, (ya | ((1 << HierZ::kRowsLog) - 1)) + 1);
-      if (!ctx.hier_z->band_worth_asking(ya >> HierZ::kRowsLog)) {
-        hz |= kHzFirstAsked;  // not asked this time (HierZ::band_worth_asking): the Kernel does not ask either
-        break;
-      }
-      if (!ask_band(t, clip, st, ctx, zmask, ya, end - 1, run)) {
-        hz |= kHzFirstAsked;
-        break;
-      }
-      if (!div) {
-        div.emplace(std::array<Divider, 3>{edge_divider(t.edge[0]), edge_divider(t.edge[1]), edge_divider(t.edge[2])});
-        walk.prepare(t, div->data());
-        walk.start(t, div->data(), ya);
-      }
-      walk.count(t, end - ya, ctx.counters);
-      hz |= kHzRejected;
-      ya = end;
-      if (ya >= yz) return;
+  kernel_for(st, gouraud)(t, st, ctx, ya, yz, 0, yz);
+}
+
+void rasterize_bands(const Triangle& t, const DrawState& st, RasterContext& ctx, int row_begin, int row_end, int stride) {
+  if (t.preview || stride <= 0 || t.x1 - t.x0 <= 8) {  // preview and small triangles: band by band
+    for (; row_begin < t.y1; row_begin += stride, row_end += stride) {
+      rasterize_rows(t, st, ctx, row_begin, row_end);
+      if (stride <= 0) return;
     }
+    return;
   }
-  const unsigned key = (gouraud ? 1u : 0u) | (st.textured ? 2u : 0u) | (depth ? 4u : 0u) | (st.simple_color ? 8u : 0u);
-  kKernels[key](t, st, ctx, ya, yz, hz);
+  if (row_begin >= t.y1) return;
+  kernel_for(st, draws_gouraud(t, st))(t, st, ctx, row_begin, row_end, stride, t.y1);
 }
 
 void observe_triangle(const Triangle& t, const DrawState& st, const PixelObserver& observer) {

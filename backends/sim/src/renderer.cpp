@@ -268,10 +268,13 @@ void Renderer::draw_bands(unsigned worker) {
     const unsigned first = static_cast<unsigned>(r.y0) / kBandRows;
     unsigned ahead = worker + n - first % n;
     if (ahead >= n) ahead -= n;
-    for (int band = static_cast<int>(first + ahead); band * kBandRows < r.y1; band += static_cast<int>(n)) {
-      if (r.small) rasterize_small(smalls[i], small, c.counters, band * kBandRows, (band + 1) * kBandRows);
-      else rasterize_rows(full[i], st, c, band * kBandRows, (band + 1) * kBandRows);
+    const int band = static_cast<int>(first + ahead);
+    if (!r.small) {  // every band of the triangle with one Kernel
+      rasterize_bands(full[i], st, c, band * kBandRows, (band + 1) * kBandRows, static_cast<int>(n) * kBandRows);
+      continue;
     }
+    for (int b = band; b * kBandRows < r.y1; b += static_cast<int>(n))
+      rasterize_small(smalls[i], small, c.counters, b * kBandRows, (b + 1) * kBandRows);
   }
 }
 
