@@ -10,9 +10,11 @@
 // too high or a test off by its equality would reject pixels the kernel passes.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 
 #include "preview_plain.hpp"
+#include "preview_simd.hpp"
 #include "sim_test_util.hpp"
 
 namespace gpubridge::sim::test {
@@ -228,6 +230,105 @@ void same_with_and_without_bounds(Draw draw, const char* what, std::vector<std::
       }
     }
   }
+}
+
+// The kernel's count of a rejected band's covered pixels (count_rows, four rows in lanes; every
+// instance this CPU runs) against SpanWalk::count (the row walk) from the same start: the same
+// count, and the walk left at the same row (the spans of the rows after agree). Random triangles'
+// edges (the kinds the kernel sees, rows not a multiple of four), random independent edges of small
+// values (any kinds, horizontal ones included: lines that meet exactly on rows and pixels), and
+// wide values (remainders near the steps, large quotients).
+struct CountCase {
+  std::int64_t e[3], ex[3], ey[3];
+  int ky, width, rows;
+};
+
+void expect_lanes_count_as_the_walk(BandCount lanes, const CountCase& c, const char* what, int index) {
+  SpanWalk got(c.e, c.ex, c.ey, c.ky), want(c.e, c.ex, c.ey, c.ky);
+  ASSERT_EQ(lanes(got, c.width, c.rows), want.count(c.width, c.rows)) << what << " case " << index;
+  for (int r = 0; r < 5; ++r, got.next_row(), want.next_row()) {
+    int kl0 = -1, kr0 = -1, kl1 = -1, kr1 = -1;
+    const int w = std::max(c.width, 1);
+    ASSERT_EQ(got.span(w, kl0, kr0), want.span(w, kl1, kr1)) << what << " case " << index << " after, row " << r;
+    ASSERT_EQ(kl0, kl1) << what << " case " << index << " after, row " << r;
+    ASSERT_EQ(kr0, kr1) << what << " case " << index << " after, row " << r;
+  }
+}
+
+TEST(SimPreviewBounds, LaneCountIsTheWalksCount) {
+  unsigned instances = 0;
+  for (unsigned isa = 0; isa < 3; ++isa) {
+    const BandCount lanes = band_count_instance(isa);
+    if (!lanes) continue;
+    ++instances;
+    std::mt19937_64 rng(24);
+    auto uniform = [&](std::int64_t lo, std::int64_t hi) { return std::uniform_int_distribution<std::int64_t>(lo, hi)(rng); };
+    std::uint64_t nonzero = 0, total = 0;
+    auto check = [&](const CountCase& c, const char* what, int i) {
+      expect_lanes_count_as_the_walk(lanes, c, what, i);
+      SpanWalk w(c.e, c.ex, c.ey, c.ky);
+      const std::uint64_t n = w.count(c.width, c.rows);
+      nonzero += n != 0;
+      total += n;
+    };
+    // Triangles of random vertices (4 fractional bits), edges E = ex·x + ey·y + c from each side,
+    // the box at the smallest x and y, oriented so that the inside is E >= 0 (top-left bias: −1 on
+    // the edges that are not top or left, as setup.hpp biases them).
+    for (int i = 0; i < 4000; ++i) {
+      const int span = i % 4 == 0 ? 64 : 2048;
+      std::int64_t x[3], y[3];
+      for (int v = 0; v < 3; ++v) x[v] = uniform(0, span * 16), y[v] = uniform(0, span * 16);
+      if (i % 5 == 1) y[1] = y[0];  // a horizontal edge
+      const std::int64_t d = (x[1] - x[0]) * (y[2] - y[0]) - (x[2] - x[0]) * (y[1] - y[0]);
+      if (d == 0) continue;
+      const std::int64_t x0 = std::min({x[0], x[1], x[2]}) / 16, y0 = std::min({y[0], y[1], y[2]}) / 16;
+      CountCase c{};
+      for (int k = 0; k < 3; ++k) {
+        const int a = (k + 1) % 3, b = (k + 2) % 3;
+        std::int64_t ex = y[a] - y[b], ey = x[b] - x[a];
+        if (d < 0) ex = -ex, ey = -ey;
+        // E at pixel centre (x0 + 0.5, y0 + 0.5), in 1/256 units: E(p) = ex·(px − xa) + ey·(py − ya).
+        const std::int64_t e = ex * (x0 * 16 + 8 - x[a]) + ey * (y0 * 16 + 8 - y[a]);
+        const bool top_left = ey < 0 || (ey == 0 && ex > 0);
+        c.e[k] = e - (top_left ? 0 : 1);
+        c.ex[k] = ex * 16;
+        c.ey[k] = ey * 16;
+      }
+      const int width = static_cast<int>((std::max({x[0], x[1], x[2]}) + 15) / 16 - x0) + 1;
+      const int height = static_cast<int>((std::max({y[0], y[1], y[2]}) + 15) / 16 - y0) + 1;
+      c.width = i % 7 == 0 ? static_cast<int>(uniform(0, width)) : width;  // clipped boxes too
+      c.ky = static_cast<int>(uniform(0, height));
+      c.rows = static_cast<int>(uniform(0, i % 3 == 0 ? 16 : height - c.ky));
+      check(c, "triangle", i);
+    }
+    // Independent edges of small values: lines meeting exactly on rows and pixel columns, zero steps.
+    for (int i = 0; i < 20000; ++i) {
+      CountCase c{};
+      for (int k = 0; k < 3; ++k) c.e[k] = uniform(-40, 40), c.ex[k] = uniform(-4, 4), c.ey[k] = uniform(-4, 4);
+      c.ky = static_cast<int>(uniform(0, 8));
+      c.width = static_cast<int>(uniform(0, 24));
+      c.rows = static_cast<int>(uniform(0, 24));
+      check(c, "small", i);
+    }
+    // Wide independent edges, up to the edge values of a protocol triangle.
+    for (int i = 0; i < 4000; ++i) {
+      CountCase c{};
+      const std::int64_t limit = i % 5 == 0 ? std::int64_t{1} << 40 : std::int64_t{1} << 31;
+      for (int k = 0; k < 3; ++k) {
+        c.e[k] = uniform(-limit, limit);
+        c.ex[k] = uniform(-limit / 2048, limit / 2048);
+        c.ey[k] = uniform(-limit / 2048, limit / 2048);
+      }
+      c.ky = static_cast<int>(uniform(0, 2048));
+      c.width = static_cast<int>(uniform(1, 2048));
+      c.rows = static_cast<int>(uniform(0, 64));
+      check(c, "wide", i);
+    }
+    // The cases drew something to count (the comparison is not of zeros).
+    EXPECT_GT(nonzero, 5000u) << "instance " << isa;
+    EXPECT_GT(total, 1000000u) << "instance " << isa;
+  }
+  EXPECT_GE(instances, 1u);
 }
 
 TEST(SimPreviewBounds, RandomDepthScenesDrawAsWithoutTheBounds) {

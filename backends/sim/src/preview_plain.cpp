@@ -118,6 +118,15 @@ SmallSetupRoutine small_setup_instance(unsigned isa) {
   }
 }
 
+BandCount band_count_instance(unsigned isa) {
+  switch (isa) {
+    case 0: return &plain_baseline::band_count;
+    case 1: return cpu_has_avx2() ? &plain_avx2::band_count : nullptr;
+    case 2: return cpu_has_avx512() ? &plain_avx512::band_count : nullptr;
+    default: return nullptr;
+  }
+}
+
 SmallKernel small_kernel(const DrawState& st) { return small_kernel_table()[st.preview_small - 1]; }
 
 }  // namespace gpubridge::sim

@@ -77,6 +77,11 @@ struct PreviewPlain {
   const FixedPlanes* planes = nullptr;
   int width = 0;                    // box width
   int ky0 = 0, rows = 0;            // first row drawn (from the box origin), rows drawn
+  // Bands (issue 24, fourteenth round): above 1, only the rows of every band_step-th 16-row band
+  // of the buffer (HierZ's, the renderer's worker bands) from the band of row ky0 are drawn, the
+  // others left alone and not counted: one call per worker and triangle at N threads, not one per
+  // band (each call set up its band tests, walk and lanes afresh). `y` is the box origin's row.
+  int band_step = 0, y = 0;
   std::uint8_t* color = nullptr;    // box origin column, first row drawn
   std::uint8_t* depth = nullptr;    // its depth word (when the draw tests or writes depth)
   std::size_t pitch = 0;            // bytes per row of either buffer (both 4 bytes per pixel)
@@ -95,6 +100,13 @@ struct PreviewPlain {
 bool preview_plain_applies(const DrawState& st);
 
 PreviewCounts shade_preview_plain(const PreviewPlain& t);
+
+// The count of a rejected band's covered pixels the kernel uses (count_rows in
+// preview_plain_kernel.inc: SpanWalk::count in lanes, four rows at a time), leaving the walk after
+// the rows as SpanWalk::count does. One instance: 0 the baseline, 1 AVX2, 2 AVX-512; null when
+// this CPU cannot run it. For the tests that compare it with SpanWalk::count.
+using BandCount = std::uint64_t (*)(SpanWalk& walk, int width, int rows);
+BandCount band_count_instance(unsigned isa);
 
 // --- Small triangles (docs/simulator.md "Preview", issue 24) ---
 // A triangle of an untextured plain draw whose vertices span at most 255/16 pixel in x and in y

@@ -69,19 +69,19 @@ class SpanWalk {
   SpanWalk() = default;  // start() before use
   void start(const std::int64_t* e, const std::int64_t* ex, const std::int64_t* ey, int ky) {
     for (int i = 0; i < 3; ++i) {
-      kind_[i] = ex[i] > 0 ? 1 : ex[i] < 0 ? -1 : 0;
-      a_[i] = kind_[i] == 0 ? 1 : ex[i] > 0 ? ex[i] : -ex[i];
-      floor_divmod(e[i] + ky * ey[i], a_[i], f_[i], m_[i]);
-      floor_divmod(ey[i], a_[i], qy_[i], ry_[i]);
+      s_.kind[i] = ex[i] > 0 ? 1 : ex[i] < 0 ? -1 : 0;
+      s_.a[i] = s_.kind[i] == 0 ? 1 : ex[i] > 0 ? ex[i] : -ex[i];
+      floor_divmod(e[i] + ky * ey[i], s_.a[i], s_.f[i], s_.m[i]);
+      floor_divmod(ey[i], s_.a[i], s_.qy[i], s_.ry[i]);
     }
   }
   // This row's covered span within [0, width): false when it is empty.
   [[gnu::always_inline]] bool span(int width, int& kl, int& kr) const {
     std::int64_t lo = 0, hi = width - 1;
     for (int i = 0; i < 3; ++i) {
-      if (kind_[i] > 0) lo = -f_[i] > lo ? -f_[i] : lo;
-      else if (kind_[i] < 0) hi = f_[i] < hi ? f_[i] : hi;
-      else if (f_[i] < 0) return false;
+      if (s_.kind[i] > 0) lo = -s_.f[i] > lo ? -s_.f[i] : lo;
+      else if (s_.kind[i] < 0) hi = s_.f[i] < hi ? s_.f[i] : hi;
+      else if (s_.f[i] < 0) return false;
     }
     if (lo > hi) return false;
     kl = static_cast<int>(lo);  // both inside [0, width) now
@@ -92,18 +92,17 @@ class SpanWalk {
   // leaving the walk after them. A triangle's edges are two left ones and a right one, a left one
   // and two right ones, or a left, a right and a horizontal one (their ex sum to 0): the edges are
   // put in that order once, so the row loop has no branch on an edge's kind (about half the
-  // instructions of span() and next_row() per row).
+  // instructions of span() and next_row() per row). The plain kernel counts a rejected band with
+  // its own version in lanes (preview_plain_kernel.inc, count_rows: four rows at a time); this is
+  // the reference it is tested against (SimPreviewBounds.LaneCountIsTheWalksCount).
   std::uint64_t count(int width, int rows) {
-    int order[3], n_left = 0, n_right = 0;
-    for (int i = 0; i < 3; ++i)
-      if (kind_[i] > 0) order[n_left++] = i;
-    for (int i = 0; i < 3; ++i)
-      if (kind_[i] < 0) order[n_left + n_right++] = i;
-    for (int i = 0; i < 3; ++i)
-      if (kind_[i] == 0) order[n_left + n_right] = i;
-    if (n_left == 2 && n_right == 1) return count_as<2, 1>(order, width, rows);
-    if (n_left == 1 && n_right == 2) return count_as<1, 2>(order, width, rows);
-    if (n_left == 1 && n_right == 1) return count_as<1, 1>(order, width, rows);
+    int order[3];
+    switch (kinds(order)) {
+      case Kinds::TwoLeft: return count_as<2, 1>(order, width, rows);
+      case Kinds::TwoRight: return count_as<1, 2>(order, width, rows);
+      case Kinds::Horizontal: return count_as<1, 1>(order, width, rows);
+      case Kinds::Other: break;
+    }
     std::uint64_t n = 0;  // no other kinds for a triangle of D != 0: kept general all the same
     for (int r = 0; r < rows; ++r, next_row()) {
       int kl = 0, kr = 0;
@@ -111,13 +110,38 @@ class SpanWalk {
     }
     return n;
   }
+  // The kinds of a triangle's edges (count): order[] lists the left edges (ex > 0) first, then
+  // the right ones (ex < 0), then the horizontal one (ex = 0), when they are one of its three
+  // kinds; Other otherwise (order[] unspecified).
+  enum class Kinds { TwoLeft, TwoRight, Horizontal, Other };
+  Kinds kinds(int* order) const {
+    int n_left = 0, n_right = 0;
+    for (int i = 0; i < 3; ++i)
+      if (s_.kind[i] > 0) order[n_left++] = i;
+    for (int i = 0; i < 3; ++i)
+      if (s_.kind[i] < 0) order[n_left + n_right++] = i;
+    for (int i = 0; i < 3; ++i)
+      if (s_.kind[i] == 0) order[n_left + n_right] = i;
+    if (n_left == 2 && n_right == 1) return Kinds::TwoLeft;
+    if (n_left == 1 && n_right == 2) return Kinds::TwoRight;
+    if (n_left == 1 && n_right == 1) return Kinds::Horizontal;
+    return Kinds::Other;
+  }
+  // The walk's state at its row: edge i's pixel k is inside when k >= −f[i] (kind 1, ex > 0),
+  // k <= f[i] (kind −1) or f[i] >= 0 (kind 0), with remainder m[i] in [0, a[i]); a row's step is
+  // f += qy, m += ry and one carry. Read and written by the kernels' own count.
+  struct State {
+    std::int64_t f[3] = {}, m[3] = {}, a[3] = {1, 1, 1}, qy[3] = {}, ry[3] = {};
+    int kind[3] = {};
+  };
+  State& state() { return s_; }
   [[gnu::always_inline]] void next_row() {
     for (int i = 0; i < 3; ++i) {
-      f_[i] += qy_[i];
-      m_[i] += ry_[i];
-      const bool carry = m_[i] >= a_[i];
-      m_[i] -= carry ? a_[i] : 0;
-      f_[i] += carry;
+      s_.f[i] += s_.qy[i];
+      s_.m[i] += s_.ry[i];
+      const bool carry = s_.m[i] >= s_.a[i];
+      s_.m[i] -= carry ? s_.a[i] : 0;
+      s_.f[i] += carry;
     }
   }
 
@@ -137,7 +161,7 @@ class SpanWalk {
     std::int64_t f[3], m[3], a[3], qy[3], ry[3];
     for (int j = 0; j < 3; ++j) {
       const int i = order[j];
-      f[j] = f_[i], m[j] = m_[i], a[j] = a_[i], qy[j] = qy_[i], ry[j] = ry_[i];
+      f[j] = s_.f[i], m[j] = s_.m[i], a[j] = s_.a[i], qy[j] = s_.qy[i], ry[j] = s_.ry[i];
     }
     std::uint64_t n = 0;
     const std::int64_t last = width - 1;
@@ -157,12 +181,11 @@ class SpanWalk {
     }
     for (int j = 0; j < 3; ++j) {
       const int i = order[j];
-      f_[i] = f[j], m_[i] = m[j];
+      s_.f[i] = f[j], s_.m[i] = m[j];
     }
     return n;
   }
-  std::int64_t f_[3] = {}, m_[3] = {}, a_[3] = {1, 1, 1}, qy_[3] = {}, ry_[3] = {};
-  int kind_[3] = {};
+  State s_;
 };
 
 }  // namespace gpubridge::sim

@@ -978,13 +978,17 @@ void draw_preview(const Triangle& t, const DrawState& st, RasterContext& ctx, in
 }
 
 // The plain-draw preview kernel (preview_plain.hpp) for rows [ya, yz); preview_plain_applies(st).
-void draw_preview_plain(const Triangle& t, const DrawState& st, RasterContext& ctx, int ya, int yz, bool depth) {
+// band_step > 1: only every band_step-th 16-row band from ya's (PreviewPlain::band_step).
+void draw_preview_plain(const Triangle& t, const DrawState& st, RasterContext& ctx, int ya, int yz, bool depth,
+                        int band_step = 0) {
   PreviewPlain p;
   p.width = t.x1 - t.x0;
   copy_edges(t, p);
   p.planes = &t.xplane;
   p.ky0 = ya - t.y0;
   p.rows = yz - ya;
+  p.band_step = band_step;
+  p.y = t.y0;
   const std::size_t pix = static_cast<std::size_t>(ya) * st.fb_width + static_cast<std::size_t>(t.x0);
   p.color = ctx.mem.data() + st.fb_draw + pix * 4;
   p.depth = depth ? ctx.mem.data() + st.fb_z + pix * 4 : nullptr;
@@ -1073,6 +1077,13 @@ KernelFn kernel_for(const DrawState& st, bool gouraud) {
 }
 
 }  // namespace
+
+static_assert(kPreviewBandRows == 1 << HierZ::kRowsLog, "PreviewPlain::band_step counts the bounds' bands");
+void rasterize_preview_bands(const Triangle& t, const DrawState& st, RasterContext& ctx, int band, int step) {
+  const int ya = std::max(band * kPreviewBandRows, t.y0);
+  if (ya >= t.y1) return;
+  draw_preview_plain(t, st, ctx, ya, t.y1, st.z_test || st.z_write, step);
+}
 
 void rasterize_rows(const Triangle& t, const DrawState& st, RasterContext& ctx, int row_begin, int row_end) {
   const int ya = std::max(row_begin, t.y0);
