@@ -100,6 +100,11 @@ struct PreviewPlain {
 bool preview_plain_applies(const DrawState& st);
 
 PreviewCounts shade_preview_plain(const PreviewPlain& t);
+// One instance of the kernel shade_preview_plain picks from: 0 the baseline, 1 AVX2, 2 AVX-512
+// (chunks of 16 pixels on untextured wide rows); null when this CPU cannot run it. For the tests
+// that compare the instances' bytes.
+using ShadeRoutine = PreviewCounts (*)(const PreviewPlain& t);
+ShadeRoutine shade_instance(unsigned isa);
 
 // The count of a rejected band's covered pixels the kernel uses (count_rows in
 // preview_plain_kernel.inc: SpanWalk::count in lanes, four rows at a time), leaving the walk after

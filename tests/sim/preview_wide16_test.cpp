@@ -1,0 +1,134 @@
+// The plain preview kernel's instances (backends/sim/src/preview_plain.cpp): the AVX-512 one draws
+// the wide rows of untextured draws in chunks of 16 pixels (span16, preview_plain_kernel.inc), the
+// AVX2 and baseline ones in chunks of 8. Every instance must store the same bytes and count the
+// same pixels on this CPU: random wide boxes (spans of 1 to about 200 pixels, so whole chunks of
+// 16, tails of 1 to 15 and rows shorter than 16), every depth function with and without the Z
+// write, blend OFF and ALPHA, random stored depths (lanes pass and fail within a chunk) and
+// stored depths every lane passes or fails against.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <random>
+#include <vector>
+
+#include "preview_plain.hpp"
+#include "setup.hpp"
+
+namespace gpubridge::sim::test {
+namespace {
+
+constexpr unsigned kW = 256, kH = 40;  // the buffers' size in pixels
+constexpr std::size_t kPitch = std::size_t{kW} * 4;
+
+// Biased edge values of the triangle a, b, c (1/16 pixel) at the sample points of the box whose
+// origin pixel is (bx, by), as setup_coverage makes them (positive winding: D > 0).
+void edges(const int* x, const int* y, int bx, int by, PreviewPlain& p) {
+  const std::int64_t sx = 16 * bx + 8, sy = 16 * by + 8;
+  for (int i = 0; i < 3; ++i) {
+    const int a = (i + 1) % 3, b = (i + 2) % 3;
+    const std::int64_t dx = x[b] - x[a], dy = y[b] - y[a];
+    const bool top_left = (dy == 0 && dx > 0) || dy < 0;
+    p.e[i] = dx * (sy - y[a]) - dy * (sx - x[a]) + (top_left ? 0 : -1);
+    p.ex[i] = -16 * dy;
+    p.ey[i] = 16 * dx;
+  }
+}
+
+struct Case {
+  PreviewPlain p;
+  FixedPlanes planes;
+  std::vector<std::uint8_t> color, depth;
+};
+
+Case random_case(std::mt19937& rng) {
+  Case c;
+  c.color.resize(kPitch * kH);
+  c.depth.resize(kPitch * kH);
+  for (auto& b : c.color) b = static_cast<std::uint8_t>(rng());
+  const unsigned fill = rng() % 4;  // 0, 1: random depths; 2: the farthest (LESS passes); 3: 0
+  for (std::size_t k = 0; k < c.depth.size(); ++k)
+    c.depth[k] = fill < 2 ? static_cast<std::uint8_t>(rng()) : fill == 2 ? 0xFF : 0;
+  // A triangle with its box inside the buffer: wide (up to the whole row) or thin.
+  int x[3], y[3];
+  for (int i = 0; i < 3; ++i) {
+    x[i] = static_cast<int>(rng() % (16 * kW));
+    y[i] = static_cast<int>(rng() % (16 * kH));
+  }
+  if ((x[1] - x[0]) * (y[2] - y[0]) - (x[2] - x[0]) * (y[1] - y[0]) < 0) {
+    std::swap(x[1], x[2]);
+    std::swap(y[1], y[2]);
+  }
+  const int bx0 = std::min({x[0], x[1], x[2]}) / 16, bx1 = std::max({x[0], x[1], x[2]}) / 16 + 1;
+  const int by0 = std::min({y[0], y[1], y[2]}) / 16, by1 = std::max({y[0], y[1], y[2]}) / 16 + 1;
+  PreviewPlain& p = c.p;
+  edges(x, y, bx0, by0, p);
+  // Planes: any integers (the lanes are modular sums); Z steps small enough that a row's depths
+  // cross the stored ones, sometimes negative.
+  for (unsigned ch = 0; ch < 4; ++ch) {
+    c.planes.c[ch] = static_cast<std::uint32_t>(rng());
+    c.planes.cdx[ch] = static_cast<std::uint32_t>(rng()) >> (rng() % 32);
+    c.planes.cdy[ch] = static_cast<std::uint32_t>(rng());
+  }
+  c.planes.z = (std::uint64_t{rng()} << 32 | rng()) >> 8;
+  c.planes.zdx = static_cast<std::uint64_t>(static_cast<std::int64_t>(static_cast<std::int32_t>(rng())) << (rng() % 24));
+  c.planes.zdy = static_cast<std::uint64_t>(static_cast<std::int64_t>(static_cast<std::int32_t>(rng())) << (rng() % 24));
+  p.planes = &c.planes;
+  p.width = std::min(bx1, static_cast<int>(kW)) - bx0;
+  p.ky0 = static_cast<int>(rng() % 3);
+  p.rows = std::min(by1, static_cast<int>(kH)) - by0 - p.ky0;
+  if (p.rows < 0) p.rows = 0;
+  p.pitch = kPitch;
+  p.room = kW - static_cast<unsigned>(bx0);
+  constexpr protocol::DepthFunc kFuncs[] = {protocol::DepthFunc::Less, protocol::DepthFunc::LessEqual,
+                                            protocol::DepthFunc::Greater, protocol::DepthFunc::GreaterEqual,
+                                            protocol::DepthFunc::Always};
+  p.depth_on = rng() % 4 != 0;
+  p.z_func = kFuncs[rng() % 5];
+  p.z_write = p.depth_on && rng() % 3 != 0;
+  p.zmask = rng() % 2 ? 0xFFFFFFu : 0xFFFF00u;
+  p.blend = rng() % 3 == 0 ? protocol::BlendMode::Alpha : protocol::BlendMode::Off;
+  p.y = by0;
+  return c;
+}
+
+PreviewCounts draw(ShadeRoutine shade, const Case& c, std::vector<std::uint8_t>& color, std::vector<std::uint8_t>& depth) {
+  color = c.color;
+  depth = c.depth;
+  PreviewPlain p = c.p;
+  const std::size_t origin = static_cast<std::size_t>(p.y + p.ky0) * kPitch + (kW - p.room) * 4;
+  p.color = color.data() + origin;
+  p.depth = p.depth_on ? depth.data() + origin : nullptr;
+  return shade(p);
+}
+
+TEST(SimPreviewWide16, SameBytesAndCountsAsTheEightLaneInstances) {
+  const ShadeRoutine wide = shade_instance(2);
+  if (!wide) GTEST_SKIP() << "no AVX-512 on this CPU";
+  ASSERT_NE(shade_instance(0), nullptr);
+  std::mt19937 rng(2411);
+  std::uint64_t passed = 0, chunks16 = 0;
+  for (int n = 0; n < 3000; ++n) {
+    const Case c = random_case(rng);
+    std::vector<std::uint8_t> color16, depth16;
+    const PreviewCounts got = draw(wide, c, color16, depth16);
+    for (unsigned isa = 0; isa < 2; ++isa) {
+      const ShadeRoutine ref = shade_instance(isa);
+      if (!ref) continue;
+      std::vector<std::uint8_t> color8, depth8;
+      const PreviewCounts want = draw(ref, c, color8, depth8);
+      ASSERT_EQ(got.scanned, want.scanned) << "case " << n << " isa " << isa;
+      ASSERT_EQ(got.covered, want.covered) << "case " << n << " isa " << isa;
+      ASSERT_EQ(got.passed, want.passed) << "case " << n << " isa " << isa;
+      ASSERT_TRUE(color16 == color8) << "colour bytes differ, case " << n << " isa " << isa;
+      ASSERT_TRUE(depth16 == depth8) << "depth bytes differ, case " << n << " isa " << isa;
+    }
+    passed += got.passed;
+    if (c.p.width >= 16) ++chunks16;
+  }
+  // The cases drew something, with boxes wide enough for chunks of 16 among them.
+  EXPECT_GT(passed, 0u);
+  EXPECT_GT(chunks16, 1000u);
+}
+
+}  // namespace
+}  // namespace gpubridge::sim::test
