@@ -104,6 +104,18 @@ const SmallKernel* small_kernel_table() {
 }  // namespace
 
 namespace {
+// One instance of a routine compiled three times (isa 0 the baseline, 1 AVX2, 2 AVX-512), null where
+// this CPU cannot run it: for the tests that compare the instances' results.
+template <class F>
+F pick_instance(unsigned isa, F baseline, F avx2, F avx512) {
+  switch (isa) {
+    case 0: return baseline;
+    case 1: return cpu_has_avx2() ? avx2 : nullptr;
+    case 2: return cpu_has_avx512() ? avx512 : nullptr;
+    default: return nullptr;
+  }
+}
+
 // Whether a triangle's spans are 16 pixels or more on average (its area over its height): twice
 // the area is |ex0·ey1 − ex1·ey0| / 2^16 pixels (ex = −16·dy, ey = 16·dx in 1/16 pixel) and the
 // height max |ex| / 2^8 pixels. In double: any edge steps, no overflow.
@@ -125,12 +137,7 @@ PreviewCounts shade_preview_plain(const PreviewPlain& t) {
 }
 
 ShadeRoutine shade_instance(unsigned isa) {
-  switch (isa) {
-    case 0: return &plain_baseline::shade;
-    case 1: return cpu_has_avx2() ? &plain_avx2::shade : nullptr;
-    case 2: return cpu_has_avx512() ? &plain_avx512::shade : nullptr;
-    default: return nullptr;
-  }
+  return pick_instance<ShadeRoutine>(isa, &plain_baseline::shade, &plain_avx2::shade, &plain_avx512::shade);
 }
 
 SmallSetup setup_small_preview(const Vertex& a, const Vertex& b, const Vertex& c, const DrawState& st,
@@ -143,21 +150,11 @@ SmallSetupRoutine small_setup_routine() {
 }
 
 SmallSetupRoutine small_setup_instance(unsigned isa) {
-  switch (isa) {
-    case 0: return &plain_baseline::setup_small;
-    case 1: return cpu_has_avx2() ? &plain_avx2::setup_small : nullptr;
-    case 2: return cpu_has_avx512() ? &plain_avx512::setup_small : nullptr;
-    default: return nullptr;
-  }
+  return pick_instance<SmallSetupRoutine>(isa, &plain_baseline::setup_small, &plain_avx2::setup_small, &plain_avx512::setup_small);
 }
 
 BandCount band_count_instance(unsigned isa) {
-  switch (isa) {
-    case 0: return &plain_baseline::band_count;
-    case 1: return cpu_has_avx2() ? &plain_avx2::band_count : nullptr;
-    case 2: return cpu_has_avx512() ? &plain_avx512::band_count : nullptr;
-    default: return nullptr;
-  }
+  return pick_instance<BandCount>(isa, &plain_baseline::band_count, &plain_avx2::band_count, &plain_avx512::band_count);
 }
 
 SmallKernel small_kernel(const DrawState& st) { return small_kernel_table()[st.preview_small - 1]; }

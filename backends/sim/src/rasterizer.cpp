@@ -1078,13 +1078,6 @@ KernelFn kernel_for(const DrawState& st, bool gouraud) {
 
 }  // namespace
 
-static_assert(kPreviewBandRows == 1 << HierZ::kRowsLog, "PreviewPlain::band_step counts the bounds' bands");
-void rasterize_preview_bands(const Triangle& t, const DrawState& st, RasterContext& ctx, int band, int step) {
-  const int ya = std::max(band * kPreviewBandRows, t.y0);
-  if (ya >= t.y1) return;
-  draw_preview_plain(t, st, ctx, ya, t.y1, st.z_test || st.z_write, step);
-}
-
 void rasterize_rows(const Triangle& t, const DrawState& st, RasterContext& ctx, int row_begin, int row_end) {
   const int ya = std::max(row_begin, t.y0);
   const int yz = std::min(row_end, t.y1);
@@ -1099,7 +1092,14 @@ void rasterize_rows(const Triangle& t, const DrawState& st, RasterContext& ctx, 
   kernel_for(st, gouraud)(t, st, ctx, ya, yz, 0, yz);
 }
 
+static_assert(kPreviewBandRows == 1 << HierZ::kRowsLog, "PreviewPlain::band_step counts the bounds' bands");
 void rasterize_bands(const Triangle& t, const DrawState& st, RasterContext& ctx, int row_begin, int row_end, int stride) {
+  if (t.preview && st.preview_plain && stride > 0 && row_end - row_begin == kPreviewBandRows &&
+      stride % kPreviewBandRows == 0) {  // the plain preview kernel draws every one of the bands itself
+    const int ya = std::max(row_begin, t.y0);
+    if (ya < t.y1) draw_preview_plain(t, st, ctx, ya, t.y1, st.z_test || st.z_write, stride / kPreviewBandRows);
+    return;
+  }
   if (t.preview || stride <= 0 || t.x1 - t.x0 <= 8) {  // preview and small triangles: band by band
     for (; row_begin < t.y1; row_begin += stride, row_end += stride) {
       rasterize_rows(t, st, ctx, row_begin, row_end);

@@ -92,11 +92,10 @@ void rasterize_rows(const Triangle& t, const DrawState& st, RasterContext& ctx, 
 // fan crosses a dozen 16-row bands).
 void rasterize_bands(const Triangle& t, const DrawState& st, RasterContext& ctx, int row_begin, int row_end, int stride);
 
-// The rows of bands band, band + step, band + 2·step, ... (16 rows each, kPreviewBandRows) of t, a
-// triangle set up for the preview's plain kernel (t.preview && st.preview_plain), in one call:
-// the same bytes and counts as rasterize_rows on each band (a worker's share at N threads).
+// A preview triangle of the plain kernel (t.preview && st.preview_plain) whose bands are
+// kPreviewBandRows high goes to that kernel in one call (PreviewPlain::band_step); other preview
+// triangles are drawn band by band: the same bytes and counts as rasterize_rows on each band.
 constexpr int kPreviewBandRows = 16;
-void rasterize_preview_bands(const Triangle& t, const DrawState& st, RasterContext& ctx, int band, int step);
 
 // The slow, obviously exact path for --dump-attributes: reports every covered pixel's attribute
 // values as N / D (section 9) in double.

@@ -261,7 +261,7 @@ void Renderer::draw_bands(unsigned worker) {
   const SmallTriangle* const smalls = drawing_.small.data();
   const Triangle* const full = drawing_.full.data();
   const std::size_t count = drawing_n_;
-  static_assert(kBandRows == kPreviewBandRows, "the plain preview kernel draws a worker's bands itself");
+  static_assert(kBandRows == kPreviewBandRows, "rasterize_bands gives the plain preview kernel a worker's bands in one call");
   for (std::size_t i = 0; i < count; ++i) {
     const BatchRows r = rows[i];
     // This worker's first band from the box's first (boxes lie inside the clip rectangle: y0 >= 0):
@@ -270,11 +270,7 @@ void Renderer::draw_bands(unsigned worker) {
     unsigned ahead = worker + n - first % n;
     if (ahead >= n) ahead -= n;
     const int band = static_cast<int>(first + ahead);
-    if (!r.small && full[i].preview && st.preview_plain) {  // the plain preview kernel: all its bands in one call
-      rasterize_preview_bands(full[i], st, c, band, static_cast<int>(n));
-      continue;
-    }
-    if (!r.small) {  // every band of the triangle with one Kernel
+    if (!r.small) {  // every band of the triangle in one call (one Kernel, or the plain preview kernel)
       rasterize_bands(full[i], st, c, band * kBandRows, (band + 1) * kBandRows, static_cast<int>(n) * kBandRows);
       continue;
     }
