@@ -98,6 +98,7 @@ struct EdgeWalk {
   int upper_end = 0, lower_begin = 0;  // rows < upper_end: the upper pair; rows >= lower_begin: the lower pair
   int up_lo = 0, up_hi = 0, up_skip = 0;  // the upper pair's left (ex > 0) and right (ex < 0) edge, the edge it skips
   int dn_lo = 0, dn_hi = 0, dn_skip = 0;  // the lower pair's
+  unsigned up_bit = 0, dn_bit = 0, dn_need = 0;  // 1 << up_skip, 1 << dn_skip, the lower pair's edges
   unsigned stale = 0;                     // edges a strip skipped since they were last started
   // The row steps and the strips (once per triangle; div: the edges' dividers, edge_divider, which
   // must outlive the walk).
@@ -121,6 +122,9 @@ struct EdgeWalk {
     if (!pair(t, mid, bot, up_lo, up_hi) || !pair(t, mid, top, dn_lo, dn_hi)) return;
     up_skip = top;
     dn_skip = bot;
+    up_bit = 1u << up_skip;
+    dn_bit = 1u << dn_skip;
+    dn_need = 7u & ~dn_bit;
     // Row y's sample line is 16y + 8 (1/16 pixel).
     const std::int64_t m = t.v[mid].y - 8;
     upper_end = static_cast<int>(ceil_div(m, 16));        // first row with 16y + 8 >= the middle vertex's y
@@ -171,11 +175,11 @@ struct EdgeWalk {
       int lo, hi;
       if (y < upper_end) {
         lo = up_lo, hi = up_hi;
-        stale |= 1u << up_skip;
+        stale |= up_bit;
       } else if (y >= lower_begin) {
-        if (stale & ~(1u << dn_skip)) refresh(t, ~(1u << dn_skip) & 7u, y);
+        if (stale & dn_need) refresh(t, dn_need, y);
         lo = dn_lo, hi = dn_hi;
-        stale |= 1u << dn_skip;
+        stale |= dn_bit;
       } else {
         if (stale) refresh(t, 7u, y);
         return span_all(t, w, kl, kr);
@@ -311,6 +315,7 @@ class Kernel {
     zmask_ = z_mask(ctx);
     const std::uint8_t stored = st.fb_format == protocol::PixelFormat::RGB565 ? 0x7 : 0xF;
     skip_color_ = (st.keep_mask & stored) == stored;
+    plain_rgba_ = kSimple && !skip_color_ && st.color_in_vram;
     if (kGouraud) {
       flat_ = {};
     } else if (st.gouraud) {  // Gouraud requested but every vertex has the same colour
@@ -407,6 +412,9 @@ class Kernel {
     bool walking = false;  // walk_ holds row y's quotients
     bool anchored = false;  // cur_ holds the planes at (y - 1, col_) (false before the first drawn row and after a rejected band)
     bool resumed = false;   // the cursor was carried over a gap and has not moved since
+    // Covered pixels of drawn rows, and those of short spans without depth (all pass): counted
+    // here and added to the context once per run, not stored through ctx_ on every row.
+    std::uint64_t drawn = 0, short_passed = 0;
     if (walk_ok_ && ya > ended_at_) {
       // A later band of the same triangle (rasterize_bands): the walk and the cursor where the last
       // run left them, carried over the rows between (other workers' bands) in one step each.
@@ -473,29 +481,43 @@ class Kernel {
         }
         col_ = kl;
         if (simd_ && y + kPrefetchRows < yz) prefetch_row(y + kPrefetchRows, t_.x0 + static_cast<int>(kl), static_cast<int>(kr - kl + 1));
-        if (kr - kl + 1 >= kMinSimdSpan && simd_ready()) {
-          if (!occluded(kl, kr, y)) simd_span<kLanes>(t_.x0 + static_cast<int>(kl), y, static_cast<unsigned>(kr - kl + 1));
+        const std::int64_t n = kr - kl + 1;
+        drawn += static_cast<std::uint64_t>(n);
+        if (n >= kMinSimdSpan && simd_ready()) {
+          if (!occluded(kl, kr, y)) simd_span<kLanes>(t_.x0 + static_cast<int>(kl), y, static_cast<unsigned>(n));
         } else if constexpr (kLanes) {
-          if constexpr (!kDepth) ctx_.counters.passed += static_cast<std::uint64_t>(kr - kl + 1);
-          Steppers s = cur_;  // the planes other than colour
+          if constexpr (!kDepth) short_passed += static_cast<std::uint64_t>(n);
           ColorLanes c = ccur_;
+          if constexpr (kSimple && !kDepth && !kTextured) {
+            if (plain_rgba_) {  // pixel()'s store, without its per-pixel tests of the draw's constants
+              std::uint8_t* p = color_ + (static_cast<std::size_t>(y) * width_ + static_cast<std::size_t>(t_.x0 + kl)) * 4;
+              for (std::int64_t kx = 0; kx < n; ++kx, p += 4) {
+                store_rgba(p, c.rgba());
+                c.step(cx_, cden_);
+              }
+              continue;
+            }
+          }
+          Steppers s = cur_;  // the planes other than colour
           for (std::int64_t kx = kl; kx <= kr; ++kx) {
             pixel(t_.x0 + static_cast<int>(kx), y, s, c.rgba());
             step_x<kScalar>(s);
             c.step(cx_, cden_);
           }
         } else {
-          if constexpr (!kDepth) ctx_.counters.passed += static_cast<std::uint64_t>(kr - kl + 1);
+          if constexpr (!kDepth) short_passed += static_cast<std::uint64_t>(n);
           Steppers s = cur_;
           for (std::int64_t kx = kl; kx <= kr; ++kx) {
             pixel(t_.x0 + static_cast<int>(kx), y, s, rgba_of(s));
             step_x(s);
           }
         }
-        ctx_.counters.scanned += static_cast<std::uint64_t>(kr - kl + 1);
-        ctx_.counters.covered += static_cast<std::uint64_t>(kr - kl + 1);
       }
     }
+    // Every covered pixel of the drawn rows is scanned; without depth every one passes.
+    ctx_.counters.scanned += drawn;
+    ctx_.counters.covered += drawn;
+    ctx_.counters.passed += short_passed;
     walk_ok_ = walking;  // the walk at row yz, the cursor at (yz - 1, col_)
     cursor_ok_ = anchored;
     ended_at_ = yz;
@@ -863,6 +885,7 @@ class Kernel {
   std::uint8_t* zbuf_ = nullptr;
   std::uint32_t zmask_ = 0xFFFFFF;
   bool skip_color_ = false;
+  bool plain_rgba_ = false;  // kSimple: pixel() stores the colour word straight into VRAM
   Rgba8 flat_;
   bool q_const_ = false;
   Reciprocal const_rc_;
