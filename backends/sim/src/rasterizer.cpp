@@ -81,28 +81,119 @@ inline Divider edge_divider(const Edge& e) { return Divider(e.ex < 0 ? -e.ex : (
 // The edge walk of a wide box (w >= kSpanSolveWidth): (q, r) = floor-divmod of each edge value by
 // its |ex| (the span bounds' quotients), stepped a row at a time by floor-divmod(ey, |ex|) and one
 // carry: the same integers as dividing on every row, with no division a row.
+//
+// Strips: a row whose sample line lies above the middle vertex (in y) is bounded by the two edges
+// of the top vertex, one on either side; the third edge (middle to bottom) lies below that line,
+// so every sample between the two lies in the closed triangle off the third edge's line, where its
+// exact edge value is positive: at least 1, so at least 0 with the top-left bias (section 8.3) as
+// well. Below the middle vertex's line the same holds for the bottom vertex's two edges. Those rows
+// walk two edges, with the left and right one known per triangle (no test of ex's sign a row); the
+// edge a strip skips is not stepped and is started afresh (one division) when a later row needs it.
+// The middle vertex's own line walks all three. Triangles with a horizontal edge (ex == 0) walk all
+// three on every row.
 struct EdgeWalk {
   std::int64_t q[3], r[3], qy[3], ry[3], d[3];
-  // The row steps (once per triangle; div: the edges' dividers, edge_divider).
-  void prepare(const Triangle& t, const Divider div[3]) {
+  const Divider* div = nullptr;  // the edges' dividers (edge_divider)
+  bool strips = false;
+  int upper_end = 0, lower_begin = 0;  // rows < upper_end: the upper pair; rows >= lower_begin: the lower pair
+  int up_lo = 0, up_hi = 0, up_skip = 0;  // the upper pair's left (ex > 0) and right (ex < 0) edge, the edge it skips
+  int dn_lo = 0, dn_hi = 0, dn_skip = 0;  // the lower pair's
+  unsigned up_bit = 0, dn_bit = 0, dn_need = 0;  // 1 << up_skip, 1 << dn_skip, the lower pair's edges
+  unsigned stale = 0;                     // edges a strip skipped since they were last started
+  // The row steps and the strips (once per triangle; div: the edges' dividers, edge_divider, which
+  // must outlive the walk).
+  void prepare(const Triangle& t, const Divider d_[3]) {
+    div = d_;
     for (int i = 0; i < 3; ++i) {
       const DivMod s = div[i](t.edge[i].ey);
       qy[i] = s.q;
       ry[i] = s.r;
       d[i] = div[i].divisor();
     }
+    strips = false;
+    for (int i = 0; i < 3; ++i)
+      if (t.edge[i].ex == 0) return;  // a horizontal edge: vertices share a y
+    // Edge i joins the two vertices other than i. No edge is horizontal, so the y differ.
+    int top = 0, mid = 1, bot = 2;
+    if (t.v[mid].y < t.v[top].y) std::swap(mid, top);
+    if (t.v[bot].y < t.v[mid].y) std::swap(bot, mid);
+    if (t.v[mid].y < t.v[top].y) std::swap(mid, top);
+    // Upper rows: the edges of the top vertex (edge[mid], edge[bot]); lower: of the bottom vertex.
+    if (!pair(t, mid, bot, up_lo, up_hi) || !pair(t, mid, top, dn_lo, dn_hi)) return;
+    up_skip = top;
+    dn_skip = bot;
+    up_bit = 1u << up_skip;
+    dn_bit = 1u << dn_skip;
+    dn_need = 7u & ~dn_bit;
+    // Row y's sample line is 16y + 8 (1/16 pixel).
+    const std::int64_t m = t.v[mid].y - 8;
+    upper_end = static_cast<int>(ceil_div(m, 16));        // first row with 16y + 8 >= the middle vertex's y
+    lower_begin = static_cast<int>(floor_div(m, 16) + 1);  // first row with 16y + 8 > it
+    strips = true;
+  }
+  // Edges a and b as a pair: lo the one with ex > 0 (it bounds the span's left end), hi ex < 0.
+  static bool pair(const Triangle& t, int a, int b, int& lo, int& hi) {
+    if (t.edge[a].ex > 0 && t.edge[b].ex < 0) {
+      lo = a, hi = b;
+      return true;
+    }
+    if (t.edge[b].ex > 0 && t.edge[a].ex < 0) {
+      lo = b, hi = a;
+      return true;
+    }
+    return false;
+  }
+  // Edge i's quotient at box row y (absolute).
+  void start_edge(const Triangle& t, int i, int y) {
+    const DivMod a = div[i](t.edge[i].e + static_cast<std::int64_t>(y - t.y0) * t.edge[i].ey);
+    q[i] = a.q;
+    r[i] = a.r;
   }
   // The quotients of box row y (absolute).
-  void start(const Triangle& t, const Divider div[3], int y) {
-    const std::int64_t k = y - t.y0;
-    for (int i = 0; i < 3; ++i) {
-      const DivMod a = div[i](t.edge[i].e + k * t.edge[i].ey);
-      q[i] = a.q;
-      r[i] = a.r;
-    }
+  void start(const Triangle& t, int y) {
+    for (int i = 0; i < 3; ++i) start_edge(t, i, y);
+    stale = 0;
   }
-  // This row's covered span kl..kr (box-relative; empty when kl > kr), then on to the next row.
-  [[gnu::always_inline]] void span_and_step(const Triangle& t, std::int64_t w, std::int64_t& kl, std::int64_t& kr) {
+  // The stale edges among `mask` started afresh at row y.
+  [[gnu::noinline]] void refresh(const Triangle& t, unsigned mask, int y) {
+    for (int i = 0; i < 3; ++i)
+      if ((stale & mask) >> i & 1) start_edge(t, i, y);
+    stale &= ~mask;
+  }
+  [[gnu::always_inline]] void step(int i) {
+    q[i] += qy[i];
+    r[i] += ry[i];
+    const bool carry = r[i] >= d[i];
+    r[i] -= carry ? d[i] : 0;
+    q[i] += carry;
+  }
+  // Row y's covered span kl..kr (box-relative; empty when kl > kr), then on to the next row. Rows
+  // are walked in increasing order.
+  [[gnu::always_inline]] void span_and_step(const Triangle& t, int y, std::int64_t w, std::int64_t& kl,
+                                            std::int64_t& kr) {
+    if (strips) {
+      int lo, hi;
+      if (y < upper_end) {
+        lo = up_lo, hi = up_hi;
+        stale |= up_bit;
+      } else if (y >= lower_begin) {
+        if (stale & dn_need) refresh(t, dn_need, y);
+        lo = dn_lo, hi = dn_hi;
+        stale |= dn_bit;
+      } else {
+        if (stale) refresh(t, 7u, y);
+        return span_all(t, w, kl, kr);
+      }
+      kl = std::max<std::int64_t>(0, -q[lo]);
+      kr = std::min<std::int64_t>(w - 1, q[hi]);
+      step(lo);
+      step(hi);
+      return;
+    }
+    span_all(t, w, kl, kr);
+  }
+  // span_and_step over all three edges.
+  [[gnu::always_inline]] void span_all(const Triangle& t, std::int64_t w, std::int64_t& kl, std::int64_t& kr) {
     kl = 0;
     kr = w - 1;
     for (int i = 0; i < 3; ++i) {
@@ -110,21 +201,17 @@ struct EdgeWalk {
       if (ex > 0) kl = std::max(kl, -q[i]);
       else if (ex < 0) kr = std::min(kr, q[i]);
       else if (q[i] < 0) kr = -1;
-      q[i] += qy[i];
-      r[i] += ry[i];
-      const bool carry = r[i] >= d[i];
-      r[i] -= carry ? d[i] : 0;
-      q[i] += carry;
+      step(i);
     }
   }
-  // What drawing the next `rows` rows counts when all their pixels fail the depth test: every
+  // What drawing rows y.. y + rows - 1 counts when all their pixels fail the depth test: every
   // covered pixel scanned and covered, none passed. Leaves the walk after them.
-  void count(const Triangle& t, int rows, RasterCounters& c) {
+  void count(const Triangle& t, int y, int rows, RasterCounters& c) {
     const std::int64_t w = t.x1 - t.x0;
     std::uint64_t n = 0;
     for (int row = 0; row < rows; ++row) {
       std::int64_t kl, kr;
-      span_and_step(t, w, kl, kr);
+      span_and_step(t, y + row, w, kl, kr);
       n += kl <= kr ? static_cast<std::uint64_t>(kr - kl + 1) : 0u;
     }
     c.scanned += n;
@@ -228,6 +315,7 @@ class Kernel {
     zmask_ = z_mask(ctx);
     const std::uint8_t stored = st.fb_format == protocol::PixelFormat::RGB565 ? 0x7 : 0xF;
     skip_color_ = (st.keep_mask & stored) == stored;
+    plain_rgba_ = kSimple && !skip_color_ && st.color_in_vram;
     if (kGouraud) {
       flat_ = {};
     } else if (st.gouraud) {  // Gouraud requested but every vertex has the same colour
@@ -324,6 +412,9 @@ class Kernel {
     bool walking = false;  // walk_ holds row y's quotients
     bool anchored = false;  // cur_ holds the planes at (y - 1, col_) (false before the first drawn row and after a rejected band)
     bool resumed = false;   // the cursor was carried over a gap and has not moved since
+    // Covered pixels of drawn rows, and those of short spans without depth (all pass): counted
+    // here and added to the context once per run, not stored through ctx_ on every row.
+    std::uint64_t drawn = 0, short_passed = 0;
     if (walk_ok_ && ya > ended_at_) {
       // A later band of the same triangle (rasterize_bands): the walk and the cursor where the last
       // run left them, carried over the rows between (other workers' bands) in one step each.
@@ -356,9 +447,9 @@ class Kernel {
           ask_band(t_, clip_, st_, ctx_, zmask_, y, end - 1, hz_run_)) {
         hz_tries_ = HierZ::kTries;
         hz_rejected_ = true;
-        if (!walking) walk_.start(t_, edge_div_, y);
+        if (!walking) walk_.start(t_, y);
         walking = true;
-        walk_.count(t_, end - y, ctx_.counters);  // the walk goes on after the band
+        walk_.count(t_, y, end - y, ctx_.counters);  // the walk goes on after the band
         if (mark_from == y) mark_from = end;
         y = end;
         first = false;
@@ -367,12 +458,12 @@ class Kernel {
       }
       first = false;
       if (!walking) {
-        walk_.start(t_, edge_div_, y);
+        walk_.start(t_, y);
         walking = true;
       }
       for (; y < end; ++y) {
         std::int64_t kl, kr;
-        walk_.span_and_step(t_, w, kl, kr);
+        walk_.span_and_step(t_, y, w, kl, kr);
         if (kl > kr) {  // no sample covered: the cursor stays in its column
           if (anchored) {
             step_y<kScalar>(cur_);
@@ -390,29 +481,43 @@ class Kernel {
         }
         col_ = kl;
         if (simd_ && y + kPrefetchRows < yz) prefetch_row(y + kPrefetchRows, t_.x0 + static_cast<int>(kl), static_cast<int>(kr - kl + 1));
-        if (kr - kl + 1 >= kMinSimdSpan && simd_ready()) {
-          if (!occluded(kl, kr, y)) simd_span<kLanes>(t_.x0 + static_cast<int>(kl), y, static_cast<unsigned>(kr - kl + 1));
+        const std::int64_t n = kr - kl + 1;
+        drawn += static_cast<std::uint64_t>(n);
+        if (n >= kMinSimdSpan && simd_ready()) {
+          if (!occluded(kl, kr, y)) simd_span<kLanes>(t_.x0 + static_cast<int>(kl), y, static_cast<unsigned>(n));
         } else if constexpr (kLanes) {
-          if constexpr (!kDepth) ctx_.counters.passed += static_cast<std::uint64_t>(kr - kl + 1);
-          Steppers s = cur_;  // the planes other than colour
+          if constexpr (!kDepth) short_passed += static_cast<std::uint64_t>(n);
           ColorLanes c = ccur_;
+          if constexpr (kSimple && !kDepth && !kTextured) {
+            if (plain_rgba_) {  // pixel()'s store, without its per-pixel tests of the draw's constants
+              std::uint8_t* p = color_ + (static_cast<std::size_t>(y) * width_ + static_cast<std::size_t>(t_.x0 + kl)) * 4;
+              for (std::int64_t kx = 0; kx < n; ++kx, p += 4) {
+                store_rgba(p, c.rgba());
+                c.step(cx_, cden_);
+              }
+              continue;
+            }
+          }
+          Steppers s = cur_;  // the planes other than colour
           for (std::int64_t kx = kl; kx <= kr; ++kx) {
             pixel(t_.x0 + static_cast<int>(kx), y, s, c.rgba());
             step_x<kScalar>(s);
             c.step(cx_, cden_);
           }
         } else {
-          if constexpr (!kDepth) ctx_.counters.passed += static_cast<std::uint64_t>(kr - kl + 1);
+          if constexpr (!kDepth) short_passed += static_cast<std::uint64_t>(n);
           Steppers s = cur_;
           for (std::int64_t kx = kl; kx <= kr; ++kx) {
             pixel(t_.x0 + static_cast<int>(kx), y, s, rgba_of(s));
             step_x(s);
           }
         }
-        ctx_.counters.scanned += static_cast<std::uint64_t>(kr - kl + 1);
-        ctx_.counters.covered += static_cast<std::uint64_t>(kr - kl + 1);
       }
     }
+    // Every covered pixel of the drawn rows is scanned; without depth every one passes.
+    ctx_.counters.scanned += drawn;
+    ctx_.counters.covered += drawn;
+    ctx_.counters.passed += short_passed;
     walk_ok_ = walking;  // the walk at row yz, the cursor at (yz - 1, col_)
     cursor_ok_ = anchored;
     ended_at_ = yz;
@@ -626,6 +731,7 @@ class Kernel {
     }
     set_pixel_lanes(simd_tpl_.pixel, st_, ctx_, flat_, kGouraud, kDepth);
     if (kTextured) simd_tpl_.pixel.texture = {&tex_, &ctx_.recip, q_const_, const_rc_, st_.tex.wl, st_.tex.hl, st_.decal};
+    span_fn_ = span_routine(simd_tpl_.pixel);
     simd_ = true;
   }
   static constexpr bool simd_plane_used(unsigned p) { return p < 4 ? kGouraud : p == 4 ? kDepth : kTextured; }
@@ -691,7 +797,7 @@ class Kernel {
     sp.depth = kDepth ? zbuf_ + pix * 4 : nullptr;
     sp.count = count;
     sp.room = width_ - static_cast<unsigned>(x);
-    const std::uint64_t passed = shade_span_simd(sp);
+    const std::uint64_t passed = span_fn_(sp);
     ctx_.counters.passed += passed;
     if (st_.blend != protocol::BlendMode::Off) ctx_.counters.blended += passed;
     if (kTextured) textured_ += passed;
@@ -779,12 +885,14 @@ class Kernel {
   std::uint8_t* zbuf_ = nullptr;
   std::uint32_t zmask_ = 0xFFFFFF;
   bool skip_color_ = false;
+  bool plain_rgba_ = false;  // kSimple: pixel() stores the colour word straight into VRAM
   Rgba8 flat_;
   bool q_const_ = false;
   Reciprocal const_rc_;
   Divider edge_div_[3] = {Divider(1), Divider(1), Divider(1)};
   bool simd_ = false, simd_checked_ = false;
   SimdSpan simd_tpl_{};
+  SpanRoutine span_fn_ = nullptr;  // the span routine for this draw (span_routine, by prepare_simd)
   std::uint64_t textured_ = 0;  // texture-unit pixels of this run
   std::uint32_t hz_run_ = 0;    // this run's number for the coarse depth bounds
   unsigned hz_tries_ = 0;       // rows left to ask them before giving up on this run (0: not asked)
@@ -1053,9 +1161,9 @@ bool ask_leading_bands(const Triangle& t, const DrawState& st, RasterContext& ct
     if (!div) {
       div.emplace(std::array<Divider, 3>{edge_divider(t.edge[0]), edge_divider(t.edge[1]), edge_divider(t.edge[2])});
       walk.prepare(t, div->data());
-      walk.start(t, div->data(), ya);
+      walk.start(t, ya);
     }
-    walk.count(t, end - ya, ctx.counters);
+    walk.count(t, ya, end - ya, ctx.counters);
     hz |= kHzRejected;
     ya = end;
     if (ya >= yz) return false;

@@ -153,56 +153,46 @@ template <bool kMasked, bool kGouraud>
 namespace {
 
 // Each instance is the same source compiled for one ISA; all of them compute the same integers.
-std::uint64_t span_baseline(const SimdSpan& s) {
-  return simd::dispatch(s.pixel, [&]<bool kTextured, PixelFormat kFormat>() __attribute__((always_inline)) {
-    return s.pixel.gouraud ? shade_span<kTextured, kFormat, true, false>(s)
-                           : shade_span<kTextured, kFormat, false, false>(s);
-  });
+// The *_of functions are one draw's specialisation (texture, colour format, colour source): what
+// span_routine hands the rasteriser once per triangle, so that a span pays neither the instance
+// look-up nor the dispatch (about 35 instructions a span of the 1,000-px front's ~30 pixels).
+template <bool kTextured, PixelFormat kFormat, bool kGouraud>
+[[gnu::noinline]] std::uint64_t span_baseline_of(const SimdSpan& s) {
+  return shade_span<kTextured, kFormat, kGouraud, false>(s);
 }
-__attribute__((target("avx2"))) std::uint64_t span_avx2(const SimdSpan& s) {
-  return simd::dispatch(s.pixel, [&]<bool kTextured, PixelFormat kFormat>() __attribute__((always_inline)) {
-    return s.pixel.gouraud ? shade_span<kTextured, kFormat, true, true>(s)
-                           : shade_span<kTextured, kFormat, false, true>(s);
-  });
+template <bool kTextured, PixelFormat kFormat, bool kGouraud>
+[[gnu::noinline]] __attribute__((target("avx2"))) std::uint64_t span_avx2_of(const SimdSpan& s) {
+  return shade_span<kTextured, kFormat, kGouraud, true>(s);
 }
 // AVX-512 (F, VL, BW, DQ) in 256-bit vectors: the same eight lanes with 32 vector registers and
 // compares into mask registers. Tails as in AVX2 (whole loads where the row has room, stores of n
 // words): masked moves for them cost the road 15 % and the 1,000-px front rows a few per cent.
 #define SPAN_AVX512 __attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq")))
-SPAN_AVX512 std::uint64_t span_avx512_256(const SimdSpan& s) {
-  return simd::dispatch(s.pixel, [&]<bool kTextured, PixelFormat kFormat>() __attribute__((always_inline)) {
-    return s.pixel.gouraud ? shade_span<kTextured, kFormat, true, true>(s)
-                           : shade_span<kTextured, kFormat, false, true>(s);
-  });
+template <bool kTextured, PixelFormat kFormat, bool kGouraud>
+[[gnu::noinline]] SPAN_AVX512 std::uint64_t span_avx512_256_of(const SimdSpan& s) {
+  return shade_span<kTextured, kFormat, kGouraud, true>(s);
 }
 // Untextured RGBA8888 spans of at least kWideSpan pixels in sixteen lanes (shade_span_wide, tails
 // through masked moves: the 50,000-px front rows 108-113 → 101-102 ms a frame against unmasked
-// tails); every other span as span_avx512_256. Shorter spans stay in eight lanes: sixteen for
+// tails); every other span as span_avx512_256_of. Shorter spans stay in eight lanes: sixteen for
 // spans from 9 or 32 pixels on cost the 1,000-px front rows a few per cent (spans of 20-45 pixels,
 // where the second set of lanes' start and the 8-lane tail are paid on every row); from 64 they
 // do not (docs/simulator.md, issue 17's AVX-512 part).
 constexpr unsigned kWideSpan = 64;
-SPAN_AVX512 std::uint64_t span_avx512(const SimdSpan& s) {
-  return simd::dispatch(s.pixel, [&]<bool kTextured, PixelFormat kFormat>() __attribute__((always_inline)) {
-    if constexpr (!kTextured && kFormat == PixelFormat::RGBA8888) {
-      if (s.count >= kWideSpan)
-        return s.pixel.gouraud ? shade_span_wide<true, true>(s) : shade_span_wide<true, false>(s);
-    }
-    return s.pixel.gouraud ? shade_span<kTextured, kFormat, true, true>(s)
-                           : shade_span<kTextured, kFormat, false, true>(s);
-  });
+template <bool kTextured, PixelFormat kFormat, bool kGouraud>
+[[gnu::noinline]] SPAN_AVX512 std::uint64_t span_avx512_of(const SimdSpan& s) {
+  if constexpr (!kTextured && kFormat == PixelFormat::RGBA8888) {
+    if (s.count >= kWideSpan) return shade_span_wide<true, kGouraud>(s);
+  }
+  return shade_span<kTextured, kFormat, kGouraud, true>(s);
 }
-#undef SPAN_AVX512
 
-struct Instance {
-  SpanIsa isa;
-  std::uint64_t (*routine)(const SimdSpan&);
-};
+#undef SPAN_AVX512
 
 // The widest instance the CPU runs, capped by GPUBRIDGE_SIM_SPAN_ISA (avx512-256, avx2 or baseline)
 // so that the instances can be timed against each other in one binary. Any other value is named
 // in a warning and caps nothing: a typo must not pass for a measurement of another instance.
-Instance pick_instance() {
+SpanIsa pick_instance() {
   SpanIsa cap = SpanIsa::Avx512;
   if (const char* env = std::getenv("GPUBRIDGE_SIM_SPAN_ISA"); env && *env) {
     if (std::strcmp(env, "avx512-256") == 0) cap = SpanIsa::Avx512x256;
@@ -213,21 +203,38 @@ Instance pick_instance() {
                           "routine runs the widest instance this CPU has",
                           env);
   }
-  if (cap == SpanIsa::Avx512 && cpu_has_avx512()) return {SpanIsa::Avx512, &span_avx512};
-  if (cap == SpanIsa::Avx512x256 && cpu_has_avx512()) return {SpanIsa::Avx512x256, &span_avx512_256};
-  if (cap != SpanIsa::Baseline && cpu_has_avx2()) return {SpanIsa::Avx2, &span_avx2};
-  return {SpanIsa::Baseline, &span_baseline};
+  if (cap == SpanIsa::Avx512 && cpu_has_avx512()) return SpanIsa::Avx512;
+  if (cap == SpanIsa::Avx512x256 && cpu_has_avx512()) return SpanIsa::Avx512x256;
+  if (cap != SpanIsa::Baseline && cpu_has_avx2()) return SpanIsa::Avx2;
+  return SpanIsa::Baseline;
 }
 
-const Instance& instance() {
-  static const Instance picked = pick_instance();
+SpanIsa instance() {
+  static const SpanIsa picked = pick_instance();
   return picked;
 }
 
 }  // namespace
 
-SpanIsa span_simd_isa() { return instance().isa; }
+SpanIsa span_simd_isa() { return instance(); }
 
-std::uint64_t shade_span_simd(const SimdSpan& s) { return instance().routine(s); }
+SpanRoutine span_routine(const PixelLanes& px) {
+  const SpanIsa isa = instance();
+  return simd::dispatch(px, [&]<bool kTextured, PixelFormat kFormat>() -> SpanRoutine {
+    const bool g = px.gouraud;
+    switch (isa) {
+      case SpanIsa::Avx512:
+        return g ? &span_avx512_of<kTextured, kFormat, true> : &span_avx512_of<kTextured, kFormat, false>;
+      case SpanIsa::Avx512x256:
+        return g ? &span_avx512_256_of<kTextured, kFormat, true> : &span_avx512_256_of<kTextured, kFormat, false>;
+      case SpanIsa::Avx2:
+        return g ? &span_avx2_of<kTextured, kFormat, true> : &span_avx2_of<kTextured, kFormat, false>;
+      case SpanIsa::Baseline: break;
+    }
+    return g ? &span_baseline_of<kTextured, kFormat, true> : &span_baseline_of<kTextured, kFormat, false>;
+  });
+}
+
+std::uint64_t shade_span_simd(const SimdSpan& s) { return span_routine(s.pixel)(s); }
 
 }  // namespace gpubridge::sim

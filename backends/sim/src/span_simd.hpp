@@ -37,6 +37,13 @@ struct SimdSpan {
 // each other in one binary and to test each on a CPU that has a wider one.
 std::uint64_t shade_span_simd(const SimdSpan& span);
 
+// What shade_span_simd runs for each span of a draw whose stages are px (px.texture.tex, format,
+// gouraud): the instance's routine for them, picked once per triangle so that a span pays neither
+// the instance look-up nor the dispatch on its stages. Its spans' `pixel` must have the same
+// texture, format and colour source as px.
+using SpanRoutine = std::uint64_t (*)(const SimdSpan&);
+SpanRoutine span_routine(const PixelLanes& px);
+
 // The instruction sets of the span routine's instances (all give the same bytes).
 enum class SpanIsa { Baseline, Avx2, Avx512x256, Avx512 };
 // The instance shade_span_simd() runs in this process.
