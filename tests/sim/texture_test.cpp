@@ -7,6 +7,7 @@
 #include <bit>
 #include <random>
 
+#include "reciprocal.hpp"
 #include "reference.hpp"
 #include "sim_test_util.hpp"
 
@@ -87,8 +88,9 @@ void upload_texture(Device& d) {
     }
 }
 
-void check_triangle(const TexVertex (&v)[3], unsigned ws, unsigned wt, bool bilinear, bool modulate) {
-  Canvas c(24, 24);
+void check_triangle(const TexVertex (&v)[3], unsigned ws, unsigned wt, bool bilinear, bool modulate,
+                    int size = 24) {
+  Canvas c(size, size);
   upload_texture(*c.dev);
   w(*c.dev, Reg::TEX_BASE, kTexBase);
   w(*c.dev, Reg::TEX_FMT, (std::uint64_t{bilinear} << 12) | (wt << 10) | (ws << 8) | (kLog2 << 4) | kLog2);
@@ -101,8 +103,8 @@ void check_triangle(const TexVertex (&v)[3], unsigned ws, unsigned wt, bool bili
   }
   const ref::P P[3] = {{v[0].x, v[0].y}, {v[1].x, v[1].y}, {v[2].x, v[2].y}};
   unsigned covered = 0;
-  for (int y = 0; y < 24; ++y)
-    for (int x = 0; x < 24; ++x) {
+  for (int y = 0; y < size; ++y)
+    for (int x = 0; x < size; ++x) {
       const ref::Bary b = ref::sample(P[0], P[1], P[2], x, y);
       if (!b.covered) continue;
       ++covered;
@@ -145,6 +147,59 @@ TEST(SimTexture, PerspectiveAndModulate) {
                             {5 * 16, 24 * 16, sd(rng), sd(rng), qd(rng)}};
     check_triangle(v, iter % 3, (iter + 1) % 3, iter % 2 == 0, iter % 3 == 0);
   }
+}
+
+// Q constant along x (two vertices on one row with equal Q), varying along y: the span routine
+// computes one reciprocal a span for such triangles; every pixel must still be the reference's.
+// Wide rows (up to 90 pixels) so that the spans run whole chunks of eight and tails.
+TEST(SimTexture, PerspectiveQConstantAlongRows) {
+  std::mt19937 rng(1717);
+  std::uniform_int_distribution<std::uint32_t> qd(0x01000000u, 0xFFFFFFFFu);
+  std::uniform_int_distribution<std::int32_t> sd(-(3 << 24), 3 << 24);
+  for (int iter = 0; iter < 6; ++iter) {
+    const std::uint32_t q_top = qd(rng), q_bottom = qd(rng);
+    const bool top_edge = iter % 2 == 0;  // the equal-Q edge on the first or on the last row
+    const int ye = top_edge ? 2 * 16 : 94 * 16, yo = top_edge ? 94 * 16 : 2 * 16;
+    const TexVertex v[3] = {{1 * 16, ye, sd(rng), sd(rng), q_top},
+                            {95 * 16, ye, sd(rng), sd(rng), q_top},
+                            {(30 + 7 * iter) * 16, yo, sd(rng), sd(rng), q_bottom}};
+    // Wraps (0, 0) bilinear first: the vector routines' specialised fetch (RGBA8888, repeat, bilinear).
+    check_triangle(v, iter % 3, (iter / 2) % 3, iter % 3 != 1, iter % 2 == 1, 96);
+  }
+}
+
+// The reciprocal unit (section 10.1) for every table size and step count the knobs allow, against
+// the document's formula in 128-bit arithmetic: the unit's Newton-Raphson step multiplies in 64
+// bits, which is exact only because y and t both stay below 2^32.
+TEST(SimTexture, ReciprocalMatchesWideArithmetic) {
+  std::mt19937 rng(10);
+  std::vector<std::uint32_t> qs = {1u, 2u, 3u, 0x7FFFFFFFu, 0x80000000u, 0x80000001u, 0xFFFFFFFEu, 0xFFFFFFFFu};
+  for (unsigned b = 0; b < 32; ++b) {
+    qs.push_back(1u << b);
+    qs.push_back((1u << b) | ((1u << b) - 1));  // all ones below bit b
+  }
+  for (int k = 0; k < 4000; ++k) qs.push_back(rng() >> (rng() % 32) | 1u);
+  for (unsigned bits = 1; bits <= 16; ++bits)
+    for (unsigned steps = 0; steps <= 4; ++steps) {
+      const ReciprocalUnit unit(bits, steps);
+      for (const std::uint32_t q : qs) {
+        const unsigned n = static_cast<unsigned>(std::countl_zero(q));
+        const unsigned __int128 m = static_cast<unsigned __int128>(q) << n;
+        const unsigned __int128 i = (m >> (31 - bits)) & ((1u << bits) - 1);
+        const unsigned __int128 den = (static_cast<unsigned __int128>(1) << (bits + 1)) + 2 * i + 1;
+        unsigned __int128 y = ((static_cast<unsigned __int128>(1) << (bits + 34)) + den) / (2 * den);
+        if (y > 0xFFFFFFFFu) y = 0xFFFFFFFFu;
+        for (unsigned s = 0; s < steps; ++s) {
+          const unsigned __int128 p = (m * y) & ~std::uint64_t{0};
+          const unsigned __int128 t = ((static_cast<unsigned __int128>(1) << 64) - p) & ~std::uint64_t{0};
+          y = (y * (t >> 32)) >> 31;
+          if (y > 0xFFFFFFFFu) y = 0xFFFFFFFFu;
+        }
+        const Reciprocal r = unit(q);
+        ASSERT_EQ(r.n, n) << "q " << q;
+        ASSERT_EQ(r.y, static_cast<std::uint32_t>(y)) << "q " << q << " bits " << bits << " steps " << steps;
+      }
+    }
 }
 
 TEST(SimTexture, ZeroQSamplesTexelZero) {

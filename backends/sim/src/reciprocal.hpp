@@ -24,7 +24,9 @@ class ReciprocalUnit {
     for (unsigned k = 0; k < steps_; ++k) {
       const std::uint64_t p = m * y;               // < 2^64 (u1.63)
       const std::uint64_t t = (0 - p) >> 32;       // (2^64 − p) mod 2^64, as u1.31
-      const std::uint64_t yt = static_cast<std::uint64_t>((static_cast<unsigned __int128>(y) * t) >> 31);
+      // y <= 2^32 − 1 (the table's words and the clamp below) and t < 2^32, so y·t < 2^64: one
+      // 64-bit multiply, where a 128-bit one cost a widening multiply and a double shift a pixel.
+      const std::uint64_t yt = (y * t) >> 31;
       y = yt > 0xFFFFFFFFu ? 0xFFFFFFFFu : yt;
     }
     return {static_cast<std::uint32_t>(y), n};

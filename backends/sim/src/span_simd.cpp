@@ -28,6 +28,18 @@ template <bool kTextured, PixelFormat kFormat, bool kGouraud, bool kAvx2>
   PixelLanes px = s.pixel;
   px.gouraud = kGouraud;
   const unsigned count = s.count, room = s.room;
+  if constexpr (kTextured) {
+    // Q constant along x (a screen row at one depth, the road's case: its triangles have a
+    // horizontal edge of equal W): every pixel of the span has the span's first Q, so the
+    // reciprocal is computed once a span rather than once a pixel. Same integers: lane k's Q is
+    // q0 + k·0 and r0 < den, and texture8's constant-Q loop is its per-lane loop with that one
+    // reciprocal. Q = 0 keeps the per-lane loop (its texel coordinates are (0, 0)).
+    constexpr unsigned kQ = 7;
+    if (!px.texture.q_const && s.qx[kQ] == 0 && s.rk[kQ][1] == 0 && s.q0[kQ] != 0) {
+      px.texture.q_const = true;
+      px.texture.const_rc = (*px.texture.recip)(s.q0[kQ]);
+    }
+  }
   u32x8 q[kUsed] = {}, r[kUsed] = {}, q8[kUsed] = {}, r8[kUsed] = {};  // unused planes: zeros, never read
   const u32x8 den = u32x8{} + s.den;
   // The rasteriser hands over the planes at the span's first pixel (its cursor): lane k adds k

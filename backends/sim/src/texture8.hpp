@@ -16,8 +16,15 @@ namespace gpubridge::sim {
   std::uint32_t pv[8];
   simd::store8(pv, pass);
   alignas(32) std::uint32_t c00[8] = {}, c10[8] = {}, c01[8] = {}, c11[8] = {}, fu[8] = {}, fv[8] = {};
-  for (unsigned k = 0; k < n; ++k)
-    if (pv[k]) s.tex->quad(tc[k], c00[k], c10[k], c01[k], c11[k], fu[k], fv[k]);  // rejected lanes: never sampled
+  // Rejected lanes are never sampled. The draw's texture fixes which loop runs (one branch a chunk
+  // that always goes the same way within a triangle).
+  if (s.tex->bilinear_rgba_repeat()) {
+    for (unsigned k = 0; k < n; ++k)
+      if (pv[k]) s.tex->quad_rgba_repeat(tc[k], c00[k], c10[k], c01[k], c11[k], fu[k], fv[k]);
+  } else {
+    for (unsigned k = 0; k < n; ++k)
+      if (pv[k]) s.tex->quad(tc[k], c00[k], c10[k], c01[k], c11[k], fu[k], fv[k]);
+  }
   u32x8 texel = simd::load8(c00);
   if (s.tex->bilinear()) {
     const u32x8 t10 = simd::load8(c10), t01 = simd::load8(c01), t11 = simd::load8(c11);
