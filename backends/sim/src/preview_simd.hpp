@@ -135,6 +135,32 @@ class SpanWalk {
     int kind[3] = {};
   };
   State& state() { return s_; }
+  // `rows` rows' step of each edge, rows·ey = q·a + r (one division per edge, once per call), for
+  // advance(): the walk over rows it does not draw (another worker's bands, rejected rows) in one
+  // step and a carry per edge, instead of a restart (six divisions) after them.
+  struct Jump {
+    std::int64_t q[3], r[3];
+  };
+  Jump jump(int rows) const {
+    Jump j;
+    for (int i = 0; i < 3; ++i) {
+      const std::int64_t n = static_cast<std::int64_t>(rows) * s_.ry[i];  // below rows·a: no overflow
+      j.q[i] = rows * s_.qy[i] + n / s_.a[i];
+      j.r[i] = n % s_.a[i];
+    }
+    return j;
+  }
+  // The walk moved by a jump's rows: the same f and m as that many next_row() (f·a + m is the edge
+  // value, and m stays in [0, a) with one carry since both remainders are below a).
+  [[gnu::always_inline]] void advance(const Jump& j) {
+    for (int i = 0; i < 3; ++i) {
+      s_.f[i] += j.q[i];
+      s_.m[i] += j.r[i];
+      const bool carry = s_.m[i] >= s_.a[i];
+      s_.m[i] -= carry ? s_.a[i] : 0;
+      s_.f[i] += carry;
+    }
+  }
   [[gnu::always_inline]] void next_row() {
     for (int i = 0; i < 3; ++i) {
       s_.f[i] += s_.qy[i];

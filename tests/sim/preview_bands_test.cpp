@@ -1,0 +1,159 @@
+// The plain preview kernel's wide rows in one call over rows it does not draw (issue 24,
+// sim-preview12: shade_wide steps its walk and colour anchor over another worker's bands instead
+// of a call per band). At N threads a worker draws every N-th 16-row band of a triangle
+// (PreviewPlain::band_step); that one call must store the same bytes and count the same pixels as
+// a call per own band (band_step 0, rows of that band only: what the kernel did before), for
+// every instance this CPU runs, on tall boxes (thin slivers crossing many bands, and wide ones),
+// every depth function, blend OFF and ALPHA, random stored depths.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <random>
+#include <vector>
+
+#include "preview_plain.hpp"
+#include "setup.hpp"
+
+namespace gpubridge::sim::test {
+namespace {
+
+constexpr unsigned kW = 192, kH = 200;  // the buffers' size in pixels
+constexpr std::size_t kPitch = std::size_t{kW} * 4;
+constexpr int kBand = 16;
+
+// Biased edge values of the triangle (1/16 pixel, D > 0) at the box origin (bx, by), as
+// setup_coverage makes them.
+void edges(const int* x, const int* y, int bx, int by, PreviewPlain& p) {
+  const std::int64_t sx = 16 * bx + 8, sy = 16 * by + 8;
+  for (int i = 0; i < 3; ++i) {
+    const int a = (i + 1) % 3, b = (i + 2) % 3;
+    const std::int64_t dx = x[b] - x[a], dy = y[b] - y[a];
+    const bool top_left = (dy == 0 && dx > 0) || dy < 0;
+    p.e[i] = dx * (sy - y[a]) - dy * (sx - x[a]) + (top_left ? 0 : -1);
+    p.ex[i] = -16 * dy;
+    p.ey[i] = 16 * dx;
+  }
+}
+
+struct Case {
+  PreviewPlain p;
+  FixedPlanes planes;
+  std::vector<std::uint8_t> color, depth;
+};
+
+Case random_case(std::mt19937& rng) {
+  Case c;
+  c.color.resize(kPitch * kH);
+  c.depth.resize(kPitch * kH);
+  for (auto& b : c.color) b = static_cast<std::uint8_t>(rng());
+  for (auto& b : c.depth) b = static_cast<std::uint8_t>(rng());
+  int x[3], y[3];
+  if (rng() % 2) {  // a sliver from a point out to a far one, as the fan's: short spans, many bands
+    x[0] = static_cast<int>(rng() % (16 * kW));
+    y[0] = static_cast<int>(rng() % (16 * kH));
+    x[1] = static_cast<int>(rng() % (16 * kW));
+    y[1] = static_cast<int>(rng() % (16 * kH));
+    const int spread = 8 + static_cast<int>(rng() % 64);
+    x[2] = std::clamp(x[1] + static_cast<int>(rng() % (2 * spread)) - spread, 0, 16 * static_cast<int>(kW) - 1);
+    y[2] = std::clamp(y[1] + static_cast<int>(rng() % (2 * spread)) - spread, 0, 16 * static_cast<int>(kH) - 1);
+  } else {
+    for (int i = 0; i < 3; ++i) {
+      x[i] = static_cast<int>(rng() % (16 * kW));
+      y[i] = static_cast<int>(rng() % (16 * kH));
+    }
+  }
+  if ((x[1] - x[0]) * (y[2] - y[0]) - (x[2] - x[0]) * (y[1] - y[0]) < 0) {
+    std::swap(x[1], x[2]);
+    std::swap(y[1], y[2]);
+  }
+  const int bx0 = std::min({x[0], x[1], x[2]}) / 16, bx1 = std::max({x[0], x[1], x[2]}) / 16 + 1;
+  const int by0 = std::min({y[0], y[1], y[2]}) / 16, by1 = std::max({y[0], y[1], y[2]}) / 16 + 1;
+  PreviewPlain& p = c.p;
+  edges(x, y, bx0, by0, p);
+  for (unsigned ch = 0; ch < 4; ++ch) {  // any integers: the lanes are modular sums
+    c.planes.c[ch] = static_cast<std::uint32_t>(rng());
+    c.planes.cdx[ch] = static_cast<std::uint32_t>(rng()) >> (rng() % 32);
+    c.planes.cdy[ch] = static_cast<std::uint32_t>(rng()) >> (rng() % 32);
+  }
+  c.planes.z = (std::uint64_t{rng()} << 32 | rng()) >> 8;
+  c.planes.zdx = static_cast<std::uint64_t>(static_cast<std::int64_t>(static_cast<std::int32_t>(rng())) << (rng() % 24));
+  c.planes.zdy = static_cast<std::uint64_t>(static_cast<std::int64_t>(static_cast<std::int32_t>(rng())) << (rng() % 24));
+  p.planes = &c.planes;
+  p.width = std::min(bx1, static_cast<int>(kW)) - bx0;
+  p.y = by0;
+  p.pitch = kPitch;
+  p.room = kW - static_cast<unsigned>(bx0);
+  constexpr protocol::DepthFunc kFuncs[] = {protocol::DepthFunc::Less, protocol::DepthFunc::LessEqual,
+                                            protocol::DepthFunc::Greater, protocol::DepthFunc::GreaterEqual,
+                                            protocol::DepthFunc::Always};
+  p.depth_on = rng() % 3 != 0;
+  p.z_func = kFuncs[rng() % 5];
+  p.z_write = p.depth_on && rng() % 3 != 0;
+  p.blend = rng() % 3 == 0 ? protocol::BlendMode::Alpha : protocol::BlendMode::Off;
+  // The rows a worker gets: from a random row of the box to its end (as rasterize_bands passes
+  // them: the first row of the worker's first band).
+  const int rows = std::min(by1, static_cast<int>(kH)) - by0;
+  p.ky0 = rows > 0 ? static_cast<int>(rng() % static_cast<unsigned>(std::min(rows, 20))) : 0;
+  p.rows = std::max(0, rows - p.ky0);
+  return c;
+}
+
+// Rows [ky0, ky0 + rows) of the case's box drawn by `shade` with band_step `step` (0: all of them).
+PreviewCounts draw_rows(ShadeRoutine shade, const Case& c, int ky0, int rows, int step, std::vector<std::uint8_t>& color,
+                        std::vector<std::uint8_t>& depth) {
+  PreviewPlain p = c.p;
+  p.ky0 = ky0;
+  p.rows = rows;
+  p.band_step = step;
+  const std::size_t origin = static_cast<std::size_t>(p.y + ky0) * kPitch + (kW - p.room) * 4;
+  p.color = color.data() + origin;
+  p.depth = p.depth_on ? depth.data() + origin : nullptr;
+  return shade(p);
+}
+
+TEST(SimPreviewBands, OneCallOverAWorkersBandsIsACallPerBand) {
+  std::mt19937 rng(2412);
+  std::uint64_t passed = 0, many_bands = 0, thin = 0;
+  for (int n = 0; n < 1500; ++n) {
+    const Case c = random_case(rng);
+    if (c.p.rows <= 0 || c.p.width <= 8) continue;
+    const int step = 2 + static_cast<int>(rng() % 2);
+    for (unsigned isa = 0; isa < 3; ++isa) {
+      const ShadeRoutine shade = shade_instance(isa);
+      if (!shade) continue;
+      std::vector<std::uint8_t> color1 = c.color, depth1 = c.depth;
+      const PreviewCounts got = draw_rows(shade, c, c.p.ky0, c.p.rows, step, color1, depth1);
+      // The same worker's bands one call each: the first band from ky0, then every step-th.
+      std::vector<std::uint8_t> color2 = c.color, depth2 = c.depth;
+      PreviewCounts want;
+      int bands = 0;
+      for (int r = 0; r < c.p.rows;) {
+        const int y = c.p.y + c.p.ky0 + r;
+        const int end = std::min(c.p.rows, (y | (kBand - 1)) + 1 - c.p.y - c.p.ky0);
+        const PreviewCounts d = draw_rows(shade, c, c.p.ky0 + r, end - r, 0, color2, depth2);
+        want.scanned += d.scanned;
+        want.covered += d.covered;
+        want.passed += d.passed;
+        ++bands;
+        r = end + (step - 1) * kBand;
+      }
+      ASSERT_EQ(got.scanned, want.scanned) << "case " << n << " isa " << isa;
+      ASSERT_EQ(got.covered, want.covered) << "case " << n << " isa " << isa;
+      ASSERT_EQ(got.passed, want.passed) << "case " << n << " isa " << isa;
+      ASSERT_TRUE(color1 == color2) << "colour bytes differ, case " << n << " isa " << isa;
+      ASSERT_TRUE(depth1 == depth2) << "depth bytes differ, case " << n << " isa " << isa;
+      if (isa == 0) {
+        passed += got.passed;
+        if (bands >= 3) ++many_bands;
+        if (c.p.width > 8 && got.covered < static_cast<std::uint64_t>(4 * c.p.rows)) ++thin;
+      }
+    }
+  }
+  // Something was drawn, by workers with three or more bands of a box, thin slivers among them.
+  EXPECT_GT(passed, 0u);
+  EXPECT_GT(many_bands, 200u);
+  EXPECT_GT(thin, 100u);
+}
+
+}  // namespace
+}  // namespace gpubridge::sim::test
