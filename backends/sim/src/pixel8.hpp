@@ -75,7 +75,7 @@ template <bool kTextured, PixelFormat kFormat, Chunk kChunk, bool kTexelLanes = 
   V word = V{} + px.flat;
   if (px.gouraud) word = (q[0] & 255u) | ((q[1] & 255u) << 8) | ((q[2] & 255u) << 16) | (q[3] << 24);
   if constexpr (kTextured && kTexelLanes) word = texture8_lanes(px.texture, q[5], q[6], pass, n, word);
-  else if constexpr (kTextured) word = texture8<kAvx2 && kChunk == Chunk::Span>(px.texture, q[5], q[6], q[7], pass, n, word);
+  else if constexpr (kTextured) word = texture8(px.texture, q[5], q[6], q[7], pass, n, word);
   if (kChunk == Chunk::Span && all && !f.reads_color) {  // a fully passing chunk of a plain store: no read
     store_color<kFormat, kMasked>(cp, pack_color<kFormat>(word, bayer, px.temporal), kLanesOf<V>);
     return pass;

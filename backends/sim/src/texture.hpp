@@ -117,12 +117,6 @@ class TextureUnit {
     std::memcpy(&c01, row1 + a0, 4);
     std::memcpy(&c11, row1 + a1, 4);
   }
-  // What the vector routines' gathered fetch needs of a bilinear_rgba_repeat() texture: its first
-  // byte and the masks and row shift of quad_rgba_repeat, which fit 32-bit lanes (sizes <= 2^10).
-  const std::uint8_t* texels() const { return direct_; }
-  std::uint32_t wmask() const { return static_cast<std::uint32_t>(wmask_); }
-  std::uint32_t hmask() const { return static_cast<std::uint32_t>(hmask_); }
-  unsigned wl() const { return wl_; }
   bool direct() const { return direct_ != nullptr; }
   bool bilinear() const { return bilinear_; }
 
