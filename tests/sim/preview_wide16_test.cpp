@@ -11,6 +11,7 @@
 #include <random>
 #include <vector>
 
+#include "preview_box_edges.hpp"
 #include "preview_plain.hpp"
 #include "setup.hpp"
 
@@ -19,20 +20,6 @@ namespace {
 
 constexpr unsigned kW = 256, kH = 40;  // the buffers' size in pixels
 constexpr std::size_t kPitch = std::size_t{kW} * 4;
-
-// Biased edge values of the triangle a, b, c (1/16 pixel) at the sample points of the box whose
-// origin pixel is (bx, by), as setup_coverage makes them (positive winding: D > 0).
-void edges(const int* x, const int* y, int bx, int by, PreviewPlain& p) {
-  const std::int64_t sx = 16 * bx + 8, sy = 16 * by + 8;
-  for (int i = 0; i < 3; ++i) {
-    const int a = (i + 1) % 3, b = (i + 2) % 3;
-    const std::int64_t dx = x[b] - x[a], dy = y[b] - y[a];
-    const bool top_left = (dy == 0 && dx > 0) || dy < 0;
-    p.e[i] = dx * (sy - y[a]) - dy * (sx - x[a]) + (top_left ? 0 : -1);
-    p.ex[i] = -16 * dy;
-    p.ey[i] = 16 * dx;
-  }
-}
 
 struct Case {
   PreviewPlain p;
@@ -61,7 +48,7 @@ Case random_case(std::mt19937& rng) {
   const int bx0 = std::min({x[0], x[1], x[2]}) / 16, bx1 = std::max({x[0], x[1], x[2]}) / 16 + 1;
   const int by0 = std::min({y[0], y[1], y[2]}) / 16, by1 = std::max({y[0], y[1], y[2]}) / 16 + 1;
   PreviewPlain& p = c.p;
-  edges(x, y, bx0, by0, p);
+  preview_box_edges(x, y, bx0, by0, p);
   // Planes: any integers (the lanes are modular sums); Z steps small enough that a row's depths
   // cross the stored ones, sometimes negative.
   for (unsigned ch = 0; ch < 4; ++ch) {
