@@ -19,16 +19,7 @@ Rendered render_flat_q(const Case& c, const DeviceOptions& o) {
   Canvas cv(kW, kH, 0, o);
   Device& d = *cv.dev;
   std::mt19937 rng(c.seed);
-  auto mem = d.memory();
-  for (std::uint32_t i = 0; i < 128 * 128 * 4; ++i) mem[kTexBase + i] = static_cast<std::uint8_t>(rng());
-  w(d, Reg::FB_FORMAT, c.fb_fmt);
-  w(d, Reg::FB_DRAW, c.fb_draw);
-  w(d, Reg::FB_Z, c.fb_z);
-  w(d, Reg::CLEAR_COLOR, rng());
-  w(d, Reg::CLEAR, 0);
-  w(d, Reg::TEX_BASE, c.tex_base);
-  w(d, Reg::TEX_FMT, c.tex_fmt);
-  w(d, Reg::TRI_MODE, c.tri_mode);
+  start_frame(d, c, rng, false);
   std::uniform_int_distribution<int> px(-8 * 16, (kW + 8) * 16), py(0, kH * 16);
   std::uniform_int_distribution<std::int32_t> st(-(1 << 26), 1 << 26);
   const int sizes[] = {6, 20, 70, 200};  // narrow boxes, short spans, long spans, larger than the target

@@ -75,6 +75,25 @@ inline void expect_same(const Case& c, const Rendered& v, const Rendered& s, int
   EXPECT_TRUE(v.stats == s.stats) << i << ": the timing counters too";
 }
 
+// A random texture at kTexBase, case c's buffers and state, the colour buffer cleared to a random
+// colour and, with clear_depth, the depth buffer to a random depth (render, preview_flat_q_test.cpp).
+inline void start_frame(Device& d, const Case& c, std::mt19937& rng, bool clear_depth) {
+  auto mem = d.memory();
+  for (std::uint32_t i = 0; i < 128 * 128 * 4; ++i) mem[kTexBase + i] = static_cast<std::uint8_t>(rng());
+  w(d, Reg::FB_FORMAT, c.fb_fmt);
+  w(d, Reg::FB_DRAW, c.fb_draw);
+  w(d, Reg::FB_Z, c.fb_z);
+  w(d, Reg::CLEAR_COLOR, rng());
+  w(d, Reg::CLEAR, 0);
+  if (clear_depth) {
+    w(d, Reg::CLEAR_DEPTH, rng() & 0xFFFFFF);
+    w(d, Reg::CLEAR_Z, 0);
+  }
+  w(d, Reg::TEX_BASE, c.tex_base);
+  w(d, Reg::TEX_FMT, c.tex_fmt);
+  w(d, Reg::TRI_MODE, c.tri_mode);
+}
+
 // Draws 24 random triangles of four size classes (narrow boxes, short and long spans, larger than
 // the target) in state c with device options o; the memory covers colour, depth and texture.
 // flat_z: each triangle's three vertices take its first vertex's Z, below 2^23 (so that Z + 0.5,
@@ -83,18 +102,7 @@ inline Rendered render(const Case& c, const DeviceOptions& o, bool flat_z = fals
   Canvas cv(kW, kH, 0, o);
   Device& d = *cv.dev;
   std::mt19937 rng(c.seed);
-  auto mem = d.memory();
-  for (std::uint32_t i = 0; i < 128 * 128 * 4; ++i) mem[kTexBase + i] = static_cast<std::uint8_t>(rng());
-  w(d, Reg::FB_FORMAT, c.fb_fmt);
-  w(d, Reg::FB_DRAW, c.fb_draw);
-  w(d, Reg::FB_Z, c.fb_z);
-  w(d, Reg::CLEAR_COLOR, rng());
-  w(d, Reg::CLEAR, 0);
-  w(d, Reg::CLEAR_DEPTH, rng() & 0xFFFFFF);
-  w(d, Reg::CLEAR_Z, 0);
-  w(d, Reg::TEX_BASE, c.tex_base);
-  w(d, Reg::TEX_FMT, c.tex_fmt);
-  w(d, Reg::TRI_MODE, c.tri_mode);
+  start_frame(d, c, rng, true);
   std::uniform_int_distribution<int> px(-16 * 16, (kW + 16) * 16), py(-16 * 16, (kH + 16) * 16);
   std::uniform_int_distribution<std::int32_t> st(-(1 << 26), 1 << 26);
   const int sizes[] = {6, 20, 70, 200};  // px: narrow boxes, short spans, long spans, larger than the target
