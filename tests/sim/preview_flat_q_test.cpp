@@ -40,12 +40,7 @@ Rendered render_flat_q(const Case& c, const DeviceOptions& o) {
       w(d, Reg::VERTEX, vtx(vx[k], vy[k], 0));
     }
   }
-  d.drain();
-  const auto m = d.memory();
-  Rendered r;
-  r.memory.assign(m.begin(), m.begin() + kTexBase + 128 * 128 * 4);
-  r.stats = d.stats();
-  return r;
+  return end_frame(d);
 }
 
 TEST(SimPreviewFlatQ, RowReciprocalSamplesAsTheFloatRoutine) {

@@ -41,14 +41,8 @@ Case random_case(std::mt19937& rng) {
     x[i] = static_cast<int>(rng() % (16 * kW));
     y[i] = static_cast<int>(rng() % (16 * kH));
   }
-  if ((x[1] - x[0]) * (y[2] - y[0]) - (x[2] - x[0]) * (y[1] - y[0]) < 0) {
-    std::swap(x[1], x[2]);
-    std::swap(y[1], y[2]);
-  }
-  const int bx0 = std::min({x[0], x[1], x[2]}) / 16, bx1 = std::max({x[0], x[1], x[2]}) / 16 + 1;
-  const int by0 = std::min({y[0], y[1], y[2]}) / 16, by1 = std::max({y[0], y[1], y[2]}) / 16 + 1;
+  const auto [bx0, bx1, by0, by1] = preview_box(x, y, c.p);
   PreviewPlain& p = c.p;
-  preview_box_edges(x, y, bx0, by0, p);
   // Planes: any integers (the lanes are modular sums); Z steps small enough that a row's depths
   // cross the stored ones, sometimes negative.
   for (unsigned ch = 0; ch < 4; ++ch) {

@@ -94,6 +94,16 @@ inline void start_frame(Device& d, const Case& c, std::mt19937& rng, bool clear_
   w(d, Reg::TRI_MODE, c.tri_mode);
 }
 
+// The frame drawn: the memory up to the texture's end and the counters (render, preview_flat_q_test.cpp).
+inline Rendered end_frame(Device& d) {
+  d.drain();
+  const auto m = d.memory();
+  Rendered r;
+  r.memory.assign(m.begin(), m.begin() + kTexBase + 128 * 128 * 4);
+  r.stats = d.stats();
+  return r;
+}
+
 // Draws 24 random triangles of four size classes (narrow boxes, short and long spans, larger than
 // the target) in state c with device options o; the memory covers colour, depth and texture.
 // flat_z: each triangle's three vertices take its first vertex's Z, below 2^23 (so that Z + 0.5,
@@ -124,12 +134,7 @@ inline Rendered render(const Case& c, const DeviceOptions& o, bool flat_z = fals
       w(d, Reg::VERTEX, vtx(vx, vy, flat_z ? z0 : z));
     }
   }
-  d.drain();
-  const auto m = d.memory();
-  Rendered r;
-  r.memory.assign(m.begin(), m.begin() + kTexBase + 128 * 128 * 4);
-  r.stats = d.stats();
-  return r;
+  return end_frame(d);
 }
 
 }  // namespace gpubridge::sim::test

@@ -6,6 +6,7 @@
 #include "cpu_features.hpp"
 #include "gpubridge/common/log.hpp"
 #include "pixel8.hpp"
+#include "setup.hpp"
 
 namespace gpubridge::sim {
 
@@ -33,8 +34,8 @@ template <bool kTextured, PixelFormat kFormat, bool kGouraud, bool kAvx2>
     // horizontal edge of equal W): every pixel of the span has the span's first Q, so the
     // reciprocal is computed once a span rather than once a pixel. Same integers: lane k's Q is
     // q0 + k·0 and r0 < den, and texture8's constant-Q loop is its per-lane loop with that one
-    // reciprocal. Q = 0 keeps the per-lane loop (its texel coordinates are (0, 0)).
-    constexpr unsigned kQ = 7;
+    // reciprocal. Q = 0 keeps the per-lane loop (its texel coordinates are (0, 0)). Planes in
+    // setup.hpp's attribute order.
     if (!px.texture.q_const && s.qx[kQ] == 0 && s.rk[kQ][1] == 0 && s.q0[kQ] != 0) {
       px.texture.q_const = true;
       px.texture.const_rc = (*px.texture.recip)(s.q0[kQ]);

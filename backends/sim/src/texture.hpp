@@ -51,7 +51,9 @@ class TextureUnit {
         wrap_t_(tex.wrap_t),
         bilinear_(tex.bilinear),
         wmask_((std::uint64_t{1} << tex.wl) - 1),
-        hmask_((std::uint64_t{1} << tex.hl) - 1) {}
+        hmask_((std::uint64_t{1} << tex.hl) - 1),
+        rgba_repeat_(bilinear_ && direct_ != nullptr && format_ == protocol::PixelFormat::RGBA8888 &&
+                     wrap_s_ == protocol::Wrap::Repeat && wrap_t_ == protocol::Wrap::Repeat) {}
 
   // Filtered texel at texel coordinates (tu, tv); sets ERR_MEM_RANGE in errors for fetches beyond VRAM.
   [[gnu::always_inline]] protocol::Rgba8 sample(TexelCoords c, std::uint16_t& errors) const {
@@ -97,10 +99,7 @@ class TextureUnit {
   // an RGBA8888 bilinear texture inside VRAM that repeats on both axes. quad_rgba_repeat gives the
   // same words and weights as quad() without a wrap-mode switch, a format test and four multiplies
   // by the bytes per texel in every lane.
-  bool bilinear_rgba_repeat() const {
-    return bilinear_ && direct_ != nullptr && format_ == protocol::PixelFormat::RGBA8888 &&
-           wrap_s_ == protocol::Wrap::Repeat && wrap_t_ == protocol::Wrap::Repeat;
-  }
+  bool bilinear_rgba_repeat() const { return rgba_repeat_; }
   [[gnu::always_inline]] void quad_rgba_repeat(TexelCoords c, std::uint32_t& c00, std::uint32_t& c10,
                                                std::uint32_t& c01, std::uint32_t& c11, std::uint32_t& fu,
                                                std::uint32_t& fv) const {
@@ -156,6 +155,7 @@ class TextureUnit {
   protocol::Wrap wrap_s_, wrap_t_;
   bool bilinear_;
   std::uint64_t wmask_, hmask_;  // size − 1 of each axis
+  bool rgba_repeat_;  // quad_rgba_repeat applies (bilinear_rgba_repeat): fixed per draw, read per chunk
 };
 
 // Section 10.5.
