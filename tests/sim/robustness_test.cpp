@@ -68,5 +68,23 @@ TEST(SimRobustness, VideoMemoryRefusesASizeWhoseRoundingWraps) {
   EXPECT_EQ(huge.data()[(std::uint64_t{4} << 20) - 1], 0);
 }
 
+// Memories of at least one huge page are mapped 2 MiB-aligned (whole huge pages for the kernel to
+// grant) and read zero everywhere; a size that is not a whole number of huge pages keeps its size.
+TEST(SimRobustness, VideoMemoryOfHugePagesIsAlignedAndZero) {
+  constexpr std::uint64_t kHuge = std::uint64_t{2} << 20;
+  for (const std::uint64_t size : {kHuge, 3 * kHuge + 5, 16 * kHuge}) {
+    VideoMemory mem(size);
+    EXPECT_EQ(mem.size(), size);
+    EXPECT_EQ(reinterpret_cast<std::uintptr_t>(mem.data()) % kHuge, 0u) << size;
+    std::uint64_t nonzero = 0;
+    for (std::uint64_t i = 0; i < size; ++i) nonzero += mem.data()[i] != 0;
+    EXPECT_EQ(nonzero, 0u) << size;
+    const std::uint8_t last = 0xA5;  // the last byte is writable and read back
+    EXPECT_TRUE(mem.write(size - 1, &last, 1));
+    EXPECT_EQ(mem.data()[size - 1], last);
+    EXPECT_FALSE(mem.contains(size - 1, 2));
+  }
+}
+
 }  // namespace
 }  // namespace gpubridge::sim::test
