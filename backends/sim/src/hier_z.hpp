@@ -134,7 +134,9 @@ class HierZ {
  private:
   static constexpr unsigned kMaxLevel = 6;
   static constexpr unsigned kBandMisses = 8;
-  struct Band {
+  // One cache line a band: neighbouring bands belong to different workers, which update these on
+  // every band test (2-byte records side by side bounced one line between the cores).
+  struct alignas(64) Band {
     std::uint8_t misses = 0;  // band tests in a row that did not reject (capped)
     std::uint8_t skip = 0;    // band tests to let pass before asking again
   };

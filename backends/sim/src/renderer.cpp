@@ -230,7 +230,7 @@ void Renderer::submit() {
   drawing_gen_ = batch_gen_;
   batch_state_.reset();
   drawing_ctx_.clear();
-  for (unsigned w = 0; w < pool_.workers(); ++w) drawing_ctx_.push_back(context(*drawing_state_, drawing_gen_, w));
+  for (unsigned w = 0; w < pool_.workers(); ++w) drawing_ctx_.push_back({context(*drawing_state_, drawing_gen_, w)});
   drawing_active_ = true;
   pool_.start(draw_job_);
 }
@@ -239,7 +239,7 @@ void Renderer::wait_drawing() {
   if (!drawing_active_) return;
   pool_.wait();
   for (unsigned w = 0; w < drawing_ctx_.size(); ++w) {
-    const RasterContext& c = drawing_ctx_[w];
+    const RasterContext& c = drawing_ctx_[w].ctx;
     errors_ |= c.errors;
     add_counters(c.counters, *drawing_state_);  // one state per batch
     if (c.hier_z) hz_runs_[w] = c.hz_run;
@@ -253,7 +253,7 @@ void Renderer::wait_drawing() {
 void Renderer::draw_bands(unsigned worker) {
   const DrawState& st = *drawing_state_;
   const unsigned n = pool_.workers();
-  RasterContext& c = drawing_ctx_[worker];
+  RasterContext& c = drawing_ctx_[worker].ctx;
   const SmallDraw small = knobs_.preview && st.preview_small != 0 ? small_draw(st, mem_, knobs_.z_bits) : SmallDraw{};
   // In locals: the kernels are called through pointers, so the compiler would load the batch's
   // fields again for every triangle.
