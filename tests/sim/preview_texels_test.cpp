@@ -1,11 +1,11 @@
 // The plain preview kernel's texture stage in its instances (backends/sim/src/preview_plain.cpp):
 // the AVX2 and AVX-512 instances load the two columns of a bilinear texel row as one 64-bit word
-// per lane and filter in 16-bit lanes (sim-preview14); the baseline instance loads word by word and
-// filters word by word in 32-bit lanes. Every instance must store the same bytes, all four
-// channels (the comparison with the float routine in preview_test.cpp sees only RGB), and count
-// the same pixels: random textures 8 to 128 texels a side in every wrap mode (REPEAT's seam, the
-// edges of CLAMP and MIRROR, MIRROR's reflected copies), nearest and bilinear, decal and modulate,
-// perspective Q that sometimes falls to 0 or below, and random depths, blend and boxes.
+// per lane (sim-preview14), the baseline instance word by word. Every instance must store the
+// same bytes, all four channels (the comparison with the float routine in preview_test.cpp sees
+// only RGB), and count the same pixels: random textures 8 to 128 texels a side in every wrap
+// mode (REPEAT's seam, the edges of CLAMP and MIRROR, MIRROR's reflected copies), nearest and
+// bilinear, decal and modulate, perspective Q that sometimes falls to 0 or below, and random
+// depths, blend and boxes.
 #include <gtest/gtest.h>
 
 #include <cmath>
