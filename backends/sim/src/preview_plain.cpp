@@ -132,7 +132,10 @@ PreviewCounts shade_preview_plain(const PreviewPlain& t) {
   // The AVX-512 instance (its chunks of 16) for untextured triangles whose spans are 16 pixels or
   // more on average; the AVX2 one otherwise: the thin triangles of the fan scene (boxes wider than
   // 16, spans mostly shorter) were 16 % slower in the AVX-512 instance (15.8 against 13.6 ms).
-  if (t.width >= 16 && !t.tex.texels && cpu_has_avx512() && wide_spans(t)) return plain_avx512::shade(t);
+  // Textured draws take the AVX-512 instance whatever their shape: their chunks are the same 8
+  // lanes, but its 32 vector registers keep the texture stage's lanes and constants, which the
+  // AVX2 instance's 16 spill and reload in every chunk (sim-preview14).
+  if (cpu_has_avx512() && (t.tex.texels ? true : t.width >= 16 && wide_spans(t))) return plain_avx512::shade(t);
   return cpu_has_avx2() ? plain_avx2::shade(t) : plain_baseline::shade(t);
 }
 

@@ -1,0 +1,140 @@
+// The plain preview kernel's texture stage in its instances (backends/sim/src/preview_plain.cpp):
+// the AVX2 and AVX-512 instances load the two columns of a bilinear texel row as one 64-bit word
+// per lane (sim-preview14), the baseline instance word by word. Every instance must store the
+// same bytes, all four channels (the comparison with the float routine in preview_test.cpp sees
+// only RGB), and count the same pixels: random textures 8 to 128 texels a side in every wrap
+// mode (REPEAT's seam, the edges of CLAMP and MIRROR, MIRROR's reflected copies), nearest and
+// bilinear, decal and modulate, perspective Q that sometimes falls to 0 or below, and random
+// depths, blend and boxes.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "preview_box_edges.hpp"
+#include "preview_plain.hpp"
+#include "setup.hpp"
+
+namespace gpubridge::sim::test {
+namespace {
+
+constexpr unsigned kW = 96, kH = 40;  // the buffers' size in pixels
+constexpr std::size_t kPitch = std::size_t{kW} * 4;
+
+struct Case {
+  PreviewPlain p;
+  FixedPlanes planes;
+  FloatPlanes tex_planes;
+  std::vector<std::uint8_t> color, depth, texels;
+};
+
+Case random_case(std::mt19937& rng) {
+  Case c;
+  c.color.resize(kPitch * kH);
+  c.depth.resize(kPitch * kH);
+  for (auto& b : c.color) b = static_cast<std::uint8_t>(rng());
+  for (auto& b : c.depth) b = static_cast<std::uint8_t>(rng());
+  int x[3], y[3];
+  for (int i = 0; i < 3; ++i) {
+    x[i] = static_cast<int>(rng() % (16 * kW));
+    y[i] = static_cast<int>(rng() % (16 * kH));
+  }
+  const auto [bx0, bx1, by0, by1] = preview_box(x, y, c.p);
+  PreviewPlain& p = c.p;
+  for (unsigned ch = 0; ch < 4; ++ch) {
+    c.planes.c[ch] = static_cast<std::uint32_t>(rng());
+    c.planes.cdx[ch] = static_cast<std::uint32_t>(rng()) >> (rng() % 32);
+    c.planes.cdy[ch] = static_cast<std::uint32_t>(rng());
+  }
+  c.planes.z = (std::uint64_t{rng()} << 32 | rng()) >> 8;
+  c.planes.zdx = static_cast<std::uint64_t>(static_cast<std::int64_t>(static_cast<std::int32_t>(rng())) << (rng() % 24));
+  c.planes.zdy = static_cast<std::uint64_t>(static_cast<std::int64_t>(static_cast<std::int32_t>(rng())) << (rng() % 24));
+  p.planes = &c.planes;
+  p.width = std::min(bx1, static_cast<int>(kW)) - bx0;
+  p.ky0 = 0;
+  p.rows = std::min(by1, static_cast<int>(kH)) - by0;
+  p.pitch = kPitch;
+  p.room = kW - static_cast<unsigned>(bx0);
+  constexpr protocol::DepthFunc kFuncs[] = {protocol::DepthFunc::Less, protocol::DepthFunc::LessEqual,
+                                            protocol::DepthFunc::Greater, protocol::DepthFunc::GreaterEqual,
+                                            protocol::DepthFunc::Always};
+  p.depth_on = rng() % 3 != 0;
+  p.z_func = kFuncs[rng() % 5];
+  p.z_write = p.depth_on && rng() % 3 != 0;
+  p.zmask = 0xFFFFFFu;
+  p.blend = rng() % 3 == 0 ? protocol::BlendMode::Alpha : protocol::BlendMode::Off;
+  p.y = by0;
+  // The texture and its S, T, Q planes (per pixel of the box, as the renderer's double planes):
+  // coordinates over a few texture widths either side of 0, so every wrap mode meets its edges.
+  PreviewTexels& t = p.tex;
+  t.wl = 3 + rng() % 5;
+  t.hl = 3 + rng() % 5;
+  c.texels.resize(std::size_t{4} << (t.wl + t.hl));
+  for (auto& b : c.texels) b = static_cast<std::uint8_t>(rng());
+  const auto uniform = [&](double lo, double hi) { return lo + (hi - lo) * (rng() / 4294967296.0); };
+  const bool perspective = rng() % 2 != 0;
+  const double q = perspective ? uniform(0.05, 2.0) : 1.0;
+  c.tex_planes.base[kS] = uniform(-3, 3) * q;
+  c.tex_planes.base[kT] = uniform(-3, 3) * q;
+  c.tex_planes.base[kQ] = q;
+  for (unsigned a = kS; a <= kQ; ++a) {
+    const double range = a == kQ ? (perspective ? 0.03 : 0.0) : uniform(0.001, 0.2);
+    c.tex_planes.dx[a] = uniform(-range, range);
+    c.tex_planes.dy[a] = uniform(-range, range);
+  }
+  t.texels = c.texels.data();
+  t.planes = &c.tex_planes;
+  t.wrap_s = static_cast<protocol::Wrap>(rng() % 3);
+  t.wrap_t = static_cast<protocol::Wrap>(rng() % 3);
+  t.bilinear = rng() % 4 != 0;
+  t.decal = rng() % 2 != 0;
+  t.scale_u = std::ldexp(1.0f, 20 + static_cast<int>(t.wl));
+  t.scale_v = std::ldexp(1.0f, 20 + static_cast<int>(t.hl));
+  return c;
+}
+
+PreviewCounts draw(ShadeRoutine shade, const Case& c, std::vector<std::uint8_t>& color, std::vector<std::uint8_t>& depth) {
+  color = c.color;
+  depth = c.depth;
+  PreviewPlain p = c.p;
+  const std::size_t origin = static_cast<std::size_t>(p.y + p.ky0) * kPitch + (kW - p.room) * 4;
+  p.color = color.data() + origin;
+  p.depth = p.depth_on ? depth.data() + origin : nullptr;
+  return shade(p);
+}
+
+TEST(SimPreviewTexels, InstancesSampleTheSameBytes) {
+  const ShadeRoutine reference = shade_instance(0);
+  ASSERT_NE(reference, nullptr);
+  if (!shade_instance(1) && !shade_instance(2)) GTEST_SKIP() << "no AVX2 on this CPU";
+  std::mt19937 rng(1424);
+  std::uint64_t passed = 0;
+  unsigned wraps_seen = 0, bilinear_cases = 0;
+  for (int n = 0; n < 3000; ++n) {
+    const Case c = random_case(rng);
+    if (c.p.rows <= 0 || c.p.width <= 0) continue;
+    std::vector<std::uint8_t> color0, depth0;
+    const PreviewCounts want = draw(reference, c, color0, depth0);
+    for (unsigned isa = 1; isa < 3; ++isa) {
+      const ShadeRoutine shade = shade_instance(isa);
+      if (!shade) continue;
+      std::vector<std::uint8_t> color, depth;
+      const PreviewCounts got = draw(shade, c, color, depth);
+      ASSERT_EQ(got.scanned, want.scanned) << "case " << n << " isa " << isa;
+      ASSERT_EQ(got.covered, want.covered) << "case " << n << " isa " << isa;
+      ASSERT_EQ(got.passed, want.passed) << "case " << n << " isa " << isa;
+      ASSERT_TRUE(color == color0) << "colour bytes differ, case " << n << " isa " << isa;
+      ASSERT_TRUE(depth == depth0) << "depth bytes differ, case " << n << " isa " << isa;
+    }
+    passed += want.passed;
+    wraps_seen |= 1u << static_cast<unsigned>(c.p.tex.wrap_s);
+    bilinear_cases += c.p.tex.bilinear;
+  }
+  EXPECT_GT(passed, 100000u);
+  EXPECT_EQ(wraps_seen, 7u);
+  EXPECT_GT(bilinear_cases, 1000u);
+}
+
+}  // namespace
+}  // namespace gpubridge::sim::test
