@@ -51,14 +51,7 @@ Case random_case(std::mt19937& rng) {
   }
   const auto [bx0, bx1, by0, by1] = preview_box(x, y, c.p);
   PreviewPlain& p = c.p;
-  for (unsigned ch = 0; ch < 4; ++ch) {  // any integers: the lanes are modular sums
-    c.planes.c[ch] = static_cast<std::uint32_t>(rng());
-    c.planes.cdx[ch] = static_cast<std::uint32_t>(rng()) >> (rng() % 32);
-    c.planes.cdy[ch] = static_cast<std::uint32_t>(rng()) >> (rng() % 32);
-  }
-  c.planes.z = (std::uint64_t{rng()} << 32 | rng()) >> 8;
-  c.planes.zdx = static_cast<std::uint64_t>(static_cast<std::int64_t>(static_cast<std::int32_t>(rng())) << (rng() % 24));
-  c.planes.zdy = static_cast<std::uint64_t>(static_cast<std::int64_t>(static_cast<std::int32_t>(rng())) << (rng() % 24));
+  random_planes(rng, c.planes, /*small_cdy=*/true);
   p.planes = &c.planes;
   p.width = std::min(bx1, static_cast<int>(kW)) - bx0;
   p.y = by0;
@@ -86,9 +79,7 @@ PreviewCounts draw_rows(ShadeRoutine shade, const Case& c, int ky0, int rows, in
   p.ky0 = ky0;
   p.rows = rows;
   p.band_step = step;
-  const std::size_t origin = static_cast<std::size_t>(p.y + ky0) * kPitch + (kW - p.room) * 4;
-  p.color = color.data() + origin;
-  p.depth = p.depth_on ? depth.data() + origin : nullptr;
+  aim_at_rows(p, ky0, color.data(), depth.data(), kW);
   return shade(p);
 }
 

@@ -1,11 +1,15 @@
 #pragma once
-// The plain preview kernel's edge inputs for tests that drive the kernel directly
-// (preview_wide16_test.cpp, preview_bands_test.cpp) rather than through a device.
+// The plain preview kernel's inputs for tests that drive the kernel directly
+// (preview_wide16_test.cpp, preview_bands_test.cpp, preview_texels_test.cpp) rather than through a
+// device: edge values, random planes, and the buffers' origin.
 #include <algorithm>
+#include <cstddef>
 #include <cstdint>
 #include <utility>
+#include <vector>
 
 #include "preview_plain.hpp"
+#include "setup.hpp"
 
 namespace gpubridge::sim::test {
 
@@ -38,6 +42,43 @@ inline PreviewBox preview_box(int* x, int* y, PreviewPlain& p) {
                      std::min({y[0], y[1], y[2]}) / 16, std::max({y[0], y[1], y[2]}) / 16 + 1};
   preview_box_edges(x, y, b.bx0, b.by0, p);
   return b;
+}
+
+// Random colour and Z planes: any integers (the lanes are modular sums); Z steps small enough that
+// a row's depths cross the stored ones, sometimes negative. small_cdy also shifts the colour's y
+// steps down by a random amount (tall boxes, where full-size steps would only wrap).
+template <class Rng>
+void random_planes(Rng& rng, FixedPlanes& planes, bool small_cdy = false) {
+  for (unsigned ch = 0; ch < 4; ++ch) {
+    planes.c[ch] = static_cast<std::uint32_t>(rng());
+    planes.cdx[ch] = static_cast<std::uint32_t>(rng()) >> (rng() % 32);
+    planes.cdy[ch] = static_cast<std::uint32_t>(rng());
+    if (small_cdy) planes.cdy[ch] >>= rng() % 32;
+  }
+  planes.z = (std::uint64_t{rng()} << 32 | rng()) >> 8;
+  planes.zdx = static_cast<std::uint64_t>(static_cast<std::int64_t>(static_cast<std::int32_t>(rng())) << (rng() % 24));
+  planes.zdy = static_cast<std::uint64_t>(static_cast<std::int64_t>(static_cast<std::int32_t>(rng())) << (rng() % 24));
+}
+
+// Points p's colour and depth (depth only when on) at the box's first column in row p.y + ky0 of
+// buffers buffer_w pixels wide.
+inline void aim_at_rows(PreviewPlain& p, int ky0, std::uint8_t* color, std::uint8_t* depth, unsigned buffer_w) {
+  const std::size_t pitch = std::size_t{buffer_w} * 4;
+  const std::size_t origin = static_cast<std::size_t>(p.y + ky0) * pitch + (buffer_w - p.room) * 4;
+  p.color = color + origin;
+  p.depth = p.depth_on ? depth + origin : nullptr;
+}
+
+// Draws case c (a PreviewPlain p and its starting colour and depth buffers) with one instance into
+// copies of its buffers, and returns the counts.
+template <class Case>
+PreviewCounts draw_case(ShadeRoutine shade, const Case& c, unsigned buffer_w, std::vector<std::uint8_t>& color,
+                        std::vector<std::uint8_t>& depth) {
+  color = c.color;
+  depth = c.depth;
+  PreviewPlain p = c.p;
+  aim_at_rows(p, p.ky0, color.data(), depth.data(), buffer_w);
+  return shade(p);
 }
 
 }  // namespace gpubridge::sim::test

@@ -42,14 +42,7 @@ Case random_case(std::mt19937& rng) {
   }
   const auto [bx0, bx1, by0, by1] = preview_box(x, y, c.p);
   PreviewPlain& p = c.p;
-  for (unsigned ch = 0; ch < 4; ++ch) {
-    c.planes.c[ch] = static_cast<std::uint32_t>(rng());
-    c.planes.cdx[ch] = static_cast<std::uint32_t>(rng()) >> (rng() % 32);
-    c.planes.cdy[ch] = static_cast<std::uint32_t>(rng());
-  }
-  c.planes.z = (std::uint64_t{rng()} << 32 | rng()) >> 8;
-  c.planes.zdx = static_cast<std::uint64_t>(static_cast<std::int64_t>(static_cast<std::int32_t>(rng())) << (rng() % 24));
-  c.planes.zdy = static_cast<std::uint64_t>(static_cast<std::int64_t>(static_cast<std::int32_t>(rng())) << (rng() % 24));
+  random_planes(rng, c.planes);
   p.planes = &c.planes;
   p.width = std::min(bx1, static_cast<int>(kW)) - bx0;
   p.ky0 = 0;
@@ -95,13 +88,7 @@ Case random_case(std::mt19937& rng) {
 }
 
 PreviewCounts draw(ShadeRoutine shade, const Case& c, std::vector<std::uint8_t>& color, std::vector<std::uint8_t>& depth) {
-  color = c.color;
-  depth = c.depth;
-  PreviewPlain p = c.p;
-  const std::size_t origin = static_cast<std::size_t>(p.y + p.ky0) * kPitch + (kW - p.room) * 4;
-  p.color = color.data() + origin;
-  p.depth = p.depth_on ? depth.data() + origin : nullptr;
-  return shade(p);
+  return draw_case(shade, c, kW, color, depth);
 }
 
 TEST(SimPreviewTexels, InstancesSampleTheSameBytes) {
