@@ -135,7 +135,7 @@ PreviewCounts shade_preview_plain(const PreviewPlain& t) {
   // Textured draws take the AVX-512 instance whatever their shape: their chunks are the same 8
   // lanes, but its 32 vector registers keep the texture stage's lanes and constants, which the
   // AVX2 instance's 16 spill and reload in every chunk (sim-preview14).
-  if (cpu_has_avx512() && (t.tex.texels ? true : t.width >= 16 && wide_spans(t))) return plain_avx512::shade(t);
+  if (cpu_has_avx512() && (t.tex.texels || (t.width >= 16 && wide_spans(t)))) return plain_avx512::shade(t);
   return cpu_has_avx2() ? plain_avx2::shade(t) : plain_baseline::shade(t);
 }
 
