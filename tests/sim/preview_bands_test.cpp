@@ -30,10 +30,8 @@ struct Case {
 
 Case random_case(std::mt19937& rng) {
   Case c;
-  c.color.resize(kPitch * kH);
-  c.depth.resize(kPitch * kH);
-  for (auto& b : c.color) b = static_cast<std::uint8_t>(rng());
-  for (auto& b : c.depth) b = static_cast<std::uint8_t>(rng());
+  random_buffer(rng, c.color, kW, kH);
+  random_buffer(rng, c.depth, kW, kH);
   int x[3], y[3];
   if (rng() % 2) {  // a sliver from a point out to a far one, as the fan's: short spans, many bands
     x[0] = static_cast<int>(rng() % (16 * kW));
@@ -44,10 +42,7 @@ Case random_case(std::mt19937& rng) {
     x[2] = std::clamp(x[1] + static_cast<int>(rng() % (2 * spread)) - spread, 0, 16 * static_cast<int>(kW) - 1);
     y[2] = std::clamp(y[1] + static_cast<int>(rng() % (2 * spread)) - spread, 0, 16 * static_cast<int>(kH) - 1);
   } else {
-    for (int i = 0; i < 3; ++i) {
-      x[i] = static_cast<int>(rng() % (16 * kW));
-      y[i] = static_cast<int>(rng() % (16 * kH));
-    }
+    random_points(rng, x, y, kW, kH);
   }
   const auto [bx0, bx1, by0, by1] = preview_box(x, y, c.p);
   PreviewPlain& p = c.p;
@@ -57,12 +52,7 @@ Case random_case(std::mt19937& rng) {
   p.y = by0;
   p.pitch = kPitch;
   p.room = kW - static_cast<unsigned>(bx0);
-  constexpr protocol::DepthFunc kFuncs[] = {protocol::DepthFunc::Less, protocol::DepthFunc::LessEqual,
-                                            protocol::DepthFunc::Greater, protocol::DepthFunc::GreaterEqual,
-                                            protocol::DepthFunc::Always};
-  p.depth_on = rng() % 3 != 0;
-  p.z_func = kFuncs[rng() % 5];
-  p.z_write = p.depth_on && rng() % 3 != 0;
+  random_depth_test(rng, p, 3);
   p.blend = rng() % 3 == 0 ? protocol::BlendMode::Alpha : protocol::BlendMode::Off;
   // The rows a worker gets: from a random row of the box to its end (as rasterize_bands passes
   // them: the first row of the worker's first band).
@@ -109,11 +99,7 @@ TEST(SimPreviewBands, OneCallOverAWorkersBandsIsACallPerBand) {
         ++bands;
         r = end + (step - 1) * kBand;
       }
-      ASSERT_EQ(got.scanned, want.scanned) << "case " << n << " isa " << isa;
-      ASSERT_EQ(got.covered, want.covered) << "case " << n << " isa " << isa;
-      ASSERT_EQ(got.passed, want.passed) << "case " << n << " isa " << isa;
-      ASSERT_TRUE(color1 == color2) << "colour bytes differ, case " << n << " isa " << isa;
-      ASSERT_TRUE(depth1 == depth2) << "depth bytes differ, case " << n << " isa " << isa;
+      ASSERT_TRUE(same_draw(got, want, color1, color2, depth1, depth2)) << "case " << n << " isa " << isa;
       if (isa == 0) {
         passed += got.passed;
         if (bands >= 3) ++many_bands;

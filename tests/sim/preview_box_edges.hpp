@@ -8,6 +8,8 @@
 #include <utility>
 #include <vector>
 
+#include <gtest/gtest.h>
+
 #include "preview_plain.hpp"
 #include "setup.hpp"
 
@@ -79,6 +81,48 @@ PreviewCounts draw_case(ShadeRoutine shade, const Case& c, unsigned buffer_w, st
   PreviewPlain p = c.p;
   aim_at_rows(p, p.ky0, color.data(), depth.data(), buffer_w);
   return shade(p);
+}
+
+// Buffers of w x h pixels (4 bytes each) filled with random bytes.
+template <class Rng>
+void random_buffer(Rng& rng, std::vector<std::uint8_t>& buffer, unsigned w, unsigned h) {
+  buffer.resize(std::size_t{w} * h * 4);
+  for (auto& b : buffer) b = static_cast<std::uint8_t>(rng());
+}
+
+// A triangle's three vertices anywhere in a w x h pixel buffer (1/16 pixel).
+template <class Rng>
+void random_points(Rng& rng, int* x, int* y, unsigned w, unsigned h) {
+  for (int i = 0; i < 3; ++i) {
+    x[i] = static_cast<int>(rng() % (16 * w));
+    y[i] = static_cast<int>(rng() % (16 * h));
+  }
+}
+
+// A random depth test: on unless rng() % off_one_in is 0, any function, writing in two of three.
+template <class Rng>
+void random_depth_test(Rng& rng, PreviewPlain& p, unsigned off_one_in) {
+  constexpr protocol::DepthFunc kFuncs[] = {protocol::DepthFunc::Less, protocol::DepthFunc::LessEqual,
+                                            protocol::DepthFunc::Greater, protocol::DepthFunc::GreaterEqual,
+                                            protocol::DepthFunc::Always};
+  p.depth_on = rng() % off_one_in != 0;
+  p.z_func = kFuncs[rng() % 5];
+  p.z_write = p.depth_on && rng() % 3 != 0;
+}
+
+// Two draws of one case agree: the same counts and the same colour and depth bytes.
+inline ::testing::AssertionResult same_draw(const PreviewCounts& got, const PreviewCounts& want,
+                                            const std::vector<std::uint8_t>& got_color,
+                                            const std::vector<std::uint8_t>& want_color,
+                                            const std::vector<std::uint8_t>& got_depth,
+                                            const std::vector<std::uint8_t>& want_depth) {
+  if (got.scanned != want.scanned || got.covered != want.covered || got.passed != want.passed)
+    return ::testing::AssertionFailure() << "counts differ: scanned " << got.scanned << " / " << want.scanned << ", covered "
+                                         << got.covered << " / " << want.covered << ", passed " << got.passed << " / "
+                                         << want.passed;
+  if (got_color != want_color) return ::testing::AssertionFailure() << "colour bytes differ";
+  if (got_depth != want_depth) return ::testing::AssertionFailure() << "depth bytes differ";
+  return ::testing::AssertionSuccess();
 }
 
 }  // namespace gpubridge::sim::test

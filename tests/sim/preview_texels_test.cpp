@@ -31,15 +31,10 @@ struct Case {
 
 Case random_case(std::mt19937& rng) {
   Case c;
-  c.color.resize(kPitch * kH);
-  c.depth.resize(kPitch * kH);
-  for (auto& b : c.color) b = static_cast<std::uint8_t>(rng());
-  for (auto& b : c.depth) b = static_cast<std::uint8_t>(rng());
+  random_buffer(rng, c.color, kW, kH);
+  random_buffer(rng, c.depth, kW, kH);
   int x[3], y[3];
-  for (int i = 0; i < 3; ++i) {
-    x[i] = static_cast<int>(rng() % (16 * kW));
-    y[i] = static_cast<int>(rng() % (16 * kH));
-  }
+  random_points(rng, x, y, kW, kH);
   const auto [bx0, bx1, by0, by1] = preview_box(x, y, c.p);
   PreviewPlain& p = c.p;
   random_planes(rng, c.planes);
@@ -49,12 +44,7 @@ Case random_case(std::mt19937& rng) {
   p.rows = std::min(by1, static_cast<int>(kH)) - by0;
   p.pitch = kPitch;
   p.room = kW - static_cast<unsigned>(bx0);
-  constexpr protocol::DepthFunc kFuncs[] = {protocol::DepthFunc::Less, protocol::DepthFunc::LessEqual,
-                                            protocol::DepthFunc::Greater, protocol::DepthFunc::GreaterEqual,
-                                            protocol::DepthFunc::Always};
-  p.depth_on = rng() % 3 != 0;
-  p.z_func = kFuncs[rng() % 5];
-  p.z_write = p.depth_on && rng() % 3 != 0;
+  random_depth_test(rng, p, 3);
   p.zmask = 0xFFFFFFu;
   p.blend = rng() % 3 == 0 ? protocol::BlendMode::Alpha : protocol::BlendMode::Off;
   p.y = by0;
@@ -108,11 +98,7 @@ TEST(SimPreviewTexels, InstancesSampleTheSameBytes) {
       if (!shade) continue;
       std::vector<std::uint8_t> color, depth;
       const PreviewCounts got = draw(shade, c, color, depth);
-      ASSERT_EQ(got.scanned, want.scanned) << "case " << n << " isa " << isa;
-      ASSERT_EQ(got.covered, want.covered) << "case " << n << " isa " << isa;
-      ASSERT_EQ(got.passed, want.passed) << "case " << n << " isa " << isa;
-      ASSERT_TRUE(color == color0) << "colour bytes differ, case " << n << " isa " << isa;
-      ASSERT_TRUE(depth == depth0) << "depth bytes differ, case " << n << " isa " << isa;
+      ASSERT_TRUE(same_draw(got, want, color, color0, depth, depth0)) << "case " << n << " isa " << isa;
     }
     passed += want.passed;
     wraps_seen |= 1u << static_cast<unsigned>(c.p.tex.wrap_s);

@@ -29,18 +29,14 @@ struct Case {
 
 Case random_case(std::mt19937& rng) {
   Case c;
-  c.color.resize(kPitch * kH);
+  random_buffer(rng, c.color, kW, kH);
   c.depth.resize(kPitch * kH);
-  for (auto& b : c.color) b = static_cast<std::uint8_t>(rng());
   const unsigned fill = rng() % 4;  // 0, 1: random depths; 2: the farthest (LESS passes); 3: 0
   for (std::size_t k = 0; k < c.depth.size(); ++k)
     c.depth[k] = fill < 2 ? static_cast<std::uint8_t>(rng()) : fill == 2 ? 0xFF : 0;
   // A triangle with its box inside the buffer: wide (up to the whole row) or thin.
   int x[3], y[3];
-  for (int i = 0; i < 3; ++i) {
-    x[i] = static_cast<int>(rng() % (16 * kW));
-    y[i] = static_cast<int>(rng() % (16 * kH));
-  }
+  random_points(rng, x, y, kW, kH);
   const auto [bx0, bx1, by0, by1] = preview_box(x, y, c.p);
   PreviewPlain& p = c.p;
   random_planes(rng, c.planes);
@@ -51,12 +47,7 @@ Case random_case(std::mt19937& rng) {
   if (p.rows < 0) p.rows = 0;
   p.pitch = kPitch;
   p.room = kW - static_cast<unsigned>(bx0);
-  constexpr protocol::DepthFunc kFuncs[] = {protocol::DepthFunc::Less, protocol::DepthFunc::LessEqual,
-                                            protocol::DepthFunc::Greater, protocol::DepthFunc::GreaterEqual,
-                                            protocol::DepthFunc::Always};
-  p.depth_on = rng() % 4 != 0;
-  p.z_func = kFuncs[rng() % 5];
-  p.z_write = p.depth_on && rng() % 3 != 0;
+  random_depth_test(rng, p, 4);
   p.zmask = rng() % 2 ? 0xFFFFFFu : 0xFFFF00u;
   p.blend = rng() % 3 == 0 ? protocol::BlendMode::Alpha : protocol::BlendMode::Off;
   p.y = by0;
@@ -82,11 +73,7 @@ TEST(SimPreviewWide16, SameBytesAndCountsAsTheEightLaneInstances) {
       if (!ref) continue;
       std::vector<std::uint8_t> color8, depth8;
       const PreviewCounts want = draw(ref, c, color8, depth8);
-      ASSERT_EQ(got.scanned, want.scanned) << "case " << n << " isa " << isa;
-      ASSERT_EQ(got.covered, want.covered) << "case " << n << " isa " << isa;
-      ASSERT_EQ(got.passed, want.passed) << "case " << n << " isa " << isa;
-      ASSERT_TRUE(color16 == color8) << "colour bytes differ, case " << n << " isa " << isa;
-      ASSERT_TRUE(depth16 == depth8) << "depth bytes differ, case " << n << " isa " << isa;
+      ASSERT_TRUE(same_draw(got, want, color16, color8, depth16, depth8)) << "case " << n << " isa " << isa;
     }
     passed += got.passed;
     if (c.p.width >= 16) ++chunks16;
