@@ -75,6 +75,18 @@ inline void expect_same(const Case& c, const Rendered& v, const Rendered& s, int
   EXPECT_TRUE(v.stats == s.stats) << i << ": the timing counters too";
 }
 
+// Two preview renderings of case c with the same R, G and B in every pixel of the colour buffer
+// (its alpha is not compared: the float routine keeps it, the lanes' masked case too).
+inline ::testing::AssertionResult same_rgb(const Case& c, const Rendered& a, const Rendered& b) {
+  for (std::size_t px = 0; px < std::size_t{kW} * kH; ++px)
+    for (std::size_t ch = 0; ch < 3; ++ch)
+      if (a.memory[px * 4 + ch] != b.memory[px * 4 + ch])
+        return ::testing::AssertionFailure() << "pixel " << px << " channel " << ch << ": " << int{a.memory[px * 4 + ch]}
+                                             << " against " << int{b.memory[px * 4 + ch]} << ", TRI_MODE 0x" << std::hex
+                                             << c.tri_mode << " TEX_FMT 0x" << c.tex_fmt;
+  return ::testing::AssertionSuccess();
+}
+
 // A random texture at kTexBase, case c's buffers and state, the colour buffer cleared to a random
 // colour and, with clear_depth, the depth buffer to a random depth (render, preview_flat_q_test.cpp).
 inline void start_frame(Device& d, const Case& c, std::mt19937& rng, bool clear_depth) {
