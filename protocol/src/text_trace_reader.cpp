@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "gpubridge/protocol/text_trace.hpp"
+#include "gpubridge/protocol/trace.hpp"
 #include "text_trace_internal.hpp"
 
 namespace gpubridge::protocol {
@@ -70,6 +71,14 @@ class TextTraceReader {
     const std::string json(start == std::string_view::npos ? std::string_view() : rest.substr(start));
     if (auto problem = json_object_problem(json); !problem.empty())
       return LineError{column, ".meta value " + problem + "; write a one-line JSON object"};
+    // Text traces hold spigpu register writes only; a DMC-1 trace is binary (docs/protocol.md 18.1).
+    const auto kind = trace_metadata_device_kind(json);
+    if (!kind) return LineError{column, ".meta " + kind.error().message + "; remove it or write \"spigpu\""};
+    if (*kind != DeviceKind::Spigpu)
+      return LineError{column, ".meta says device_kind \"" + std::string(device_kind_info(*kind).name) +
+                                   "\", but a text trace holds spigpu register writes (" +
+                                   std::string(device_kind_info(*kind).label) +
+                                   " traces are binary only); remove \"device_kind\" or write \"spigpu\""};
     stream_.metadata_json = json;
     have_meta_ = true;
     return std::nullopt;

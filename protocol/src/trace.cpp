@@ -81,13 +81,9 @@ Result<void> BinaryTraceReader::open() {
   if (auto r = read_exact(std::span(reinterpret_cast<std::uint8_t*>(json.data()), json.size()), false); !r)
     return r.error();
   if (auto problem = json_object_problem(json); !problem.empty()) return fail(16, "metadata " + problem);
-  const auto meta = nlohmann::json::parse(json, nullptr, false);
-  if (meta.contains("device_kind")) {
-    const auto& k = meta["device_kind"];
-    const auto kind = k.is_string() ? parse_device_kind(k.get<std::string>()) : std::nullopt;
-    if (!kind) return fail(16, "metadata device_kind " + k.dump() + " is not a device kind (" + device_kind_names() + ")");
-    kind_ = *kind;
-  }
+  const auto kind = trace_metadata_device_kind(json);
+  if (!kind) return fail(16, "metadata " + kind.error().message);
+  kind_ = *kind;
   metadata_ = std::move(json);
   opened_ = true;
   return {};
@@ -173,6 +169,15 @@ Result<CommandStream> read_binary_trace(std::span<const std::uint8_t> bytes, con
   return s;
 }
 
+Result<DeviceKind> trace_metadata_device_kind(std::string_view metadata_json) {
+  const auto meta = nlohmann::json::parse(metadata_json, nullptr, /*allow_exceptions=*/false);
+  if (!meta.is_object() || !meta.contains("device_kind")) return DeviceKind::Spigpu;
+  const auto& k = meta["device_kind"];
+  const auto kind = k.is_string() ? parse_device_kind(k.get<std::string>()) : std::nullopt;
+  if (!kind) return make_error("device_kind " + k.dump() + " is not a device kind (" + device_kind_names() + ")");
+  return *kind;
+}
+
 Result<DeviceKind> binary_trace_device_kind(std::span<const std::uint8_t> bytes, const std::string& name_for_errors) {
   MemorySource src(bytes);
   BinaryTraceReader reader(src, name_for_errors);
@@ -225,6 +230,15 @@ Result<void> append_trace_record(const TimedCommand& c, std::uint64_t record_num
 }
 
 Result<std::vector<std::uint8_t>> write_binary_trace(const CommandStream& s) {
+  // A CommandStream holds spigpu commands: metadata naming another kind would make a trace that
+  // every reader refuses (DMC-1 traces are written record by record: append_trace_message).
+  if (!s.metadata_json.empty() && json_object_problem(s.metadata_json).empty()) {
+    const auto kind = trace_metadata_device_kind(s.metadata_json);
+    if (!kind) return make_error("trace metadata " + kind.error().message);
+    if (*kind != DeviceKind::Spigpu)
+      return make_error("trace metadata says device_kind \"" + std::string(device_kind_info(*kind).name) +
+                        "\", but the commands are spigpu register writes; remove \"device_kind\" or set it to \"spigpu\"");
+  }
   std::vector<std::uint8_t> out;
   if (auto r = append_trace_header(s.metadata_json, out); !r) return r.error();
   std::uint64_t last = 0;

@@ -230,6 +230,29 @@ TEST(BinaryTrace, BinaryTextBinaryIsByteIdentical) {
   EXPECT_EQ(write_text_trace(*again), text);
 }
 
+// A CommandStream is spigpu commands: writing it under metadata naming another (or no) kind would
+// make a trace every reader refuses, so the writer refuses it and says what to change.
+TEST(BinaryTrace, WriterRefusesMetadataOfAnotherKind) {
+  CommandStream s;
+  s.commands.push_back(TimedCommand{0, FenceCmd{1}});
+  s.metadata_json = R"({"device_kind":"dmc1"})";
+  auto dmc1 = write_binary_trace(s);
+  ASSERT_FALSE(dmc1);
+  EXPECT_EQ(dmc1.error().message,
+            "trace metadata says device_kind \"dmc1\", but the commands are spigpu register writes; remove "
+            "\"device_kind\" or set it to \"spigpu\"");
+  s.metadata_json = R"({"device_kind":7})";
+  auto seven = write_binary_trace(s);
+  ASSERT_FALSE(seven);
+  EXPECT_EQ(seven.error().message, "trace metadata device_kind 7 is not a device kind (spigpu, dmc1)");
+  s.metadata_json = R"({"device_kind":"spigpu"})";
+  auto ok = write_binary_trace(s);
+  ASSERT_TRUE(ok) << ok.error().message;
+  auto back = read_binary_trace(*ok, "s.gbt");
+  ASSERT_TRUE(back) << back.error().message;
+  EXPECT_EQ(back->commands, s.commands);
+}
+
 // A DMC-1 session's trace (docs/protocol.md 18.1): metadata "device_kind": "dmc1", records
 // DMC1_WORDS and FENCE. The DMC-1 reader returns its words in order; the spigpu reader refuses it by
 // kind, and an unknown kind is refused at the metadata.

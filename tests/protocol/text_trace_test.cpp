@@ -177,6 +177,35 @@ TEST(TextTrace, LongAndBinaryTokensAreShownShortened) {
   EXPECT_NE(unknown.find("... (100 bytes)"), std::string::npos) << unknown;
 }
 
+// Text traces hold spigpu register writes, so their metadata may name only that kind: a text trace
+// saying "dmc1" (or naming no kind at all) used to be accepted and then produce a binary trace that
+// every reader refused (found by fuzz_text_trace).
+TEST(TextTrace, MetaNamesOnlyTheSpigpuKind) {
+  const auto dmc1 = error_of("CLEAR\n.meta {\"device_kind\": \"dmc1\"}\n");
+  EXPECT_EQ(dmc1.rfind("scene.trace:2:1: .meta says device_kind \"dmc1\", but a text trace holds spigpu register "
+                       "writes (DMC-1 traces are binary only); remove \"device_kind\" or write \"spigpu\"",
+                       0),
+            0u)
+      << dmc1;
+  for (const char* bad : {R"(5)", R"("vga")", R"(null)", R"(["spigpu"])"}) {
+    const auto e = error_of(std::string(".meta {\"a\": 1, \"device_kind\": ") + bad + "}\n");
+    EXPECT_EQ(e.rfind(std::string("scene.trace:1:1: .meta device_kind ") + bad +
+                          " is not a device kind (spigpu, dmc1); remove it or write \"spigpu\"",
+                      0),
+              0u)
+        << e;
+  }
+  // "spigpu" is the default said aloud: accepted, kept, and the binary form reads back.
+  auto s = parse(".meta {\"device_kind\": \"spigpu\"}\nCLEAR\n");
+  ASSERT_TRUE(s.ok()) << s.error().message;
+  auto bytes = write_binary_trace(*s);
+  ASSERT_TRUE(bytes.ok()) << bytes.error().message;
+  auto back = read_binary_trace(*bytes, "b");
+  ASSERT_TRUE(back.ok()) << back.error().message;
+  EXPECT_EQ(back->commands, s->commands);
+  EXPECT_EQ(back->metadata_json, "{\"device_kind\": \"spigpu\"}");
+}
+
 TEST(TextTrace, SecondMetaIsAnError) {
   EXPECT_EQ(error_of(".meta {}\n.meta {}\n").rfind("scene.trace:2:1: .meta appears twice", 0), 0u);
 }

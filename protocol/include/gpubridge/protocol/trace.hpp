@@ -77,6 +77,11 @@ class BinaryTraceReader {
   DeviceKind kind_ = DeviceKind::Spigpu;
 };
 
+// The device kind trace metadata names in its optional "device_kind" (docs/protocol.md 18.1):
+// spigpu when it has none; an error ("device_kind 5 is not a device kind (spigpu, dmc1)") when the
+// value is not a kind's name. metadata_json must already be a JSON object (json_object_problem).
+Result<DeviceKind> trace_metadata_device_kind(std::string_view metadata_json);
+
 // The device kind a binary trace held in memory records (its header and metadata only).
 Result<DeviceKind> binary_trace_device_kind(std::span<const std::uint8_t> bytes, const std::string& name_for_errors);
 // Reads a whole DMC-1 binary trace held in memory: every command word, in order.
