@@ -270,6 +270,9 @@ void Renderer::draw_bands(unsigned worker) {
     unsigned ahead = worker + n - first % n;
     if (ahead >= n) ahead -= n;
     const int band = static_cast<int>(first + ahead);
+    // A box inside other workers' bands (the fan's flat slivers: one band): nothing to do here, not
+    // even a call.
+    if (band * kBandRows >= r.y1) continue;
     if (!r.small) {  // every band of the triangle in one call (one Kernel, or the plain preview kernel)
       rasterize_bands(full[i], st, c, band * kBandRows, (band + 1) * kBandRows, static_cast<int>(n) * kBandRows);
       continue;
