@@ -109,8 +109,9 @@ TEST(SimPreviewTexels, InstancesSampleTheSameBytes) {
   EXPECT_GT(bilinear_cases, 1000u);
 }
 
-// Triangles whose Q step along x is ±0 in float (sim-constq) take instances that work out 1/Q once
-// per row; the instances that divide in every chunk must store the same bytes and counts for them:
+// Bilinear triangles whose Q step along x is ±0 in float (sim-constq) take instances that work out
+// 1/Q once per row (AVX2, AVX-512); the instances that divide in every chunk must store the same
+// bytes and counts for them (nearest draws, which always divide, come along as a control):
 // steps of +0, −0 and of a double too small for a float, Q changing from row to row and on some
 // boxes reaching 0 and below (those rows sample texel (0, 0)), in every instance on this CPU.
 TEST(SimPreviewTexels, FlatQRowsSampleAsTheDividingInstances) {
