@@ -109,5 +109,48 @@ TEST(SimPreviewTexels, InstancesSampleTheSameBytes) {
   EXPECT_GT(bilinear_cases, 1000u);
 }
 
+// Bilinear triangles whose Q step along x is ±0 in float (sim-constq) take instances that work out
+// 1/Q once per row (AVX2, AVX-512); the instances that divide in every chunk must store the same
+// bytes and counts for them (nearest draws, which always divide, come along as a control):
+// steps of +0, −0 and of a double too small for a float, Q changing from row to row and on some
+// boxes reaching 0 and below (those rows sample texel (0, 0)), in every instance on this CPU.
+TEST(SimPreviewTexels, FlatQRowsSampleAsTheDividingInstances) {
+  std::mt19937 rng(2424);
+  std::uint64_t passed = 0;
+  unsigned bilinear_cases = 0, nearest_cases = 0, through_zero = 0, instances = 0;
+  for (unsigned isa = 0; isa < 3; ++isa) instances += shade_instance(isa) != nullptr;
+  ASSERT_GT(instances, 0u);
+  for (int n = 0; n < 3000; ++n) {
+    Case c = random_case(rng);
+    if (c.p.rows <= 0 || c.p.width <= 0) continue;
+    const double flat_steps[4] = {0.0, -0.0, 1e-50, -1e-50};  // all ±0 as floats
+    c.p.planes = &c.planes;  // this copy's planes
+    c.p.tex.planes = &c.tex_planes;
+    const double q = rng() % 4 == 0 ? 0.02 * (rng() % 3) - 0.02 : c.tex_planes.base[kQ];  // some from -0.02 to 0.02
+    c.tex_planes.base[kQ] = q;
+    c.tex_planes.dx[kQ] = flat_steps[rng() % 4];
+    c.tex_planes.dy[kQ] = (rng() % 2 ? 0.01 : -0.01) * (rng() % 4);
+    ASSERT_EQ(static_cast<float>(c.tex_planes.dx[kQ]), 0.0f);
+    const double q_last = q + c.tex_planes.dy[kQ] * (c.p.rows - 1);
+    through_zero += (q <= 0) != (q_last <= 0) || q <= 0;
+    for (unsigned isa = 0; isa < 3; ++isa) {
+      const ShadeRoutine flat = shade_instance(isa), dividing = dividing_shade_instance(isa);
+      if (!flat) continue;
+      ASSERT_NE(dividing, nullptr);
+      std::vector<std::uint8_t> color0, depth0, color, depth;
+      const PreviewCounts want = draw(dividing, c, color0, depth0);
+      const PreviewCounts got = draw(flat, c, color, depth);
+      ASSERT_TRUE(same_draw(got, want, color, color0, depth, depth0)) << "case " << n << " isa " << isa;
+      if (isa == 0) passed += want.passed;
+    }
+    bilinear_cases += c.p.tex.bilinear;
+    nearest_cases += !c.p.tex.bilinear;
+  }
+  EXPECT_GT(passed, 100000u);
+  EXPECT_GT(bilinear_cases, 1000u);
+  EXPECT_GT(nearest_cases, 300u);
+  EXPECT_GT(through_zero, 300u);
+}
+
 }  // namespace
 }  // namespace gpubridge::sim::test

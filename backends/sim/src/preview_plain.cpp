@@ -143,6 +143,11 @@ ShadeRoutine shade_instance(unsigned isa) {
   return pick_instance<ShadeRoutine>(isa, &plain_baseline::shade, &plain_avx2::shade, &plain_avx512::shade);
 }
 
+ShadeRoutine dividing_shade_instance(unsigned isa) {
+  return pick_instance<ShadeRoutine>(isa, &plain_baseline::shade_dividing, &plain_avx2::shade_dividing,
+                                     &plain_avx512::shade_dividing);
+}
+
 SmallSetup setup_small_preview(const Vertex& a, const Vertex& b, const Vertex& c, const DrawState& st,
                                unsigned subpixel_bits, SmallTriangle& t) {
   return small_setup_routine()(a, b, c, st, subpixel_bits, t);

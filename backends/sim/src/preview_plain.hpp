@@ -105,6 +105,9 @@ PreviewCounts shade_preview_plain(const PreviewPlain& t);
 // that compare the instances' bytes.
 using ShadeRoutine = PreviewCounts (*)(const PreviewPlain& t);
 ShadeRoutine shade_instance(unsigned isa);
+// The same instance with the flat-Q choice off: every textured triangle divides by Q in every
+// chunk of 8 pixels, also where Q's step along x is ±0 (for the tests of that choice).
+ShadeRoutine dividing_shade_instance(unsigned isa);
 
 // The count of a rejected band's covered pixels the kernel uses (count_rows in
 // preview_plain_kernel.inc: SpanWalk::count in lanes, four rows at a time), leaving the walk after
