@@ -594,14 +594,41 @@ class Kernel {
       }
       CursorStep& c = keep ? steps_[slot] : once;
       step = &c;
-      c.d = d;
-      for (unsigned i = 0; i < kAttrCount; ++i) {
-        if (!((kPlanes >> i) & 1)) continue;
-        const Plane& p = t_.plane[i];
-        const DivMod f = den_div_(p.ry + d * p.rx);  // |d·rx| < 2^11 · 2^36: exact in the Divider
-        c.q[i] = p.qy + d * p.qx + f.q;
-        c.r[i] = f.r;
+      // A kept step one pixel off (an edge's two distances differ by one): this one is it and one
+      // x step, with one carry or borrow, instead of a division per plane. Either slot may be c.
+      const CursorStep* near = steps_[0].d == d - 1 || steps_[0].d == d + 1 ? &steps_[0]
+                               : steps_[1].d == d - 1 || steps_[1].d == d + 1 ? &steps_[1]
+                                                                              : nullptr;
+      if (near) {
+        const bool right = near->d < d;
+        for (unsigned i = 0; i < kAttrCount; ++i) {
+          if (!((kPlanes >> i) & 1)) continue;
+          const Plane& p = t_.plane[i];
+          std::int64_t q = near->q[i], r = near->r[i];
+          if (right) {
+            r += p.rx;
+            const bool carry = r >= t_.den;
+            r -= carry ? t_.den : 0;
+            q += p.qx + carry;
+          } else {
+            r -= p.rx;
+            const bool borrow = r < 0;
+            r += borrow ? t_.den : 0;
+            q -= p.qx + borrow;
+          }
+          c.q[i] = q;
+          c.r[i] = r;
+        }
+      } else {
+        for (unsigned i = 0; i < kAttrCount; ++i) {
+          if (!((kPlanes >> i) & 1)) continue;
+          const Plane& p = t_.plane[i];
+          const DivMod f = den_div_(p.ry + d * p.rx);  // |d·rx| < 2^11 · 2^36: exact in the Divider
+          c.q[i] = p.qy + d * p.qx + f.q;
+          c.r[i] = f.r;
+        }
       }
+      c.d = d;
       if constexpr (kLanes) c.c = color_lanes(c.q, c.r);
     }
     const CursorStep& c = *step;
