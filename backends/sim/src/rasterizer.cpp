@@ -580,56 +580,25 @@ class Kernel {
   // step, (qy + d·qx + f, ry + d·rx − f·den) with f = floor((ry + d·rx) / den), and one carry. A
   // straight edge moves the span's start by one of two distances a row, so the last two steps are
   // kept (steps_) and a division is paid only when the distance changes (at a vertex).
-  // `keep` false: a step not among the last two is used once and not kept (the first drawn row
-  // after a gap between runs moves by a distance of its own, which would evict a row's step).
+  // `keep` false: the first drawn row after a gap between runs, which moves by a distance of its
+  // own (about 16 rows' worth of the edge); its step is kept apart (after_gap_), so it evicts no
+  // row's step, and the next run's, a pixel off as a rule, is derived from it (fill_step).
+  struct CursorStep;  // below, with the cursor
   template <bool kLanes>
   void move(std::int64_t d, bool keep = true) {
-    unsigned slot = steps_[1].d == d ? 1u : 0u;
-    CursorStep once;
-    const CursorStep* step = &steps_[slot];
-    if (steps_[slot].d != d) {
-      if (keep) {
+    const CursorStep* step = &after_gap_;
+    if (!keep) {
+      if (after_gap_.d != d) gap_step<kLanes>(d);
+    } else {
+      unsigned slot = steps_[1].d == d ? 1u : 0u;
+      if (steps_[slot].d != d) {
         slot = victim_;
         victim_ ^= 1u;
+        fill_step<kLanes>(steps_[slot], d, steps_[0].d == d - 1 || steps_[0].d == d + 1   ? &steps_[0]
+                                           : steps_[1].d == d - 1 || steps_[1].d == d + 1 ? &steps_[1]
+                                                                                          : nullptr);
       }
-      CursorStep& c = keep ? steps_[slot] : once;
-      step = &c;
-      // A kept step one pixel off (an edge's two distances differ by one): this one is it and one
-      // x step, with one carry or borrow, instead of a division per plane. Either slot may be c.
-      const CursorStep* near = steps_[0].d == d - 1 || steps_[0].d == d + 1 ? &steps_[0]
-                               : steps_[1].d == d - 1 || steps_[1].d == d + 1 ? &steps_[1]
-                                                                              : nullptr;
-      if (near) {
-        const bool right = near->d < d;
-        for (unsigned i = 0; i < kAttrCount; ++i) {
-          if (!((kPlanes >> i) & 1)) continue;
-          const Plane& p = t_.plane[i];
-          std::int64_t q = near->q[i], r = near->r[i];
-          if (right) {
-            r += p.rx;
-            const bool carry = r >= t_.den;
-            r -= carry ? t_.den : 0;
-            q += p.qx + carry;
-          } else {
-            r -= p.rx;
-            const bool borrow = r < 0;
-            r += borrow ? t_.den : 0;
-            q -= p.qx + borrow;
-          }
-          c.q[i] = q;
-          c.r[i] = r;
-        }
-      } else {
-        for (unsigned i = 0; i < kAttrCount; ++i) {
-          if (!((kPlanes >> i) & 1)) continue;
-          const Plane& p = t_.plane[i];
-          const DivMod f = den_div_(p.ry + d * p.rx);  // |d·rx| < 2^11 · 2^36: exact in the Divider
-          c.q[i] = p.qy + d * p.qx + f.q;
-          c.r[i] = f.r;
-        }
-      }
-      c.d = d;
-      if constexpr (kLanes) c.c = color_lanes(c.q, c.r);
+      step = &steps_[slot];
     }
     const CursorStep& c = *step;
     if constexpr (kLanes) ccur_.step(c.c, cden_);
@@ -641,6 +610,48 @@ class Kernel {
       cur_.r[i] -= carry ? t_.den : 0;
       cur_.q[i] += carry;
     }
+  }
+  // c := the step of distance d. From `near` (a step of distance d ± 1, possibly c itself) it is
+  // near's and one x step with one carry or borrow: an edge's two distances differ by one, so only
+  // its first costs a division per plane.
+  // after_gap_ := the step of distance d (once per run: out of the row loop).
+  template <bool kLanes>
+  [[gnu::noinline]] void gap_step(std::int64_t d) {
+    fill_step<kLanes>(after_gap_, d, after_gap_.d == d - 1 || after_gap_.d == d + 1 ? &after_gap_ : nullptr);
+  }
+  template <bool kLanes>
+  [[gnu::always_inline]] void fill_step(CursorStep& c, std::int64_t d, const CursorStep* near) {
+    if (near) {
+      const bool right = near->d < d;
+      for (unsigned i = 0; i < kAttrCount; ++i) {
+        if (!((kPlanes >> i) & 1)) continue;
+        const Plane& p = t_.plane[i];
+        std::int64_t q = near->q[i], r = near->r[i];
+        if (right) {
+          r += p.rx;
+          const bool carry = r >= t_.den;
+          r -= carry ? t_.den : 0;
+          q += p.qx + carry;
+        } else {
+          r -= p.rx;
+          const bool borrow = r < 0;
+          r += borrow ? t_.den : 0;
+          q -= p.qx + borrow;
+        }
+        c.q[i] = q;
+        c.r[i] = r;
+      }
+    } else {
+      for (unsigned i = 0; i < kAttrCount; ++i) {
+        if (!((kPlanes >> i) & 1)) continue;
+        const Plane& p = t_.plane[i];
+        const DivMod f = den_div_(p.ry + d * p.rx);  // |d·rx| < 2^11 · 2^36: exact in the Divider
+        c.q[i] = p.qy + d * p.qx + f.q;
+        c.r[i] = f.r;
+      }
+    }
+    c.d = d;
+    if constexpr (kLanes) c.c = color_lanes(c.q, c.r);
   }
 
   // The planes stepped as scalars: all but the colour planes when they step in lanes.
@@ -944,7 +955,7 @@ class Kernel {
     std::int64_t d = INT64_MIN;  // the distance it moves the span's start (INT64_MIN: none yet)
     std::int64_t q[kAttrCount], r[kAttrCount];
     ColorLanes c;  // the colour planes' step in lanes (run_wide<true>)
-  } steps_[2];
+  } steps_[2], after_gap_;  // the last two row steps; the last first step after a gap (move)
   unsigned victim_ = 0;  // the step to replace next
   // Between runs of one Kernel (rasterize_bands): whether the walk (at row ended_at_) and the cursor
   // (at row ended_at_ − 1) are valid, and the steps over the last gap (prepare_gap).
