@@ -586,19 +586,20 @@ class Kernel {
   struct CursorStep;  // below, with the cursor
   template <bool kLanes>
   void move(std::int64_t d, bool keep = true) {
-    const CursorStep* step = &after_gap_;
-    if (!keep) {
-      if (after_gap_.d != d) gap_step<kLanes>(d);
-    } else {
-      unsigned slot = steps_[1].d == d ? 1u : 0u;
-      if (steps_[slot].d != d) {
+    unsigned slot = steps_[1].d == d ? 1u : 0u;
+    const CursorStep* step = &steps_[slot];
+    if (steps_[slot].d != d) {  // not a kept row step (the tests of a row that hits, and no more)
+      if (!keep) {
+        if (after_gap_.d != d) gap_step<kLanes>(d);
+        step = &after_gap_;
+      } else {
         slot = victim_;
         victim_ ^= 1u;
         fill_step<kLanes>(steps_[slot], d, steps_[0].d == d - 1 || steps_[0].d == d + 1   ? &steps_[0]
                                            : steps_[1].d == d - 1 || steps_[1].d == d + 1 ? &steps_[1]
                                                                                           : nullptr);
+        step = &steps_[slot];
       }
-      step = &steps_[slot];
     }
     const CursorStep& c = *step;
     if constexpr (kLanes) ccur_.step(c.c, cden_);
