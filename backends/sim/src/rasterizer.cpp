@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <new>
 #include <optional>
 #include <utility>
 
@@ -579,29 +580,26 @@ class Kernel {
   // step, (qy + d·qx + f, ry + d·rx − f·den) with f = floor((ry + d·rx) / den), and one carry. A
   // straight edge moves the span's start by one of two distances a row, so the last two steps are
   // kept (steps_) and a division is paid only when the distance changes (at a vertex).
-  // `keep` false: a step not among the last two is used once and not kept (the first drawn row
-  // after a gap between runs moves by a distance of its own, which would evict a row's step).
+  // `keep` false: the first drawn row after a gap between runs, which moves by a distance of its
+  // own (about 16 rows' worth of the edge); its step is kept apart (after_gap_), so it evicts no
+  // row's step, and the next run's, a pixel off as a rule, is derived from it (fill_step).
+  struct CursorStep;  // below, with the cursor
   template <bool kLanes>
   void move(std::int64_t d, bool keep = true) {
     unsigned slot = steps_[1].d == d ? 1u : 0u;
-    CursorStep once;
     const CursorStep* step = &steps_[slot];
-    if (steps_[slot].d != d) {
-      if (keep) {
+    if (steps_[slot].d != d) {  // not a kept row step (the tests of a row that hits, and no more)
+      if (!keep) {
+        if (after_gap_.d != d) gap_step<kLanes>(d);
+        step = &after_gap_;
+      } else {
         slot = victim_;
         victim_ ^= 1u;
+        fill_step<kLanes>(steps_[slot], d, steps_[0].d == d - 1 || steps_[0].d == d + 1   ? &steps_[0]
+                                           : steps_[1].d == d - 1 || steps_[1].d == d + 1 ? &steps_[1]
+                                                                                          : nullptr);
+        step = &steps_[slot];
       }
-      CursorStep& c = keep ? steps_[slot] : once;
-      step = &c;
-      c.d = d;
-      for (unsigned i = 0; i < kAttrCount; ++i) {
-        if (!((kPlanes >> i) & 1)) continue;
-        const Plane& p = t_.plane[i];
-        const DivMod f = den_div_(p.ry + d * p.rx);  // |d·rx| < 2^11 · 2^36: exact in the Divider
-        c.q[i] = p.qy + d * p.qx + f.q;
-        c.r[i] = f.r;
-      }
-      if constexpr (kLanes) c.c = color_lanes(c.q, c.r);
     }
     const CursorStep& c = *step;
     if constexpr (kLanes) ccur_.step(c.c, cden_);
@@ -613,6 +611,48 @@ class Kernel {
       cur_.r[i] -= carry ? t_.den : 0;
       cur_.q[i] += carry;
     }
+  }
+  // c := the step of distance d. From `near` (a step of distance d ± 1, possibly c itself) it is
+  // near's and one x step with one carry or borrow: an edge's two distances differ by one, so only
+  // its first costs a division per plane.
+  // after_gap_ := the step of distance d (once per run: out of the row loop).
+  template <bool kLanes>
+  [[gnu::noinline]] void gap_step(std::int64_t d) {
+    fill_step<kLanes>(after_gap_, d, after_gap_.d == d - 1 || after_gap_.d == d + 1 ? &after_gap_ : nullptr);
+  }
+  template <bool kLanes>
+  [[gnu::always_inline]] void fill_step(CursorStep& c, std::int64_t d, const CursorStep* near) {
+    if (near) {
+      const bool right = near->d < d;
+      for (unsigned i = 0; i < kAttrCount; ++i) {
+        if (!((kPlanes >> i) & 1)) continue;
+        const Plane& p = t_.plane[i];
+        std::int64_t q = near->q[i], r = near->r[i];
+        if (right) {
+          r += p.rx;
+          const bool carry = r >= t_.den;
+          r -= carry ? t_.den : 0;
+          q += p.qx + carry;
+        } else {
+          r -= p.rx;
+          const bool borrow = r < 0;
+          r += borrow ? t_.den : 0;
+          q -= p.qx + borrow;
+        }
+        c.q[i] = q;
+        c.r[i] = r;
+      }
+    } else {
+      for (unsigned i = 0; i < kAttrCount; ++i) {
+        if (!((kPlanes >> i) & 1)) continue;
+        const Plane& p = t_.plane[i];
+        const DivMod f = den_div_(p.ry + d * p.rx);  // |d·rx| < 2^11 · 2^36: exact in the Divider
+        c.q[i] = p.qy + d * p.qx + f.q;
+        c.r[i] = f.r;
+      }
+    }
+    c.d = d;
+    if constexpr (kLanes) c.c = color_lanes(c.q, c.r);
   }
 
   // The planes stepped as scalars: all but the colour planes when they step in lanes.
@@ -713,8 +753,8 @@ class Kernel {
     simd_tpl_.inv_den = 1.0 / static_cast<double>(t_.den);
     for (unsigned p = 0; p < SimdSpan::kPlanes; ++p) {
       const Plane& pl = t_.plane[kR + p];
-      if (!simd_plane_used(p)) {
-        simd_tpl_.q8[p] = simd_tpl_.r8[p] = simd_tpl_.qx[p] = 0;
+      if (!simd_plane_used(p)) {  // zeros in every lane (simd_span writes the used planes' q0, r0 only)
+        simd_tpl_.q0[p] = simd_tpl_.r0[p] = simd_tpl_.q8[p] = simd_tpl_.r8[p] = simd_tpl_.qx[p] = 0;
         for (unsigned k = 0; k < 8; ++k) simd_tpl_.qk[p][k] = simd_tpl_.rk[p][k] = 0;
         continue;
       }
@@ -790,7 +830,7 @@ class Kernel {
       std::memcpy(sp.q0, &ccur_.q, sizeof ccur_.q);
       std::memcpy(sp.r0, &ccur_.r, sizeof ccur_.r);
     }
-    // Planes the draw does not use keep the template's zeros (simd_tpl_ is value-initialised).
+    // Planes the draw does not use keep the zeros prepare_simd wrote into the template.
     for (unsigned p = kLanes ? 4 : 0; p < SimdSpan::kPlanes; ++p) {
       if (!simd_plane_used(p)) continue;
       sp.q0[p] = static_cast<std::uint32_t>(cur_.q[kR + p]);
@@ -897,7 +937,7 @@ class Kernel {
   Reciprocal const_rc_;
   Divider edge_div_[3] = {Divider(1), Divider(1), Divider(1)};
   bool simd_ = false, simd_checked_ = false;
-  SimdSpan simd_tpl_{};
+  SimdSpan simd_tpl_;  // its lane fields written by prepare_simd, not value-initialised (unused when no span is long)
   SpanRoutine span_fn_ = nullptr;  // the span routine for this draw (span_routine, by prepare_simd)
   std::uint64_t textured_ = 0;  // texture-unit pixels of this run
   std::uint32_t hz_run_ = 0;    // this run's number for the coarse depth bounds
@@ -906,17 +946,17 @@ class Kernel {
   std::optional<BandClip> clip_;  // for band_occluded, when a band is asked
   // Wide rows: the edge walk, the cursor (the planes at the last drawn span's first
   // pixel, column col_) and its last two combined steps (move).
-  EdgeWalk walk_{};
-  Steppers cur_{};
+  EdgeWalk walk_;
+  Steppers cur_;  // set by anchor() before it is read
   std::int64_t col_ = 0;
   // run_wide<true>: the cursor's colour planes (cur_'s are then stale), their x and y steps, den.
-  ColorLanes ccur_{}, cx_{}, cy_{};
-  i32x4 cden_{};
+  ColorLanes ccur_, cx_, cy_;
+  i32x4 cden_;
   struct CursorStep {
     std::int64_t d = INT64_MIN;  // the distance it moves the span's start (INT64_MIN: none yet)
     std::int64_t q[kAttrCount], r[kAttrCount];
     ColorLanes c;  // the colour planes' step in lanes (run_wide<true>)
-  } steps_[2];
+  } steps_[2], after_gap_;  // the last two row steps; the last first step after a gap (move)
   unsigned victim_ = 0;  // the step to replace next
   // Between runs of one Kernel (rasterize_bands): whether the walk (at row ended_at_) and the cursor
   // (at row ended_at_ − 1) are valid, and the steps over the last gap (prepare_gap).
@@ -924,9 +964,9 @@ class Kernel {
   int ended_at_ = 0, gap_ = 0;
   struct {
     std::int64_t q[3], r[3];
-  } gap_walk_{};
-  Steppers gap_cursor_{};
-  ColorLanes gap_color_{};
+  } gap_walk_;  // the gap_ fields: set by prepare_gap before they are read
+  Steppers gap_cursor_;
+  ColorLanes gap_color_;
 };
 
 // The rows [ya, yz) of a wide triangle: rasterize_rows's leading band tests (the triangle's
@@ -940,9 +980,33 @@ bool ask_leading_bands(const Triangle& t, const DrawState& st, RasterContext& ct
 // built when the first run needs it, so its set-up (edge dividers, lane steps, the span template,
 // the cursor's cached steps) is paid once per triangle, not once per band. The caller has tried
 // the small-triangle routine (draw_narrow) where it applies.
+// A Kernel built in place when the first run needs it. Not std::optional: GCC zeroed the whole
+// optional (2.2 KB, a `rep stos`) on every call, about 280 instructions per triangle and band
+// worker, and the Kernel's members need no zeros (each is written before it is read).
+template <class K>
+class KernelSlot {
+ public:
+  KernelSlot() {}
+  KernelSlot(const KernelSlot&) = delete;
+  KernelSlot& operator=(const KernelSlot&) = delete;
+  ~KernelSlot() {
+    if (k_) k_->~K();
+  }
+  explicit operator bool() const { return k_ != nullptr; }
+  K* operator->() const { return k_; }
+  template <class... A>
+  void emplace(A&&... a) {
+    k_ = ::new (static_cast<void*>(buf_)) K(std::forward<A>(a)...);
+  }
+
+ private:
+  alignas(K) unsigned char buf_[sizeof(K)];
+  K* k_ = nullptr;
+};
+
 template <bool G, bool T, bool Z, bool S>
 void run_kernel(const Triangle& t, const DrawState& st, RasterContext& ctx, int ya, int yz, int stride, int end) {
-  std::optional<Kernel<G, T, Z, S>> kernel;
+  KernelSlot<Kernel<G, T, Z, S>> kernel;
   for (;; ya += stride, yz += stride) {
     int a = std::max(ya, t.y0);
     const int z = std::min(yz, t.y1);
