@@ -174,7 +174,8 @@ GPUBRIDGE_COMMAND("bench", 80, [](CLI::App& app, GlobalOptions& g, auto& runners
   sub->add_flag("--no-llvmpipe", args->no_llvmpipe, "skip the llvmpipe peer rows");
   sub->add_option("--peer-rounds", args->peer_rounds,
                   "rounds in which the llvmpipe peer and the minimal GL program (bench/llvmpipe/minimal_gl.c) "
-                  "alternate, per thread count; each keeps its best frame (--quick: 1)")
+                  "alternate, per thread count; each keeps its best frame; the simulator's exact configuration is timed in as "
+                  "many rounds (--quick: 1)")
       ->check(CLI::Range(1u, 20u))
       ->capture_default_str();
   sub->add_option("--scene", args->scenes,

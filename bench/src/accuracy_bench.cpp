@@ -154,6 +154,14 @@ Result<Report> run_accuracy_bench(const AccuracyBenchOptions& opt, const std::fu
   if (opt.preview_only) configs = {configs.front(), configs.back()};
   // Preview rows carry the exact rate measured alternately with them (same scene and threads), so
   // their ratio is side by side even when the machine's load drifts between configurations.
+  // A simulator row's rates from its best frame, against the peer at the same thread count.
+  auto set_sim_speed = [&](Row& row, double seconds, std::size_t si, std::size_t ti) {
+    row.seconds = seconds;
+    row.mtri_s = double(rep.scenes[si].triangles.size()) / seconds / 1e6;
+    row.mpix_s = double(rep.scene_pixels[si]) / seconds / 1e6;
+    row.fill_fraction = fill_fraction(row.threads, row.mpix_s);
+    if (lp[ti]) row.ratio_vs_llvmpipe = lp[ti]->seconds[si] / seconds;
+  };
   struct PreviewPair {
     std::string scene;
     unsigned threads;
@@ -194,16 +202,27 @@ Result<Report> run_accuracy_bench(const AccuracyBenchOptions& opt, const std::fu
         row.config = ci == 0 ? "exact" : sim::to_string(k);
         row.scene = s.name;
         row.threads = t;
-        row.seconds = timing->best_seconds;
-        row.mtri_s = double(s.triangles.size()) / row.seconds / 1e6;
-        row.mpix_s = double(rep.scene_pixels[si]) / row.seconds / 1e6;
-        row.fill_fraction = fill_fraction(t, row.mpix_s);
-        if (lp[ti]) row.ratio_vs_llvmpipe = lp[ti]->seconds[si] / row.seconds;
+        set_sim_speed(row, timing->best_seconds, si, ti);
         if (ti == 0) row.error = err;  // error does not depend on the thread count (tested)
         rep.rows.push_back(row);
       }
     }
   }
+  // Issue 17's goals compare the exact rows with the peer, which keeps its best frame of `rounds`
+  // rounds: the exact configuration gets as many rounds, the later ones after every other
+  // configuration, so that one burst of load on the shared machine decides neither side alone.
+  for (unsigned round = 1; rep.llvmpipe_ok && round < rounds; ++round)
+    for (std::size_t si = 0; si < rep.scenes.size(); ++si)
+      for (std::size_t ti = 0; ti < opt.threads.size(); ++ti) {
+        const unsigned t = opt.threads[ti];
+        progress("sim exact, " + rep.scenes[si].name + ", round " + std::to_string(round + 1));
+        auto again = time_sim(rep.scenes[si], configs.front(), t, budget);
+        if (!again) return again.error();
+        for (auto& row : rep.rows)
+          if (row.config == "exact" && row.scene == rep.scenes[si].name && row.threads == t &&
+              again->best_seconds < row.seconds)
+            set_sim_speed(row, again->best_seconds, si, ti);
+      }
   for (std::size_t ti = 0; ti < opt.threads.size(); ++ti) {
     if (!lp[ti]) continue;
     for (std::size_t si = 0; si < rep.scenes.size(); ++si) {
