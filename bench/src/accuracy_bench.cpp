@@ -152,8 +152,6 @@ Result<Report> run_accuracy_bench(const AccuracyBenchOptions& opt, const std::fu
   auto configs = bench_configs();
   if (opt.exact_only) configs.resize(1);
   if (opt.preview_only) configs = {configs.front(), configs.back()};
-  // Preview rows carry the exact rate measured alternately with them (same scene and threads), so
-  // their ratio is side by side even when the machine's load drifts between configurations.
   // A simulator row's rates from its best frame, against the peer at the same thread count.
   auto set_sim_speed = [&](Row& row, double seconds, std::size_t si, std::size_t ti) {
     row.seconds = seconds;
@@ -162,6 +160,8 @@ Result<Report> run_accuracy_bench(const AccuracyBenchOptions& opt, const std::fu
     row.fill_fraction = fill_fraction(row.threads, row.mpix_s);
     if (lp[ti]) row.ratio_vs_llvmpipe = lp[ti]->seconds[si] / seconds;
   };
+  // Preview rows carry the exact rate measured alternately with them (same scene and threads), so
+  // their ratio is side by side even when the machine's load drifts between configurations.
   struct PreviewPair {
     std::string scene;
     unsigned threads;

@@ -230,17 +230,15 @@ Result<void> append_trace_record(const TimedCommand& c, std::uint64_t record_num
 }
 
 Result<std::vector<std::uint8_t>> write_binary_trace(const CommandStream& s) {
+  std::vector<std::uint8_t> out;
+  if (auto r = append_trace_header(s.metadata_json, out); !r) return r.error();  // also: a JSON object
   // A CommandStream holds spigpu commands: metadata naming another kind would make a trace that
   // every reader refuses (DMC-1 traces are written record by record: append_trace_message).
-  if (!s.metadata_json.empty() && json_object_problem(s.metadata_json).empty()) {
-    const auto kind = trace_metadata_device_kind(s.metadata_json);
-    if (!kind) return make_error("trace metadata " + kind.error().message);
-    if (*kind != DeviceKind::Spigpu)
-      return make_error("trace metadata says device_kind \"" + std::string(device_kind_info(*kind).name) +
-                        "\", but the commands are spigpu register writes; remove \"device_kind\" or set it to \"spigpu\"");
-  }
-  std::vector<std::uint8_t> out;
-  if (auto r = append_trace_header(s.metadata_json, out); !r) return r.error();
+  const auto kind = trace_metadata_device_kind(s.metadata_json);
+  if (!kind) return make_error("trace metadata " + kind.error().message);
+  if (*kind != DeviceKind::Spigpu)
+    return make_error("trace metadata says device_kind \"" + std::string(device_kind_info(*kind).name) +
+                      "\", but the commands are spigpu register writes; remove \"device_kind\" or set it to \"spigpu\"");
   std::uint64_t last = 0;
   for (std::size_t i = 0; i < s.commands.size(); ++i) {
     const auto& c = s.commands[i];

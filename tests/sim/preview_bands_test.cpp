@@ -19,7 +19,6 @@ namespace gpubridge::sim::test {
 namespace {
 
 constexpr unsigned kW = 192, kH = 200;  // the buffers' size in pixels
-constexpr std::size_t kPitch = std::size_t{kW} * 4;
 constexpr int kBand = 16;
 
 struct Case {
@@ -44,19 +43,14 @@ Case random_case(std::mt19937& rng) {
   } else {
     random_points(rng, x, y, kW, kH);
   }
-  const auto [bx0, bx1, by0, by1] = preview_box(x, y, c.p);
+  const PreviewBox b = place_triangle(x, y, c.p, c.planes, kW);
   PreviewPlain& p = c.p;
   random_planes(rng, c.planes, /*small_cdy=*/true);
-  p.planes = &c.planes;
-  p.width = std::min(bx1, static_cast<int>(kW)) - bx0;
-  p.y = by0;
-  p.pitch = kPitch;
-  p.room = kW - static_cast<unsigned>(bx0);
   random_depth_test(rng, p, 3);
   p.blend = rng() % 3 == 0 ? protocol::BlendMode::Alpha : protocol::BlendMode::Off;
   // The rows a worker gets: from a random row of the box to its end (as rasterize_bands passes
   // them: the first row of the worker's first band).
-  const int rows = std::min(by1, static_cast<int>(kH)) - by0;
+  const int rows = std::min(b.by1, static_cast<int>(kH)) - b.by0;
   p.ky0 = rows > 0 ? static_cast<int>(rng() % static_cast<unsigned>(std::min(rows, 20))) : 0;
   p.rows = std::max(0, rows - p.ky0);
   return c;

@@ -46,6 +46,19 @@ inline PreviewBox preview_box(int* x, int* y, PreviewPlain& p) {
   return b;
 }
 
+// Puts the triangle x, y (1/16 pixel) into p as a box of a buffer w pixels wide: its edge values
+// (preview_box), planes, width clipped to the buffer, first row, pitch and room to the buffer's
+// right edge. The rows it draws (ky0, rows) are the caller's choice; returns the box.
+inline PreviewBox place_triangle(int* x, int* y, PreviewPlain& p, const FixedPlanes& planes, unsigned w) {
+  const PreviewBox b = preview_box(x, y, p);
+  p.planes = &planes;
+  p.width = std::min(b.bx1, static_cast<int>(w)) - b.bx0;
+  p.y = b.by0;
+  p.pitch = std::size_t{w} * 4;
+  p.room = w - static_cast<unsigned>(b.bx0);
+  return b;
+}
+
 // Random colour and Z planes: any integers (the lanes are modular sums); Z steps small enough that
 // a row's depths cross the stored ones, sometimes negative. small_cdy also shifts the colour's y
 // steps down by a random amount (tall boxes, where full-size steps would only wrap).

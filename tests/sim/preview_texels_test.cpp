@@ -20,7 +20,6 @@ namespace gpubridge::sim::test {
 namespace {
 
 constexpr unsigned kW = 96, kH = 40;  // the buffers' size in pixels
-constexpr std::size_t kPitch = std::size_t{kW} * 4;
 
 struct Case {
   PreviewPlain p;
@@ -35,26 +34,21 @@ Case random_case(std::mt19937& rng) {
   random_buffer(rng, c.depth, kW, kH);
   int x[3], y[3];
   random_points(rng, x, y, kW, kH);
-  const auto [bx0, bx1, by0, by1] = preview_box(x, y, c.p);
+  const PreviewBox b = place_triangle(x, y, c.p, c.planes, kW);
   PreviewPlain& p = c.p;
   random_planes(rng, c.planes);
-  p.planes = &c.planes;
-  p.width = std::min(bx1, static_cast<int>(kW)) - bx0;
   p.ky0 = 0;
-  p.rows = std::min(by1, static_cast<int>(kH)) - by0;
-  p.pitch = kPitch;
-  p.room = kW - static_cast<unsigned>(bx0);
+  p.rows = std::min(b.by1, static_cast<int>(kH)) - b.by0;
   random_depth_test(rng, p, 3);
   p.zmask = 0xFFFFFFu;
   p.blend = rng() % 3 == 0 ? protocol::BlendMode::Alpha : protocol::BlendMode::Off;
-  p.y = by0;
   // The texture and its S, T, Q planes (per pixel of the box, as the renderer's double planes):
   // coordinates over a few texture widths either side of 0, so every wrap mode meets its edges.
   PreviewTexels& t = p.tex;
   t.wl = 3 + rng() % 5;
   t.hl = 3 + rng() % 5;
   c.texels.resize(std::size_t{4} << (t.wl + t.hl));
-  for (auto& b : c.texels) b = static_cast<std::uint8_t>(rng());
+  for (auto& byte : c.texels) byte = static_cast<std::uint8_t>(rng());
   const auto uniform = [&](double lo, double hi) { return lo + (hi - lo) * (rng() / 4294967296.0); };
   const bool perspective = rng() % 2 != 0;
   const double q = perspective ? uniform(0.05, 2.0) : 1.0;

@@ -37,20 +37,14 @@ Case random_case(std::mt19937& rng) {
   // A triangle with its box inside the buffer: wide (up to the whole row) or thin.
   int x[3], y[3];
   random_points(rng, x, y, kW, kH);
-  const auto [bx0, bx1, by0, by1] = preview_box(x, y, c.p);
+  const PreviewBox b = place_triangle(x, y, c.p, c.planes, kW);
   PreviewPlain& p = c.p;
   random_planes(rng, c.planes);
-  p.planes = &c.planes;
-  p.width = std::min(bx1, static_cast<int>(kW)) - bx0;
   p.ky0 = static_cast<int>(rng() % 3);
-  p.rows = std::min(by1, static_cast<int>(kH)) - by0 - p.ky0;
-  if (p.rows < 0) p.rows = 0;
-  p.pitch = kPitch;
-  p.room = kW - static_cast<unsigned>(bx0);
+  p.rows = std::max(0, std::min(b.by1, static_cast<int>(kH)) - b.by0 - p.ky0);
   random_depth_test(rng, p, 4);
   p.zmask = rng() % 2 ? 0xFFFFFFu : 0xFFFF00u;
   p.blend = rng() % 3 == 0 ? protocol::BlendMode::Alpha : protocol::BlendMode::Off;
-  p.y = by0;
   return c;
 }
 
