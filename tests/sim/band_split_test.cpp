@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
 #include <random>
 #include <vector>
 
@@ -31,7 +32,7 @@ TEST(SimBandSplit, EvenWorkIsCutEvenly) {
   BandSplit s;
   std::vector<int> cuts;
   for (unsigned n = 1; n <= 7; ++n) {
-    for (int y = 0; y < 480; ++y) s.add(y, y + 1, 512.0 * 20);  // one row of 20 px on every row
+    for (int y = 0; y < 480; ++y) s.add(y, y + 1, 512 * 20);  // one row of 20 px on every row
     s.split(n, cuts);
     expect_well_formed(cuts, n);
     for (unsigned k = 1; k < n; ++k) {  // each cut within half a band of k/n of the rows
@@ -45,15 +46,15 @@ TEST(SimBandSplit, CutsFollowTheWork) {
   BandSplit s;
   std::vector<int> cuts;
   // A few wide rows at the bottom outweigh many narrow ones at the top.
-  for (int y = 0; y < 320; y += 4) s.add(y, y + 4, 512.0 * 4 * 2);
-  s.add(400, 480, 512.0 * 80 * 600);
+  for (int y = 0; y < 320; y += 4) s.add(y, y + 4, 512 * 4 * 2);
+  s.add(400, 480, 512 * 80 * 600);
   s.split(2, cuts);
   expect_well_formed(cuts, 2);
   EXPECT_GE(cuts[1], 400);
   EXPECT_LT(cuts[1], 480);
   // The estimate starts afresh: the same rows the other way round cut near the top.
-  s.add(0, 80, 512.0 * 80 * 600);
-  for (int y = 160; y < 480; y += 4) s.add(y, y + 4, 512.0 * 4 * 2);
+  s.add(0, 80, 512 * 80 * 600);
+  for (int y = 160; y < 480; y += 4) s.add(y, y + 4, 512 * 4 * 2);
   s.split(2, cuts);
   EXPECT_GT(cuts[1], 0);
   EXPECT_LE(cuts[1], 80);
@@ -77,7 +78,7 @@ TEST(SimBandSplit, RandomBatchesGiveWellFormedCuts) {
     for (int i = 0; i < count; ++i) {
       const int y0 = static_cast<int>(rng() % BandSplit::kMaxRows);
       const int y1 = y0 + 1 + static_cast<int>(rng() % static_cast<unsigned>(BandSplit::kMaxRows - y0));
-      s.add(y0, y1, static_cast<double>(rng() % 100000000));
+      s.add(y0, y1, static_cast<std::int64_t>(rng() % 100000000));
     }
     const unsigned n = 1 + rng() % 7;
     s.split(n, cuts);

@@ -7,11 +7,14 @@
 // "the exact path at two threads"). Any cuts give the same bytes: the workers' rows are disjoint
 // and each pixel is still written in submission order.
 //
-// The estimate, per row, is a difference array the device thread adds each set-up triangle to
-// (two or three stores): its rows times a row's cost plus its area, spread evenly over its rows,
-// plus a Kernel's set-up at its first row, all in pixels' worth of work.
-#include <algorithm>
+// The estimate is a triangle's work added to the band of its middle row (one add on the device
+// thread: spreading it over its rows cost a division and three stores a triangle, +3 % of the
+// device thread's instructions on 10-px triangles, where that thread is the critical path): its
+// rows times a row's cost, its area, and a Kernel's set-up, in pixels' worth of work. A cut through
+// a triangle then counts all of its work on one side, as often the one as the other.
+#include <array>
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 namespace gpubridge::sim {
@@ -22,18 +25,14 @@ class BandSplit {
   static constexpr int kMaxRows = 2048;  // a clip rectangle's rows (below 2^11)
   // What a row and a triangle's set-up cost against a drawn pixel (callgrind, 1,000-px triangles:
   // about 22 instructions a pixel in the span routine, 300 a row in the row loop, 1,500 a Kernel).
-  static constexpr float kRowWork = 14.f, kTriangleWork = 70.f;
+  static constexpr std::int64_t kRowWork = 14, kTriangleWork = 70;
 
-  BandSplit() : diff_(kMaxRows + 2, 0.f) {}
+  static constexpr int kBands = kMaxRows / kBandRows;
 
-  // A triangle of rows y0..y1-1 (0 <= y0 < y1 <= kMaxRows) and twice its area `den` in 1/16 px units.
-  void add(int y0, int y1, double den) {
-    const float per_row = kRowWork + static_cast<float>(den * (1.0 / 512)) / static_cast<float>(y1 - y0);
-    diff_[static_cast<std::size_t>(y0)] += per_row + kTriangleWork;
-    diff_[static_cast<std::size_t>(y0) + 1] -= kTriangleWork;
-    diff_[static_cast<std::size_t>(y1)] -= per_row;
-    lo_ = std::min(lo_, y0);
-    hi_ = std::max(hi_, y1);
+  // A triangle of rows y0..y1-1 (0 <= y0 < y1 <= kMaxRows) and twice its area `den` in 1/16 px
+  // units (so den is its area in 1/512 px, the estimate's unit).
+  void add(int y0, int y1, std::int64_t den) {
+    work_[static_cast<std::size_t>((y0 + y1) >> 1) / kBandRows] += den + ((kTriangleWork + kRowWork * (y1 - y0)) << 9);
   }
 
   // cuts[0..n]: worker w draws rows cuts[w]..cuts[w+1]-1 (cuts[0] = 0, cuts[n] = kMaxRows), whole
@@ -41,36 +40,22 @@ class BandSplit {
   void split(unsigned n, std::vector<int>& cuts) {
     cuts.assign(n + 1, 0);
     cuts[n] = kMaxRows;
-    if (hi_ <= lo_) {  // nothing added: every row to worker 0
-      for (unsigned w = 1; w < n; ++w) cuts[w] = kMaxRows;
-      return;
-    }
-    // Work per band, from the first band with a row to the last.
-    const int b0 = lo_ / kBandRows, b1 = (hi_ + kBandRows - 1) / kBandRows;
-    band_work_.assign(static_cast<std::size_t>(b1 - b0), 0.f);
-    float rate = 0.f, total = 0.f;
-    for (int y = b0 * kBandRows; y < std::min(b1 * kBandRows, kMaxRows); ++y) {
-      rate += diff_[static_cast<std::size_t>(y)];
-      band_work_[static_cast<std::size_t>(y / kBandRows - b0)] += rate;
-    }
-    for (float w : band_work_) total += w;
-    // Cut k after the band where the running sum comes nearest k·total/n.
-    float sum = 0.f;
+    std::int64_t total = 0;
+    for (std::int64_t w : work_) total += w;
+    // Cut k after the band where the running sum comes nearest k·total/n (nothing added: every
+    // row to worker 0).
+    std::int64_t sum = 0;
     std::size_t b = 0;
     for (unsigned k = 1; k < n; ++k) {
-      const float target = total * static_cast<float>(k) / static_cast<float>(n);
-      while (b < band_work_.size() && sum + band_work_[b] * 0.5f < target) sum += band_work_[b++];
-      cuts[k] = (b0 + static_cast<int>(b)) * kBandRows;
+      const double target = static_cast<double>(total) * k / n;
+      while (b < work_.size() && static_cast<double>(sum) + 0.5 * static_cast<double>(work_[b]) < target) sum += work_[b++];
+      cuts[k] = total == 0 ? kMaxRows : static_cast<int>(b) * kBandRows;
     }
-    std::fill(diff_.begin() + lo_, diff_.begin() + std::min(hi_ + 2, kMaxRows + 2), 0.f);
-    lo_ = kMaxRows;
-    hi_ = 0;
+    work_.fill(0);
   }
 
  private:
-  std::vector<float> diff_;        // per row: the change of the work a row against the row above
-  std::vector<float> band_work_;   // split's scratch
-  int lo_ = kMaxRows, hi_ = 0;     // rows added: lo_..hi_-1
+  std::array<std::int64_t, kBands> work_{};  // per band: the work of the triangles whose middle row is in it
 };
 
 }  // namespace gpubridge::sim

@@ -154,7 +154,7 @@ void Renderer::draw(const Vertex& a, const Vertex& b, const Vertex& c, const std
       count_box(s.x0, s.y0, s.x1, s.y1, st);
     } else {
       rows = {static_cast<std::int16_t>(t.y0), static_cast<std::int16_t>(t.y1), false};
-      split_.add(t.y0, t.y1, static_cast<double>(t.den));
+      split_.add(t.y0, t.y1, t.den);
       t.index = index;
       count_rasterised(t, st);
     }
