@@ -1,6 +1,7 @@
 // Batches of small triangles drawn by the band workers (backends/sim/src/renderer.hpp): with N
-// threads the front end sets the batch up and each worker draws its own 16-row bands of every
-// triangle (whoever sets up, the tests hold for any split of the work). The bytes, the error flags
+// threads the front end sets the batch up and each worker draws its own rows of every triangle (a
+// run of whole 16-row bands each, cut where the batch's work splits evenly; whoever sets up, the
+// tests hold for any split of the work). The bytes, the error flags
 // and every counter (triangles rasterised and rejected, rows and columns per state class, pixels)
 // must be those of one thread, each triangle counted once: small triangles around the band edges,
 // triangles that draw nothing (D = 0, between sample rows, above the framebuffer, outside the

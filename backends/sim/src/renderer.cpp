@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "hier_z.hpp"
 #include "sdram_spans.hpp"
 
 namespace gpubridge::sim {
@@ -20,6 +21,9 @@ Renderer::Renderer(VideoMemory& mem, const AccuracyKnobs& knobs, unsigned thread
   draw_job_ = [this](unsigned worker) { draw_bands(worker); };
   hz_runs_.assign(pool_.workers(), 0);
 }
+
+// Each coarse depth block, and its band's records, is touched by the one worker owning its rows.
+static_assert(BandSplit::kBandRows == 1 << HierZ::kRowsLog, "cuts fall between the coarse depth bounds' bands");
 
 namespace {
 // The coarse depth bounds hold for a state whose depth writes only ever lower the stored depth
@@ -146,9 +150,11 @@ void Renderer::draw(const Vertex& a, const Vertex& b, const Vertex& c, const std
     }
     if (how == SetUp::Small) {
       rows = {s.y0, s.y1, true};
+      split_.add(s.y0, s.y1, s.den);
       count_box(s.x0, s.y0, s.x1, s.y1, st);
     } else {
       rows = {static_cast<std::int16_t>(t.y0), static_cast<std::int16_t>(t.y1), false};
+      split_.add(t.y0, t.y1, t.den);
       t.index = index;
       count_rasterised(t, st);
     }
@@ -228,6 +234,7 @@ void Renderer::submit() {
   batch_limit_ = std::min(2 * batch_limit_, kMaxBatch);
   drawing_state_ = std::move(batch_state_);
   drawing_gen_ = batch_gen_;
+  split_.split(pool_.workers(), drawing_cuts_);
   batch_state_.reset();
   drawing_ctx_.clear();
   for (unsigned w = 0; w < pool_.workers(); ++w) drawing_ctx_.push_back({context(*drawing_state_, drawing_gen_, w)});
@@ -249,10 +256,9 @@ void Renderer::wait_drawing() {
   drawing_active_ = false;
 }
 
-// One worker's share of a batch: the rows of its bands of every triangle, in submission order.
+// One worker's share of a batch: its rows of every triangle, in submission order.
 void Renderer::draw_bands(unsigned worker) {
   const DrawState& st = *drawing_state_;
-  const unsigned n = pool_.workers();
   RasterContext& c = drawing_ctx_[worker].ctx;
   const SmallDraw small = knobs_.preview && st.preview_small != 0 ? small_draw(st, mem_, knobs_.z_bits) : SmallDraw{};
   // In locals: the kernels are called through pointers, so the compiler would load the batch's
@@ -261,24 +267,14 @@ void Renderer::draw_bands(unsigned worker) {
   const SmallTriangle* const smalls = drawing_.small.data();
   const Triangle* const full = drawing_.full.data();
   const std::size_t count = drawing_n_;
-  static_assert(kBandRows == kPreviewBandRows, "rasterize_bands gives the plain preview kernel a worker's bands in one call");
+  // This worker's rows of the batch (BandSplit): each triangle's rows among them in one call.
+  const int lo = drawing_cuts_[worker], hi = drawing_cuts_[worker + 1];
+  if (lo >= hi) return;
   for (std::size_t i = 0; i < count; ++i) {
     const BatchRows r = rows[i];
-    // This worker's first band from the box's first (boxes lie inside the clip rectangle: y0 >= 0):
-    // one division by n per triangle, not two.
-    const unsigned first = static_cast<unsigned>(r.y0) / kBandRows;
-    unsigned ahead = worker + n - first % n;
-    if (ahead >= n) ahead -= n;
-    const int band = static_cast<int>(first + ahead);
-    // A box inside other workers' bands (the fan's flat slivers: one band): nothing to do here, not
-    // even a call.
-    if (band * kBandRows >= r.y1) continue;
-    if (!r.small) {  // every band of the triangle in one call (one Kernel, or the plain preview kernel)
-      rasterize_bands(full[i], st, c, band * kBandRows, (band + 1) * kBandRows, static_cast<int>(n) * kBandRows);
-      continue;
-    }
-    for (int b = band; b * kBandRows < r.y1; b += static_cast<int>(n))
-      rasterize_small(smalls[i], small, c.counters, b * kBandRows, (b + 1) * kBandRows);
+    if (r.y1 <= lo || r.y0 >= hi) continue;  // a box outside this worker's rows: not even a call
+    if (r.small) rasterize_small(smalls[i], small, c.counters, lo, hi);
+    else rasterize_rows(full[i], st, c, lo, hi);
   }
 }
 

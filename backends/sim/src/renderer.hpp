@@ -1,16 +1,18 @@
 #pragma once
 // Runs kicked triangles through setup and the rasteriser. With one thread every triangle is drawn
 // at once. With N threads triangles are batched while the render state stays the same; a batch is
-// drawn by N workers that each walk all triangles in submission order and draw only the rows of
-// their own 16-row bands (band i → worker i % N), so the bytes are identical for any N. The
-// calling thread (the device front end) decodes and sets up the next batch while the workers draw
-// the previous one; batches are drawn one after another, and flush() waits for both.
+// drawn by N workers that each walk all triangles in submission order and draw only their own
+// rows (a run of whole 16-row bands each, cut by an estimate of the batch's work: BandSplit), so
+// the bytes are identical for any N. The calling thread (the device front end) decodes and sets
+// up the next batch while the workers draw the previous one; batches are drawn one after another,
+// and flush() waits for both.
 #include <array>
 #include <cstdint>
 #include <functional>
 #include <memory>
 #include <vector>
 
+#include "band_split.hpp"
 #include "gpubridge/common/band_pool.hpp"
 #include "draw_state.hpp"
 #include "gpubridge/sim/device.hpp"
@@ -65,7 +67,6 @@ class Renderer {
     modes_ = {};
   }
 
-  static constexpr int kBandRows = 16;
   static constexpr std::size_t kMaxBatch = 4096;
   // The first batch after a flush holds at most this many triangles, and each batch after it
   // twice as many as the one before, up to kMaxBatch: the workers start drawing after the first
@@ -125,6 +126,8 @@ class Renderer {
   Batch drawing_;  // being drawn by the workers: its first drawing_n_
   std::size_t drawing_n_ = 0;
   std::shared_ptr<const DrawState> drawing_state_;
+  BandSplit split_;  // the filling batch's estimated work by band
+  std::vector<int> drawing_cuts_;  // worker w draws the drawing batch's rows drawing_cuts_[w]..[w + 1] - 1
   // One worker's context on cache lines of its own: the workers write their counters and run
   // numbers while they draw, and two contexts side by side in one line bounced it between cores.
   struct alignas(64) WorkerContext {
