@@ -25,13 +25,21 @@ struct TexQuad8 {
   simd::u32x8 t00, t10, t01, t11, fu, fv;
 };
 
-// Lanes k in `pass` (all ones or zero; rejected lanes and lanes beyond the span are 0) get their
-// texels; the other lanes' words are unspecified (the caller's blend and stores mask them off).
-// s.tex->bilinear_rgba_repeat() must hold and s.q_const must not.
-__attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq"))) inline void texel_quads_wide(
-    const TextureLanes& s, const simd::u32x8* sq, const simd::u32x8* tq, const simd::u32x8* qq,
-    const simd::u32x8* pass, TexQuad8* out) {
+#define TEXTURE8_WIDE_TARGET __attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq")))
+
+// Eight lanes' bilinear footprints: the fractions, the left column a0 (and i0, the unwrapped
+// index it came from) and the two rows' first words b0, b1 (word indices into the texture).
+struct TexAddress8 {
+  simd::u32x8 fu, fv, i0, a0, b0, b1;
+};
+
+// Sections 10.1-10.3 for lanes (s, t, q): the same integers as ReciprocalUnit::operator(),
+// texel_coords and quad_rgba_repeat's addressing. s.tex->bilinear_rgba_repeat() must hold.
+[[gnu::always_inline]] TEXTURE8_WIDE_TARGET inline TexAddress8 texel_address_wide(const TextureLanes& s,
+                                                                                  simd::u32x8 sqv, simd::u32x8 tqv,
+                                                                                  simd::u32x8 qqv) {
   using simd::u32x8;
+  TexAddress8 a;
   const ReciprocalUnit& ru = *s.recip;
   const TextureUnit& tex = *s.tex;
   // Section 10.1 in eight 64-bit lanes. Q = 0 takes the reciprocal of 1 and its lanes' coordinates
@@ -41,7 +49,7 @@ __attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq"))) inline void t
   typedef double f64x8 __attribute__((vector_size(64)));
   // Generic vector operations where they compile to one instruction (GCC 12's 512-bit intrinsics
   // trip -Wmaybe-uninitialized on their undefined pass-through operands).
-  const __m256i q = (__m256i)*qq;
+  const __m256i q = (__m256i)qqv;
   const __mmask8 q_nz = _mm256_test_epi32_mask(q, q);
   const u32x8 qn = (u32x8)_mm256_mask_blend_epi32(q_nz, _mm256_set1_epi32(1), q);
   // Leading zeros from the exponent of q as a double (exact: q < 2^53): n = 31 − floor(log2 q).
@@ -61,19 +69,38 @@ __attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq"))) inline void t
   }
   // Section 10.2: (s · y) >> (43 − n − log2 size), signed 64-bit (|s · y| < 2^63), then only the
   // low 32 bits: the repeat masks and fractions read bits 4..21 (sizes <= 2^10).
-  const i64x8 sy = __builtin_convertvector((simd::i32x8)*sq, i64x8) * (i64x8)y;
-  const i64x8 ty = __builtin_convertvector((simd::i32x8)*tq, i64x8) * (i64x8)y;
+  const i64x8 sy = __builtin_convertvector((simd::i32x8)sqv, i64x8) * (i64x8)y;
+  const i64x8 ty = __builtin_convertvector((simd::i32x8)tqv, i64x8) * (i64x8)y;
   const i64x8 tu = sy >> (i64x8)((43 - s.wl) - n), tv = ty >> (i64x8)((43 - s.hl) - n);
   // quad_rgba_repeat in 32-bit lanes (mod 2^32, the same bits).
   const u32x8 uu = (u32x8)_mm512_maskz_cvtepi64_epi32(q_nz, (__m512i)tu) - 2048u;
   const u32x8 vv = (u32x8)_mm512_maskz_cvtepi64_epi32(q_nz, (__m512i)tv) - 2048u;
-  out->fu = (uu >> 4) & 255u;
-  out->fv = (vv >> 4) & 255u;
+  a.fu = (uu >> 4) & 255u;
+  a.fv = (vv >> 4) & 255u;
   const std::uint32_t wm = tex.wmask(), hm = tex.hmask();
   const unsigned wl = tex.wl();
   const u32x8 i0 = uu >> 12, j0 = vv >> 12;
   const u32x8 a0 = i0 & wm;
   const u32x8 b0 = (j0 & hm) << wl, b1 = ((j0 + 1u) & hm) << wl;
+  a.i0 = i0;
+  a.a0 = a0;
+  a.b0 = b0;
+  a.b1 = b1;
+  return a;
+}
+
+// Lanes k in `pass` (all ones or zero; rejected lanes and lanes beyond the span are 0) get their
+// texels; the other lanes' words are unspecified (the caller's blend and stores mask them off).
+// s.tex->bilinear_rgba_repeat() must hold and s.q_const must not.
+TEXTURE8_WIDE_TARGET inline void texel_quads_wide(const TextureLanes& s, const simd::u32x8* sq, const simd::u32x8* tq,
+                                                  const simd::u32x8* qq, const simd::u32x8* pass, TexQuad8* out) {
+  using simd::u32x8;
+  const TexAddress8 a = texel_address_wide(s, *sq, *tq, *qq);
+  out->fu = a.fu;
+  out->fv = a.fv;
+  const TextureUnit& tex = *s.tex;
+  const std::uint32_t wm = tex.wmask();
+  const u32x8 i0 = a.i0, a0 = a.a0, b0 = a.b0, b1 = a.b1;
   const u32x8 ok = *pass;
   const std::uint8_t* texels = tex.texels();
   // A passing lane's two columns are words a0 and a0 + 1 of their rows unless a0 is the last
