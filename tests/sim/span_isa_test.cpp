@@ -95,11 +95,17 @@ TEST(SimSpanIsa, PerspectiveRepeatTexturesSameBytesAsScalar) {
         w(d, Reg::PRIM, 0);
         for (int k = 0; k < 3; ++k) {
           std::uint32_t q = static_cast<std::uint32_t>(r());
-          switch ((t + k) % 4) {
-            case 0: q = k == 0 ? 0 : q & 0xFF; break;  // Q = 0 at a vertex, a few units at the others
-            case 1: q &= 0xFFFF; break;
-            case 2: q |= 0x80000000u; break;  // full scale
-            default: break;
+          if (t % 8 == 7) {
+            q = 0;  // Q = 0 at every pixel: texel (0, 0) everywhere
+          } else if (t % 4 == 3) {
+            q = k < 2 ? 0 : q & 0xF;  // Q = 0 along an edge, a few units away from it
+          } else {
+            switch ((t + k) % 4) {
+              case 0: q = k == 0 ? 0 : q & 0xFF; break;  // Q = 0 at a vertex, a few units at the others
+              case 1: q &= 0xFFFF; break;
+              case 2: q |= 0x80000000u; break;  // full scale
+              default: break;
+            }
           }
           w(d, Reg::COLOR, color(static_cast<std::uint32_t>(r()), q));
           w(d, Reg::TEXCOORD, (std::uint64_t{static_cast<std::uint32_t>(r())} << 32) | static_cast<std::uint32_t>(r()));
