@@ -70,7 +70,8 @@ TEST(SimSpanIsa, SameBytesAndCountersAsScalar) {
 // Q = 0 or at a few units, so that the reciprocal's leading zeros reach 31 and the coordinates'
 // shift its smallest), Q at full scale, texture coordinates over the whole signed range (many
 // wraps, so that footprints straddle the repeat's seam, where the lanes load word by word) and
-// every texture size the random cases draw (8-wide textures: a seam in one footprint of eight).
+// every texture size the random cases draw (8-wide textures: a seam in one footprint of eight),
+// and reciprocal tables of 1-16 bits with 0-4 Newton-Raphson steps.
 TEST(SimSpanIsa, PerspectiveRepeatTexturesSameBytesAsScalar) {
   SpanIsa isa{};
   const std::string name = expected_instance(isa);
@@ -114,7 +115,11 @@ TEST(SimSpanIsa, PerspectiveRepeatTexturesSameBytesAsScalar) {
       }
       return end_frame(d);
     };
-    const Rendered v = draw(vector_options(true)), s = draw(vector_options(false));
+    // The reciprocal unit's table sizes and steps: the lanes compute the table's words (b <= 16).
+    DeviceOptions on = vector_options(true), off = vector_options(false);
+    on.accuracy.recip_bits = off.accuracy.recip_bits = i % 3 == 0 ? 10 : 1 + static_cast<unsigned>(rng() % 16);
+    on.accuracy.nr_steps = off.accuracy.nr_steps = i % 3 == 0 ? 1 : static_cast<unsigned>(rng() % 5);
+    const Rendered v = draw(on), s = draw(off);
     expect_same(c, v, s, i);
     if (::testing::Test::HasFatalFailure()) return;
     textured += s.stats.pixels_textured;

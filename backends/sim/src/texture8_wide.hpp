@@ -57,9 +57,21 @@ struct TexAddress8 {
   const u64x8 m = __builtin_convertvector(qn, u64x8) << n;  // 2^31 <= m < 2^32
   const unsigned b = ru.table_bits();
   const u64x8 idx = (m >> (31 - b)) & ((std::uint64_t{1} << b) - 1);
-  // The table (4 KiB at the hardware's 10 bits) stays in L1: one gather a chunk.
-  u64x8 y = __builtin_convertvector(
-      (u32x8)_mm512_mask_i64gather_epi32(_mm256_setzero_si256(), 0xFF, (__m512i)idx, ru.table(), 4), u64x8);
+  // The table's word, computed rather than looked up (the gather's latency showed in the profile of
+  // a texture that never misses): reciprocal.cpp's y = floor((2^(b+34) + den) / (2·den)), den = 2^(b+1) + 2i + 1, in
+  // doubles. Exact: numerator and divisor are integers below 2^53; a quotient below 2^32 is
+  // rounded by less than 2^-21, and a non-integer one lies at least 1/(2·den) > 2^-19 (b <= 16)
+  // from the integers, so truncating the rounded quotient gives the floor.
+  // (The knobs allow b <= 16; a unit built with a larger table reads it, one gather a chunk.)
+  u64x8 y;
+  if (b <= 16) {
+    const u64x8 den = 2 * idx + ((std::uint64_t{1} << (b + 1)) + 1);
+    const f64x8 num = __builtin_convertvector(den, f64x8) + static_cast<double>(std::uint64_t{1} << (b + 34));
+    y = __builtin_convertvector(num / __builtin_convertvector(2 * den, f64x8), u64x8);
+  } else {
+    y = __builtin_convertvector(
+        (u32x8)_mm512_mask_i64gather_epi32(_mm256_setzero_si256(), 0xFF, (__m512i)idx, ru.table(), 4), u64x8);
+  }
   for (unsigned k = 0; k < ru.nr_steps(); ++k) {
     // m and y < 2^32: vpmuludq's 32 × 32 → 64-bit products are operator()'s 64-bit ones.
     const u64x8 p = (u64x8)_mm512_maskz_mul_epu32(0xFF, (__m512i)m, (__m512i)y);
