@@ -3,8 +3,8 @@
 // AVX-512 vectors, for the span routine's AVX-512 instances (texture8.hpp's kWide): perspective
 // triangles (Q varies along x) on an RGBA8888 bilinear texture inside VRAM that repeats on both
 // axes, the cubes' case. The same integers as ReciprocalUnit::operator(), texel_coords and
-// TextureUnit::quad_rgba_repeat lane by lane (docs/simulator.md, sim-cubes): where those are about
-// 70 scalar instructions a lane, here a chunk's eight lanes go through one chain of vector
+// TextureUnit::quad_rgba_repeat lane by lane (docs/simulator.md, sim-cubes): where those are
+// dozens of scalar instructions a lane, here a chunk's eight lanes go through one chain of vector
 // instructions, and nothing goes back through memory between the reciprocal and the texel loads.
 // Internal to span_simd.cpp: only its AVX-512 instances call it (the target attribute lets it
 // inline there and nowhere else; vectors go by pointer for the reason given at simd_lanes.hpp's
@@ -57,12 +57,12 @@ struct TexAddress8 {
   const u64x8 m = __builtin_convertvector(qn, u64x8) << n;  // 2^31 <= m < 2^32
   const unsigned b = ru.table_bits();
   const u64x8 idx = (m >> (31 - b)) & ((std::uint64_t{1} << b) - 1);
-  // The table's word, computed rather than looked up (the gather's latency showed in the profile of
-  // a texture that never misses): reciprocal.cpp's y = floor((2^(b+34) + den) / (2·den)), den = 2^(b+1) + 2i + 1, in
-  // doubles. Exact: numerator and divisor are integers below 2^53; a quotient below 2^32 is
-  // rounded by less than 2^-21, and a non-integer one lies at least 1/(2·den) > 2^-19 (b <= 16)
-  // from the integers, so truncating the rounded quotient gives the floor.
-  // (The knobs allow b <= 16; a unit built with a larger table reads it, one gather a chunk.)
+  // The table's word computed rather than looked up (the gather's latency showed in the profile of
+  // a texture that never misses): reciprocal.cpp's y = floor((2^(b+34) + den) / (2·den)),
+  // den = 2^(b+1) + 2i + 1, in doubles. Exact: numerator and divisor are integers below 2^53; a
+  // quotient below 2^32 is rounded by less than 2^-21, and a non-integer one lies at least
+  // 1/(2·den) > 2^-19 (b <= 16) from the integers, so truncating the rounded quotient gives the
+  // floor. (The knobs allow b <= 16; a unit built with a larger table reads it, one gather a chunk.)
   u64x8 y;
   if (b <= 16) {
     const u64x8 den = 2 * idx + ((std::uint64_t{1} << (b + 1)) + 1);
