@@ -110,7 +110,8 @@ TEST(SimSpanIsa, PerspectiveRepeatTexturesSameBytesAsScalar) {
           }
           w(d, Reg::COLOR, color(static_cast<std::uint32_t>(r()), q));
           w(d, Reg::TEXCOORD, (std::uint64_t{static_cast<std::uint32_t>(r())} << 32) | static_cast<std::uint32_t>(r()));
-          w(d, Reg::VERTEX, vtx(k == 0 ? x : x + dv(r), k == 0 ? y : y + dv(r), static_cast<std::uint32_t>(r()) & 0xFFFFFF));
+          const std::uint32_t z = static_cast<std::uint32_t>(r()) & 0xFFFFFF;
+          w(d, Reg::VERTEX, vtx(k == 0 ? x : x + dv(r), k == 0 ? y : y + dv(r), z));
         }
       }
       return end_frame(d);

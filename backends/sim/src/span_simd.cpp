@@ -91,8 +91,8 @@ template <bool kTextured, PixelFormat kFormat, bool kGouraud, bool kAvx2, bool k
     // spans (2-7 pixels) then reach into another cache line more often, and the perspective road
     // lost 7% (cubes unchanged), while untextured 1,000-px spans gained 10%.
     const bool whole = !kTextured && i + 8 <= room;
-    passed -= simd::pixel8<kTextured, kFormat, simd::Chunk::Span, false, false, kAvx2, kAvx512>(px, flags, q, in_span, cp, zp,
-                                                                                       n, whole, bayer);
+    passed -= simd::pixel8<kTextured, kFormat, simd::Chunk::Span, false, false, kAvx2, kAvx512>(
+        px, flags, q, in_span, cp, zp, n, whole, bayer);
   }
   return simd::lane_sum(passed);  // pass lanes are all ones (−1)
 }
