@@ -37,9 +37,10 @@ struct StageFlags {
 // V: u32x8, or u32x16 for untextured RGBA8888 spans (the span routine's AVX-512 instance); kMasked:
 // tails through AVX-512's masked moves (load_words); kAvx2 (the span routine's instances with AVX2 or
 // AVX-512): the depth words' byte order by one byte shuffle (bswap) and a chunk's pass mask as lane
-// bits (lane_bits: one vmovmskps where four extracts, ors and ands were).
+// bits (lane_bits: one vmovmskps where four extracts, ors and ands were). kAvx512 (the span
+// routine's AVX-512 instances): texture8's lanes (texture8_wide.hpp).
 template <bool kTextured, PixelFormat kFormat, Chunk kChunk, bool kTexelLanes = false, bool kMasked = false,
-          bool kAvx2 = false, class V>
+          bool kAvx2 = false, bool kAvx512 = false, class V>
 [[gnu::always_inline]] inline V pixel8(const PixelLanes& px, StageFlags f, const V* q, V pass, std::uint8_t* cp,
                                        std::uint8_t* zp, unsigned n, bool whole, V bayer) {
   using S = signed_lanes<V>;
@@ -75,7 +76,7 @@ template <bool kTextured, PixelFormat kFormat, Chunk kChunk, bool kTexelLanes = 
   V word = V{} + px.flat;
   if (px.gouraud) word = (q[0] & 255u) | ((q[1] & 255u) << 8) | ((q[2] & 255u) << 16) | (q[3] << 24);
   if constexpr (kTextured && kTexelLanes) word = texture8_lanes(px.texture, q[5], q[6], pass, n, word);
-  else if constexpr (kTextured) word = texture8(px.texture, q[5], q[6], q[7], pass, n, word);
+  else if constexpr (kTextured) word = texture8<kAvx512>(px.texture, q[5], q[6], q[7], pass, n, word);
   if (kChunk == Chunk::Span && all && !f.reads_color) {  // a fully passing chunk of a plain store: no read
     store_color<kFormat, kMasked>(cp, pack_color<kFormat>(word, bayer, px.temporal), kLanesOf<V>);
     return pass;

@@ -32,6 +32,9 @@ class ReciprocalUnit {
     return {static_cast<std::uint32_t>(y), n};
   }
   unsigned table_bits() const { return bits_; }
+  // For the lanes' copy of operator() (texture8_wide.hpp).
+  unsigned nr_steps() const { return steps_; }
+  const std::uint32_t* table() const { return table_.data(); }
 
  private:
   unsigned bits_, steps_;

@@ -17,8 +17,9 @@ using simd::u32x8;
 // One instance per plane count and colour source, so the plane loops have constant bounds and the
 // lanes stay in registers (a run-time bound cost the untextured spans 5-15%; a run-time first
 // plane, Gouraud or not, kept every plane's lanes on the stack, loaded and stored on every chunk).
-// kAvx2: the instance has AVX2 or AVX-512 (pixel8's byte shuffle and lane bits).
-template <bool kTextured, PixelFormat kFormat, bool kGouraud, bool kAvx2>
+// kAvx2: the instance has AVX2 or AVX-512 (pixel8's byte shuffle and lane bits); kAvx512: it has
+// AVX-512 (texture8's lanes for perspective repeat textures, texture8_wide.hpp).
+template <bool kTextured, PixelFormat kFormat, bool kGouraud, bool kAvx2, bool kAvx512 = false>
 [[gnu::always_inline]] inline std::uint64_t shade_span(const SimdSpan& s) {
   constexpr std::size_t kBpp = protocol::bytes_per_pixel(kFormat);
   constexpr unsigned kUsed = kTextured ? 8 : 5;
@@ -70,7 +71,7 @@ template <bool kTextured, PixelFormat kFormat, bool kGouraud, bool kAvx2>
         simd::carry(q[p], r[p], den);
       }
     }
-    passed -= simd::pixel8<kTextured, kFormat, simd::Chunk::Span, false, false, kAvx2>(
+    passed -= simd::pixel8<kTextured, kFormat, simd::Chunk::Span, false, false, kAvx2, kAvx512>(
         px, flags, q, ~u32x8{}, cp, zp, 8, true, bayer);
     cp += 8 * kBpp;
     if (flags.depth) zp += 8 * 4;  // s.depth is null without depth
@@ -90,8 +91,8 @@ template <bool kTextured, PixelFormat kFormat, bool kGouraud, bool kAvx2>
     // spans (2-7 pixels) then reach into another cache line more often, and the perspective road
     // lost 7% (cubes unchanged), while untextured 1,000-px spans gained 10%.
     const bool whole = !kTextured && i + 8 <= room;
-    passed -= simd::pixel8<kTextured, kFormat, simd::Chunk::Span, false, false, kAvx2>(px, flags, q, in_span, cp, zp,
-                                                                                       n, whole, bayer);
+    passed -= simd::pixel8<kTextured, kFormat, simd::Chunk::Span, false, false, kAvx2, kAvx512>(
+        px, flags, q, in_span, cp, zp, n, whole, bayer);
   }
   return simd::lane_sum(passed);  // pass lanes are all ones (−1)
 }
@@ -183,7 +184,7 @@ template <bool kTextured, PixelFormat kFormat, bool kGouraud>
 #define SPAN_AVX512 __attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq")))
 template <bool kTextured, PixelFormat kFormat, bool kGouraud>
 [[gnu::noinline]] SPAN_AVX512 std::uint64_t span_avx512_256_of(const SimdSpan& s) {
-  return shade_span<kTextured, kFormat, kGouraud, true>(s);
+  return shade_span<kTextured, kFormat, kGouraud, true, true>(s);
 }
 // Untextured RGBA8888 spans of at least kWideSpan pixels in sixteen lanes (shade_span_wide, tails
 // through masked moves: the 50,000-px front rows 108-113 → 101-102 ms a frame against unmasked
@@ -197,7 +198,7 @@ template <bool kTextured, PixelFormat kFormat, bool kGouraud>
   if constexpr (!kTextured && kFormat == PixelFormat::RGBA8888) {
     if (s.count >= kWideSpan) return shade_span_wide<true, kGouraud>(s);
   }
-  return shade_span<kTextured, kFormat, kGouraud, true>(s);
+  return shade_span<kTextured, kFormat, kGouraud, true, true>(s);
 }
 
 #undef SPAN_AVX512

@@ -118,6 +118,11 @@ class TextureUnit {
   }
   bool direct() const { return direct_ != nullptr; }
   bool bilinear() const { return bilinear_; }
+  // What texture8_wide.hpp's lanes address with (an RGBA8888 repeat texture inside VRAM).
+  const std::uint8_t* texels() const { return direct_; }
+  unsigned wl() const { return wl_; }
+  std::uint32_t wmask() const { return static_cast<std::uint32_t>(wmask_); }
+  std::uint32_t hmask() const { return static_cast<std::uint32_t>(hmask_); }
 
   // Texel (i, j) of an addressed (in-range) index pair, expanded to 8 bits per channel.
   [[gnu::always_inline]] protocol::Rgba8 fetch(std::int64_t i, std::int64_t j, std::uint16_t& errors) const {
