@@ -1,6 +1,7 @@
 // The plain preview kernel's instances (backends/sim/src/preview_plain.cpp): the AVX-512 one draws
-// the wide rows of untextured draws in chunks of 16 pixels (span16, preview_plain_kernel.inc), the
-// AVX2 and baseline ones in chunks of 8. Every instance must store the same bytes and count the
+// the wide rows of untextured draws in chunks of 16 pixels (span16, preview_plain_kernel.inc; since
+// sim-rzrow to the span's end, its last chunk masked to the last 1-15 pixels), the AVX2 and baseline
+// ones in chunks of 8. Every instance must store the same bytes and count the
 // same pixels on this CPU: random wide boxes (spans of 1 to about 200 pixels, so whole chunks of
 // 16, tails of 1 to 15 and rows shorter than 16), every depth function with and without the Z
 // write, blend OFF and ALPHA, random stored depths (lanes pass and fail within a chunk) and

@@ -116,7 +116,9 @@ F pick_instance(unsigned isa, F baseline, F avx2, F avx512) {
   }
 }
 
-// Whether a triangle's spans are 16 pixels or more on average (its area over its height): twice
+// Whether a triangle's spans are 8 pixels or more on average (its area over its height; 16 before
+// sim-rzrow, when a span's last count % 16 pixels took 8-lane chunks and the AVX-512 instance had
+// no LaneWalk): twice
 // the area is |ex0·ey1 − ex1·ey0| / 2^16 pixels (ex = −16·dy, ey = 16·dx in 1/16 pixel) and the
 // height max |ex| / 2^8 pixels. In double: any edge steps, no overflow.
 bool wide_spans(const PreviewPlain& t) {
@@ -124,14 +126,16 @@ bool wide_spans(const PreviewPlain& t) {
                                  static_cast<double>(t.ex[1]) * static_cast<double>(t.ey[0]));
   double height = 0;
   for (int i = 0; i < 3; ++i) height = std::max(height, std::fabs(static_cast<double>(t.ex[i])));
-  return cross >= 8192.0 * height;
+  return cross >= 4096.0 * height;
 }
 }  // namespace
 
 PreviewCounts shade_preview_plain(const PreviewPlain& t) {
-  // The AVX-512 instance (its chunks of 16) for untextured triangles whose spans are 16 pixels or
-  // more on average; the AVX2 one otherwise: the thin triangles of the fan scene (boxes wider than
-  // 16, spans mostly shorter) were 16 % slower in the AVX-512 instance (15.8 against 13.6 ms).
+  // The AVX-512 instance (its chunks of 16, the last one masked) for untextured triangles whose
+  // spans are 8 pixels or more on average; the AVX2 one otherwise: the thin triangles of the fan
+  // scene (boxes wider than 16, spans mostly shorter) were 16 % slower in the AVX-512 instance
+  // (15.8 against 13.6 ms, before its masked last chunk and lanes; at 4 pixels the fan read the
+  // same to 5 % slower, sim-rzrow).
   // Textured draws take the AVX-512 instance whatever their shape: their chunks are the same 8
   // lanes, but its 32 vector registers keep the texture stage's lanes and constants, which the
   // AVX2 instance's 16 spill and reload in every chunk (sim-preview14).
