@@ -48,8 +48,8 @@ Case random_case(std::mt19937& rng) {
   random_planes(rng, c.planes, /*small_cdy=*/true);
   random_depth_test(rng, p, 3);
   p.blend = rng() % 3 == 0 ? protocol::BlendMode::Alpha : protocol::BlendMode::Off;
-  // The rows a worker gets: from a random row of the box to its end (as rasterize_bands passes
-  // them: the first row of the worker's first band).
+  // The rows a worker got: from a random row of the box to its end (as rasterize_bands passed
+  // them, the first row of the worker's first band, before sim-gap's one run of bands per worker).
   const int rows = std::min(b.by1, static_cast<int>(kH)) - b.by0;
   p.ky0 = rows > 0 ? static_cast<int>(rng() % static_cast<unsigned>(std::min(rows, 20))) : 0;
   p.rows = std::max(0, rows - p.ky0);

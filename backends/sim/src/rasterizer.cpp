@@ -4,7 +4,6 @@
 #include <array>
 #include <cmath>
 #include <cstring>
-#include <new>
 #include <optional>
 #include <utility>
 
@@ -284,7 +283,7 @@ bool band_occluded(const Triangle& t, const BandClip& c, const DrawState& st, Ra
 
 // Asks t's rows ya..yb (one 16-row band) as band_occluded does and gives the band's backoff the
 // answer (HierZ::band_answered); the edges are clipped (`clip`) the first time the triangle asks.
-// For rasterize_rows's leading bands and Kernel::run's later ones alike.
+// For rasterize_rows's leading bands and the Kernel's later ones alike.
 bool ask_band(const Triangle& t, std::optional<BandClip>& clip, const DrawState& st, RasterContext& ctx,
               std::uint32_t zmask, int ya, int yb, std::uint32_t run) {
   if (!clip) clip.emplace(t);
@@ -296,12 +295,6 @@ bool ask_band(const Triangle& t, std::optional<BandClip>& clip, const DrawState&
 // What rasterize_rows's band tests found before the Kernel was built (Kernel::run's `hz`).
 constexpr unsigned kHzFirstAsked = 1;  // the first band of the run was asked and not rejected (or let pass)
 constexpr unsigned kHzRejected = 2;    // bands before the run were rejected
-// A later run of the same Kernel (a band worker's next band of the triangle, rasterize_bands): its
-// first band is asked by the Kernel (its clipped edges kept from the first run) instead of by
-// rasterize_rows's leading band tests, under the same rules (a run's tries afresh: carrying them
-// over from the worker's last band, as one thread does, cost the random-Z scenes more rows drawn
-// than the asks saved, tri50k-random +36 % instructions at two threads).
-constexpr unsigned kHzContinued = 4;
 
 template <bool kGouraud, bool kTextured, bool kDepth, bool kSimple>
 class Kernel {
@@ -342,9 +335,9 @@ class Kernel {
     }
   }
 
-  // Rows ya..yz-1. `hz` (kHzFirstAsked, kHzRejected) tells what the caller's band tests found before the Kernel was
-  // built (rasterize_rows): the first band was asked and not rejected, and whether bands before ya
-  // were rejected; kHzContinued: a later run of this Kernel, which asks its first band itself.
+  // Rows ya..yz-1, once per Kernel. `hz` (kHzFirstAsked, kHzRejected) tells what the caller's band
+  // tests found before the Kernel was built (rasterize_rows): the first band was asked and not
+  // rejected, and whether bands before ya were rejected.
   void run(int ya, int yz, unsigned hz) {
     if (kDepth && ctx_.hier_z) {
       hz_run_ = HierZ::next_run(ctx_.hz_run);
@@ -362,7 +355,6 @@ class Kernel {
     if constexpr (kTextured) {
       ctx_.counters.textured += textured_;
       ctx_.counters.texel_bytes += textured_ * (st_.tex.bilinear ? 4u : 1u) * protocol::bytes_per_pixel(st_.tex.format);
-      textured_ = 0;  // the next run (a later band of the same Kernel) counts afresh
     }
   }
 
@@ -418,30 +410,9 @@ class Kernel {
     bool first = true;
     bool walking = false;  // walk_ holds row y's quotients
     bool anchored = false;  // cur_ holds the planes at (y - 1, col_) (false before the first drawn row and after a rejected band)
-    bool resumed = false;   // the cursor was carried over a gap and has not moved since
     // Covered pixels of drawn rows, and those of short spans without depth (all pass): counted
     // here and added to the context once per run, not stored through ctx_ on every row.
     std::uint64_t drawn = 0, short_passed = 0;
-    if (walk_ok_ && ya > ended_at_) {
-      // A later band of the same triangle (rasterize_bands): the walk and the cursor where the last
-      // run left them, carried over the rows between (other workers' bands) in one step each.
-      const int gap = ya - ended_at_;
-      if (gap != gap_) prepare_gap(gap);
-      for (int i = 0; i < 3; ++i) {
-        walk_.q[i] += gap_walk_.q[i];
-        walk_.r[i] += gap_walk_.r[i];
-        const bool carry = walk_.r[i] >= walk_.d[i];
-        walk_.r[i] -= carry ? walk_.d[i] : 0;
-        walk_.q[i] += carry;
-      }
-      walking = true;
-      if (cursor_ok_) {
-        carry_step<kScalar>(cur_, gap_cursor_);
-        if constexpr (kLanes) ccur_.step(gap_color_, cden_);
-        anchored = true;
-        resumed = true;
-      }
-    }
     for (int y = ya; y < yz;) {
       const int end = std::min(yz, (y | ((1 << HierZ::kRowsLog) - 1)) + 1);  // this band's rows
       // A new 16-row band of blocks: its tries afresh (HierZ::band_asks_afresh).
@@ -483,8 +454,7 @@ class Kernel {
           if constexpr (kLanes) ccur_ = color_lanes(cur_.q, cur_.r);
           anchored = true;
         } else {
-          move<kLanes>(kl - col_, !resumed);
-          resumed = false;
+          move<kLanes>(kl - col_);
         }
         col_ = kl;
         if (simd_ && y + kPrefetchRows < yz) prefetch_row(y + kPrefetchRows, t_.x0 + static_cast<int>(kl), static_cast<int>(kr - kl + 1));
@@ -525,41 +495,7 @@ class Kernel {
     ctx_.counters.scanned += drawn;
     ctx_.counters.covered += drawn;
     ctx_.counters.passed += short_passed;
-    walk_ok_ = walking;  // the walk at row yz, the cursor at (yz - 1, col_)
-    cursor_ok_ = anchored;
-    ended_at_ = yz;
     return mark_from;
-  }
-
-  // The steps over `gap` rows between two runs: each edge's floor-divmod(gap·ey, |ex|) and each
-  // plane's (gap·qy + f, gap·ry − f·den), f = floor(gap·ry / den) (the cursor stays in its column).
-  void prepare_gap(int gap) {
-    gap_ = gap;
-    for (int i = 0; i < 3; ++i) {
-      const DivMod g = edge_div_[i](gap * t_.edge[i].ey);
-      gap_walk_.q[i] = g.q;
-      gap_walk_.r[i] = g.r;
-    }
-    for (unsigned i = 0; i < kAttrCount; ++i) {
-      if (!((kPlanes >> i) & 1)) continue;
-      const Plane& p = t_.plane[i];
-      const DivMod f = den_div_(gap * p.ry);  // gap < 2^16, ry < 2^36
-      gap_cursor_.q[i] = gap * p.qy + f.q;
-      gap_cursor_.r[i] = f.r;
-    }
-    if constexpr (kGouraud) gap_color_ = color_lanes(gap_cursor_.q, gap_cursor_.r);
-  }
-  // s advanced by the step (q, r) of each plane in kMask (r in [0, den)) and one carry.
-  template <unsigned kMask>
-  void carry_step(Steppers& s, const Steppers& step) const {
-    for (unsigned i = 0; i < kAttrCount; ++i) {
-      if (!((kMask >> i) & 1)) continue;
-      s.q[i] += step.q[i];
-      s.r[i] += step.r[i];
-      const bool carry = s.r[i] >= t_.den;
-      s.r[i] -= carry ? t_.den : 0;
-      s.q[i] += carry;
-    }
   }
 
   // The planes at (y, kx): the triangle's planes advanced y − y0 rows (exact, 128-bit) and jumped
@@ -580,28 +516,18 @@ class Kernel {
   // step, (qy + d·qx + f, ry + d·rx − f·den) with f = floor((ry + d·rx) / den), and one carry. A
   // straight edge moves the span's start by one of two distances a row, so the last two steps are
   // kept (steps_) and a division is paid only when the distance changes (at a vertex).
-  // `keep` false: the first drawn row after a gap between runs, which moves by a distance of its
-  // own (about 16 rows' worth of the edge); its step is kept apart (after_gap_), so it evicts no
-  // row's step, and the next run's, a pixel off as a rule, is derived from it (fill_step).
   struct CursorStep;  // below, with the cursor
   template <bool kLanes>
-  void move(std::int64_t d, bool keep = true) {
+  void move(std::int64_t d) {
     unsigned slot = steps_[1].d == d ? 1u : 0u;
-    const CursorStep* step = &steps_[slot];
     if (steps_[slot].d != d) {  // not a kept row step (the tests of a row that hits, and no more)
-      if (!keep) {
-        if (after_gap_.d != d) gap_step<kLanes>(d);
-        step = &after_gap_;
-      } else {
-        slot = victim_;
-        victim_ ^= 1u;
-        fill_step<kLanes>(steps_[slot], d, steps_[0].d == d - 1 || steps_[0].d == d + 1   ? &steps_[0]
-                                           : steps_[1].d == d - 1 || steps_[1].d == d + 1 ? &steps_[1]
-                                                                                          : nullptr);
-        step = &steps_[slot];
-      }
+      slot = victim_;
+      victim_ ^= 1u;
+      fill_step<kLanes>(steps_[slot], d, steps_[0].d == d - 1 || steps_[0].d == d + 1   ? &steps_[0]
+                                         : steps_[1].d == d - 1 || steps_[1].d == d + 1 ? &steps_[1]
+                                                                                        : nullptr);
     }
-    const CursorStep& c = *step;
+    const CursorStep& c = steps_[slot];
     if constexpr (kLanes) ccur_.step(c.c, cden_);
     for (unsigned i = 0; i < kAttrCount; ++i) {
       if (!((scalar_planes<kLanes>() >> i) & 1)) continue;
@@ -615,11 +541,6 @@ class Kernel {
   // c := the step of distance d. From `near` (a step of distance d ± 1, possibly c itself) it is
   // near's and one x step with one carry or borrow: an edge's two distances differ by one, so only
   // its first costs a division per plane.
-  // after_gap_ := the step of distance d (once per run: out of the row loop).
-  template <bool kLanes>
-  [[gnu::noinline]] void gap_step(std::int64_t d) {
-    fill_step<kLanes>(after_gap_, d, after_gap_.d == d - 1 || after_gap_.d == d + 1 ? &after_gap_ : nullptr);
-  }
   template <bool kLanes>
   [[gnu::always_inline]] void fill_step(CursorStep& c, std::int64_t d, const CursorStep* near) {
     if (near) {
@@ -956,17 +877,8 @@ class Kernel {
     std::int64_t d = INT64_MIN;  // the distance it moves the span's start (INT64_MIN: none yet)
     std::int64_t q[kAttrCount], r[kAttrCount];
     ColorLanes c;  // the colour planes' step in lanes (run_wide<true>)
-  } steps_[2], after_gap_;  // the last two row steps; the last first step after a gap (move)
+  } steps_[2];  // the last two row steps (move)
   unsigned victim_ = 0;  // the step to replace next
-  // Between runs of one Kernel (rasterize_bands): whether the walk (at row ended_at_) and the cursor
-  // (at row ended_at_ − 1) are valid, and the steps over the last gap (prepare_gap).
-  bool walk_ok_ = false, cursor_ok_ = false;
-  int ended_at_ = 0, gap_ = 0;
-  struct {
-    std::int64_t q[3], r[3];
-  } gap_walk_;  // the gap_ fields: set by prepare_gap before they are read
-  Steppers gap_cursor_;
-  ColorLanes gap_color_;
 };
 
 // The rows [ya, yz) of a wide triangle: rasterize_rows's leading band tests (the triangle's
@@ -975,55 +887,19 @@ class Kernel {
 // the rejected bands and says what was found in hz (Kernel::run's); false when no row is left.
 bool ask_leading_bands(const Triangle& t, const DrawState& st, RasterContext& ctx, int& ya, int yz, unsigned& hz);
 
-// Rows [ya, yz), then [ya + stride, yz + stride) and so on while ya < end (stride 0: one run), all
-// clipped to the box: one Kernel for all of them (a band worker's 16-row bands of one triangle),
-// built when the first run needs it, so its set-up (edge dividers, lane steps, the span template,
-// the cursor's cached steps) is paid once per triangle, not once per band. The caller has tried
-// the small-triangle routine (draw_narrow) where it applies.
-// A Kernel built in place when the first run needs it. Not std::optional: GCC zeroed the whole
-// optional (2.2 KB, a `rep stos`) on every call, about 280 instructions per triangle and band
-// worker, and the Kernel's members need no zeros (each is written before it is read).
-template <class K>
-class KernelSlot {
- public:
-  KernelSlot() {}
-  KernelSlot(const KernelSlot&) = delete;
-  KernelSlot& operator=(const KernelSlot&) = delete;
-  ~KernelSlot() {
-    if (k_) k_->~K();
-  }
-  explicit operator bool() const { return k_ != nullptr; }
-  K* operator->() const { return k_; }
-  template <class... A>
-  void emplace(A&&... a) {
-    k_ = ::new (static_cast<void*>(buf_)) K(std::forward<A>(a)...);
-  }
-
- private:
-  alignas(K) unsigned char buf_[sizeof(K)];
-  K* k_ = nullptr;
-};
-
+// Rows [ya, yz) (inside the box) with one Kernel, built once the leading band tests leave rows to
+// draw. The caller has tried the small-triangle routine (draw_narrow) where it applies. A plain
+// local, not std::optional: GCC zeroed the whole optional (2.2 KB, a `rep stos`) on every call,
+// and the Kernel's members need no zeros (each is written before it is read).
 template <bool G, bool T, bool Z, bool S>
-void run_kernel(const Triangle& t, const DrawState& st, RasterContext& ctx, int ya, int yz, int stride, int end) {
-  KernelSlot<Kernel<G, T, Z, S>> kernel;
-  for (;; ya += stride, yz += stride) {
-    int a = std::max(ya, t.y0);
-    const int z = std::min(yz, t.y1);
-    if (a < z) {
-      // A later run asks its first band in the Kernel (kHzContinued). One call site of run():
-      // with two, GCC no longer inlined run_wide (alpha-blend +1.2 % instructions at two threads).
-      unsigned hz = kernel ? kHzContinued : 0;
-      if (kernel || ask_leading_bands(t, st, ctx, a, z, hz)) {
-        if (!kernel) kernel.emplace(t, st, ctx);
-        kernel->run(a, z, hz);
-      }
-    }
-    if (stride == 0 || ya + stride >= end) return;
-  }
+void run_kernel(const Triangle& t, const DrawState& st, RasterContext& ctx, int ya, int yz) {
+  unsigned hz = 0;
+  if (!ask_leading_bands(t, st, ctx, ya, yz, hz)) return;
+  Kernel<G, T, Z, S> kernel(t, st, ctx);
+  kernel.run(ya, yz, hz);
 }
 
-using KernelFn = void (*)(const Triangle&, const DrawState&, RasterContext&, int, int, int, int);
+using KernelFn = void (*)(const Triangle&, const DrawState&, RasterContext&, int, int);
 
 // What a vector kernel drew, into the timing model's counters: `passed` pixels were blended when
 // `blended` and textured (their texel reads by the filter's footprint) when `textured`.
@@ -1057,8 +933,8 @@ constexpr auto make_table(std::integer_sequence<unsigned, I...>) {
 constexpr auto kKernels = make_table(std::make_integer_sequence<unsigned, 16>{});
 
 // The small-triangle vector routine (narrow_simd.hpp) when its conditions hold; false otherwise.
-// Inlined into rasterize_rows, its one caller, as it was before rasterize_bands (a call cost the
-// 10-px triangles 4 % more instructions).
+// Inlined into rasterize_rows, its one caller (a call cost the 10-px triangles 4 % more
+// instructions).
 [[gnu::always_inline]] inline bool draw_narrow(const Triangle& t, const DrawState& st, RasterContext& ctx, int ya, int yz,
                                                bool gouraud, bool depth) {
   const int w = t.x1 - t.x0;
@@ -1158,16 +1034,13 @@ void draw_preview(const Triangle& t, const DrawState& st, RasterContext& ctx, in
 }
 
 // The plain-draw preview kernel (preview_plain.hpp) for rows [ya, yz); preview_plain_applies(st).
-// band_step > 1: only every band_step-th 16-row band from ya's (PreviewPlain::band_step).
-void draw_preview_plain(const Triangle& t, const DrawState& st, RasterContext& ctx, int ya, int yz, bool depth,
-                        int band_step = 0) {
+void draw_preview_plain(const Triangle& t, const DrawState& st, RasterContext& ctx, int ya, int yz, bool depth) {
   PreviewPlain p;
   p.width = t.x1 - t.x0;
   copy_edges(t, p);
   p.planes = &t.xplane;
   p.ky0 = ya - t.y0;
   p.rows = yz - ya;
-  p.band_step = band_step;
   p.y = t.y0;
   const std::size_t pix = static_cast<std::size_t>(ya) * st.fb_width + static_cast<std::size_t>(t.x0);
   p.color = ctx.mem.data() + st.fb_draw + pix * 4;
@@ -1249,7 +1122,7 @@ bool draws_gouraud(const Triangle& t, const DrawState& st) {
   return st.gouraud && colors_differ;
 }
 
-// The exact kernel for a draw (rasterize_rows, rasterize_bands).
+// The exact kernel for a draw (rasterize_rows).
 KernelFn kernel_for(const DrawState& st, bool gouraud) {
   const bool depth = st.z_test || st.z_write;
   const unsigned key = (gouraud ? 1u : 0u) | (st.textured ? 2u : 0u) | (depth ? 4u : 0u) | (st.simple_color ? 8u : 0u);
@@ -1269,26 +1142,7 @@ void rasterize_rows(const Triangle& t, const DrawState& st, RasterContext& ctx, 
     return draw_preview(t, st, ctx, ya, yz, gouraud, depth);
   }
   if (ctx.vector && draw_narrow(t, st, ctx, ya, yz, gouraud, depth)) return;
-  kernel_for(st, gouraud)(t, st, ctx, ya, yz, 0, yz);
-}
-
-static_assert(kPreviewBandRows == 1 << HierZ::kRowsLog, "PreviewPlain::band_step counts the bounds' bands");
-void rasterize_bands(const Triangle& t, const DrawState& st, RasterContext& ctx, int row_begin, int row_end, int stride) {
-  if (t.preview && st.preview_plain && stride > 0 && row_end - row_begin == kPreviewBandRows &&
-      stride % kPreviewBandRows == 0) {  // the plain preview kernel draws every one of the bands itself
-    const int ya = std::max(row_begin, t.y0);
-    if (ya < t.y1) draw_preview_plain(t, st, ctx, ya, t.y1, st.z_test || st.z_write, stride / kPreviewBandRows);
-    return;
-  }
-  if (t.preview || stride <= 0 || t.x1 - t.x0 <= 8) {  // preview and small triangles: band by band
-    for (; row_begin < t.y1; row_begin += stride, row_end += stride) {
-      rasterize_rows(t, st, ctx, row_begin, row_end);
-      if (stride <= 0) return;
-    }
-    return;
-  }
-  if (row_begin >= t.y1) return;
-  kernel_for(st, draws_gouraud(t, st))(t, st, ctx, row_begin, row_end, stride, t.y1);
+  kernel_for(st, gouraud)(t, st, ctx, ya, yz);
 }
 
 void observe_triangle(const Triangle& t, const DrawState& st, const PixelObserver& observer) {

@@ -86,17 +86,6 @@ SmallDraw small_draw(const DrawState& st, VideoMemory& mem, unsigned z_bits);
 
 // Draws the rows [row_begin, row_end) of t (a preview triangle through the preview routine) (clipped to its bounding box) with state st.
 void rasterize_rows(const Triangle& t, const DrawState& st, RasterContext& ctx, int row_begin, int row_end);
-// The rows [row_begin, row_end), [row_begin + stride, row_end + stride), ... of t up to its box's
-// end (a band worker's bands): as rasterize_rows on each, with one exact Kernel for all of them, so
-// its set-up is paid once per triangle and worker rather than once per band (a tall sliver of the
-// fan crosses a dozen 16-row bands).
-void rasterize_bands(const Triangle& t, const DrawState& st, RasterContext& ctx, int row_begin, int row_end, int stride);
-
-// A preview triangle of the plain kernel (t.preview && st.preview_plain) whose bands are
-// kPreviewBandRows high goes to that kernel in one call (PreviewPlain::band_step); other preview
-// triangles are drawn band by band: the same bytes and counts as rasterize_rows on each band.
-constexpr int kPreviewBandRows = 16;
-
 // The slow, obviously exact path for --dump-attributes: reports every covered pixel's attribute
 // values as N / D (section 9) in double.
 void observe_triangle(const Triangle& t, const DrawState& st, const PixelObserver& observer);
