@@ -8,7 +8,8 @@
 // instructions, and nothing goes back through memory between the reciprocal and the texel loads.
 // Internal to span_simd.cpp: only its AVX-512 instances call it (the target attribute lets it
 // inline there and nowhere else; vectors go by pointer for the reason given at simd_lanes.hpp's
-// masked_load).
+// masked_load, and go to and from memory by memcpy, not simd::load8 / store8: clang refuses a
+// vector argument to a function compiled without AVX from one compiled with it).
 #include <immintrin.h>
 
 #include <cstdint>
@@ -122,8 +123,9 @@ TEXTURE8_WIDE_TARGET inline void texel_quads_wide(const TextureLanes& s, const s
                                                      _mm256_set1_epi32(static_cast<int>(wm)));
   alignas(32) std::uint32_t at0[8], at1[8];
   if (seam == 0) {
-    simd::store8(at0, (b0 + a0) & ok);
-    simd::store8(at1, (b1 + a0) & ok);
+    const u32x8 w0 = (b0 + a0) & ok, w1 = (b1 + a0) & ok;
+    std::memcpy(at0, &w0, sizeof w0);
+    std::memcpy(at1, &w1, sizeof w1);
     const auto pair = [&](const std::uint32_t* at, unsigned k) __attribute__((always_inline)) {
       std::uint64_t w;
       std::memcpy(&w, texels + std::size_t{at[k]} * 4, 8);
@@ -143,10 +145,10 @@ TEXTURE8_WIDE_TARGET inline void texel_quads_wide(const TextureLanes& s, const s
   }
   const u32x8 a1 = (i0 + 1u) & wm;
   alignas(32) std::uint32_t c0[8], c1[8], w[4][8] = {};
-  simd::store8(at0, b0);
-  simd::store8(at1, b1);
-  simd::store8(c0, a0);
-  simd::store8(c1, a1);
+  std::memcpy(at0, &b0, sizeof b0);
+  std::memcpy(at1, &b1, sizeof b1);
+  std::memcpy(c0, &a0, sizeof a0);
+  std::memcpy(c1, &a1, sizeof a1);
   for (unsigned k = 0; k < 8; ++k) {
     if (!ok[k]) continue;
     std::memcpy(&w[0][k], texels + (std::size_t{at0[k]} + c0[k]) * 4, 4);
@@ -154,10 +156,10 @@ TEXTURE8_WIDE_TARGET inline void texel_quads_wide(const TextureLanes& s, const s
     std::memcpy(&w[2][k], texels + (std::size_t{at1[k]} + c0[k]) * 4, 4);
     std::memcpy(&w[3][k], texels + (std::size_t{at1[k]} + c1[k]) * 4, 4);
   }
-  out->t00 = simd::load8(w[0]);
-  out->t10 = simd::load8(w[1]);
-  out->t01 = simd::load8(w[2]);
-  out->t11 = simd::load8(w[3]);
+  std::memcpy(&out->t00, w[0], sizeof out->t00);
+  std::memcpy(&out->t10, w[1], sizeof out->t10);
+  std::memcpy(&out->t01, w[2], sizeof out->t01);
+  std::memcpy(&out->t11, w[3], sizeof out->t11);
 }
 
 }  // namespace gpubridge::sim
