@@ -53,7 +53,6 @@ inline PreviewBox place_triangle(int* x, int* y, PreviewPlain& p, const FixedPla
   const PreviewBox b = preview_box(x, y, p);
   p.planes = &planes;
   p.width = std::min(b.bx1, static_cast<int>(w)) - b.bx0;
-  p.y = b.by0;
   p.pitch = std::size_t{w} * 4;
   p.room = w - static_cast<unsigned>(b.bx0);
   return b;
@@ -75,24 +74,25 @@ void random_planes(Rng& rng, FixedPlanes& planes, bool small_cdy = false) {
   planes.zdy = static_cast<std::uint64_t>(static_cast<std::int64_t>(static_cast<std::int32_t>(rng())) << (rng() % 24));
 }
 
-// Points p's colour and depth (depth only when on) at the box's first column in row p.y + ky0 of
-// buffers buffer_w pixels wide.
-inline void aim_at_rows(PreviewPlain& p, int ky0, std::uint8_t* color, std::uint8_t* depth, unsigned buffer_w) {
+// Points p's colour and depth (depth only when on) at the box's first column in row y0 + ky0 of
+// buffers buffer_w pixels wide (y0: the box origin's row, place_triangle's by0).
+inline void aim_at_rows(PreviewPlain& p, int y0, int ky0, std::uint8_t* color, std::uint8_t* depth,
+                        unsigned buffer_w) {
   const std::size_t pitch = std::size_t{buffer_w} * 4;
-  const std::size_t origin = static_cast<std::size_t>(p.y + ky0) * pitch + (buffer_w - p.room) * 4;
+  const std::size_t origin = static_cast<std::size_t>(y0 + ky0) * pitch + (buffer_w - p.room) * 4;
   p.color = color + origin;
   p.depth = p.depth_on ? depth + origin : nullptr;
 }
 
-// Draws case c (a PreviewPlain p and its starting colour and depth buffers) with one instance into
-// copies of its buffers, and returns the counts.
+// Draws case c (a PreviewPlain p, its box origin's row y0 and its starting colour and depth
+// buffers) with one instance into copies of its buffers, and returns the counts.
 template <class Case>
 PreviewCounts draw_case(ShadeRoutine shade, const Case& c, unsigned buffer_w, std::vector<std::uint8_t>& color,
                         std::vector<std::uint8_t>& depth) {
   color = c.color;
   depth = c.depth;
   PreviewPlain p = c.p;
-  aim_at_rows(p, p.ky0, color.data(), depth.data(), buffer_w);
+  aim_at_rows(p, c.y0, p.ky0, color.data(), depth.data(), buffer_w);
   return shade(p);
 }
 

@@ -23,6 +23,7 @@ constexpr unsigned kW = 96, kH = 40;  // the buffers' size in pixels
 
 struct Case {
   PreviewPlain p;
+  int y0 = 0;  // the box origin's row
   FixedPlanes planes;
   FloatPlanes tex_planes;
   std::vector<std::uint8_t> color, depth, texels;
@@ -35,6 +36,7 @@ Case random_case(std::mt19937& rng) {
   int x[3], y[3];
   random_points(rng, x, y, kW, kH);
   const PreviewBox b = place_triangle(x, y, c.p, c.planes, kW);
+  c.y0 = b.by0;
   PreviewPlain& p = c.p;
   random_planes(rng, c.planes);
   p.ky0 = 0;

@@ -24,6 +24,7 @@ constexpr std::size_t kPitch = std::size_t{kW} * 4;
 
 struct Case {
   PreviewPlain p;
+  int y0 = 0;  // the box origin's row
   FixedPlanes planes;
   std::vector<std::uint8_t> color, depth;
 };
@@ -39,6 +40,7 @@ Case random_case(std::mt19937& rng) {
   int x[3], y[3];
   random_points(rng, x, y, kW, kH);
   const PreviewBox b = place_triangle(x, y, c.p, c.planes, kW);
+  c.y0 = b.by0;
   PreviewPlain& p = c.p;
   random_planes(rng, c.planes);
   p.ky0 = static_cast<int>(rng() % 3);

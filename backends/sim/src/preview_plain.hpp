@@ -77,11 +77,6 @@ struct PreviewPlain {
   const FixedPlanes* planes = nullptr;
   int width = 0;                    // box width
   int ky0 = 0, rows = 0;            // first row drawn (from the box origin), rows drawn
-  // Bands (issue 24, fourteenth round): above 1, only the rows of every band_step-th 16-row band
-  // of the buffer (HierZ's, the renderer's worker bands) from the band of row ky0 are drawn, the
-  // others left alone and not counted: one call per worker and triangle at N threads, not one per
-  // band (each call set up its band tests, walk and lanes afresh). `y` is the box origin's row.
-  int band_step = 0, y = 0;
   std::uint8_t* color = nullptr;    // box origin column, first row drawn
   std::uint8_t* depth = nullptr;    // its depth word (when the draw tests or writes depth)
   std::size_t pitch = 0;            // bytes per row of either buffer (both 4 bytes per pixel)

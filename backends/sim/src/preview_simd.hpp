@@ -136,8 +136,8 @@ class SpanWalk {
   };
   State& state() { return s_; }
   // `rows` rows' step of each edge, rows·ey = q·a + r (one division per edge, once per call), for
-  // advance(): the walk over rows it does not draw (another worker's bands, rejected rows) in one
-  // step and a carry per edge, instead of a restart (six divisions) after them.
+  // advance(): the walk over rows it does not draw (rows the coarse bounds rejected) in one step
+  // and a carry per edge, instead of a restart (six divisions) after them.
   struct Jump {
     std::int64_t q[3], r[3];
   };

@@ -1041,7 +1041,6 @@ void draw_preview_plain(const Triangle& t, const DrawState& st, RasterContext& c
   p.planes = &t.xplane;
   p.ky0 = ya - t.y0;
   p.rows = yz - ya;
-  p.y = t.y0;
   const std::size_t pix = static_cast<std::size_t>(ya) * st.fb_width + static_cast<std::size_t>(t.x0);
   p.color = ctx.mem.data() + st.fb_draw + pix * 4;
   p.depth = depth ? ctx.mem.data() + st.fb_z + pix * 4 : nullptr;
