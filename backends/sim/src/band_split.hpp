@@ -17,6 +17,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "gpubridge/protocol/registers.hpp"
+
 namespace gpubridge::sim {
 
 class BandSplit {
@@ -28,6 +30,9 @@ class BandSplit {
   static constexpr std::int64_t kRowWork = 14, kTriangleWork = 70;
 
   static constexpr int kBands = kMaxRows / kBandRows;
+  // add() indexes work_ by a triangle's middle row: every framebuffer the options accept must fit.
+  static_assert(kMaxRows >= static_cast<int>(protocol::kMaxFramebufferDim),
+                "BandSplit's table must cover the tallest framebuffer");
 
   // A triangle of rows y0..y1-1 (0 <= y0 < y1 <= kMaxRows) and twice its area `den` in 1/16 px
   // units (so den is its area in 1/512 px, the estimate's unit).
