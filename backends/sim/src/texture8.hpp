@@ -55,8 +55,8 @@ template <bool kWide = false>
     for (unsigned k = 0; k < n; ++k)
       if (pv[k]) s.tex->quad(tc[k], c00[k], c10[k], c01[k], c11[k], fu[k], fv[k]);
   }
-  return filter_combine8<kWide>(s, simd::load8(c00), simd::load8(c10), simd::load8(c01), simd::load8(c11), simd::load8(fu),
-                         simd::load8(fv), color);
+  return filter_combine8<kWide>(s, simd::load8(c00), simd::load8(c10), simd::load8(c01), simd::load8(c11),
+                                simd::load8(fu), simd::load8(fv), color);
 }
 
 // The texture stage for eight pixels (section 10): texel coordinates of every lane from the exact

@@ -6,6 +6,8 @@
 // TextureUnit::quad_rgba_repeat lane by lane (docs/simulator.md, sim-cubes): where those are
 // dozens of scalar instructions a lane, here a chunk's eight lanes go through one chain of vector
 // instructions, and nothing goes back through memory between the reciprocal and the texel loads.
+// Also section 10.4's bilinear filter in 16-bit lanes for any bilinear texture of those instances
+// (bilinear_filter_wide: sim-tex8).
 // Internal to span_simd.cpp: only its AVX-512 instances call it (the target attribute lets it
 // inline there and nowhere else; vectors go by pointer for the reason given at simd_lanes.hpp's
 // masked_load, and go to and from memory by memcpy, not simd::load8 / store8: clang refuses a
