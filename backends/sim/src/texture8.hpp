@@ -9,13 +9,17 @@
 namespace gpubridge::sim {
 
 // Section 10.4's bilinear filter (nearest: t00 as it is) and 10.5's combine with the vertex colour
-// `color` of eight lanes whose texels are fetched. Returns the combined words.
+// `color` of eight lanes whose texels are fetched. Returns the combined words. kWide (the span
+// routine's AVX-512 instances): the filter in 16-bit lanes (bilinear_filter_wide, the same integers).
+template <bool kWide = false>
 [[gnu::always_inline]] inline simd::u32x8 filter_combine8(const TextureLanes& s, simd::u32x8 t00, simd::u32x8 t10,
                                                           simd::u32x8 t01, simd::u32x8 t11, simd::u32x8 u,
                                                           simd::u32x8 v, simd::u32x8 color) {
   using simd::u32x8;
   u32x8 texel = t00;
-  if (s.tex->bilinear()) {
+  if constexpr (kWide) {
+    if (s.tex->bilinear()) bilinear_filter_wide(&t00, &t10, &t01, &t11, &u, &v, &texel);
+  } else if (s.tex->bilinear()) {
     const u32x8 w00 = (256u - u) * (256u - v), w10 = u * (256u - v), w01 = (256u - u) * v, w11 = u * v;
     texel = u32x8{};
     for (unsigned c = 0; c < 32; c += 8) {  // the weights sum to 2^16: every term stays below 2^24
@@ -36,6 +40,7 @@ namespace gpubridge::sim {
 // The filter and combine of eight lanes whose texel coordinates are known (tc[k] for k < n):
 // lanes that passed the depth test get their addressed neighbours one by one, then the bilinear
 // filter and the combine with the vertex colour `color` run in lanes. Returns the combined words.
+template <bool kWide = false>
 [[gnu::always_inline]] inline simd::u32x8 texture8_sample(const TextureLanes& s, const TexelCoords* tc, simd::u32x8 pass,
                                                           unsigned n, simd::u32x8 color) {
   std::uint32_t pv[8];
@@ -50,8 +55,8 @@ namespace gpubridge::sim {
     for (unsigned k = 0; k < n; ++k)
       if (pv[k]) s.tex->quad(tc[k], c00[k], c10[k], c01[k], c11[k], fu[k], fv[k]);
   }
-  return filter_combine8(s, simd::load8(c00), simd::load8(c10), simd::load8(c01), simd::load8(c11), simd::load8(fu),
-                         simd::load8(fv), color);
+  return filter_combine8<kWide>(s, simd::load8(c00), simd::load8(c10), simd::load8(c01), simd::load8(c11),
+                                simd::load8(fu), simd::load8(fv), color);
 }
 
 // The texture stage for eight pixels (section 10): texel coordinates of every lane from the exact
@@ -68,7 +73,7 @@ template <bool kWide = false>
       const simd::u32x8 ok = pass & simd::mask(lane < static_cast<std::int32_t>(n));
       TexQuad8 t;
       texel_quads_wide(s, &sq, &tq, &qq, &ok, &t);
-      return filter_combine8(s, t.t00, t.t10, t.t01, t.t11, t.fu, t.fv, color);
+      return filter_combine8<true>(s, t.t00, t.t10, t.t01, t.t11, t.fu, t.fv, color);
     }
   }
   std::uint32_t sv[8], tv[8], qv[8];
@@ -89,7 +94,7 @@ template <bool kWide = false>
       tc[k] = q != 0 ? c : TexelCoords{};
     }
   }
-  return texture8_sample(s, tc, pass, n, color);
+  return texture8_sample<kWide>(s, tc, pass, n, color);
 }
 
 // The preview path's texture stage: the lanes already hold the texel coordinates (1/4096 texel,
