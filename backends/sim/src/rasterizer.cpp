@@ -205,8 +205,8 @@ struct EdgeWalk {
     }
   }
   // What drawing rows y.. y + rows - 1 counts when all their pixels fail the depth test: every
-  // covered pixel scanned and covered, none passed. Leaves the walk after them.
-  void count(const Triangle& t, int y, int rows, RasterCounters& c) {
+  // covered pixel scanned and covered, none passed. Leaves the walk after them. Returns the count.
+  std::uint64_t count(const Triangle& t, int y, int rows, RasterCounters& c) {
     const std::int64_t w = t.x1 - t.x0;
     std::uint64_t n = 0;
     for (int row = 0; row < rows; ++row) {
@@ -216,6 +216,7 @@ struct EdgeWalk {
     }
     c.scanned += n;
     c.covered += n;
+    return n;
   }
 };
 
@@ -427,7 +428,8 @@ class Kernel {
         hz_rejected_ = true;
         if (!walking) walk_.start(t_, y);
         walking = true;
-        walk_.count(t_, y, end - y, ctx_.counters);  // the walk goes on after the band
+        ctx_.hz_skipped_pixels += walk_.count(t_, y, end - y, ctx_.counters);  // the walk goes on after the band
+        ctx_.hz_skipped_rows += static_cast<std::uint64_t>(end - y);
         if (mark_from == y) mark_from = end;
         y = end;
         first = false;
@@ -736,6 +738,8 @@ class Kernel {
                                 st_.z_func == protocol::DepthFunc::Less, ctx_.hz_gen, hz_run_)) {
         hz_tries_ = HierZ::kTries;
         hz_rejected_ = true;
+        ctx_.hz_skipped_pixels += static_cast<std::uint64_t>(kr - kl + 1);
+        ++ctx_.hz_skipped_rows;
         return true;
       }
       --hz_tries_;
@@ -1107,7 +1111,8 @@ bool ask_leading_bands(const Triangle& t, const DrawState& st, RasterContext& ct
       walk.prepare(t, div->data());
       walk.start(t, ya);
     }
-    walk.count(t, ya, end - ya, ctx.counters);
+    ctx.hz_skipped_pixels += walk.count(t, ya, end - ya, ctx.counters);
+    ctx.hz_skipped_rows += static_cast<std::uint64_t>(end - ya);
     hz |= kHzRejected;
     ya = end;
     if (ya >= yz) return false;

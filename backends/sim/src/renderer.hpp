@@ -122,6 +122,7 @@ class Renderer {
   Batch batch_;  // being filled by the front end: its first batch_n_
   std::size_t batch_n_ = 0;
   std::size_t batch_limit_ = kFirstBatch;  // the filling batch is handed over at this many triangles
+  unsigned batches_since_flush_ = 0;  // batches handed over since the last flush (BandSplit's weight sets)
   std::shared_ptr<const DrawState> batch_state_;
   Batch drawing_;  // being drawn by the workers: its first drawing_n_
   std::size_t drawing_n_ = 0;
@@ -132,8 +133,12 @@ class Renderer {
   // numbers while they draw, and two contexts side by side in one line bounced it between cores.
   struct alignas(64) WorkerContext {
     RasterContext ctx;
+    // The triangles this worker drew rows of and those rows (their boxes' rows in its run): with
+    // the context's covered and coarse-depth-rejected pixels, its measured work (BandSplit).
+    std::uint64_t triangles = 0, rows = 0;
   };
   std::vector<WorkerContext> drawing_ctx_;  // one per worker
+  std::vector<std::int64_t> measured_;  // each worker's measured work on the batch just drawn (BandSplit::measured)
   bool drawing_active_ = false;
   std::function<void(unsigned)> draw_job_;
   Triangle slots_[2];
