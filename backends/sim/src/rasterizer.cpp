@@ -414,6 +414,8 @@ class Kernel {
     // Covered pixels of drawn rows, and those of short spans without depth (all pass): counted
     // here and added to the context once per run, not stored through ctx_ on every row.
     std::uint64_t drawn = 0, short_passed = 0;
+    // Covered pixels and whole bands' rows the coarse depth rejected (RasterContext::hz_skipped_*).
+    std::uint64_t skipped = 0, skipped_rows = 0;
     for (int y = ya; y < yz;) {
       const int end = std::min(yz, (y | ((1 << HierZ::kRowsLog) - 1)) + 1);  // this band's rows
       // A new 16-row band of blocks: its tries afresh (HierZ::band_asks_afresh).
@@ -428,8 +430,8 @@ class Kernel {
         hz_rejected_ = true;
         if (!walking) walk_.start(t_, y);
         walking = true;
-        ctx_.hz_skipped_pixels += walk_.count(t_, y, end - y, ctx_.counters);  // the walk goes on after the band
-        ctx_.hz_skipped_rows += static_cast<std::uint64_t>(end - y);
+        skipped += walk_.count(t_, y, end - y, ctx_.counters);  // the walk goes on after the band
+        skipped_rows += static_cast<std::uint64_t>(end - y);
         if (mark_from == y) mark_from = end;
         y = end;
         first = false;
@@ -464,6 +466,7 @@ class Kernel {
         drawn += static_cast<std::uint64_t>(n);
         if (n >= kMinSimdSpan && simd_ready()) {
           if (!occluded(kl, kr, y)) simd_span<kLanes>(t_.x0 + static_cast<int>(kl), y, static_cast<unsigned>(n));
+          else skipped += static_cast<std::uint64_t>(n);  // the row itself was walked
         } else if constexpr (kLanes) {
           if constexpr (!kDepth) short_passed += static_cast<std::uint64_t>(n);
           ColorLanes c = ccur_;
@@ -497,6 +500,8 @@ class Kernel {
     ctx_.counters.scanned += drawn;
     ctx_.counters.covered += drawn;
     ctx_.counters.passed += short_passed;
+    ctx_.hz_skipped_pixels += skipped;
+    ctx_.hz_skipped_rows += skipped_rows;
     return mark_from;
   }
 
@@ -738,8 +743,6 @@ class Kernel {
                                 st_.z_func == protocol::DepthFunc::Less, ctx_.hz_gen, hz_run_)) {
         hz_tries_ = HierZ::kTries;
         hz_rejected_ = true;
-        ctx_.hz_skipped_pixels += static_cast<std::uint64_t>(kr - kl + 1);
-        ++ctx_.hz_skipped_rows;
         return true;
       }
       --hz_tries_;
