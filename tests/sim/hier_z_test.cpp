@@ -80,11 +80,15 @@ TEST(SimHierZ, CountsTheCoveredPixelsItRejects) {
   Triangle t;
   ASSERT_TRUE(setup_triangle(a, b, c, st, 4, false, t));
   const ReciprocalUnit recip(10, 1);
-  for (const std::uint32_t stored : {0x000000u, 0xFFFFFFu}) {  // nearer than the triangle, then farther
+  // Stored depths nearer than the triangle everywhere, farther everywhere, and farther above row 48
+  // only (the Kernel draws the top and its row loop rejects bands below: run_wide's own count).
+  constexpr std::uint32_t kSplit = 1u << 24;
+  for (const std::uint32_t stored : {0x000000u, 0xFFFFFFu, kSplit}) {
     VideoMemory mem(kVram);
     for (std::uint64_t i = 0; i < std::uint64_t{kW} * kH; ++i) {
+      const std::uint32_t v = stored != kSplit ? stored : i / kW < 48 ? 0xFFFFFFu : 0u;
       std::uint8_t* p = mem.data() + kZAt + i * 4;
-      p[1] = static_cast<std::uint8_t>(stored >> 16), p[2] = static_cast<std::uint8_t>(stored >> 8), p[3] = static_cast<std::uint8_t>(stored);
+      p[1] = static_cast<std::uint8_t>(v >> 16), p[2] = static_cast<std::uint8_t>(v >> 8), p[3] = static_cast<std::uint8_t>(v);
     }
     HierZ h;
     h.prepare(kW, kH);
@@ -97,10 +101,16 @@ TEST(SimHierZ, CountsTheCoveredPixelsItRejects) {
       EXPECT_EQ(ctx.counters.passed, 0u);
       EXPECT_EQ(ctx.hz_skipped_pixels, ctx.counters.covered);
       EXPECT_EQ(ctx.hz_skipped_rows, static_cast<std::uint64_t>(t.y1 - t.y0));
-    } else {
+    } else if (stored == 0xFFFFFF) {
       EXPECT_EQ(ctx.counters.passed, ctx.counters.covered);
       EXPECT_EQ(ctx.hz_skipped_pixels, 0u);
       EXPECT_EQ(ctx.hz_skipped_rows, 0u);
+    } else {  // skipped pixels failed the test; not every failing pixel need be skipped
+      EXPECT_GT(ctx.counters.passed, 1000u);
+      EXPECT_GT(ctx.hz_skipped_pixels, 500u);
+      EXPECT_LE(ctx.hz_skipped_pixels + ctx.counters.passed, ctx.counters.covered);
+      EXPECT_GE(ctx.hz_skipped_rows, 16u);
+      EXPECT_LT(ctx.hz_skipped_rows, static_cast<std::uint64_t>(t.y1 - 48));
     }
   }
 }
