@@ -158,6 +158,22 @@ TEST(SimBandSplit, TallTrianglesFollowTheMeasuredWork) {
   EXPECT_GE(cuts[1], 160);
 }
 
+// Tall slivers (under 4 px a row) stay in their middle row's band: the fan's spread ran slower.
+TEST(SimBandSplit, TallSliversStayInTheirMiddleBand) {
+  BandSplit s;
+  std::vector<int> cuts;
+  auto add_slivers = [&] {
+    for (int i = 0; i < 100; ++i) s.add(0, 480, 512 * 400);
+  };
+  add_slivers();
+  s.split(2, 0, cuts);
+  EXPECT_EQ(cuts[1], 240);
+  s.measured({3000, 1000});
+  add_slivers();
+  s.split(2, 0, cuts);
+  EXPECT_EQ(cuts[1], 240);  // all in band 15: no weight moves it
+}
+
 TEST(SimBandSplit, WeightsAreKeptPerBatchSinceAFlush) {
   BandSplit s;
   std::vector<int> cuts;

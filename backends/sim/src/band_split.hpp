@@ -12,7 +12,7 @@
 // device thread's instructions on 10-px triangles, where that thread is the critical path): its
 // rows times a row's cost, its area, and a Kernel's set-up, in pixels' worth of work. A cut through
 // a triangle then counts all of its work on one side, as often the one as the other. Tall, wide
-// triangles (more than four bands, 16 px a row) are spread over their bands: few, each worth the division.
+// triangles (more than four bands, 4 px a row) are spread over their bands: few, each worth the division.
 //
 // What the estimate cannot see is corrected by what the workers did (measured()): after a batch
 // each worker reports its work counted the same way but from what it drew (its rows of each
@@ -159,7 +159,9 @@ class BandSplit {
   // Triangles of more rows than this spread their work over their bands (add()): one division
   // each, too much for the device thread on small triangles, where it is the critical path.
   static constexpr int kSpreadRows = 4 * kBandRows;
-  static constexpr std::int64_t kSpreadWidth = 16;  // ... and at least this many pixels a row on average
+  // ... and at least this many pixels a row on average (16 left the cubes' tall faces in one band:
+  // their slower worker 33.6 M instructions, main's, against 31.8 M spread).
+  static constexpr std::int64_t kSpreadWidth = 4;
   using Bands = std::array<std::int64_t, kBands>;
   Bands work_{};  // per band: the work of the triangles whose middle row is in it
   std::array<std::int64_t, kBands + 1> spread_{};  // the tall triangles' work per band, as differences
