@@ -8,8 +8,13 @@
 
 #include <random>
 
+#include "draw_state.hpp"
 #include "hier_z.hpp"
+#include "rasterizer.hpp"
+#include "reciprocal.hpp"
+#include "setup.hpp"
 #include "sim_test_util.hpp"
+#include "video_memory.hpp"
 
 namespace gpubridge::sim::test {
 namespace {
@@ -55,6 +60,59 @@ TEST(SimHierZ, OccludesOnlyWhatEveryStoredDepthRejects) {
   put_depth(z, width, 10, 10, 0x900);
   EXPECT_TRUE(h.occludes(z.data(), 3, 0, 31, 0x200, true, gen, 3));  // the stale bound, same generation
   EXPECT_FALSE(h.occludes(z.data(), 3, 0, 31, 0x200, true, gen + 1, 3));
+}
+
+// The covered pixels and rows the bounds reject, counted for the band workers' measured work
+// (BandSplit::measured_work): all of a triangle's behind a nearer depth buffer, none of one in front.
+TEST(SimHierZ, CountsTheCoveredPixelsItRejects) {
+  constexpr unsigned kW = 128, kH = 96;
+  constexpr std::uint64_t kZAt = std::uint64_t{kW} * kH * 4, kVram = 2 * kZAt;
+  const std::uint64_t less = 1 | 4 | (1u << 3) | (1u << 6);
+  const DrawState st = decode_draw_state({less, 0, 0, scissor(0, 0, 2047, 2047), 0, kZAt, fb_format(kW, kH, 0)}, kVram);
+  Vertex a, b, c;
+  a.x = 4 * 16, a.y = 3 * 16;
+  b.x = 120 * 16, b.y = 20 * 16;
+  c.x = 30 * 16, c.y = 90 * 16;
+  for (Vertex* v : {&a, &b, &c}) {
+    v->z = 0x400000;
+    v->c[0] = 200, v->c[3] = 255;
+  }
+  Triangle t;
+  ASSERT_TRUE(setup_triangle(a, b, c, st, 4, false, t));
+  const ReciprocalUnit recip(10, 1);
+  // Stored depths nearer than the triangle everywhere, farther everywhere, and farther above row 48
+  // only (the Kernel draws the top and its row loop rejects bands below: run_wide's own count).
+  constexpr std::uint32_t kSplit = 1u << 24;
+  for (const std::uint32_t stored : {0x000000u, 0xFFFFFFu, kSplit}) {
+    VideoMemory mem(kVram);
+    for (std::uint64_t i = 0; i < std::uint64_t{kW} * kH; ++i) {
+      const std::uint32_t v = stored != kSplit ? stored : i / kW < 48 ? 0xFFFFFFu : 0u;
+      std::uint8_t* p = mem.data() + kZAt + i * 4;
+      p[1] = static_cast<std::uint8_t>(v >> 16), p[2] = static_cast<std::uint8_t>(v >> 8), p[3] = static_cast<std::uint8_t>(v);
+    }
+    HierZ h;
+    h.prepare(kW, kH);
+    RasterContext ctx{mem, recip, 24, 0, {}, true};
+    ctx.hier_z = &h;
+    ctx.hz_gen = 1;
+    rasterize_rows(t, st, ctx, t.y0, t.y1);
+    ASSERT_GT(ctx.counters.covered, 3000u);
+    if (stored == 0) {
+      EXPECT_EQ(ctx.counters.passed, 0u);
+      EXPECT_EQ(ctx.hz_skipped_pixels, ctx.counters.covered);
+      EXPECT_EQ(ctx.hz_skipped_rows, static_cast<std::uint64_t>(t.y1 - t.y0));
+    } else if (stored == 0xFFFFFF) {
+      EXPECT_EQ(ctx.counters.passed, ctx.counters.covered);
+      EXPECT_EQ(ctx.hz_skipped_pixels, 0u);
+      EXPECT_EQ(ctx.hz_skipped_rows, 0u);
+    } else {  // skipped pixels failed the test; not every failing pixel need be skipped
+      EXPECT_GT(ctx.counters.passed, 1000u);
+      EXPECT_GT(ctx.hz_skipped_pixels, 500u);
+      EXPECT_LE(ctx.hz_skipped_pixels + ctx.counters.passed, ctx.counters.covered);
+      EXPECT_GE(ctx.hz_skipped_rows, 16u);
+      EXPECT_LT(ctx.hz_skipped_rows, static_cast<std::uint64_t>(t.y1 - 48));
+    }
+  }
 }
 
 enum class Raise { MemWrites, ClearDepth, AlwaysDraw, MemorySpan };

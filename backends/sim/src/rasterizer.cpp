@@ -205,8 +205,8 @@ struct EdgeWalk {
     }
   }
   // What drawing rows y.. y + rows - 1 counts when all their pixels fail the depth test: every
-  // covered pixel scanned and covered, none passed. Leaves the walk after them.
-  void count(const Triangle& t, int y, int rows, RasterCounters& c) {
+  // covered pixel scanned and covered, none passed. Leaves the walk after them. Returns the count.
+  std::uint64_t count(const Triangle& t, int y, int rows, RasterCounters& c) {
     const std::int64_t w = t.x1 - t.x0;
     std::uint64_t n = 0;
     for (int row = 0; row < rows; ++row) {
@@ -216,6 +216,7 @@ struct EdgeWalk {
     }
     c.scanned += n;
     c.covered += n;
+    return n;
   }
 };
 
@@ -413,6 +414,8 @@ class Kernel {
     // Covered pixels of drawn rows, and those of short spans without depth (all pass): counted
     // here and added to the context once per run, not stored through ctx_ on every row.
     std::uint64_t drawn = 0, short_passed = 0;
+    // Covered pixels and whole bands' rows the coarse depth rejected (RasterContext::hz_skipped_*).
+    std::uint64_t skipped = 0, skipped_rows = 0;
     for (int y = ya; y < yz;) {
       const int end = std::min(yz, (y | ((1 << HierZ::kRowsLog) - 1)) + 1);  // this band's rows
       // A new 16-row band of blocks: its tries afresh (HierZ::band_asks_afresh).
@@ -427,7 +430,8 @@ class Kernel {
         hz_rejected_ = true;
         if (!walking) walk_.start(t_, y);
         walking = true;
-        walk_.count(t_, y, end - y, ctx_.counters);  // the walk goes on after the band
+        skipped += walk_.count(t_, y, end - y, ctx_.counters);  // the walk goes on after the band
+        skipped_rows += static_cast<std::uint64_t>(end - y);
         if (mark_from == y) mark_from = end;
         y = end;
         first = false;
@@ -462,6 +466,7 @@ class Kernel {
         drawn += static_cast<std::uint64_t>(n);
         if (n >= kMinSimdSpan && simd_ready()) {
           if (!occluded(kl, kr, y)) simd_span<kLanes>(t_.x0 + static_cast<int>(kl), y, static_cast<unsigned>(n));
+          else skipped += static_cast<std::uint64_t>(n);  // the row itself was walked
         } else if constexpr (kLanes) {
           if constexpr (!kDepth) short_passed += static_cast<std::uint64_t>(n);
           ColorLanes c = ccur_;
@@ -495,6 +500,8 @@ class Kernel {
     ctx_.counters.scanned += drawn;
     ctx_.counters.covered += drawn;
     ctx_.counters.passed += short_passed;
+    ctx_.hz_skipped_pixels += skipped;
+    ctx_.hz_skipped_rows += skipped_rows;
     return mark_from;
   }
 
@@ -1107,7 +1114,8 @@ bool ask_leading_bands(const Triangle& t, const DrawState& st, RasterContext& ct
       walk.prepare(t, div->data());
       walk.start(t, ya);
     }
-    walk.count(t, ya, end - ya, ctx.counters);
+    ctx.hz_skipped_pixels += walk.count(t, ya, end - ya, ctx.counters);
+    ctx.hz_skipped_rows += static_cast<std::uint64_t>(end - ya);
     hz |= kHzRejected;
     ya = end;
     if (ya >= yz) return false;

@@ -41,6 +41,12 @@ struct RasterContext {
   HierZ* hier_z = nullptr;
   std::uint64_t hz_gen = 0;
   std::uint32_t hz_run = 0;
+  // Covered pixels the coarse depth rejected before the span routine (whole bands and single rows
+  // of the exact kernel), counted in the covered pixels but not shaded, and the rows of the whole
+  // bands (not walked: a row rejected alone was). The band workers' measured work
+  // (BandSplit::measured_work) takes them off: random-Z scenes reject most of their pixels,
+  // unevenly down the screen, where the estimate cannot see it.
+  std::uint64_t hz_skipped_pixels = 0, hz_skipped_rows = 0;
 };
 
 // The preview routine (`--accuracy preview`, preview_simd.hpp) can draw with this state: both

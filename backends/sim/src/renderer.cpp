@@ -220,6 +220,7 @@ void Renderer::flush() {
   wait_drawing();
   next_generation();  // whoever flushed may now read or write memory
   batch_limit_ = kFirstBatch;  // the workers are idle: the next batch starts them soon
+  batches_since_flush_ = 0;
 }
 
 void Renderer::submit() {
@@ -234,10 +235,10 @@ void Renderer::submit() {
   batch_limit_ = std::min(2 * batch_limit_, kMaxBatch);
   drawing_state_ = std::move(batch_state_);
   drawing_gen_ = batch_gen_;
-  split_.split(pool_.workers(), drawing_cuts_);
+  split_.split(pool_.workers(), batches_since_flush_++, drawing_cuts_);
   batch_state_.reset();
   drawing_ctx_.clear();
-  for (unsigned w = 0; w < pool_.workers(); ++w) drawing_ctx_.push_back({context(*drawing_state_, drawing_gen_, w)});
+  for (unsigned w = 0; w < pool_.workers(); ++w) drawing_ctx_.push_back({context(*drawing_state_, drawing_gen_, w), 0, 0});
   drawing_active_ = true;
   pool_.start(draw_job_);
 }
@@ -245,12 +246,17 @@ void Renderer::submit() {
 void Renderer::wait_drawing() {
   if (!drawing_active_) return;
   pool_.wait();
+  measured_.resize(drawing_ctx_.size());
   for (unsigned w = 0; w < drawing_ctx_.size(); ++w) {
-    const RasterContext& c = drawing_ctx_[w].ctx;
+    const WorkerContext& wc = drawing_ctx_[w];
+    const RasterContext& c = wc.ctx;
     errors_ |= c.errors;
     add_counters(c.counters, *drawing_state_);  // one state per batch
     if (c.hier_z) hz_runs_[w] = c.hz_run;
+    const std::uint64_t shaded = c.counters.covered > c.hz_skipped_pixels ? c.counters.covered - c.hz_skipped_pixels : 0;
+    measured_[w] = BandSplit::measured_work(wc.triangles, wc.rows, c.hz_skipped_rows, shaded);
   }
+  split_.measured(measured_);  // the next batch's cuts (submit() splits after this wait)
   drawing_n_ = 0;
   drawing_state_.reset();
   drawing_active_ = false;
@@ -270,12 +276,18 @@ void Renderer::draw_bands(unsigned worker) {
   // This worker's rows of the batch (BandSplit): each triangle's rows among them in one call.
   const int lo = drawing_cuts_[worker], hi = drawing_cuts_[worker + 1];
   if (lo >= hi) return;
+  // What this worker drew, for its measured work (BandSplit): counted in locals, stored once.
+  std::uint64_t drawn = 0, drawn_rows = 0;
   for (std::size_t i = 0; i < count; ++i) {
     const BatchRows r = rows[i];
     if (r.y1 <= lo || r.y0 >= hi) continue;  // a box outside this worker's rows: not even a call
+    ++drawn;
+    drawn_rows += static_cast<unsigned>(std::min<int>(r.y1, hi) - std::max<int>(r.y0, lo));
     if (r.small) rasterize_small(smalls[i], small, c.counters, lo, hi);
     else rasterize_rows(full[i], st, c, lo, hi);
   }
+  drawing_ctx_[worker].triangles = drawn;
+  drawing_ctx_[worker].rows = drawn_rows;
 }
 
 std::uint16_t Renderer::take_errors() {

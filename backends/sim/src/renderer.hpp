@@ -2,7 +2,8 @@
 // Runs kicked triangles through setup and the rasteriser. With one thread every triangle is drawn
 // at once. With N threads triangles are batched while the render state stays the same; a batch is
 // drawn by N workers that each walk all triangles in submission order and draw only their own
-// rows (a run of whole 16-row bands each, cut by an estimate of the batch's work: BandSplit), so
+// rows (a run of whole 16-row bands each, cut by an estimate of the batch's work weighted by the
+// work the workers measured on earlier batches: BandSplit), so
 // the bytes are identical for any N. The calling thread (the device front end) decodes and sets
 // up the next batch while the workers draw the previous one; batches are drawn one after another,
 // and flush() waits for both.
@@ -122,6 +123,7 @@ class Renderer {
   Batch batch_;  // being filled by the front end: its first batch_n_
   std::size_t batch_n_ = 0;
   std::size_t batch_limit_ = kFirstBatch;  // the filling batch is handed over at this many triangles
+  unsigned batches_since_flush_ = 0;  // batches handed over since the last flush (BandSplit's weight sets)
   std::shared_ptr<const DrawState> batch_state_;
   Batch drawing_;  // being drawn by the workers: its first drawing_n_
   std::size_t drawing_n_ = 0;
@@ -132,8 +134,12 @@ class Renderer {
   // numbers while they draw, and two contexts side by side in one line bounced it between cores.
   struct alignas(64) WorkerContext {
     RasterContext ctx;
+    // The triangles this worker drew rows of and those rows (their boxes' rows in its run): with
+    // the context's covered and coarse-depth-rejected pixels, its measured work (BandSplit).
+    std::uint64_t triangles = 0, rows = 0;
   };
   std::vector<WorkerContext> drawing_ctx_;  // one per worker
+  std::vector<std::int64_t> measured_;  // each worker's measured work on the batch just drawn (BandSplit::measured)
   bool drawing_active_ = false;
   std::function<void(unsigned)> draw_job_;
   Triangle slots_[2];
