@@ -195,7 +195,7 @@ module spigpu_soc #(
   wire        swap_req, swap_ready, waiting_vsync;
   wire [27:0] swap_addr;
   command_exec #(.FEATURES(FEATURES), .MAX_WIDTH(MAX_WIDTH), .MAX_HEIGHT(MAX_HEIGHT), .VRAM_KIB(VRAM_KIB), .DEPTH(DEPTH),
-                 .VPORT(PROFILE == 0 ? 1 : 0)) u_exec (
+                 .VPORT(PROFILE == 0 ? 1 : 0), .IDX5(PROFILE == 0 ? 1 : 0)) u_exec (
     .clk(clk), .rst(rst_any), .in_valid(fifo_out_valid), .in_entry(fifo_out), .in_pop(fifo_pop),
     .sh_wr_req(sh_wr_req), .sh_wr_idx(sh_wr_idx), .sh_wr_data(sh_wr_data), .sh_wr_ack(sh_wr_ack),
     .sh_rd_idx(sh_rd_idx), .sh_rd_data(sh_rd_data), .sh_rd_valid(sh_rd_valid),
@@ -218,7 +218,7 @@ module spigpu_soc #(
   wire [31:0] rsp_rdata;
   wire        prot_active;
   wire [VAW:0] prot_lo, prot_hi;
-  mem_access #(.UNITS_L2(VAW - 1)) u_mem (
+  mem_access #(.UNITS_L2(VAW - 1), .ICE40(PROFILE == 0 ? 1 : 0)) u_mem (
     .clk(clk), .rst(rst), .soft_reset(soft_reset), .set_addr(mem_set_addr), .write(mem_write),
     .op_data(mem_op_data), .op_ack(mem_op_ack), .ex_idle(mem_ex_idle), .read_strobe(mem_read_strobe), .addr(mem_addr),
     .prefetch(prefetch), .mem_ready(mem_ready), .err_range(mem_err), .req_valid(m_req_valid),
@@ -231,7 +231,8 @@ module spigpu_soc #(
             // without it (DEPTH = 0) and holds FRAME_COUNT and the frame's read address (the counter
             // with a load costs the most cells of the scanout's; docs/gateware.md fit-soc5)
             .CRC_BYTES(CRC_BYTES), .BUF_WORDS(SCAN_BUF), .BYTES_W(SCAN_BYTES_W),
-            .DSP(PROFILE == 0 && DEPTH == 0 ? 1 : 0)) u_scan (
+            .DSP(PROFILE == 0 && DEPTH == 0 ? 1 : 0), .CRC_ROM(PROFILE == 0 ? 1 : 0),
+            .ICE40(PROFILE == 0 ? 1 : 0)) u_scan (
     .clk(clk), .rst(rst), .soft_reset(soft_reset), .tick(disp_tick), .swap_req(swap_req), .swap_addr(swap_addr),
     .swap_format(cmd_fb_format), .swap_width(cmd_fb_width), .swap_height(cmd_fb_height), .swap_ready(swap_ready),
     .swap_pending(swap_pending_w), .err_range(scan_err), .vblank(vblank), .vsync(vsync),
