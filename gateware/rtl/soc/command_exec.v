@@ -69,6 +69,7 @@ module command_exec #(
   input  wire         core_idle,
   // memory-access unit: the operation's data stays in the FIFO head until mem_op_ack
   output wire         mem_set_addr,  // MEM_ADDR offered
+  output wire         mem_addr_head, // the FIFO's head is a MEM_ADDR, offered or not (no readiness terms)
   output wire         mem_write,     // MEM_DATA write offered
   output wire [63:0]  mem_op_data,
   input  wire         mem_op_ack,    // taken (MEM_ADDR: at once; MEM_DATA: both words written)
@@ -317,6 +318,7 @@ module command_exec #(
 
   wire   mem_offer    = in_valid && core_quiet;
   assign mem_set_addr = mem_offer && is_memaddr;
+  assign mem_addr_head = is_memaddr;
   assign mem_write    = mem_offer && is_memdata;
   // MEM_DATA has no reserved, enumerated or clamped bit and MEM_ADDR none in the pointer's bits
   // [31:3], the only ones the unit reads of it, so the validated value is the entry's there: the

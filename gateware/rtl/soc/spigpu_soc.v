@@ -190,7 +190,7 @@ module spigpu_soc #(
   assign busy_pin = fifo_nearly_full;
 
   // --- executor ---
-  wire        mem_set_addr, mem_write, mem_op_ack, executed, core_stall;
+  wire        mem_set_addr, mem_addr_head, mem_write, mem_op_ack, executed, core_stall;
   wire [63:0] mem_op_data;
   wire        swap_req, swap_ready, waiting_vsync;
   wire [27:0] swap_addr;
@@ -204,7 +204,7 @@ module spigpu_soc #(
     .cmd_fb_draw(cmd_fb_draw), .cmd_fb_z(cmd_fb_z), .cmd_fb_format(cmd_fb_format), .cmd_fb_width(cmd_fb_width),
     .cmd_fb_height(cmd_fb_height), .cmd_clear_color(cmd_clear_color), .cmd_clear_depth(cmd_clear_depth),
     .cmd_v0(cmd_v0), .cmd_v1(cmd_v1), .cmd_v2(cmd_v2), .vp_addr(vp_addr), .vp_data(vp_data),
-    .core_idle(core_idle), .mem_set_addr(mem_set_addr),
+    .core_idle(core_idle), .mem_set_addr(mem_set_addr), .mem_addr_head(mem_addr_head),
     .mem_write(mem_write), .mem_op_data(mem_op_data), .mem_op_ack(mem_op_ack), .mem_idle(mem_ex_idle),
     .swap_req(swap_req), .swap_addr(swap_addr), .swap_ready(swap_ready), .waiting_vsync(waiting_vsync),
     .executed(executed));
@@ -219,7 +219,7 @@ module spigpu_soc #(
   wire        prot_active;
   wire [VAW:0] prot_lo, prot_hi;
   mem_access #(.UNITS_L2(VAW - 1), .ICE40(PROFILE == 0 ? 1 : 0)) u_mem (
-    .clk(clk), .rst(rst), .soft_reset(soft_reset), .set_addr(mem_set_addr), .write(mem_write),
+    .clk(clk), .rst(rst), .soft_reset(soft_reset), .set_addr(mem_set_addr), .set_addr_head(mem_addr_head), .write(mem_write),
     .op_data(mem_op_data), .op_ack(mem_op_ack), .ex_idle(mem_ex_idle), .read_strobe(mem_read_strobe), .addr(mem_addr),
     .prefetch(prefetch), .mem_ready(mem_ready), .err_range(mem_err), .req_valid(m_req_valid),
     .req_ready(m_req_ready), .req_we(m_req_we), .req_addr(m_req_addr), .req_wdata(m_req_wdata),
