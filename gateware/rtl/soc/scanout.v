@@ -216,9 +216,12 @@ module scanout #(
   wire bl_step = !(rst || soft_reset) && !(vsync && pending) && folding;
   generate
     if (ICE40 != 0 && CRC_BYTES == 1) begin : g_bytes_left
-      // a byte a fold: the load and the decrement in ice40_load_step's cells
+      // a byte a fold: the load and the decrement in ice40_load_step's cells. Its choice drives all the
+      // carries, so it is bl_load without the late terms (RESET's decode, the executor's swap_req):
+      // computing and reading never overlap, so it is 0 whenever bl_step counts
+      wire               bl_choose = computing && mul_step == 4'd10;
       wire [BYTES_W-1:0] bl_next, bl_co;
-      ice40_load_step #(.W(BYTES_W), .DOWN(1)) u_bl (.ld(bl_load), .d(bytes), .q(bytes_left), .q_next(bl_next), .co(bl_co));
+      ice40_load_step #(.W(BYTES_W), .DOWN(1)) u_bl (.ld(bl_choose), .d(bytes), .q(bytes_left), .q_next(bl_next), .co(bl_co));
       always @(posedge clk) if (bl_load || bl_step) bytes_left <= bl_next;
       wire unused_bl = &{1'b0, bl_co};
     end else begin : g_bytes_left
