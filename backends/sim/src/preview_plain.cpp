@@ -5,6 +5,7 @@
 #include <cstring>
 #include <immintrin.h>
 
+#include "bilinear_wide.hpp"
 #include "cpu_features.hpp"
 #include "hier_z.hpp"
 #include "setup.hpp"
