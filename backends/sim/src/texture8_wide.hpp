@@ -29,7 +29,7 @@ struct TexQuad8 {
   simd::u32x8 t00, t10, t01, t11, fu, fv;
 };
 
-#define TEXTURE8_WIDE_TARGET __attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq")))
+#define TEXTURE8_WIDE_TARGET BILINEAR_WIDE_TARGET  // one target list for both headers
 
 // Eight lanes' bilinear footprints: the fractions, the left column a0 (and i0, the unwrapped
 // index it came from) and the two rows' first words b0, b1 (word indices into the texture).
