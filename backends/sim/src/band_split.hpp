@@ -36,7 +36,7 @@ namespace gpubridge::sim {
 
 class BandSplit {
  public:
-  static constexpr int kBandRows = 16;  // cuts fall between the coarse depth blocks' bands
+  static constexpr int kBandRows = 8;  // cuts fall between the coarse depth blocks' bands
   static constexpr int kMaxRows = 2048;  // a clip rectangle's rows (below 2^11)
   // What a row and a triangle's set-up cost against a drawn pixel (callgrind, 1,000-px triangles:
   // about 22 instructions a pixel in the span routine, 300 a row in the row loop, 1,500 a Kernel),

@@ -29,7 +29,7 @@ std::uint32_t depth_block_max(const std::uint8_t* z, std::size_t pitch, unsigned
 
 class HierZ {
  public:
-  static constexpr int kRowsLog = 4, kColsLog = 5;  // 16 × 32 pixels
+  static constexpr int kRowsLog = 3, kColsLog = 5;  // 8 × 32 pixels
 
   // How a run of rows asks the bounds (the exact and the preview kernels alike). A run stops asking
   // after kTries rows in a row that they did not reject: in front-to-back scenes no row is rejected,
