@@ -1,0 +1,75 @@
+// BandPool (common/include/gpubridge/common/band_pool.hpp): the renderer's fork/join barrier. Its
+// hand-overs spin before they sleep (sim-c2t), so these cover both ways of each: back-to-back jobs
+// (the last finisher still spinning when the next job comes), jobs handed over after the workers'
+// spin has run out (asleep), and a wait() that outlasts the caller's spin (asleep until the last).
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <thread>
+#include <vector>
+
+#include "gpubridge/common/band_pool.hpp"
+
+namespace gpubridge {
+namespace {
+
+// Every worker runs every job once, and wait() returns with all their writes done.
+void run_jobs(BandPool& pool, unsigned jobs, std::chrono::microseconds pause_between) {
+  std::vector<unsigned> runs(pool.workers(), 0);  // each worker writes its own entry only
+  std::atomic<unsigned> in_job{0};
+  const std::function<void(unsigned)> job = [&](unsigned w) {
+    in_job.fetch_add(1);
+    ++runs[w];
+  };
+  for (unsigned j = 1; j <= jobs; ++j) {
+    in_job = 0;
+    pool.start(job);
+    pool.wait();
+    ASSERT_EQ(in_job.load(), pool.workers()) << "job " << j;
+    for (unsigned w = 0; w < pool.workers(); ++w) ASSERT_EQ(runs[w], j) << "worker " << w << ", job " << j;
+    if (pause_between.count() > 0) std::this_thread::sleep_for(pause_between);
+  }
+}
+
+TEST(SimBandPool, BackToBackJobsRunOncePerWorker) {
+  for (unsigned n : {2u, 3u}) {
+    BandPool pool(n);
+    run_jobs(pool, 3000, std::chrono::microseconds(0));
+  }
+}
+
+TEST(SimBandPool, JobsAfterTheWorkersSleptRunOncePerWorker) {
+  BandPool pool(2);
+  // Longer than the last finisher's spin: every job wakes sleeping workers.
+  run_jobs(pool, 20, BandPool::kWorkerSpin * 4);
+}
+
+// wait() returns only after the slowest worker, whichever it is, also when it outlasts the caller's spin.
+TEST(SimBandPool, WaitOutlastsASlowWorker) {
+  for (unsigned n : {2u, 3u})
+    for (unsigned slow = 0; slow < n; ++slow) {
+      BandPool pool(n);
+      std::atomic<bool> slow_done{false};
+      const std::function<void(unsigned)> job = [&](unsigned w) {
+        if (w != slow) return;
+        std::this_thread::sleep_for(BandPool::kCallerSpin * 5);
+        slow_done = true;
+      };
+      pool.start(job);
+      pool.wait();
+      EXPECT_TRUE(slow_done.load()) << n << " workers, slow worker " << slow;
+    }
+}
+
+TEST(SimBandPool, OneWorkerRunsTheJobOnTheCallingThread) {
+  BandPool pool(1);
+  std::thread::id ran;
+  const std::function<void(unsigned)> job = [&](unsigned) { ran = std::this_thread::get_id(); };
+  pool.start(job);
+  EXPECT_EQ(ran, std::this_thread::get_id());
+  pool.wait();
+}
+
+}  // namespace
+}  // namespace gpubridge
