@@ -15,10 +15,11 @@ template <class Done>
 bool spin_until(Done done, std::chrono::microseconds limit) {
   const auto end = std::chrono::steady_clock::now() + limit;
   for (;;) {
-    for (int i = 0; i < 64; ++i) {  // the clock read is dearer than a poll of one line
+    for (int i = 0; i < 8; ++i) {  // the clock read is dearer than a poll of one line
       if (done()) return true;
       spin_pause();
     }
+    std::this_thread::yield();  // any other thread ready on this core runs first (the machine's load)
     if (std::chrono::steady_clock::now() >= end) return done();
   }
 }
