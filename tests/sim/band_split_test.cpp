@@ -1,5 +1,5 @@
 // The band workers' rows (backends/sim/src/band_split.hpp): a batch's rows cut into one run of
-// whole bands (BandSplit::kBandRows rows) per worker where the estimated work splits evenly. The bytes do not depend on
+// whole 16-row bands per worker where the estimated work splits evenly. The bytes do not depend on
 // the cuts (band_setup_test.cpp and the scenes' CRCs check that at 1-3 threads); these check the
 // cuts themselves: whole bands, in order, covering every row, where the work is, and afresh for
 // every batch; moved by the work the workers measured on the batch before (kept per batch since a
@@ -171,7 +171,7 @@ TEST(SimBandSplit, TallSliversStayInTheirMiddleBand) {
   s.measured({3000, 1000});
   add_slivers();
   s.split(2, 0, cuts);
-  EXPECT_EQ(cuts[1], 240);  // all in the band of row 240: no weight moves it
+  EXPECT_EQ(cuts[1], 240);  // all in band 15: no weight moves it
 }
 
 TEST(SimBandSplit, WeightsAreKeptPerBatchSinceAFlush) {
@@ -180,8 +180,7 @@ TEST(SimBandSplit, WeightsAreKeptPerBatchSinceAFlush) {
   add_even_rows(s);
   s.split(2, 0, cuts);
   s.measured({3000, 1000});  // the first batch after a flush: heavy at the top
-  const int bottom_band = 320 / BandSplit::kBandRows;  // row 320: below the cut at 240
-  const std::int64_t top = s.weight(0, 0), bottom = s.weight(0, bottom_band);
+  const std::int64_t top = s.weight(0, 0), bottom = s.weight(0, 20);
   EXPECT_GT(top, BandSplit::kWeightOne);  // the top's work weighs more than estimated
   EXPECT_LT(bottom, BandSplit::kWeightOne);
   EXPECT_EQ(s.weight(1, 0), BandSplit::kWeightOne);  // the second batch's set: not measured yet
@@ -192,7 +191,7 @@ TEST(SimBandSplit, WeightsAreKeptPerBatchSinceAFlush) {
   s.measured({500, 3500});
   EXPECT_LT(s.weight(1, 0), top);
   EXPECT_EQ(s.weight(0, 0), top);  // the first batch's set is its own
-  EXPECT_EQ(s.weight(0, bottom_band), bottom);
+  EXPECT_EQ(s.weight(0, 20), bottom);
   // Batches past the last set share it.
   EXPECT_EQ(s.weight(BandSplit::kBatchSets + 3, 0), s.weight(BandSplit::kBatchSets - 1, 0));
   add_even_rows(s);

@@ -37,7 +37,7 @@ TEST(SimHierZ, BlockMaximumIgnoresTheTopByteAndReadsEveryWord) {
 }
 
 TEST(SimHierZ, OccludesOnlyWhatEveryStoredDepthRejects) {
-  const unsigned width = 70, height = 20;  // blocks of 32 and 6 columns; of 8 rows and 4 (HierZ::kRowsLog 3)
+  const unsigned width = 70, height = 20;  // blocks of 32 and 6 columns, 16 and 4 rows
   std::vector<std::uint8_t> z(std::size_t{width} * height * 4, 0);
   for (unsigned y = 0; y < height; ++y)
     for (unsigned x = 0; x < width; ++x) put_depth(z, width, x, y, 0x100);
@@ -57,7 +57,7 @@ TEST(SimHierZ, OccludesOnlyWhatEveryStoredDepthRejects) {
   h.mark(0, 16, 32, 63, 2);
   EXPECT_TRUE(h.occludes(z.data(), 3, 33, 40, 0x80, true, gen, 3));
   // Raised behind its back: a new generation reads the block again.
-  put_depth(z, width, 10, 5, 0x900);  // in row 3's block for blocks of 8 rows or more
+  put_depth(z, width, 10, 10, 0x900);
   EXPECT_TRUE(h.occludes(z.data(), 3, 0, 31, 0x200, true, gen, 3));  // the stale bound, same generation
   EXPECT_FALSE(h.occludes(z.data(), 3, 0, 31, 0x200, true, gen + 1, 3));
 }

@@ -1,5 +1,5 @@
 #pragma once
-// Which rows of a batch each band worker draws (renderer.hpp): N runs of whole 8-row bands, one
+// Which rows of a batch each band worker draws (renderer.hpp): N runs of whole 16-row bands, one
 // after another down the screen, cut where an estimate of the batch's drawing work is split evenly.
 // A triangle is then drawn by one worker in one run, as one thread draws it, unless a cut crosses
 // it; with bands dealt round-robin (band i → worker i % N) a 45-row triangle crossed three bands,
@@ -12,7 +12,7 @@
 // device thread's instructions on 10-px triangles, where that thread is the critical path): its
 // rows times a row's cost, its area, and a Kernel's set-up, in pixels' worth of work. A cut through
 // a triangle then counts all of its work on one side, as often the one as the other. Tall, wide
-// triangles (more than 64 rows, 4 px a row) are spread over their bands: few, each worth the division.
+// triangles (more than four bands, 4 px a row) are spread over their bands: few, each worth the division.
 //
 // What the estimate cannot see is corrected by what the workers did (measured()): after a batch
 // each worker reports its work counted the same way but from what it drew (its rows of each
@@ -36,7 +36,7 @@ namespace gpubridge::sim {
 
 class BandSplit {
  public:
-  static constexpr int kBandRows = 8;  // cuts fall between the coarse depth blocks' bands
+  static constexpr int kBandRows = 16;  // cuts fall between the coarse depth blocks' bands
   static constexpr int kMaxRows = 2048;  // a clip rectangle's rows (below 2^11)
   // What a row and a triangle's set-up cost against a drawn pixel (callgrind, 1,000-px triangles:
   // about 22 instructions a pixel in the span routine, 300 a row in the row loop, 1,500 a Kernel),
@@ -158,7 +158,7 @@ class BandSplit {
  private:
   // Triangles of more rows than this spread their work over their bands (add()): one division
   // each, too much for the device thread on small triangles, where it is the critical path.
-  static constexpr int kSpreadRows = 64;  // (four bands of 16 rows when it was written, sim-cost)
+  static constexpr int kSpreadRows = 4 * kBandRows;
   // ... and at least this many pixels a row on average (16 left the cubes' tall faces in one band:
   // their slower worker 33.6 M instructions, main's, against 31.8 M spread).
   static constexpr std::int64_t kSpreadWidth = 4;

@@ -1,10 +1,10 @@
 #pragma once
 // A coarse depth bound for rejecting occluded spans without reading the depth buffer (issue 17,
-// random-Z scenes): per block of 8 rows × 32 pixels, an upper bound of the 24-bit depths stored
+// random-Z scenes): per block of 16 rows × 32 pixels, an upper bound of the 24-bit depths stored
 // in it. A span whose smallest depth is not below its blocks' bounds (LESS; not at or below for
 // LEQUAL) fails the test at every pixel and is skipped; its pixels are still counted as scanned
 // and covered, so bytes, errors and DeviceStats stay those of drawing it. The exact kernel asks
-// a triangle's whole 8-row bands the same way first (rasterizer.cpp, band_occluded), with a
+// a triangle's whole 16-row bands the same way first (rasterizer.cpp, band_occluded), with a
 // lower bound of the triangle's depth over the band's rows; the preview's plain kernel too
 // (preview_plain_kernel.inc, band_occluded: the least of its spans' depths in its own integers).
 //
@@ -16,9 +16,8 @@
 // buffers in VRAM: every depth written is below the one it replaces, so the bound can only become
 // loose, never wrong. A block written since its bound was read is read again the next time a
 // later triangle asks (while the triangle that wrote it keeps the loose bound), which keeps the
-// bounds tight enough to reject. Blocks lie inside one 8-row band, so with worker threads each
-// block is only touched by the worker owning its band. (16-row blocks until sim-c2t: the band
-// workers' cuts fall between bands, and 8-row ones let the cuts balance the workers more finely.)
+// bounds tight enough to reject. Blocks lie inside one 16-row band, so with worker threads each
+// block is only touched by the worker owning its band.
 #include <cstdint>
 #include <vector>
 
@@ -30,18 +29,16 @@ std::uint32_t depth_block_max(const std::uint8_t* z, std::size_t pitch, unsigned
 
 class HierZ {
  public:
-  static constexpr int kRowsLog = 3, kColsLog = 5;  // 8 × 32 pixels
+  static constexpr int kRowsLog = 4, kColsLog = 5;  // 16 × 32 pixels
 
   // How a run of rows asks the bounds (the exact and the preview kernels alike). A run stops asking
   // after kTries rows in a row that they did not reject: in front-to-back scenes no row is rejected,
   // and asking on every row cost about 200 instructions a row (1,000-px triangles, callgrind).
   static constexpr unsigned kTries = 2;
-  // A new band of blocks gives the run its tries afresh when the bounds rejected rows in this run
-  // so far, or every 64 rows (large random-Z triangles: visible at one end, hidden at the other;
-  // front-to-back ones are never rejected and ask only every 64 rows). With 8-row bands, every
-  // fourth band (32 rows) cost 1,000-px front triangles +1.2 % instructions at one thread and gave
-  // 50,000-px random Z −6 % (sim-c2t); every 64 rows keeps 16-row bands' counts within 0.5 %.
-  static bool band_asks_afresh(int band, bool rejected) { return rejected || (band & ((64 >> kRowsLog) - 1)) == 0; }
+  // A new 16-row band of blocks gives the run its tries afresh when the bounds rejected rows in
+  // this run so far, or every fourth band (large random-Z triangles: visible at one end, hidden at
+  // the other; front-to-back ones are never rejected and ask only every fourth band).
+  static bool band_asks_afresh(int band, bool rejected) { return rejected || (band & 3) == 0; }
   // The next run's number from the context's counter (0 means "not written" in a block).
   static std::uint32_t next_run(std::uint32_t& counter) {
     const std::uint32_t run = ++counter;
@@ -60,7 +57,7 @@ class HierZ {
     if (bands_.size() < bands) bands_.resize(bands);
   }
 
-  // Whether a triangle's rows in band `band` are worth asking as a whole (the exact and the
+  // Whether a triangle's rows in 16-row band `band` are worth asking as a whole (the exact and the
   // preview kernels' band tests, before their rows are asked one by one). After kBandMisses band tests in a row in this
   // band that did not reject, only every 2nd, 4th … 16th is asked: front-to-back scenes are never
   // rejected and would pay a test a band for nothing. Kept per band, which one worker owns, so

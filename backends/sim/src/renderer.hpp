@@ -2,7 +2,7 @@
 // Runs kicked triangles through setup and the rasteriser. With one thread every triangle is drawn
 // at once. With N threads triangles are batched while the render state stays the same; a batch is
 // drawn by N workers that each walk all triangles in submission order and draw only their own
-// rows (a run of whole 8-row bands each, cut by an estimate of the batch's work weighted by the
+// rows (a run of whole 16-row bands each, cut by an estimate of the batch's work weighted by the
 // work the workers measured on earlier batches: BandSplit), so
 // the bytes are identical for any N. The calling thread (the device front end) decodes and sets
 // up the next batch while the workers draw the previous one; batches are drawn one after another,
