@@ -108,13 +108,8 @@ module spigpu_core #(
       end
       assign clip_x1 = x1_q;
       assign clip_y1 = y1_q;
-      // a <= x0 exactly when a + ~x0 (= a - x0 - 1, 12 bits: no overflow) is negative; ~x0 is
-      // shared by the two sums of each axis
-      wire [11:0] n_x0 = ~{1'b0, sc_x0}, n_y0 = ~{1'b0, sc_y0};
-      wire [11:0] e_x1 = {1'b0, sc_x1} + n_x0, e_w = {1'b0, cmd_fb_width} + n_x0;
-      wire [11:0] e_y1 = {1'b0, sc_y1} + n_y0, e_h = {1'b0, cmd_fb_height} + n_y0;
-      wire        unused_e = &{1'b0, e_x1[10:0], e_w[10:0], e_y1[10:0], e_h[10:0]};
-      assign clip_empty = e_x1[11] || e_w[11] || e_y1[11] || e_h[11];
+      assign clip_empty = (sc_x1 <= sc_x0) || (cmd_fb_width <= sc_x0) ||
+                          (sc_y1 <= sc_y0) || (cmd_fb_height <= sc_y0);
     end else begin : clip_comb
       // ecp5: the clear engine copies the rectangle in the clock the command is first offered
       assign clip_x1 = clip_x1_n;
