@@ -191,12 +191,16 @@ module scanout #(
   endfunction
 
   reg  [2:0]  n_fold;
+  // CRC_BYTES = 4: min(4, bytes_left), a flip-flop loaded with bytes_left (g_bytes_left), so that
+  // the four byte folds' choices start at a register, not at bytes_left's 4-or-more test (the
+  // ULX3S estimate's worst cone, bytes_left -> crc_final, 23 levels: docs/gateware.md up5k-clip)
+  reg  [2:0]  n_fold4;
   reg  [31:0] fold_word;       // bytes to fold, first one in [31:24]
   reg         word_done;
   always @* begin
     if (CRC_BYTES == 4) begin
       fold_word = head_word;
-      n_fold = bytes_left >= BYTES_W'(4) ? 3'd4 : bytes_left[2:0];
+      n_fold = n_fold4;
       word_done = 1'b1;
     end else begin
       case (byte_in_word)
@@ -224,10 +228,14 @@ module scanout #(
       ice40_load_step #(.W(BYTES_W), .DOWN(1)) u_bl (.ld(bl_choose), .d(bytes), .q(bytes_left), .q_next(bl_next), .co(bl_co));
       always @(posedge clk) if (bl_load || bl_step) bytes_left <= bl_next;
       wire unused_bl = &{1'b0, bl_co};
+      always @* n_fold4 = 3'd1;   // CRC_BYTES = 4 only
     end else begin : g_bytes_left
+      wire [BYTES_W-1:0] bl_next = bl_load ? bytes : bytes_left - BYTES_W'(n_fold);
       always @(posedge clk) begin
-        if (bl_load) bytes_left <= bytes;
-        else if (bl_step) bytes_left <= bytes_left - BYTES_W'(n_fold);
+        if (bl_load || bl_step) bytes_left <= bl_next;
+        // n_fold4 changes with bytes_left only: min(4, bytes_left) in every clock after the first
+        // load (a frame is folded only after its swap's computation loaded bytes_left)
+        if (bl_load || bl_step) n_fold4 <= bl_next >= BYTES_W'(4) ? 3'd4 : bl_next[2:0];
       end
     end
   endgenerate
