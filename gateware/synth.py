@@ -82,8 +82,9 @@ def synth(profile, modules=False, abc9=False, packed=False):
     if abc9 and profile == "up5k":
         cmd += " -abc9 -device u"
     files = design_files()
-    # the ecp5 profile has no SPRAM or SB_MAC16: their primitives (known to synth_ice40) are black boxes there
-    lib = "read_verilog -lib sim/SB_SPRAM256KA.v sim/SB_MAC16.v; " if profile == "ecp5" else ""
+    # the ecp5 profile has no SPRAM, SB_MAC16, SB_LUT4 or SB_CARRY: those primitives (known to synth_ice40)
+    # are black boxes there
+    lib = "read_verilog -lib sim/SB_SPRAM256KA.v sim/SB_MAC16.v sim/SB_LUT4.v sim/SB_CARRY.v; " if profile == "ecp5" else ""
     flat = " -noflatten" if modules else ""
     script = (f"{lib}read_verilog -sv -Irtl/soc -Irtl/core {' '.join(files)}; chparam -set PROFILE {value} spigpu_top; "
               f"{cmd}{flat} -top spigpu_top; {'chtype -map SB_MAC16_KEPT SB_MAC16; ' if 'ice40' in cmd else ''}stat")

@@ -147,7 +147,8 @@ module spigpu_top #(
     if (VIDEO != 0) begin : g_video
       localparam VAW = PROFILE == 0 ? 15 : 23;
       video_out #(.VAW(VAW), .PIX_DIV(VIDEO_PIX_DIV), .SCALE_LOG2(VIDEO_SCALE_LOG2),
-                  .LINE_AW(VIDEO_LINE_AW), .OUT_BITS(VIDEO_BITS), .CENTRE(VIDEO_CENTRE), .PCLK(VIDEO_PCLK)) u_video (
+                  .LINE_AW(VIDEO_LINE_AW), .OUT_BITS(VIDEO_BITS), .CENTRE(VIDEO_CENTRE), .PCLK(VIDEO_PCLK),
+                  .ICE40(PROFILE == 0 ? 1 : 0)) u_video (
         .clk(clk), .rst(rst), .pclk(pclk), .tick(disp_tick), .hcount(disp_hcount), .vcount(disp_vcount), .frame_start(frame_start),
         .frame_addr(disp_frame_addr),
         .frame_format(frame_format), .frame_width(frame_width), .frame_height(frame_height),

@@ -51,7 +51,13 @@ module core_color #(
   wire [IDX_W-1:0] in_idx = in_pix[IDX_W+31:32];
   wire [23:0] in_off = (fmt == 2'd0) ? {{(22-IDX_W){1'b0}}, in_idx, 2'b0} :
                        (fmt == 2'd1) ? {{(23-IDX_W){1'b0}}, in_idx, 1'b0} : {{(24-IDX_W){1'b0}}, in_idx};
-  wire [31:0] in_addr = byte_addr(fb_draw16, in_off);
+  wire [31:0] in_addr_full = byte_addr(fb_draw16, in_off);
+  // PACKQ (up5k): the lane is the offset's own low bits (FB_DRAW is 16-byte aligned, so the sum's low
+  // bits are the offset's), not the sum's: byte_addr makes it all ones only where the address is beyond
+  // VRAM, where the arbiter drops the write and answers a read with 0, so the lane chooses nothing
+  // anyone sees there. It then no longer waits for the address's carry chain and range test, which
+  // lay in front of the write data and byte enables (docs/gateware.md up5k-cells)
+  wire [31:0] in_addr = (PACKQ != 0) ? {in_addr_full[31:2], in_off[1:0]} : in_addr_full;
   // the item from here on: {yl, xl, word address and lane, rgba}
   wire [67:0] in_item = {in_pix[IDX_W+35:IDX_W+32], in_addr, in_pix[31:0]};
 

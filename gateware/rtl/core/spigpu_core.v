@@ -86,9 +86,37 @@ module spigpu_core #(
   // ---------------------------------------------------------------- command decode
   wire [10:0] sc_x0 = cmd_scissor[10:0], sc_y0 = cmd_scissor[21:11];
   wire [10:0] sc_x1 = cmd_scissor[32:22], sc_y1 = cmd_scissor[43:33];
-  wire [10:0] clip_x1 = (sc_x1 < cmd_fb_width) ? sc_x1 : cmd_fb_width;
-  wire [10:0] clip_y1 = (sc_y1 < cmd_fb_height) ? sc_y1 : cmd_fb_height;
-  wire        clip_empty = (clip_x1 <= sc_x0) || (clip_y1 <= sc_y0);
+  wire [10:0] clip_x1_n = (sc_x1 < cmd_fb_width) ? sc_x1 : cmd_fb_width;
+  wire [10:0] clip_y1_n = (sc_y1 < cmd_fb_height) ? sc_y1 : cmd_fb_height;
+  wire [10:0] clip_x1, clip_y1;
+  wire        clip_empty;
+  generate
+    if (SMALL != 0) begin : clip_held
+      // up5k: the clip rectangle's end in flip-flops, a clock behind SCISSOR and FB_FORMAT. Only
+      // the setup reads it, from su_go on: a command is offered (cmd_valid) at the earliest a
+      // clock after the SCISSOR or FB_FORMAT before it executes, and su_go is a clock after that,
+      // so the held value is the new one by then. The emptiness test is read in the first clock
+      // a command is offered, so it stays a function of the executor's registers, but as four
+      // comparisons side by side, not two behind the two minimums: min(a, b) <= c exactly when
+      // a <= c or b <= c. Each comparison's carry chain starts at flip-flops and ends in the
+      // accept / su_go choice (docs/gateware.md up5k-clip: main's SCISSOR -> clip_y1 carry ->
+      // clip_empty carry -> accept path, 39.6-40.0 ns on the iCEBreaker).
+      reg [10:0] x1_q, y1_q;
+      always @(posedge clk) begin
+        x1_q <= clip_x1_n;
+        y1_q <= clip_y1_n;
+      end
+      assign clip_x1 = x1_q;
+      assign clip_y1 = y1_q;
+      assign clip_empty = (sc_x1 <= sc_x0) || (cmd_fb_width <= sc_x0) ||
+                          (sc_y1 <= sc_y0) || (cmd_fb_height <= sc_y0);
+    end else begin : clip_comb
+      // ecp5: the clear engine copies the rectangle in the clock the command is first offered
+      assign clip_x1 = clip_x1_n;
+      assign clip_y1 = clip_y1_n;
+      assign clip_empty = (clip_x1 <= sc_x0) || (clip_y1 <= sc_y0);
+    end
+  endgenerate
 
   wire       m_gouraud = cmd_tri_mode[0];
   wire       m_tex     = cmd_tri_mode[1] && FEATURES[F_TEXTURE];

@@ -27,7 +27,8 @@ module command_exec #(
   parameter       MAX_HEIGHT = 1024,
   parameter       VRAM_KIB = 32768,
   parameter       DEPTH = 1,          // CAPS2.FEATURES2 bit 0; 0: Z_TEST/Z_WRITE/CLEAR_Z refused (1.4)
-  parameter       VPORT = 0           // 1: vertices through the read port, cmd_v0..2 are 0
+  parameter       VPORT = 0,          // 1: vertices through the read port, cmd_v0..2 are 0
+  parameter       IDX5 = 0            // 1: the entry's index from its five low bits (up5k, below)
 ) (
   input  wire         clk,
   input  wire         rst,           // power-on or RESET
@@ -68,6 +69,7 @@ module command_exec #(
   input  wire         core_idle,
   // memory-access unit: the operation's data stays in the FIFO head until mem_op_ack
   output wire         mem_set_addr,  // MEM_ADDR offered
+  output wire         mem_addr_head, // the FIFO's head is a MEM_ADDR, offered or not (no readiness terms)
   output wire         mem_write,     // MEM_DATA write offered
   output wire [63:0]  mem_op_data,
   input  wire         mem_op_ack,    // taken (MEM_ADDR: at once; MEM_DATA: both words written)
@@ -83,7 +85,14 @@ module command_exec #(
 `include "const_compare.vh"
 
   // --- validation (section 5) ---
-  wire [6:0]  idx = in_entry[70:64];
+  // Only queued registers reach the FIFO (COLOR .. FB_FORMAT 0x00-0x0F, FENCE 0x18, MEM_ADDR 0x70,
+  // MEM_DATA 0x71), and their five low index bits tell them apart (0x70 / 0x71 are 0x10 / 0x11 there,
+  // no other queued index has bit 4 without bit 3). IDX5 = 1 rebuilds the index from those five, so
+  // the validation's decodes (reserved masks, enumerations, clamps, the command decodes) are
+  // functions of five bits instead of seven (docs/gateware.md up5k-cells); the same value for
+  // every entry the FIFO can hold
+  wire        idx_mem = in_entry[68] && !in_entry[67];
+  wire [6:0]  idx = IDX5 != 0 ? {idx_mem, idx_mem, in_entry[68:64]} : in_entry[70:64];
   wire [63:0] raw = in_entry[63:0];
   wire [63:0] rsv = reg_reserved(idx);
   wire        rsv_err = (raw & rsv) != 64'h0;
@@ -309,6 +318,7 @@ module command_exec #(
 
   wire   mem_offer    = in_valid && core_quiet;
   assign mem_set_addr = mem_offer && is_memaddr;
+  assign mem_addr_head = is_memaddr;
   assign mem_write    = mem_offer && is_memdata;
   // MEM_DATA has no reserved, enumerated or clamped bit and MEM_ADDR none in the pointer's bits
   // [31:3], the only ones the unit reads of it, so the validated value is the entry's there: the

@@ -10,13 +10,15 @@
 // The executor offers an operation with its data (the head of the command FIFO) until op_ack; a
 // read is taken first. A reload started while another is in flight discards the older responses.
 module mem_access #(
-  parameter        UNITS_L2 = 14            // VRAM size / 8 bytes = 2^UNITS_L2
+  parameter        UNITS_L2 = 14,           // VRAM size / 8 bytes = 2^UNITS_L2
+  parameter        ICE40 = 0                // 1: the pointer's next value in one logic cell a bit (up5k)
 ) (
   input  wire        clk,
   input  wire        rst,          // power-on
   input  wire        soft_reset,   // RESET: pointer 0, buffer 0, MEM_READY 0 (the beyond flag stays, as in the simulator)
   // executor
   input  wire        set_addr,
+  input  wire        set_addr_head,// ICE40: the head is a MEM_ADDR (set_addr without its readiness terms)
   input  wire        write,
   input  wire [63:0] op_data,
   output wire        op_ack,
@@ -70,8 +72,29 @@ module mem_access #(
   wire wr_done  = phase == WR1 && issued;
   assign op_ack = do_set || (do_write && !in_vram) || wr_done;
   wire        do_load   = do_read || do_set || (do_write && !in_vram) || wr_done;
-  wire [28:0] load_addr = do_set ? op_data[31:3] : addr + 29'd1;
-  wire        load_in_vram = load_addr[28:UNITS_L2] == 0;
+  wire [28:0] load_addr;
+  wire        load_in_vram;
+  generate
+    if (ICE40 != 0) begin : g_next
+      // ice40_load_step: the increment and the choice in one cell a bit. Its choice `ld` drives all 29
+      // carries, so it is an early signal that equals do_set whenever the pointer loads (do_load):
+      // no write in progress, no read pending and a MEM_ADDR at the FIFO's head (a read's or a write's
+      // reload has one of the first two or a MEM_DATA at the head). Whether the next unit is in VRAM
+      // comes from the pointer's flip-flops, not from the sum (whose cells then feed only the pointer
+      // and pack with its flip-flops): addr + 1 is below 2^UNITS_L2 when addr is and its low bits are
+      // not all ones, or when the whole pointer is all ones (it wraps)
+      wire        ld_early = !writing && !pend_read && set_addr_head;
+      wire [28:0] co;
+      wire        low_ones = &addr[UNITS_L2-1:0];
+      ice40_load_step #(.W(29), .DOWN(0)) u_next (.ld(ld_early), .d(op_data[31:3]), .q(addr), .q_next(load_addr), .co(co));
+      assign load_in_vram = do_set ? op_data[31:3+UNITS_L2] == 0 : (in_vram && !low_ones) || (low_ones && &addr[28:UNITS_L2]);
+      wire unused_co = &{1'b0, co};
+    end else begin : g_next
+      assign load_addr = do_set ? op_data[31:3] : addr + 29'd1;
+      assign load_in_vram = load_addr[28:UNITS_L2] == 0;
+      wire unused_head = &{1'b0, set_addr_head};
+    end
+  endgenerate
   // the prefetch buffer: zeroed at reset and by a load beyond VRAM, else each half taken from its
   // response (a load's own zero wins over a response in the same clock); one enable and one reset
   // per half, the data straight from the memory

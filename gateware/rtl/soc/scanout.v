@@ -22,7 +22,10 @@ module scanout #(
   parameter        CRC_BYTES = 1,         // bytes folded into the CRC per clock: 1 or 4
   parameter        BUF_WORDS = 2,         // read-ahead words (2 or 4)
   parameter        BYTES_W = 24,          // bits of the largest frame's W x H x 4 (the sizes FB_FORMAT can hold)
-  parameter        DSP = 0                // 1: FRAME_COUNT and the read address in an SB_MAC16 (up5k)
+  parameter        DSP = 0,               // 1: FRAME_COUNT and the read address in an SB_MAC16 (up5k)
+  parameter        CRC_ROM = 0,           // 1 (CRC_BYTES = 1): the byte fold's table in block RAM (up5k,
+                                          // docs/gateware.md up5k-cells); the frame's end a clock later
+  parameter        ICE40 = 0              // 1 (CRC_BYTES = 1): bytes_left's next value in one cell a bit
 ) (
   input  wire        clk,
   input  wire        rst,
@@ -102,15 +105,17 @@ module scanout #(
   reg [VAW:0] end_vram;        // min(first word after the frame, 2^VAW)
   localparam [VAW:0] VRAM_END = {1'b1, {VAW{1'b0}}};
   reg  [BYTES_W-1:0] bytes_left; // bytes still to fold
-  reg [31:0] crc, crc_value;
-  wire       frame_done;       // the frame's last byte is folded: FRAME_COUNT advances
+  reg [31:0] crc_value;
+  wire       frame_done;       // the frame's last byte is folded
+  wire       end_now;          // its end takes effect: FRAME_COUNT, FRAME_CRC and SWAP_PENDING (g_fold)
+  wire [31:0] crc_final;       // the frame's CRC (not yet complemented) in end_now's clock
   wire       issued;           // a read of the frame was accepted: rd_addr advances
   // FRAME_COUNT, and rd_addr in the bottom half (VAW < 16; the ecp5 profile's is its own register).
   // rd_addr loads and counts also in a reset's clock: its value matters only while a swap is
   // computed, pending or read, each of which a later swap_req starts with a load.
   wire [15:0] rd_addr16;
   dsp_counter #(.DSP(DSP), .WIDE(0)) u_frame_count (
-    .clk(clk), .ld_top(rst || soft_reset), .d_top(16'd0), .inc_top(frame_done),
+    .clk(clk), .ld_top(rst || soft_reset), .d_top(16'd0), .inc_top(end_now),
     .ld_bot(swap_req), .d_bot(16'({1'b0, swap_addr[VAW-3:0], 2'b00})), .inc_bot(issued),
     .q_top(frame_count), .q_bot(rd_addr16));
   generate
@@ -186,19 +191,17 @@ module scanout #(
   endfunction
 
   reg  [2:0]  n_fold;
+  // CRC_BYTES = 4: min(4, bytes_left), a flip-flop loaded with bytes_left (g_bytes_left), so that
+  // the four byte folds' choices start at a register, not at bytes_left's 4-or-more test (the
+  // ULX3S estimate's worst cone, bytes_left -> crc_final, 23 levels: docs/gateware.md up5k-clip)
+  reg  [2:0]  n_fold4;
   reg  [31:0] fold_word;       // bytes to fold, first one in [31:24]
-  reg  [31:0] crc_next;
   reg         word_done;
   always @* begin
     if (CRC_BYTES == 4) begin
       fold_word = head_word;
-      n_fold = bytes_left >= BYTES_W'(4) ? 3'd4 : bytes_left[2:0];
+      n_fold = n_fold4;
       word_done = 1'b1;
-      crc_next = crc;
-      if (n_fold >= 3'd1) crc_next = crc_byte(crc_next, fold_word[31:24]);
-      if (n_fold >= 3'd2) crc_next = crc_byte(crc_next, fold_word[23:16]);
-      if (n_fold >= 3'd3) crc_next = crc_byte(crc_next, fold_word[15:8]);
-      if (n_fold >= 3'd4) crc_next = crc_byte(crc_next, fold_word[7:0]);
     end else begin
       case (byte_in_word)
         2'd0: fold_word = {head_word[31:24], 24'd0};
@@ -208,17 +211,34 @@ module scanout #(
       endcase
       n_fold = 3'd1;
       word_done = byte_in_word == 2'd3 || bytes_left == BYTES_W'(1);
-      crc_next = crc_byte(crc, fold_word[31:24]);
     end
   end
   wire folding = reading && have_word && bytes_left != 0;
+  wire start   = vsync && pending;   // reading starts (the CRC from all ones)
   // bytes_left: loaded one clock before the end is computed, counted down by the bytes folded
   wire bl_load = !(rst || soft_reset) && computing && !swap_req && mul_step == 4'd10;
   wire bl_step = !(rst || soft_reset) && !(vsync && pending) && folding;
-  always @(posedge clk) begin
-    if (bl_load) bytes_left <= bytes;
-    else if (bl_step) bytes_left <= bytes_left - BYTES_W'(n_fold);
-  end
+  generate
+    if (ICE40 != 0 && CRC_BYTES == 1) begin : g_bytes_left
+      // a byte a fold: the load and the decrement in ice40_load_step's cells. Its choice drives all the
+      // carries, so it is bl_load without the late terms (RESET's decode, the executor's swap_req):
+      // computing and reading never overlap, so it is 0 whenever bl_step counts
+      wire               bl_choose = computing && mul_step == 4'd10;
+      wire [BYTES_W-1:0] bl_next, bl_co;
+      ice40_load_step #(.W(BYTES_W), .DOWN(1)) u_bl (.ld(bl_choose), .d(bytes), .q(bytes_left), .q_next(bl_next), .co(bl_co));
+      always @(posedge clk) if (bl_load || bl_step) bytes_left <= bl_next;
+      wire unused_bl = &{1'b0, bl_co};
+      always @* n_fold4 = 3'd1;   // CRC_BYTES = 4 only
+    end else begin : g_bytes_left
+      wire [BYTES_W-1:0] bl_next = bl_load ? bytes : bytes_left - BYTES_W'(n_fold);
+      always @(posedge clk) begin
+        if (bl_load || bl_step) bytes_left <= bl_next;
+        // n_fold4 changes with bytes_left only: min(4, bytes_left) in every clock after the first
+        // load (a frame is folded only after its swap's computation loaded bytes_left)
+        if (bl_load || bl_step) n_fold4 <= bl_next >= BYTES_W'(4) ? 3'd4 : bl_next[2:0];
+      end
+    end
+  endgenerate
   wire popping = folding && word_done && buf_count != 3'd0;
   assign issued = req_valid && req_ready;
   wire take    = rsp_valid && drop == 3'd0;
@@ -252,6 +272,55 @@ module scanout #(
   assign frame_addr   = {{(30 - VAW){above}}, rd_addr[VAW-1:2]};
   assign frame_end    = last;
   assign frame_done   = folding && last;
+
+  // --- the CRC ---
+  generate
+    if (CRC_ROM == 0) begin : g_fold
+      // in logic: the fold of n_fold bytes in the clock they are read
+      reg  [31:0] crc, crc_next;
+      always @* begin
+        crc_next = crc;
+        if (n_fold >= 3'd1) crc_next = crc_byte(crc_next, fold_word[31:24]);
+        if (CRC_BYTES == 4) begin
+          if (n_fold >= 3'd2) crc_next = crc_byte(crc_next, fold_word[23:16]);
+          if (n_fold >= 3'd3) crc_next = crc_byte(crc_next, fold_word[15:8]);
+          if (n_fold >= 3'd4) crc_next = crc_byte(crc_next, fold_word[7:0]);
+        end
+      end
+      always @(posedge clk) begin
+        if (!(rst || soft_reset)) begin
+          if (start) crc <= 32'hFFFFFFFF;
+          else if (folding) crc <= crc_next;
+        end
+      end
+      assign end_now = frame_done;
+      assign crc_final = crc_next;
+    end else begin : g_fold
+      // The byte fold crc_byte(c, b) = (c >> 8) ^ T[(c ^ b) & 0xFF], the table T in a block RAM (256 x 32:
+      // two SB_RAM40_4K) instead of the 8-step XOR network on 32 bits (about 100 LUT4). The RAM's read
+      // is registered, so the CRC is kept as acc ^ tab_q, tab_q = T[i] read with the index i of the byte
+      // folded last: folding b takes acc <= (acc ^ tab_q) >> 8 and reads T[(acc ^ tab_q)[7:0] ^ b]. A
+      // frame starts with acc all ones and tab_q = T[0] = 0. The last byte's CRC is known a clock after
+      // its fold, so the frame's end (FRAME_COUNT, FRAME_CRC, SWAP_PENDING clearing) takes effect a
+      // clock after frame_done, all three together; nothing else changes (no read is issued and no
+      // byte folded in that clock: the frame's words are all read, bytes_left is 0)
+      reg  [31:0] crc_tab [0:255];
+      integer     t;
+      initial for (t = 0; t < 256; t = t + 1) crc_tab[t] = crc_byte(32'd0, 8'(t));
+      reg  [31:0] acc, tab_q;
+      reg         done_q;
+      wire [31:0] crc_now = acc ^ tab_q;
+      wire [7:0]  tab_idx = start ? 8'd0 : crc_now[7:0] ^ fold_word[31:24];
+      always @(posedge clk) begin
+        if (start || folding) tab_q <= crc_tab[tab_idx];
+        if (start) acc <= 32'hFFFFFFFF;
+        else if (folding) acc <= {8'd0, crc_now[31:8]};
+        done_q <= frame_done && !(rst || soft_reset);
+      end
+      assign end_now = done_q;
+      assign crc_final = crc_now;
+    end
+  endgenerate
 
   always @(posedge clk) begin
     err_range <= 1'b0;
@@ -299,18 +368,16 @@ module scanout #(
         end
       end
 
-      if (vsync && pending) begin
+      if (start) begin
         pending <= 1'b0;
         reading <= 1'b1;
-        crc <= 32'hFFFFFFFF;
         byte_in_word <= 2'd0;
       end else if (folding) begin
-        crc <= crc_next;
         byte_in_word <= word_done ? 2'd0 : byte_in_word + 2'd1;
-        if (last) begin
-          reading <= 1'b0;
-          crc_value <= ~crc_next;
-        end
+      end
+      if (end_now) begin
+        reading <= 1'b0;
+        crc_value <= ~crc_final;
       end
     end
   end

@@ -190,12 +190,12 @@ module spigpu_soc #(
   assign busy_pin = fifo_nearly_full;
 
   // --- executor ---
-  wire        mem_set_addr, mem_write, mem_op_ack, executed, core_stall;
+  wire        mem_set_addr, mem_addr_head, mem_write, mem_op_ack, executed, core_stall;
   wire [63:0] mem_op_data;
   wire        swap_req, swap_ready, waiting_vsync;
   wire [27:0] swap_addr;
   command_exec #(.FEATURES(FEATURES), .MAX_WIDTH(MAX_WIDTH), .MAX_HEIGHT(MAX_HEIGHT), .VRAM_KIB(VRAM_KIB), .DEPTH(DEPTH),
-                 .VPORT(PROFILE == 0 ? 1 : 0)) u_exec (
+                 .VPORT(PROFILE == 0 ? 1 : 0), .IDX5(PROFILE == 0 ? 1 : 0)) u_exec (
     .clk(clk), .rst(rst_any), .in_valid(fifo_out_valid), .in_entry(fifo_out), .in_pop(fifo_pop),
     .sh_wr_req(sh_wr_req), .sh_wr_idx(sh_wr_idx), .sh_wr_data(sh_wr_data), .sh_wr_ack(sh_wr_ack),
     .sh_rd_idx(sh_rd_idx), .sh_rd_data(sh_rd_data), .sh_rd_valid(sh_rd_valid),
@@ -204,7 +204,7 @@ module spigpu_soc #(
     .cmd_fb_draw(cmd_fb_draw), .cmd_fb_z(cmd_fb_z), .cmd_fb_format(cmd_fb_format), .cmd_fb_width(cmd_fb_width),
     .cmd_fb_height(cmd_fb_height), .cmd_clear_color(cmd_clear_color), .cmd_clear_depth(cmd_clear_depth),
     .cmd_v0(cmd_v0), .cmd_v1(cmd_v1), .cmd_v2(cmd_v2), .vp_addr(vp_addr), .vp_data(vp_data),
-    .core_idle(core_idle), .mem_set_addr(mem_set_addr),
+    .core_idle(core_idle), .mem_set_addr(mem_set_addr), .mem_addr_head(mem_addr_head),
     .mem_write(mem_write), .mem_op_data(mem_op_data), .mem_op_ack(mem_op_ack), .mem_idle(mem_ex_idle),
     .swap_req(swap_req), .swap_addr(swap_addr), .swap_ready(swap_ready), .waiting_vsync(waiting_vsync),
     .executed(executed));
@@ -218,8 +218,8 @@ module spigpu_soc #(
   wire [31:0] rsp_rdata;
   wire        prot_active;
   wire [VAW:0] prot_lo, prot_hi;
-  mem_access #(.UNITS_L2(VAW - 1)) u_mem (
-    .clk(clk), .rst(rst), .soft_reset(soft_reset), .set_addr(mem_set_addr), .write(mem_write),
+  mem_access #(.UNITS_L2(VAW - 1), .ICE40(PROFILE == 0 ? 1 : 0)) u_mem (
+    .clk(clk), .rst(rst), .soft_reset(soft_reset), .set_addr(mem_set_addr), .set_addr_head(mem_addr_head), .write(mem_write),
     .op_data(mem_op_data), .op_ack(mem_op_ack), .ex_idle(mem_ex_idle), .read_strobe(mem_read_strobe), .addr(mem_addr),
     .prefetch(prefetch), .mem_ready(mem_ready), .err_range(mem_err), .req_valid(m_req_valid),
     .req_ready(m_req_ready), .req_we(m_req_we), .req_addr(m_req_addr), .req_wdata(m_req_wdata),
@@ -231,7 +231,8 @@ module spigpu_soc #(
             // without it (DEPTH = 0) and holds FRAME_COUNT and the frame's read address (the counter
             // with a load costs the most cells of the scanout's; docs/gateware.md fit-soc5)
             .CRC_BYTES(CRC_BYTES), .BUF_WORDS(SCAN_BUF), .BYTES_W(SCAN_BYTES_W),
-            .DSP(PROFILE == 0 && DEPTH == 0 ? 1 : 0)) u_scan (
+            .DSP(PROFILE == 0 && DEPTH == 0 ? 1 : 0), .CRC_ROM(PROFILE == 0 ? 1 : 0),
+            .ICE40(PROFILE == 0 ? 1 : 0)) u_scan (
     .clk(clk), .rst(rst), .soft_reset(soft_reset), .tick(disp_tick), .swap_req(swap_req), .swap_addr(swap_addr),
     .swap_format(cmd_fb_format), .swap_width(cmd_fb_width), .swap_height(cmd_fb_height), .swap_ready(swap_ready),
     .swap_pending(swap_pending_w), .err_range(scan_err), .vblank(vblank), .vsync(vsync),

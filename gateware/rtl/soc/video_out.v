@@ -55,7 +55,8 @@ module video_out #(
   parameter V_BACK     = 33,
   parameter SYNC_NEG   = 1,    // sync pulses low (640 x 480 at 60 Hz)
   parameter CENTRE     = 1,    // 1: a smaller picture centred; 0: at the top left (no placement adders)
-  parameter PCLK       = 0     // 1: pixels on their own clock pclk (then PIX_DIV is 1), 0: on clk's pix_en
+  parameter PCLK       = 0,    // 1: pixels on their own clock pclk (then PIX_DIV is 1), 0: on clk's pix_en
+  parameter ICE40      = 0     // 1: the fill's address and count in one logic cell a bit (ice40_load_step)
 ) (
   input  wire                clk,
   input  wire                rst,
@@ -230,17 +231,12 @@ module video_out #(
   wire        issued = req_valid && req_ready;
   always @(posedge clk) begin
     if (rst) begin
-      f_left <= F_DONE;
       wr_idx <= {LINE_AW{1'b0}};
       {f_in, f_rep, f_half, n_show, n_half} <= 5'd0;
     end else begin
       if (rsp_valid) begin
         lb[{wr_half, wr_idx}] <= rsp_rdata;
         wr_idx <= wr_idx + 1'b1;
-      end
-      if (issued) begin
-        f_addr <= f_addr + 1'b1;
-        f_left <= f_left - 1'b1;
       end
       if (line_end) begin
         {f_in, f_rep, f_half} <= {f_in_new, f_rep_new, f_half_new};
@@ -249,9 +245,7 @@ module video_out #(
           wr_half <= f_half_new;
           wr_idx <= {LINE_AW{1'b0}};
           lead[f_half_new] <= lead0;
-          f_addr <= {1'b0, byte0[VAW+1:2]};
           f_beyond <= beyond0;
-          f_left <= n_words;
           line_byte <= byte_next[VAW+1:0];
           line_beyond <= beyond0 || byte_next[VAW+2];
         end else if (!f_in_new) begin
@@ -261,6 +255,39 @@ module video_out #(
       end
     end
   end
+
+  // the fill's next word and words left: a read issued steps them, a fetch's start loads them (and wins)
+  wire        f_load = line_end && fetch_new;
+  generate
+    if (ICE40 != 0) begin : g_fill
+      // each bit's next value one SB_LUT4 beside its SB_CARRY, not a sum LUT and a choice LUT
+      wire [VAW:0]     fa_next, fa_co;
+      wire [LINE_AW:0] fl_next, fl_co;
+      ice40_load_step #(.W(VAW + 1), .DOWN(0)) u_fa (.ld(f_load), .d({1'b0, byte0[VAW+1:2]}), .q(f_addr), .q_next(fa_next), .co(fa_co));
+      ice40_load_step #(.W(LINE_AW + 1), .DOWN(1)) u_fl (.ld(f_load), .d(n_words), .q(f_left), .q_next(fl_next), .co(fl_co));
+      always @(posedge clk) begin
+        if (!rst && (issued || f_load)) f_addr <= fa_next;
+        if (rst) f_left <= F_DONE;
+        else if (issued || f_load) f_left <= fl_next;
+      end
+      wire unused_fill = &{1'b0, fa_co, fl_co};
+    end else begin : g_fill
+      always @(posedge clk) begin
+        if (rst) begin
+          f_left <= F_DONE;
+        end else begin
+          if (issued) begin
+            f_addr <= f_addr + 1'b1;
+            f_left <= f_left - 1'b1;
+          end
+          if (f_load) begin
+            f_addr <= {1'b0, byte0[VAW+1:2]};
+            f_left <= n_words;
+          end
+        end
+      end
+    end
+  endgenerate
 
   // --- the display's clock, reset, pixel enable and timing: clk's (PCLK = 0) or pclk's own, with the
   // values it takes from clk sampled at its line end (PCLK = 1, crossing (2)) ---
