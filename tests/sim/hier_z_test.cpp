@@ -115,6 +115,73 @@ TEST(SimHierZ, CountsTheCoveredPixelsItRejects) {
   }
 }
 
+// The same counts from the preview's plain kernel (preview_plain_kernel.inc, ask_bounds), whose
+// rejections the band workers' measured work took for shaded pixels before branch sim-pv: whole
+// bands rejected (pixels and rows), and in a box at least 128 wide single rows too (pixels only:
+// a row rejected alone was walked). The depth buffer is nearer than the triangle right of column
+// 64 and farther left of it; the triangle's left edge crosses column 64 near row 37, so bands 0
+// and 1 lie in the nearer blocks (rejected whole), band 2's test sees the farther column 1 (not
+// rejected) but its rows above the crossing do not (rejected one by one).
+TEST(SimHierZ, PreviewCountsTheCoveredPixelsItRejects) {
+  constexpr unsigned kW = 256, kH = 96;
+  constexpr std::uint64_t kZAt = std::uint64_t{kW} * kH * 4, kVram = 2 * kZAt;
+  const std::uint64_t less = 1 | 4 | (1u << 3) | (1u << 6);
+  const DrawState st = decode_draw_state({less, 0, 0, scissor(0, 0, 2047, 2047), 0, kZAt, fb_format(kW, kH, 0)}, kVram);
+  ASSERT_TRUE(st.preview_plain);
+  Vertex a, b, c;
+  a.x = 250 * 16, a.y = 2 * 16;
+  b.x = 100 * 16, b.y = 2 * 16;
+  c.x = 10 * 16, c.y = 90 * 16;
+  for (Vertex* v : {&a, &b, &c}) {
+    v->z = 0x400000;
+    v->c[0] = 200, v->c[3] = 255;
+  }
+  Triangle t;
+  ASSERT_TRUE(setup_triangle_preview(a, b, c, st, 4, false, t));
+  ASSERT_TRUE(t.preview);
+  ASSERT_GE(t.x1 - t.x0, 128) << "wide enough for the row asks";
+  const ReciprocalUnit recip(10, 1);
+  enum class Stored { Nearer, Farther, FartherLeft };
+  for (const Stored stored : {Stored::Nearer, Stored::Farther, Stored::FartherLeft}) {
+    VideoMemory mem(kVram);
+    for (std::uint64_t i = 0; i < std::uint64_t{kW} * kH; ++i) {
+      const bool farther = stored == Stored::Farther || (stored == Stored::FartherLeft && i % kW < 64);
+      const std::uint32_t v = farther ? 0xFFFFFFu : 0u;
+      std::uint8_t* p = mem.data() + kZAt + i * 4;
+      p[1] = static_cast<std::uint8_t>(v >> 16), p[2] = static_cast<std::uint8_t>(v >> 8), p[3] = static_cast<std::uint8_t>(v);
+    }
+    const auto draw = [&](int ya, int yz) {
+      HierZ h;
+      h.prepare(kW, kH);
+      RasterContext ctx{mem, recip, 24, 0, {}, true};
+      ctx.hier_z = &h;
+      ctx.hz_gen = 1;
+      rasterize_rows(t, st, ctx, ya, yz);
+      return ctx;
+    };
+    const RasterContext ctx = draw(t.y0, t.y1);
+    ASSERT_GT(ctx.counters.covered, 5000u);
+    if (stored == Stored::Nearer) {
+      EXPECT_EQ(ctx.counters.passed, 0u);
+      EXPECT_EQ(ctx.hz_skipped_pixels, ctx.counters.covered);
+      EXPECT_EQ(ctx.hz_skipped_rows, static_cast<std::uint64_t>(t.y1 - t.y0));
+    } else if (stored == Stored::Farther) {
+      EXPECT_EQ(ctx.counters.passed, ctx.counters.covered);
+      EXPECT_EQ(ctx.hz_skipped_pixels, 0u);
+      EXPECT_EQ(ctx.hz_skipped_rows, 0u);
+    } else {
+      // Bands 0 and 1 whole (rows 2 to 31), then single rows of band 2: more pixels than those
+      // bands' rows cover (drawn alone, every one of them skipped), none that passed.
+      EXPECT_EQ(ctx.hz_skipped_rows, 30u);
+      const RasterContext top = draw(t.y0, 32);
+      EXPECT_EQ(top.hz_skipped_pixels, top.counters.covered);
+      EXPECT_GT(ctx.hz_skipped_pixels, top.counters.covered);
+      EXPECT_GT(ctx.counters.passed, 500u);
+      EXPECT_LE(ctx.hz_skipped_pixels + ctx.counters.passed, ctx.counters.covered);
+    }
+  }
+}
+
 enum class Raise { MemWrites, ClearDepth, AlwaysDraw, MemorySpan };
 
 constexpr unsigned kWidth = 200, kHeight = 120;  // 6.25 block columns, 7.5 block rows
