@@ -48,7 +48,8 @@ class BandSplit {
   // cost less there (lanes of 8 and 16), so a triangle's set-up and calls weigh more against them.
   // The preview fan (14,400 slivers) at 70 kept its cut a band off: the worker with more triangles
   // executed 62.6 M instructions against 58.8 M; from 100 to 140 they are 60.7 and 60.5 M. At 180
-  // and more the preview tri50k-random's slower worker took 2 % more (callgrind, branch sim-pv).
+  // and more the preview tri50k-random's slower worker took 2 % more (callgrind, docs/simulator.md
+  // branch sim-pv).
   static constexpr std::int64_t kPreviewTriangleWork = 140;
   // Band weights: 1 << kWeightBits is "as estimated"; a run's weight stays within [1/8, 8] of the mean.
   static constexpr int kWeightBits = 10;

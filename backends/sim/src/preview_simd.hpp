@@ -49,11 +49,6 @@ struct PreviewRows {
 
 struct PreviewCounts {
   std::uint64_t scanned = 0, covered = 0, passed = 0;
-  // Of the covered pixels, those the coarse depth bounds rejected before drawing (the plain
-  // kernel's ask_bounds: whole bands and single rows), and the rows of the whole bands: the
-  // exact kernel's RasterContext::hz_skipped_pixels / hz_skipped_rows, for the band workers'
-  // measured work (BandSplit::measured_work counts a rejected pixel as not shaded).
-  std::uint64_t skipped = 0, skipped_rows = 0;
 };
 
 PreviewCounts shade_preview_simd(const PreviewRows& t);

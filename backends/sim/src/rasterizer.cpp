@@ -1066,8 +1066,6 @@ void draw_preview_plain(const Triangle& t, const DrawState& st, RasterContext& c
   }
   const PreviewCounts c = shade_preview_plain(p);
   count_drawn(ctx, st, c.scanned, c.covered, c.passed, st.blend != protocol::BlendMode::Off, st.textured);
-  ctx.hz_skipped_pixels += c.skipped;  // the coarse depth's rejections, as the exact kernel's (run_wide)
-  ctx.hz_skipped_rows += c.skipped_rows;
 }
 
 }  // namespace
