@@ -204,6 +204,10 @@ TEST(SimBandSplit, MeasuredWorkCountsWalkedRowsAndShadedPixels) {
   EXPECT_EQ(BandSplit::measured_work(2, 100, 40, 500),
             2 * BandSplit::kTriangleWork + 60 * BandSplit::kRowWork + 40 * BandSplit::kSkippedRowWork + 500);
   EXPECT_EQ(BandSplit::measured_work(0, 5, 9, 0), 9 * BandSplit::kSkippedRowWork);  // more rejected than counted
+  // The preview's triangles weigh their own unit (its pixels cost less).
+  EXPECT_EQ(BandSplit::measured_work(3, 10, 0, 7, BandSplit::kPreviewTriangleWork),
+            3 * BandSplit::kPreviewTriangleWork + 10 * BandSplit::kRowWork + 7);
+  EXPECT_GT(BandSplit::kPreviewTriangleWork, BandSplit::kTriangleWork);
 }
 
 }  // namespace

@@ -44,6 +44,13 @@ class BandSplit {
   // instructions a row in EdgeWalk::count and 53 in the band and row asks, against 12.7 a shaded
   // pixel there, most of whose pixels fail the depth test).
   static constexpr std::int64_t kRowWork = 14, kTriangleWork = 70, kSkippedRowWork = 9;
+  // A triangle's measured work at `--accuracy preview` (measured_work's triangle_work): its pixels
+  // cost less there (lanes of 8 and 16), so a triangle's set-up and calls weigh more against them.
+  // The preview fan (14,400 slivers) at 70 kept its cut a band off: the worker with more triangles
+  // executed 62.6 M instructions against 58.8 M; from 100 to 140 they are 60.7 and 60.5 M. At 180
+  // and more the preview tri50k-random's slower worker took 2 % more (callgrind, docs/simulator.md
+  // branch sim-pv).
+  static constexpr std::int64_t kPreviewTriangleWork = 140;
   // Band weights: 1 << kWeightBits is "as estimated"; a run's weight stays within [1/8, 8] of the mean.
   static constexpr int kWeightBits = 10;
   static constexpr std::int64_t kWeightOne = std::int64_t{1} << kWeightBits;
@@ -119,10 +126,10 @@ class BandSplit {
   // pixels it shaded (the counts the instructions follow: on 50,000-px random Z the two workers'
   // measured work over three frames came within 1 % of their instructions' ratio).
   static std::int64_t measured_work(std::uint64_t triangles, std::uint64_t rows, std::uint64_t skipped_rows,
-                                    std::uint64_t shaded) {
+                                    std::uint64_t shaded, std::int64_t triangle_work = kTriangleWork) {
     const std::uint64_t walked = rows > skipped_rows ? rows - skipped_rows : 0;
-    return static_cast<std::int64_t>(kTriangleWork * triangles + kRowWork * walked + kSkippedRowWork * skipped_rows +
-                                     shaded);
+    return static_cast<std::int64_t>(static_cast<std::uint64_t>(triangle_work) * triangles + kRowWork * walked +
+                                     kSkippedRowWork * skipped_rows + shaded);
   }
 
   // The batch cut by the last split() took measured[w] (measured_work) on worker w's rows: each

@@ -254,7 +254,8 @@ void Renderer::wait_drawing() {
     add_counters(c.counters, *drawing_state_);  // one state per batch
     if (c.hier_z) hz_runs_[w] = c.hz_run;
     const std::uint64_t shaded = c.counters.covered > c.hz_skipped_pixels ? c.counters.covered - c.hz_skipped_pixels : 0;
-    measured_[w] = BandSplit::measured_work(wc.triangles, wc.rows, c.hz_skipped_rows, shaded);
+    measured_[w] = BandSplit::measured_work(wc.triangles, wc.rows, c.hz_skipped_rows, shaded,
+                                            knobs_.preview ? BandSplit::kPreviewTriangleWork : BandSplit::kTriangleWork);
   }
   split_.measured(measured_);  // the next batch's cuts (submit() splits after this wait)
   drawing_n_ = 0;
