@@ -189,6 +189,18 @@ module spigpu_core #(
     end
   endgenerate
 
+`ifndef SYNTHESIS
+  // what the up5k's held clip end relies on (clip_held above), checked in every co-simulation:
+  // while the setup runs, the held values are the executor's current ones (no SCISSOR or
+  // FB_FORMAT executes in the clock before su_go or during the setup)
+  always @(posedge clk) begin
+    if (!rst && (su_go || su_busy) && (clip_x1 != clip_x1_n || clip_y1 != clip_y1_n)) begin
+      $display("spigpu_core: the setup reads a clip end the executor has since changed");
+      $stop;
+    end
+  end
+`endif
+
   // ---------------------------------------------------------------- render state of the draw
   reg        r_gouraud, r_tex, r_ztest, r_zwrite, r_dither, r_decal, r_serial, r_need_dst;
   reg [2:0]  r_zfunc;
