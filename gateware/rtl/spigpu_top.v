@@ -113,7 +113,6 @@ module spigpu_top #(
   wire [29:0]  mem_req_addr;
   wire [31:0]  mem_req_wdata, mem_rsp_rdata;
   wire [3:0]   mem_req_be;
-  wire [29:0]  mem_next_waddr;
   wire         v_req_valid, v_req_ready, v_rsp_valid, disp_tick;
   wire [10:0]  disp_hcount, disp_vcount;
   wire [27:0]  disp_frame_addr;
@@ -135,8 +134,7 @@ module spigpu_top #(
     .cmd_v0(cmd_v0), .cmd_v1(cmd_v1), .cmd_v2(cmd_v2), .vp_addr(vp_addr), .vp_data(vp_data),
     .core_idle(core_idle), .mem_req_valid(mem_req_valid),
     .mem_req_ready(mem_req_ready), .mem_req_we(mem_req_we), .mem_req_addr(mem_req_addr),
-    .mem_req_wdata(mem_req_wdata), .mem_req_be(mem_req_be), .mem_next_waddr(mem_next_waddr),
-    .mem_rsp_valid(mem_rsp_valid),
+    .mem_req_wdata(mem_req_wdata), .mem_req_be(mem_req_be), .mem_rsp_valid(mem_rsp_valid),
     .mem_rsp_rdata(mem_rsp_rdata), .vblank(vblank), .vsync(vsync), .frame_valid(frame_valid),
     .frame_word(frame_word), .frame_nbytes(frame_nbytes), .frame_start(frame_start), .frame_end(frame_end),
     .frame_format(frame_format), .frame_width(frame_width), .frame_height(frame_height), .perf_cycles(perf_cycles),
@@ -176,8 +174,7 @@ module spigpu_top #(
     .cmd_v0(cmd_v0), .cmd_v1(cmd_v1), .cmd_v2(cmd_v2), .vp_addr(vp_addr), .vp_data(vp_data),
     .core_idle(core_idle), .mem_req_valid(mem_req_valid),
     .mem_req_ready(mem_req_ready), .mem_req_we(mem_req_we), .mem_req_addr(mem_req_addr),
-    .mem_req_wdata(mem_req_wdata), .mem_req_be(mem_req_be), .mem_next_waddr(mem_next_waddr),
-    .mem_rsp_valid(mem_rsp_valid),
+    .mem_req_wdata(mem_req_wdata), .mem_req_be(mem_req_be), .mem_rsp_valid(mem_rsp_valid),
     .mem_rsp_rdata(mem_rsp_rdata), .perf_triangles(perf_triangles), .perf_pixels(perf_pixels),
     .perf_passed(perf_passed), .perf_textured(perf_textured), .perf_busy(perf_core_busy), .perf_setup(perf_setup),
     .perf_raster(perf_raster));

@@ -67,9 +67,6 @@ module core_memport #(
     output wire [29:0] mem_req_addr,
     output wire [31:0] mem_req_wdata,
     output wire [3:0]  mem_req_be,
-    // the word address the output register takes when it next loads a write (a read's: any): the
-    // soc's arbiter compares it with the swap-protection window a clock ahead (up5k)
-    output wire [29:0] mem_next_waddr,
     input  wire        mem_rsp_valid,
     output wire        idle,
     output wire        pending_write  // the combiner holds a word
@@ -139,7 +136,6 @@ module core_memport #(
   reg        o_valid;
   wire       o_room = !o_valid || mem_req_ready;
   wire       s_valid;  // the skid holds a request (0 without SKID)
-  wire [29:0] k_addr_q; // its address
   wire       g_room = (SKID != 0) ? !s_valid : o_room;
   reg        g_we;
   reg [29:0] g_addr;
@@ -227,11 +223,9 @@ module core_memport #(
       end
     end
     assign s_valid = k_valid;
-    assign k_addr_q = k_addr;
     assign {n_we, n_addr, n_data, n_be} = k_valid ? {k_we, k_addr, k_data, k_be} : {g_we, g_addr, g_data, g_be};
   end else begin : no_skid
     assign s_valid = 1'b0;
-    assign k_addr_q = 30'd0;
     assign {n_we, n_addr, n_data, n_be} = {g_we, g_addr, g_data, g_be};
   end
 
@@ -257,12 +251,6 @@ module core_memport #(
   assign mem_req_addr  = o_addr;
   assign mem_req_wdata = o_data;
   assign mem_req_be    = o_be;
-  // A write's address without the grant's read sources (the colour read address is an adder's
-  // sum; the arbiter's compare a clock ahead must not wait for it): a granted write is the clear
-  // engine's if it asks, else the colour write's if one is offered, else the depth write's (with
-  // READS_FIRST a colour write that waits lets a read go, not a depth write). The skid goes first.
-  wire [29:0] w_addr = clr_valid ? clr_addr : p_req ? p_addr : zw_addr;
-  assign mem_next_waddr = s_valid ? k_addr_q : w_addr;
 
   assign idle = !p_valid && !o_valid && !s_valid && (tw == tr);
 endmodule

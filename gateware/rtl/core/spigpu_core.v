@@ -51,7 +51,6 @@ module spigpu_core #(
     output wire [29:0]  mem_req_addr,
     output wire [31:0]  mem_req_wdata,
     output wire [3:0]   mem_req_be,
-    output wire [29:0]  mem_next_waddr,  // core_memport: the next write's address (the arbiter's window)
     input  wire         mem_rsp_valid,
     input  wire [31:0]  mem_rsp_rdata,
     // counters
@@ -429,7 +428,7 @@ module spigpu_core #(
       .zr_valid(zr_valid), .zr_ready(zr_ready), .zr_addr(zr_addr), .zr_rsp(zr_rsp),
       .mem_req_valid(mem_req_valid), .mem_req_ready(mem_req_ready), .mem_req_we(mem_req_we),
       .mem_req_addr(mem_req_addr), .mem_req_wdata(mem_req_wdata), .mem_req_be(mem_req_be),
-      .mem_next_waddr(mem_next_waddr), .mem_rsp_valid(mem_rsp_valid), .idle(m_idle), .pending_write(m_pending));
+      .mem_rsp_valid(mem_rsp_valid), .idle(m_idle), .pending_write(m_pending));
 
   // the raster pipeline advances unless an emitted pixel waits; in serial mode the rasteriser
   // moves only when every earlier pixel has left the core

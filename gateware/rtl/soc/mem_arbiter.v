@@ -20,9 +20,7 @@ module mem_arbiter #(
   parameter        AW = 15,                 // back-end word address bits: VRAM is 2^AW words
   // in-flight reads tracked: 2^TAG_AW. The SPRAM answers every read in the next clock, so at most
   // one is ever in flight there (TAG_AW = 1 never runs out); the SDRAM controller keeps up to 8.
-  parameter        TAG_AW = 3,
-  // 1 (up5k): the core's window compare a clock ahead, shared with the memory-access unit's (below)
-  parameter        EARLY_WIN = 0
+  parameter        TAG_AW = 3
 ) (
   input  wire        clk,
   input  wire        rst,
@@ -50,7 +48,6 @@ module mem_arbiter #(
   input  wire [29:0] c_req_addr,
   input  wire [31:0] c_req_wdata,
   input  wire [3:0]  c_req_be,
-  input  wire [29:0] c_next_waddr,    // the address c_req_addr takes when the core's port loads a write
   output wire        c_rsp_valid,
   output wire [31:0] rsp_rdata,       // data of whichever response is valid
   output reg         c_range_err,
@@ -98,7 +95,7 @@ module mem_arbiter #(
   // and its memory requests done, so no core request meets a window in the clock it starts; one
   // that ends is seen a clock late (a write may wait a clock longer, never less).
   wire        c_act;
-  wire        c_prot;
+  wire        c_prot   = c_act && c_vram >= prot_lo && c_vram < prot_hi;
   // The memory-access unit's write is compared a clock before it is granted (issue 19, 25.125 MHz
   // on the UP5K: the compare on its address, whose low bit is the unit's phase, led through its
   // grant into the executor's FIFO pop in one clock). m_out_r: last clock the window was active
@@ -113,43 +110,9 @@ module mem_arbiter #(
   // was granted and a clock before it can start another, so no unit write meets a window in the
   // clock it starts (checked in the co-simulation); one that ends is seen a clock late.
   reg         m_wait_r, m_out_r, m_act_r;
-  wire        m_in_win;
+  wire        m_in_win = m_vram >= prot_lo && m_vram < prot_hi;
   wire m_block = m_writes && m_act_r && !(m_wait_r && m_out_r);
   assign c_act = m_act_r;
-  // EARLY_WIN (issue 19, 25.125 MHz on the UP5K: the compare on the core's address, end_vram's and
-  // rd_addr's carry chains, led through c_prot and the picks into the SPRAM's address in one clock).
-  // One comparator pair, on the address the next clock's write will have: the unit's while it
-  // writes (the core is idle then), else the core's held request's, else the one its port loads
-  // (c_next_waddr: the skid's or the granted write's, from registers). c_win_r is the compare
-  // against this clock's window, registered: while the window is active it only shrinks, so a
-  // write outside it then is outside it now, and one inside it then is inside it now unless the
-  // scanout read that very word this clock (c_lo_r && s_iss_r: rd_addr, prot_lo, counted past it)
-  // or end_vram came down to its frame's end this clock (once per swap: such a write waits a
-  // clock longer, never less). Whether the window is active is last clock's, as for the unit.
-  wire        c_held   = c_req_valid && !c_req_ready;
-  wire [AW:0] w_vram;
-  wire        w_in_win = w_vram >= prot_lo && w_vram < prot_hi;
-  generate
-    if (EARLY_WIN != 0) begin : g_early
-      reg           c_win_r, c_lo_r, s_iss_r;
-      // two pairs: the held address's and the loading one's, chosen after the chains
-      assign w_vram = m_writes ? m_vram : {1'b0, c_next_waddr[AW-1:0]};
-      assign m_in_win = w_in_win;
-      wire h_in = c_vram >= prot_lo && c_vram < prot_hi;
-      always @(posedge clk) begin
-        c_win_r <= prot_active && (c_held ? h_in : w_in_win);
-        c_lo_r  <= c_held ? c_vram == prot_lo : w_vram == prot_lo;
-        s_iss_r <= s_req_ready;
-      end
-      assign c_prot = c_win_r && !(c_lo_r && s_iss_r);
-      wire unused_next = &{1'b0, c_next_waddr[29:AW]};
-    end else begin : g_late
-      assign w_vram = m_vram;
-      assign m_in_win = w_in_win;
-      assign c_prot = c_act && c_vram >= prot_lo && c_vram < prot_hi;
-      wire unused_next = &{1'b0, c_next_waddr, c_held};
-    end
-  endgenerate
   wire c_block = c_req_we && c_prot;   // (no core request while the unit writes: see pick_c)
   wire c_oor   = c_req_addr[29:AW] != 0;   // beyond VRAM: an upper bit, no comparator
   wire v_oor   = v_req_addr[29:AW] != 0;
@@ -227,25 +190,8 @@ module mem_arbiter #(
 `ifndef SYNTHESIS
   // the invariants pick_c, pick_z, c_block and m_block rely on, checked in every co-simulation
   reg [29:0] m_addr_r;
-  reg        m_writes_r;
-  integer    extra_waits = 0;
-  wire       c_prot_now = c_act && c_vram >= prot_lo && c_vram < prot_hi;  // the compare of this clock
   always @(posedge clk) begin
     m_addr_r <= m_req_addr;
-    m_writes_r <= !rst && m_writes;
-    if (EARLY_WIN != 0 && !rst && c_req_valid && c_req_we && m_writes_r) begin
-      $display("mem_arbiter: a core write in the clock after a write of the memory-access unit");
-      $stop;
-    end
-    // a write the compare a clock ahead holds where this clock's would not (a clock longer)
-    if (EARLY_WIN != 0 && !rst && c_req_valid && c_req_we && !c_prot_now && c_prot && extra_waits < 8) begin
-      extra_waits <= extra_waits + 1;
-      $display("mem_arbiter: note: a core write waits a clock longer (window compare a clock ahead)");
-    end
-    if (EARLY_WIN != 0 && !rst && c_req_valid && c_req_we && c_prot_now && !c_prot) begin
-      $display("mem_arbiter: the compare a clock ahead lets a core write into the window");
-      $stop;
-    end
     if (!rst && m_writes && c_req_valid) begin
       $display("mem_arbiter: a write of the memory-access unit while the core requests");
       $stop;

@@ -68,7 +68,6 @@ module spigpu_soc #(
   input  wire [29:0]  mem_req_addr,
   input  wire [31:0]  mem_req_wdata,
   input  wire [3:0]   mem_req_be,
-  input  wire [29:0]  mem_next_waddr,  // the core's next write address (mem_arbiter's window, up5k)
   output wire         mem_rsp_valid,
   output wire [31:0]  mem_rsp_rdata,
   // display
@@ -248,13 +247,13 @@ module spigpu_soc #(
   wire [VAW-1:0] b_req_addr;
   wire [31:0]    b_req_wdata, b_rsp_rdata;
   wire [3:0]     b_req_be;
-  mem_arbiter #(.AW(VAW), .TAG_AW(PROFILE == 0 ? 1 : 3), .EARLY_WIN(PROFILE == 0 ? 1 : 0)) u_arb (
+  mem_arbiter #(.AW(VAW), .TAG_AW(PROFILE == 0 ? 1 : 3)) u_arb (
     .clk(clk), .rst(rst), .v_req_valid(v_req_valid), .v_req_ready(v_req_ready), .v_req_addr(v_req_addr),
     .v_rsp_valid(v_rsp_valid), .m_req_valid(m_req_valid), .m_req_ready(m_req_ready), .m_req_we(m_req_we),
     .m_req_addr(m_req_addr), .m_req_wdata(m_req_wdata), .m_rsp_valid(m_rsp_valid), .s_req_valid(s_req_valid),
     .s_req_ready(s_req_ready), .s_req_addr(s_req_addr), .s_rsp_valid(s_rsp_valid), .c_req_valid(mem_req_valid),
     .c_req_ready(mem_req_ready), .c_req_we(mem_req_we), .c_req_addr(mem_req_addr), .c_req_wdata(mem_req_wdata),
-    .c_req_be(mem_req_be), .c_next_waddr(mem_next_waddr), .c_rsp_valid(mem_rsp_valid), .rsp_rdata(rsp_rdata), .c_range_err(core_range_err),
+    .c_req_be(mem_req_be), .c_rsp_valid(mem_rsp_valid), .rsp_rdata(rsp_rdata), .c_range_err(core_range_err),
     .prot_active(prot_active), .prot_lo(prot_lo), .prot_hi(prot_hi), .b_req_valid(b_req_valid),
     .b_req_ready(b_req_ready), .b_req_we(b_req_we), .b_req_addr(b_req_addr), .b_req_wdata(b_req_wdata),
     .b_req_be(b_req_be), .b_rsp_valid(b_rsp_valid), .b_rsp_rdata(b_rsp_rdata), .core_stall(core_stall));

@@ -27,7 +27,7 @@ module arbiter_video_tb;
     .v_rsp_valid(v_rsp_valid), .m_req_valid(1'b0), .m_req_ready(m_req_ready), .m_req_we(1'b0), .m_req_addr(30'd0),
     .m_req_wdata(32'd0), .m_rsp_valid(m_rsp_valid), .s_req_valid(1'b0), .s_req_ready(s_req_ready), .s_req_addr(30'd0),
     .s_rsp_valid(s_rsp_valid), .c_req_valid(c_req_valid), .c_req_ready(c_req_ready), .c_req_we(c_req_we),
-    .c_req_addr(c_req_addr), .c_req_wdata(32'd0), .c_req_be(4'hF), .c_next_waddr(30'd0), .c_rsp_valid(c_rsp_valid), .rsp_rdata(rsp_rdata),
+    .c_req_addr(c_req_addr), .c_req_wdata(32'd0), .c_req_be(4'hF), .c_rsp_valid(c_rsp_valid), .rsp_rdata(rsp_rdata),
     .c_range_err(c_range_err), .prot_active(1'b0), .prot_lo({(AW+1){1'b0}}), .prot_hi({(AW+1){1'b0}}),
     .b_req_valid(b_req_valid), .b_req_ready(1'b1), .b_req_we(b_req_we), .b_req_addr(b_req_addr),
     .b_req_wdata(b_req_wdata), .b_req_be(b_req_be), .b_rsp_valid(b_rsp_valid), .b_rsp_rdata(b_rsp_rdata),
