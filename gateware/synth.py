@@ -77,14 +77,20 @@ def design_files():
     return files
 
 
+def ice40_blackboxes():
+    """A yosys command reading the iCE40 primitives the up5k instantiates (SPRAM, SB_MAC16, SB_LUT4,
+    SB_CARRY: their simulation models in sim/) as black boxes, for the ecp5, which has none of them
+    (synth_ice40 knows them from its own library)."""
+    models = sorted(os.path.join("sim", f) for f in os.listdir(os.path.join(GW, "sim")) if f.startswith("SB_") and f.endswith(".v"))
+    return f"read_verilog -lib {' '.join(models)}; "
+
+
 def synth(profile, modules=False, abc9=False, packed=False):
     value, cmd = PROFILES[profile]
     if abc9 and profile == "up5k":
         cmd += " -abc9 -device u"
     files = design_files()
-    # the ecp5 profile has no SPRAM, SB_MAC16, SB_LUT4 or SB_CARRY: those primitives (known to synth_ice40)
-    # are black boxes there
-    lib = "read_verilog -lib sim/SB_SPRAM256KA.v sim/SB_MAC16.v sim/SB_LUT4.v sim/SB_CARRY.v; " if profile == "ecp5" else ""
+    lib = ice40_blackboxes() if profile == "ecp5" else ""
     flat = " -noflatten" if modules else ""
     script = (f"{lib}read_verilog -sv -Irtl/soc -Irtl/core {' '.join(files)}; chparam -set PROFILE {value} spigpu_top; "
               f"{cmd}{flat} -top spigpu_top; {'chtype -map SB_MAC16_KEPT SB_MAC16; ' if 'ice40' in cmd else ''}stat")

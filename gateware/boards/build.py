@@ -57,9 +57,7 @@ def need(tool, package):
 def yosys(top_v, top, cmd, net, log_path, params=""):
     need("yosys", "yosys")
     files = " ".join(synth.design_files())
-    # the ecp5 profile has no SPRAM, SB_MAC16, SB_LUT4 or SB_CARRY: those primitives (known to synth_ice40) are
-    # black boxes there
-    lib = "read_verilog -lib sim/SB_SPRAM256KA.v sim/SB_MAC16.v sim/SB_LUT4.v sim/SB_CARRY.v; " if "ecp5" in cmd else ""
+    lib = synth.ice40_blackboxes() if "ecp5" in cmd else ""
     # the board's own modules: every .v beside its top level
     bdir = os.path.dirname(top_v)
     board_files = " ".join(os.path.relpath(os.path.join(bdir, f), GW) for f in sorted(os.listdir(bdir)) if f.endswith(".v"))
